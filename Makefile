@@ -1,0 +1,77 @@
+# VAHR: `make demo` runs the whole loop on this machine; `make test` runs the whole suite.
+# Both do every set-up step on a fresh Debian machine and are quick when it is done.
+
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+# Debian packages the project runs: the MQTT broker, speech, and ROS 1 for the ros1 backend.
+DEB_PACKAGES := mosquitto espeak-ng sox ros-core python3-rospy python3-actionlib \
+	python3-move-base-msgs python3-geometry-msgs python3-actionlib-msgs
+# The pure-Python ROS packages the venv sees through a .pth file (see FIELD-NOTES: pointing
+# the venv at all of dist-packages would leak Debian's older packages into pip's view).
+ROS_PYTHON_PACKAGES := actionlib actionlib_msgs catkin genmsg genpy geometry_msgs \
+	move_base_msgs roscpp rosgraph rosgraph_msgs roslib rospy std_msgs
+ROS_SITE := $(VENV)/ros-site
+export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
+export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
+
+.PHONY: demo test lint typecheck pytest setup system-packages bench synth skill-model clean
+
+demo: setup
+	$(BIN)/vahr demo
+
+test: setup lint typecheck pytest
+
+setup: system-packages $(VENV)/.installed $(ROS_SITE)/.linked node_modules/.installed
+
+system-packages:
+	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null \
+		| grep -q 'ok installed' || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+		if [ "$$(id -u)" = 0 ]; then \
+			echo "Installing Debian packages: $$missing"; \
+			apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null; \
+		else \
+			echo "Missing Debian packages. Run: sudo apt-get update && sudo apt-get install -y $$missing"; \
+			exit 1; \
+		fi; \
+	fi
+
+$(VENV)/.installed: requirements.txt requirements-dev.txt pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install -q --upgrade pip
+	$(BIN)/pip install -q -r requirements-dev.txt
+	$(BIN)/pip install -q --no-deps --no-build-isolation -e .
+	touch $@
+
+$(ROS_SITE)/.linked: $(VENV)/.installed
+	mkdir -p $(ROS_SITE)
+	for p in $(ROS_PYTHON_PACKAGES); do ln -sfn /usr/lib/python3/dist-packages/$$p $(ROS_SITE)/$$p; done
+	echo "$(CURDIR)/$(ROS_SITE)" > $$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))')/vahr-ros.pth
+	touch $@
+
+node_modules/.installed: package.json package-lock.json
+	npm ci --no-audit --no-fund --loglevel=error
+	touch $@
+
+lint: setup
+	$(BIN)/ruff check .
+
+typecheck: setup
+	$(BIN)/mypy
+
+pytest: setup
+	$(BIN)/pytest -q
+
+bench: setup
+	for script in bench/*.py; do case $$script in */_*) continue;; esac; $(BIN)/python $$script || exit 1; done
+
+synth: setup
+	npx cdk synth --quiet
+
+skill-model: setup
+	$(BIN)/python -m vahr.skill_model
+
+clean:
+	rm -rf $(VENV) node_modules cdk.out .build .cache .state

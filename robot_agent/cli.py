@@ -1,0 +1,25 @@
+"""`robot-agent`: run a robot, provision its credentials, and use its voice alone."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from vahr.cli_dispatch import Subcommands, dispatch
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+SUBCOMMANDS: Subcommands = {
+    "run": ("robot_agent.commands.run", "run one robot: receive commands, drive, report state"),
+    "provision": ("robot_agent.commands.provision", "create a robot's certificate, key and config"),
+    "speak": ("robot_agent.commands.speak", "render text to a WAV file with the robot's voice"),
+    "hear": ("robot_agent.commands.hear", "recognize and interpret speech in a WAV file"),
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    return dispatch("robot-agent", __doc__ or "", SUBCOMMANDS, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

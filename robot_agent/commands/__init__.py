@@ -1,0 +1,1 @@
+"""Thin command-line front ends of `robot-agent`, one module per subcommand."""

@@ -1,0 +1,40 @@
+"""Fixtures shared by every test: the fleet, real-shaped events, and a real mosquitto."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import pytest
+
+from vahr.local.broker import BrokerConfig, Mosquitto
+from vahr.local.ports import free_port
+from vahr.protocol import Fleet, load_fleet
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+
+EVENTS_DIR = Path(__file__).parent / "events"
+
+
+@pytest.fixture(scope="session")
+def fleet() -> Fleet:
+    return load_fleet()
+
+
+def load_event(name: str) -> dict[str, Any]:
+    """A real-shaped JSON event from tests/events/ by file name (without `.json`)."""
+    loaded: dict[str, Any] = json.loads((EVENTS_DIR / f"{name}.json").read_text())
+    return loaded
+
+
+@pytest.fixture
+def mosquitto(tmp_path: Path) -> Iterator[Mosquitto]:
+    """A real mosquitto with a plaintext listener on a free loopback port."""
+    broker = Mosquitto(BrokerConfig(state_dir=tmp_path / "broker", plain_port=free_port()))
+    broker.start()
+    try:
+        yield broker
+    finally:
+        broker.stop()

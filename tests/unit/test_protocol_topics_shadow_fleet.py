@@ -1,0 +1,142 @@
+"""Topic builders, the reported shadow document and the fleet model."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from vahr.protocol import (
+    ExperimentState,
+    LastCommand,
+    ProtocolError,
+    Reported,
+    ShadowPose,
+    experiment_state_from_payload,
+    load_fleet,
+    robot_shadow_from_payload,
+    topics,
+)
+from vahr.protocol.fleet import Fleet, Pose
+
+
+def test_topics_match_the_contract() -> None:
+    assert topics.robot_cmd("placebot1") == "vahr/robots/placebot1/cmd"
+    assert topics.FLEET_CMD == "vahr/fleet/cmd"
+    assert topics.robot_events("placebot2") == "vahr/robots/placebot2/events"
+    assert topics.robot_presence("placebot1") == "vahr/robots/placebot1/presence"
+    assert topics.shadow("placebot1", "update") == "$aws/things/placebot1/shadow/update"
+    assert (
+        topics.shadow("placebot1", "get/accepted", name="voice")
+        == "$aws/things/placebot1/shadow/name/voice/get/accepted"
+    )
+
+
+@pytest.mark.parametrize("thing", ["", "a/b", "+", "#", "robot one", "x" * 129])
+def test_topic_builders_refuse_names_that_would_change_the_topic(thing: str) -> None:
+    with pytest.raises(ValueError, match="thing"):
+        topics.robot_cmd(thing)
+
+
+def test_topics_parse_back() -> None:
+    assert topics.parse_robot_topic("vahr/robots/placebot1/events") == ("placebot1", "events")
+    assert topics.parse_robot_topic("vahr/fleet/cmd") is None
+    assert topics.parse_shadow_topic("$aws/things/p1/shadow/name/n1/update/delta") == (
+        "p1",
+        "n1",
+        "update/delta",
+    )
+    assert topics.parse_shadow_topic("$aws/things/p1/shadow/get") == ("p1", None, "get")
+    assert topics.parse_shadow_topic("$aws/things/p1/shadow/bogus") is None
+
+
+def test_reported_state_round_trips_through_a_shadow_document() -> None:
+    state = Reported(
+        status="navigating",
+        zone=None,
+        cargo=True,
+        last_command=LastCommand(id="c-1", action="deliver", result="accepted"),
+        connected=True,
+        destination="B",
+        task="deliver",
+        pose=ShadowPose(x=1.0, y=2.0, theta=0.5),
+    )
+    body = json.loads(state.to_payload(client_token="t-1"))
+    assert body["clientToken"] == "t-1"
+    reported = body["state"]["reported"]
+    assert {"status", "zone", "cargo", "last_command", "connected"} <= reported.keys()
+    assert reported["last_command"] == {"id": "c-1", "action": "deliver", "result": "accepted"}
+    document = {"state": {"reported": reported}, "metadata": {}, "version": 7, "timestamp": 1}
+    shadow = robot_shadow_from_payload(json.dumps(document).encode())
+    assert shadow.reported == state
+    assert shadow.version == 7
+
+
+def test_a_partial_shadow_reads_with_defaults() -> None:
+    shadow = robot_shadow_from_payload(b'{"state":{"reported":{"connected":false}},"version":1}')
+    assert shadow.reported.status == "idle"
+    assert shadow.reported.connected is False
+    assert shadow.reported.last_command is None
+
+
+def test_a_shadow_with_a_bad_status_is_a_protocol_error() -> None:
+    with pytest.raises(ProtocolError, match=r"^state\.reported\.status: "):
+        robot_shadow_from_payload(b'{"state":{"reported":{"status":"flying"}}}')
+
+
+def test_experiment_state_round_trips() -> None:
+    state = ExperimentState(weather="rainy", assignments={"placebot1": "B"}, session="s1")
+    assert experiment_state_from_payload(state.to_payload()) == state
+    assert experiment_state_from_payload(b'{"state":{}}') == ExperimentState()
+
+
+def test_the_default_fleet_is_the_papers(fleet: Fleet) -> None:
+    assert fleet.robot_things == ("placebot1", "placebot2")
+    assert set(fleet.zone_ids) == {"A", "B", "C", "D", "LOADING"}
+    assert fleet.groups[0].robots == ["placebot1", "placebot2"]
+    assert fleet.zone("LOADING").arm == "loader"
+    assert fleet.zone_at(Pose(x=9.1, y=7.0)) == fleet.zone("A")
+    assert fleet.zone_at(Pose(x=5.0, y=5.0)) is None
+    assert fleet.spoken_name("placebot2") == "placebot two"
+
+
+@pytest.mark.parametrize(
+    ("text", "field"),
+    [
+        ("robots: []\nzones: []\n", "robots"),
+        (
+            "robots: [{thing: a/b, spoken: [x], start: {x: 0, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\n",
+            "robots.0.thing",
+        ),
+        (
+            "robots: [{thing: r, spoken: [x], start: {x: 0, y: 0}}]\nzones: [{id: A, spoken: [a], pose: {x: 0, y: 0}}]\n",
+            "zones",
+        ),
+        (
+            "robots: [{thing: r, spoken: [], start: {x: 0, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\n",
+            "robots.0.spoken",
+        ),
+        (
+            "robots: [{thing: r, spoken: [x], start: {x: 0, y: 0}}, {thing: r, spoken: [y], start: {x: 0, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\n",
+            "robots",
+        ),
+        (
+            "robots: [{thing: r, spoken: [x], start: {x: 0, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\ngroups: [{id: g, spoken: [g], robots: [q]}]\n",
+            "groups.0.robots",
+        ),
+        (
+            "robots: [{thing: r, spoken: [x], start: {x: zero, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\n",
+            "robots.0.start.x",
+        ),
+        ("robots: {", "fleet"),
+    ],
+)
+def test_a_broken_fleet_file_names_the_field(text: str, field: str) -> None:
+    with pytest.raises(ProtocolError) as raised:
+        Fleet.from_yaml(text)
+    assert raised.value.field == field, str(raised.value)
+
+
+def test_a_missing_fleet_file_is_one_clear_error(tmp_path: object) -> None:
+    with pytest.raises(ProtocolError, match=r"^fleet: cannot read .*nope\.yaml"):
+        load_fleet("/nonexistent/nope.yaml")

@@ -1,0 +1,32 @@
+"""`vahr`: run the whole system on this machine, talk to it, and run the experiment."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from vahr.cli_dispatch import Subcommands, dispatch
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+SUBCOMMANDS: Subcommands = {
+    "up": ("vahr.commands.up", "run the broker, shadows, data plane, Alexa simulator and robots"),
+    "say": ("vahr.commands.say", "say an utterance to the running system as a person to Alexa"),
+    "console": ("vahr.commands.console", "talk to the running system interactively"),
+    "nlu": ("vahr.commands.nlu", "show how an utterance is understood, without executing it"),
+    "demo": ("vahr.commands.demo", "run the paper's scenario end to end on this machine"),
+    "experiment": ("vahr.commands.experiment", "run one experiment session (tasks I-III)"),
+    "tlx": ("vahr.commands.tlx", "record a participant's NASA-TLX answers for a session"),
+    "report": (
+        "vahr.commands.report",
+        "turn experiment results into the paper's tables and figures",
+    ),
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    return dispatch("vahr", __doc__ or "", SUBCOMMANDS, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,1 @@
+"""Thin command-line front ends of `vahr`, one module per subcommand."""

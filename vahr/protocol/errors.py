@@ -1,0 +1,51 @@
+"""The one error type that decoding raises, and its translation from msgspec's errors."""
+
+from __future__ import annotations
+
+import re
+
+import msgspec
+
+# msgspec reports the failing location as a JSON path such as `$.params.zone` or `$[0]`.
+_AT_PATH = re.compile(r"^(?P<reason>.*?)(?: - at `\$(?P<path>[^`]*)`)?$", re.DOTALL)
+_MISSING = re.compile(r"^Object missing required field `(?P<field>[^`]+)`$")
+_UNKNOWN = re.compile(r"^Object contains unknown field `(?P<field>[^`]+)`$")
+_EXPECTED = re.compile(r"^Expected `(?P<want>[^`]+)`, got `(?P<got>[^`]+)`$")
+_TAG = re.compile(r"^Invalid value '?(?P<value>[^']*)'?$")
+
+
+class ProtocolError(ValueError):
+    """A payload that breaks the wire contract.
+
+    `field` is a dotted path into the message (`params.zone`, or `payload` for the whole
+    thing) and `reason` says what is wrong in words a user can act on. `str(error)` is the
+    one-line form `field: reason` used in `rejected` events and CLI errors.
+    """
+
+    def __init__(self, field: str, reason: str) -> None:
+        super().__init__(f"{field}: {reason}")
+        self.field = field
+        self.reason = reason
+
+
+def _join(path: str, field: str) -> str:
+    return f"{path}.{field}" if path else field
+
+
+def from_validation_error(err: msgspec.ValidationError | msgspec.DecodeError) -> ProtocolError:
+    """Translate a msgspec error into a ProtocolError naming the field in dotted form."""
+    match = _AT_PATH.match(str(err))
+    reason = match["reason"] if match else str(err)
+    path = (match["path"] or "") if match else ""
+    path = re.sub(r"\[(\d+)\]", r".\1", path).lstrip(".")
+    if found := _MISSING.match(reason):
+        return ProtocolError(_join(path, found["field"]), "is required but missing")
+    if found := _UNKNOWN.match(reason):
+        return ProtocolError(_join(path, found["field"]), "is not a known field")
+    if found := _EXPECTED.match(reason):
+        return ProtocolError(path or "payload", f"expected {found['want']}, got {found['got']}")
+    if isinstance(err, msgspec.DecodeError) and not path:
+        return ProtocolError("payload", f"is not valid JSON ({reason.lower()})")
+    if path == "action" and (found := _TAG.match(reason)):
+        return ProtocolError("action", f"'{found['value']}' is not a known action")
+    return ProtocolError(path or "payload", reason[:1].lower() + reason[1:])

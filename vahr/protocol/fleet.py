@@ -1,0 +1,151 @@
+"""The fleet model: robots, zones and groups, loaded from `fleet.yaml` (a contract)."""
+
+from __future__ import annotations
+
+import math
+import os
+from functools import cached_property
+from typing import Annotated, Literal
+
+import msgspec
+
+from vahr.protocol.errors import ProtocolError, from_validation_error
+from vahr.protocol.topics import check_thing
+
+# The bundled fleet definition: the repository root in a checkout, the asset root in the
+# Lambda bundle (the build script copies fleet.yaml next to the vahr package). os.path
+# rather than pathlib because this module is on the Lambda's cold-start path.
+_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # noqa: PTH100, PTH120
+DEFAULT_FLEET_FILE = os.path.join(_ROOT, "fleet.yaml")  # noqa: PTH118
+
+SpokenNames = Annotated[
+    list[Annotated[str, msgspec.Meta(min_length=1)]], msgspec.Meta(min_length=1)
+]
+
+
+class Pose(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """A planar pose in the `map` frame: metres and radians."""
+
+    x: float
+    y: float
+    theta: float = 0.0
+
+    def distance_to(self, other: Pose) -> float:
+        return math.hypot(self.x - other.x, self.y - other.y)
+
+
+class Robot(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """One robot: its thing name, the names people call it, and where it starts."""
+
+    thing: str
+    spoken: SpokenNames
+    start: Pose
+
+
+class Zone(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """A place robots drive to. `arm` says whether an arm loads or unloads there."""
+
+    id: Annotated[str, msgspec.Meta(pattern=r"^[A-Z][A-Z0-9_]{0,31}$")]
+    spoken: SpokenNames
+    pose: Pose
+    arm: Literal["loader", "unloader"] | None = None
+    radius: Annotated[float, msgspec.Meta(gt=0)] = 0.5
+
+
+class Group(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """A named set of robots addressed at once (the fleet topic when it is every robot)."""
+
+    id: str
+    spoken: SpokenNames
+    robots: list[str]
+
+
+class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
+    """The whole fleet definition. Build it with `load_fleet` or `Fleet.from_yaml`."""
+
+    robots: Annotated[list[Robot], msgspec.Meta(min_length=1)]
+    zones: Annotated[list[Zone], msgspec.Meta(min_length=1)]
+    groups: list[Group] = []
+    experiment_thing: str = "vahr-experiment"
+
+    def validate(self) -> Fleet:
+        """Check the rules that span fields; return self. `from_yaml` calls this."""
+        for index, robot in enumerate(self.robots):
+            try:
+                check_thing(robot.thing)
+            except ValueError as err:
+                raise ProtocolError(f"robots.{index}.thing", str(err).split(": ", 1)[1]) from err
+        check_thing(self.experiment_thing)
+        _require_unique("robots", [robot.thing for robot in self.robots])
+        _require_unique("zones", [zone.id for zone in self.zones])
+        _require_unique("groups", [group.id for group in self.groups])
+        if "LOADING" not in self.zone_ids:
+            raise ProtocolError("zones", "a zone with id LOADING is required for deliveries")
+        for index, group in enumerate(self.groups):
+            for member in group.robots:
+                if member not in self.robot_things:
+                    raise ProtocolError(
+                        f"groups.{index}.robots", f"{member!r} is not a robot of the fleet"
+                    )
+        return self
+
+    @classmethod
+    def from_yaml(cls, text: str | bytes) -> Fleet:
+        try:
+            fleet = msgspec.yaml.decode(text, type=cls)
+        except msgspec.ValidationError as err:
+            raise from_validation_error(err) from err
+        except msgspec.DecodeError as err:
+            raise ProtocolError("fleet", f"is not valid YAML ({err})") from err
+        return fleet.validate()
+
+    @cached_property
+    def robot_things(self) -> tuple[str, ...]:
+        return tuple(robot.thing for robot in self.robots)
+
+    @cached_property
+    def zone_ids(self) -> tuple[str, ...]:
+        return tuple(zone.id for zone in self.zones)
+
+    def robot(self, thing: str) -> Robot:
+        for robot in self.robots:
+            if robot.thing == thing:
+                return robot
+        raise KeyError(thing)
+
+    def zone(self, zone_id: str) -> Zone:
+        for zone in self.zones:
+            if zone.id == zone_id:
+                return zone
+        raise KeyError(zone_id)
+
+    def zone_at(self, pose: Pose) -> Zone | None:
+        """The zone whose circle contains `pose`, if any."""
+        for zone in self.zones:
+            if zone.pose.distance_to(pose) <= zone.radius:
+                return zone
+        return None
+
+    def spoken_name(self, thing: str) -> str:
+        """The name a person would use for a robot: the first of its spoken names."""
+        return self.robot(thing).spoken[0]
+
+
+def _require_unique(field: str, values: list[str]) -> None:
+    seen: set[str] = set()
+    for value in values:
+        if value in seen:
+            raise ProtocolError(field, f"{value!r} appears twice")
+        seen.add(value)
+
+
+def load_fleet(path: str | os.PathLike[str] | None = None) -> Fleet:
+    """Read and validate a fleet file (default: the bundled `fleet.yaml`)."""
+    file = os.fspath(path) if path is not None else DEFAULT_FLEET_FILE
+    try:
+        # pathlib is avoided on purpose: this module is on the Lambda's cold-start path.
+        with open(file, "rb") as stream:  # noqa: PTH123
+            text = stream.read()
+    except OSError as err:
+        raise ProtocolError("fleet", f"cannot read {file}: {err.strerror}") from err
+    return Fleet.from_yaml(text)

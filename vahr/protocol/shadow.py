@@ -1,0 +1,136 @@
+"""Device shadow documents: a robot's reported state and the experiment's state.
+
+The reported state is a contract (DESIGN.md, Reported shadow state). `to_payload` builds
+the body of a shadow `update`; `from_payload` reads the body of `get/accepted`,
+`update/accepted` or `GetThingShadow`.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import msgspec
+
+from vahr.protocol.errors import ProtocolError, from_validation_error
+from vahr.protocol.messages import check_payload
+
+Status = Literal[
+    "idle", "navigating", "loading", "unloading", "waiting", "stopped", "stuck", "error"
+]
+Result = Literal["accepted", "rejected", "done", "failed", "cancelled"]
+Weather = Literal["sunny", "rainy"]
+
+
+class ShadowPose(msgspec.Struct, frozen=True):
+    x: float
+    y: float
+    theta: float = 0.0
+
+
+class LastCommand(msgspec.Struct, frozen=True, omit_defaults=True):
+    """The last command a robot saw and what became of it. `id` is what the skill waits for."""
+
+    id: str
+    action: str
+    result: Result
+    reason: str | None = None
+
+
+class Reported(msgspec.Struct, frozen=True):
+    """A robot's reported state. The first five fields are the contract; the rest help speech."""
+
+    status: Status = "idle"
+    zone: str | None = None
+    cargo: bool = False
+    last_command: LastCommand | None = None
+    connected: bool = False
+    # Where the current task is heading and what it is, so status can be spoken.
+    destination: str | None = None
+    task: str | None = None
+    pose: ShadowPose | None = None
+
+    def to_payload(self, client_token: str | None = None) -> bytes:
+        """The body of a shadow update reporting this whole state."""
+        body: dict[str, Any] = {"state": {"reported": self}}
+        if client_token is not None:
+            body["clientToken"] = client_token
+        return msgspec.json.encode(body)
+
+
+class RobotShadow(msgspec.Struct, frozen=True):
+    """The parts of a robot's shadow document VAHR reads."""
+
+    reported: Reported
+    desired: dict[str, Any] | None = None
+    version: int | None = None
+
+
+class _State(msgspec.Struct, frozen=True):
+    reported: Reported = Reported()
+    desired: dict[str, Any] | None = None
+
+
+class _Document(msgspec.Struct, frozen=True):
+    state: _State = _State()
+    version: int | None = None
+
+
+_document_decoder = msgspec.json.Decoder(_Document)
+
+
+def robot_shadow_from_payload(payload: bytes | bytearray | memoryview) -> RobotShadow:
+    """Read a shadow document (get/accepted, update/accepted, GetThingShadow's payload)."""
+    data = check_payload(payload) if len(payload) <= 8192 else bytes(payload)
+    try:
+        document = _document_decoder.decode(data)
+    except (msgspec.ValidationError, msgspec.DecodeError) as err:
+        raise from_validation_error(err) from err
+    return RobotShadow(
+        reported=document.state.reported, desired=document.state.desired, version=document.version
+    )
+
+
+class ExperimentState(msgspec.Struct, frozen=True, omit_defaults=True):
+    """The current experiment, kept in the reported state of the experiment thing's shadow.
+
+    The experiment runner writes it; the skill reads the weather from it (and, when none is
+    set, draws one and stores it) so the person, the robots and the judge agree.
+    """
+
+    weather: Weather | None = None
+    assignments: dict[str, str] = {}
+    session: str | None = None
+
+    def to_payload(self) -> bytes:
+        return msgspec.json.encode({"state": {"reported": self}})
+
+
+class _ExperimentStateHolder(msgspec.Struct, frozen=True):
+    reported: ExperimentState = ExperimentState()
+
+
+class _ExperimentDocument(msgspec.Struct, frozen=True):
+    state: _ExperimentStateHolder = _ExperimentStateHolder()
+
+
+def experiment_state_from_payload(payload: bytes | bytearray | memoryview) -> ExperimentState:
+    try:
+        document = msgspec.json.decode(bytes(payload), type=_ExperimentDocument)
+    except (msgspec.ValidationError, msgspec.DecodeError) as err:
+        raise from_validation_error(err) from err
+    return document.state.reported
+
+
+__all__ = [
+    "ExperimentState",
+    "LastCommand",
+    "ProtocolError",
+    "Reported",
+    "RobotShadow",
+    "ShadowPose",
+    "Status",
+    "Result",
+    "Weather",
+    "experiment_state_from_payload",
+    "robot_shadow_from_payload",
+]

@@ -1,0 +1,90 @@
+"""Every MQTT topic string VAHR uses, built here and nowhere else (DESIGN.md, Topics)."""
+
+from __future__ import annotations
+
+import re
+
+FLEET_CMD = "vahr/fleet/cmd"
+ALL_EVENTS = "vahr/robots/+/events"
+ALL_PRESENCE = "vahr/robots/+/presence"
+ALL_SHADOW_UPDATES = "$aws/things/+/shadow/update"
+
+# AWS IoT thing names: 1-128 of letters, digits, colon, underscore and hyphen. Anything
+# else (notably `/`, `+` and `#`) would change the meaning of a topic.
+_THING = re.compile(r"^[A-Za-z0-9:_-]{1,128}$")
+_SHADOW_NAME = re.compile(r"^[A-Za-z0-9:_-]{1,64}$")
+_ROBOT_TOPIC = re.compile(r"^vahr/robots/(?P<thing>[^/]+)/(?P<kind>cmd|events|presence)$")
+_SHADOW_TOPIC = re.compile(
+    r"^\$aws/things/(?P<thing>[^/]+)/shadow/(?:name/(?P<name>[^/]+)/)?(?P<op>.+)$"
+)
+
+SHADOW_OPERATIONS = (
+    "update",
+    "update/accepted",
+    "update/rejected",
+    "update/delta",
+    "update/documents",
+    "get",
+    "get/accepted",
+    "get/rejected",
+    "delete",
+    "delete/accepted",
+    "delete/rejected",
+)
+
+
+def check_thing(thing: str) -> str:
+    """Return `thing` if it is a valid thing name, else raise ValueError naming the rule."""
+    if not _THING.match(thing):
+        raise ValueError(
+            f"thing: {thing!r} is not a valid thing name (1-128 letters, digits, ':', '_', '-')"
+        )
+    return thing
+
+
+def robot_cmd(thing: str) -> str:
+    """Commands to one robot."""
+    return f"vahr/robots/{check_thing(thing)}/cmd"
+
+
+def robot_events(thing: str) -> str:
+    """What one robot did (accepted, arrived, delivered...)."""
+    return f"vahr/robots/{check_thing(thing)}/events"
+
+
+def robot_presence(thing: str) -> str:
+    """One robot's retained online/offline message (and its last will)."""
+    return f"vahr/robots/{check_thing(thing)}/presence"
+
+
+def shadow(thing: str, operation: str, name: str | None = None) -> str:
+    """A classic (or, with `name`, named) device shadow topic, e.g. `update/accepted`."""
+    if operation not in SHADOW_OPERATIONS:
+        raise ValueError(f"operation: {operation!r} is not a shadow operation")
+    base = f"$aws/things/{check_thing(thing)}/shadow"
+    if name is not None:
+        if not _SHADOW_NAME.match(name):
+            raise ValueError(f"name: {name!r} is not a valid shadow name")
+        base = f"{base}/name/{name}"
+    return f"{base}/{operation}"
+
+
+def shadow_filter(thing: str = "+") -> str:
+    """A filter matching every shadow topic of `thing` (or of every thing)."""
+    if thing != "+":
+        check_thing(thing)
+    return f"$aws/things/{thing}/shadow/#"
+
+
+def parse_robot_topic(topic: str) -> tuple[str, str] | None:
+    """`vahr/robots/{thing}/{kind}` -> (thing, kind), or None for any other topic."""
+    found = _ROBOT_TOPIC.match(topic)
+    return (found["thing"], found["kind"]) if found else None
+
+
+def parse_shadow_topic(topic: str) -> tuple[str, str | None, str] | None:
+    """`$aws/things/{thing}/shadow[/name/{name}]/{op}` -> (thing, name, op), else None."""
+    found = _SHADOW_TOPIC.match(topic)
+    if not found or found["op"] not in SHADOW_OPERATIONS:
+        return None
+    return found["thing"], found["name"], found["op"]
