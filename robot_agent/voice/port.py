@@ -1,0 +1,37 @@
+"""The port through which the executor talks to the assistant by voice.
+
+The executor owns the conversation (what to say, retry once on `unknown`, the events it
+publishes); an adapter owns the audio: where speech goes and where the answer comes from
+(a speaker and microphone next to an Echo, or the local stack's room channel).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal, Protocol
+
+WeatherIntent = Literal["sunny", "rainy", "unknown"]
+
+
+@dataclass(frozen=True)
+class Heard:
+    """What the robot understood of the assistant's spoken answer."""
+
+    text: str
+    intent: WeatherIntent
+    confidence: float
+
+
+class VoiceError(Exception):
+    """The voice path failed (no audio device, TTS missing, channel down); says why."""
+
+
+class Voice(Protocol):
+    async def say(self, text: str) -> None:
+        """Speak `text` to the assistant; returns when it has been spoken."""
+
+    async def listen(self, timeout_s: float) -> Heard:
+        """Wait up to `timeout_s` for the assistant's answer and interpret it.
+
+        Silence or speech outside the expected answers comes back as intent `unknown`.
+        """
