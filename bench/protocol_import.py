@@ -1,0 +1,74 @@
+"""Benchmark: the cold-start cost of `import vahr.protocol` and its decode throughput.
+
+The import is timed inside fresh interpreters (the way a Lambda cold start pays it), both
+alone and after boto3 and ask-sdk-core are already imported (what the skill actually adds),
+beside the cost of importing msgspec alone. Throughput decodes and validates a typical
+command against the fleet, in one process.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import time
+
+from _results import median, percentile, write_section
+
+TIMER = "import time; t = time.perf_counter(); import {module}; print((time.perf_counter() - t) * 1000)"
+
+
+def import_ms(module: str, preload: str = "", runs: int = 25) -> list[float]:
+    code = (f"import {preload}; " if preload else "") + TIMER.format(module=module)
+    return [
+        float(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout)
+        for _ in range(runs)
+    ]
+
+
+def decode_rate(seconds: float = 2.0) -> tuple[float, float]:
+    from vahr.protocol import decode_command, encode, load_fleet, new_command
+
+    fleet = load_fleet()
+    payload = encode(new_command("deliver", {"zone": "B"}, source="alexa"))
+    bad = payload.replace(b'"B"', b'"E"')
+    rates = []
+    for sample in (payload, bad):
+        count, deadline = 0, time.perf_counter() + seconds / 2
+        start = time.perf_counter()
+        while time.perf_counter() < deadline:
+            for _ in range(1000):
+                try:
+                    decode_command(sample, fleet)
+                except ValueError:
+                    pass
+            count += 1000
+        rates.append(count / (time.perf_counter() - start))
+    return rates[0], rates[1]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--runs", type=int, default=25, help="fresh interpreters per measurement")
+    args = parser.parse_args()
+    alone = import_ms("vahr.protocol", runs=args.runs)
+    msgspec_alone = import_ms("msgspec", runs=args.runs)
+    after_skill_deps = import_ms("vahr.protocol", preload="boto3, ask_sdk_core.skill_builder", runs=args.runs)
+    good, bad = decode_rate()
+    body = f"""
+Import time of `vahr.protocol` in a fresh interpreter ({args.runs} runs each; target under 30 ms):
+
+| what is imported | median ms | p90 ms |
+| --- | ---: | ---: |
+| `vahr.protocol` alone | {median(alone):.1f} | {percentile(alone, 90):.1f} |
+| `msgspec` alone (the validation library it is built on) | {median(msgspec_alone):.1f} | {percentile(msgspec_alone, 90):.1f} |
+| `vahr.protocol` after `boto3` and `ask_sdk_core` (what the skill's cold start adds) | {median(after_skill_deps):.1f} | {percentile(after_skill_deps, 90):.1f} |
+
+Decode and validate against the fleet (one process): {good:,.0f} valid commands/s;
+{bad:,.0f} rejected commands/s (bad zone, error message built).
+"""
+    write_section("protocol_import", "Wire contract: import cost and decode throughput", body)
+
+
+if __name__ == "__main__":
+    main()
