@@ -1,0 +1,126 @@
+"""The kinematic simulator backend: turn in place, drive straight, turn to the zone's heading.
+
+Speeds are in simulated time (see `ScaledClock`), so `--sim-speed-factor 50` makes a demo
+fifty times faster without changing the physics. Faults can be injected to test what the
+executor does when a robot gets stuck or a goal fails, from configuration (zones that
+always fail or stick) or at run time (`inject_stuck`, `inject_failure`).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from robot_agent.backends.port import NavigationFailed, Progress
+from vahr.protocol import Pose
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from robot_agent.core.clock import Clock
+    from vahr.protocol import Zone
+
+
+@dataclass(frozen=True, kw_only=True)
+class SimSettings:
+    speed_mps: float = 0.5
+    turn_rate_rps: float = 1.0
+    loader_delay_s: float = 3.0
+    unloader_delay_s: float = 3.0
+    # Simulated seconds between two kinematic steps (and two progress reports).
+    tick_s: float = 0.25
+    # Fault injection: goals to these zones stop moving half way / abort half way.
+    stuck_zones: tuple[str, ...] = ()
+    fail_zones: tuple[str, ...] = ()
+
+
+@dataclass
+class _Faults:
+    stuck_next: bool = False
+    fail_next: str | None = None
+    stuck_zones: set[str] = field(default_factory=set)
+    fail_zones: set[str] = field(default_factory=set)
+
+
+class SimBackend:
+    """A robot that moves at `speed_mps` and turns at `turn_rate_rps` in simulated time."""
+
+    name = "sim"
+
+    def __init__(self, *, start: Pose, clock: Clock, settings: SimSettings | None = None) -> None:
+        self.settings = settings or SimSettings()
+        self._clock = clock
+        self._pose = start
+        self._faults = _Faults(
+            stuck_zones=set(self.settings.stuck_zones), fail_zones=set(self.settings.fail_zones)
+        )
+
+    @property
+    def pose(self) -> Pose:
+        return self._pose
+
+    def inject_stuck(self) -> None:
+        """The next goal stops moving half way and never arrives (a blocked corridor)."""
+        self._faults.stuck_next = True
+
+    def inject_failure(self, reason: str = "the planner found no path") -> None:
+        """The next goal aborts half way with `reason` (as move_base aborts)."""
+        self._faults.fail_next = reason
+
+    async def go_to(self, zone: Zone, on_progress: Callable[[Progress], None]) -> None:
+        stuck = self._faults.stuck_next or zone.id in self._faults.stuck_zones
+        failure = self._faults.fail_next or (
+            "the planner found no path" if zone.id in self._faults.fail_zones else None
+        )
+        self._faults.stuck_next, self._faults.fail_next = False, None
+        goal = zone.pose
+        start = self._pose
+        total = start.distance_to(goal)
+        heading = math.atan2(goal.y - start.y, goal.x - start.x) if total > 1e-6 else start.theta
+        await self._turn_to(heading)
+        tick = self.settings.tick_s
+        step = self.settings.speed_mps * tick
+        travelled = 0.0
+        while travelled < total:
+            if (stuck or failure) and travelled >= total / 2:
+                if failure:
+                    raise NavigationFailed(f"goal to {zone.id} aborted: {failure}")
+                # Stuck: the robot holds its place and keeps reporting the same progress,
+                # which is what the executor's stuck detection must notice.
+                on_progress(Progress(travelled / total, self._pose))
+                await self._clock.sleep(tick)
+                continue
+            travelled = min(total, travelled + step)
+            self._pose = Pose(
+                start.x + (goal.x - start.x) * travelled / total,
+                start.y + (goal.y - start.y) * travelled / total,
+                heading,
+            )
+            await self._clock.sleep(tick)
+            on_progress(Progress(travelled / total, self._pose))
+        await self._turn_to(goal.theta)
+        self._pose = Pose(goal.x, goal.y, goal.theta)
+        on_progress(Progress(1.0, self._pose))
+
+    async def _turn_to(self, heading: float) -> None:
+        delta = math.atan2(
+            math.sin(heading - self._pose.theta), math.cos(heading - self._pose.theta)
+        )
+        if abs(delta) > 1e-3:
+            await self._clock.sleep(abs(delta) / self.settings.turn_rate_rps)
+        self._pose = Pose(self._pose.x, self._pose.y, heading)
+
+    async def operate_arm(self, zone: Zone) -> None:
+        delay = (
+            self.settings.loader_delay_s if zone.arm == "loader" else self.settings.unloader_delay_s
+        )
+        await self._clock.sleep(delay)
+
+    async def halt(self) -> None:
+        # The simulator stops within one tick once the driving task is cancelled.
+        await asyncio.sleep(0)
+
+    async def close(self) -> None:
+        return None

@@ -1,0 +1,416 @@
+"""The command executor: one robot's state machine, free of any transport.
+
+`execute(command)` is called on the event loop for every decoded, de-duplicated command.
+The executor decides what the robot does (preempt, stop, drive, load, wait for a peer,
+talk to the assistant), drives the `NavigationBackend`, and reports through two callables:
+`publish_state(Reported)` whenever the reported state changes (never periodically) and
+`publish_event(Event)` for everything the robot did. The state is published before the
+matching event because the skill waits on the shadow, not on events.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import msgspec
+
+from robot_agent.backends.port import NavigationFailed
+from robot_agent.core.peers import PeerDeliveries
+from robot_agent.voice.port import VoiceError
+from vahr.protocol import (
+    Deliver,
+    Event,
+    EventPose,
+    LastCommand,
+    Navigate,
+    Ping,
+    Reported,
+    SequentialDelivery,
+    ShadowPose,
+    Stop,
+    WeatherDelivery,
+)
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from robot_agent.backends.port import NavigationBackend, Progress
+    from robot_agent.core.clock import Clock
+    from robot_agent.voice.port import Voice
+    from vahr.protocol import Command, Fleet, Pose, Result, Status, Zone
+
+log = logging.getLogger(__name__)
+
+WEATHER_QUESTION = "Alexa, ask robot fleet what the weather is"
+WEATHER_ZONES = {"sunny": "A", "rainy": "C"}
+
+
+@dataclass(frozen=True, kw_only=True)
+class ExecutorSettings:
+    """Timing rules of the executor, in simulated seconds (see `ScaledClock`)."""
+
+    stuck_after_s: float = 10.0
+    sequential_timeout_s: float = 300.0
+    # A peer delivery up to this long before the command was issued still counts.
+    peer_delivery_window_s: float = 120.0
+    listen_timeout_s: float = 8.0
+    progress_interval_s: float = 1.0
+    weather_question: str = WEATHER_QUESTION
+
+
+class TaskFailed(Exception):
+    """A task ended without doing its job; `status` is what the robot reports afterwards."""
+
+    def __init__(self, reason: str, status: Status = "idle") -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.status = status
+
+
+class Executor:
+    """Runs one robot's commands; see the module docstring for the contract."""
+
+    def __init__(
+        self,
+        *,
+        thing: str,
+        fleet: Fleet,
+        backend: NavigationBackend,
+        clock: Clock,
+        publish_state: Callable[[Reported], None],
+        publish_event: Callable[[Event], None],
+        voice: Voice | None = None,
+        settings: ExecutorSettings | None = None,
+        peers: PeerDeliveries | None = None,
+    ) -> None:
+        self.thing = thing
+        self.fleet = fleet
+        self.backend = backend
+        self.clock = clock
+        self.voice = voice
+        self.settings = settings or ExecutorSettings()
+        self.peers = peers or PeerDeliveries()
+        self._publish_state = publish_state
+        self._publish_event = publish_event
+        zone = fleet.zone_at(backend.pose)
+        self.state = Reported(
+            status="idle", zone=zone.id if zone else None, pose=_pose(backend.pose)
+        )
+        self._task: asyncio.Task[None] | None = None
+        self._current: Command | None = None
+
+    # -- inputs -------------------------------------------------------------------------
+
+    def execute(self, command: Command) -> None:
+        """Start `command` now: preempt or stop what runs, acknowledge, and run it."""
+        if isinstance(command, SequentialDelivery) and command.params.after == self.thing:
+            self.reject(command.id, command.action, "params.after: a robot cannot wait for itself")
+            return
+        if isinstance(command, Ping):
+            self._update(last_command=LastCommand(command.id, command.action, "accepted"))
+            self._emit("accepted", command)
+            self._finish_ack(command)
+            return
+        previous = self._task
+        if previous is not None and not previous.done() and self._current is not None:
+            reason = f"preempted by {command.action} {command.id}"
+            self._emit("cancelled", self._current, reason=reason)
+            previous.cancel()
+        self._current = command
+        self._update(
+            last_command=LastCommand(command.id, command.action, "accepted"),
+            task=command.action if command.is_motion else None,
+            destination=_destination(command),
+        )
+        self._emit("accepted", command)
+        self._task = asyncio.get_running_loop().create_task(
+            self._run(command, previous), name=f"{self.thing}:{command.action}:{command.id}"
+        )
+
+    def reject(self, command_id: str | None, action: str | None, reason: str) -> None:
+        """Report a command that could not be decoded or is not allowed; nothing else changes."""
+        self._update(
+            last_command=LastCommand(
+                command_id or "unknown", action or "unknown", "rejected", reason
+            )
+        )
+        self._publish_event(
+            Event(
+                event="rejected",
+                thing=self.thing,
+                at=self.clock.now(),
+                command_id=command_id,
+                action=action,
+                reason=reason,
+            )
+        )
+
+    def peer_event(self, event: Event) -> None:
+        """Take note of a peer's event (only `delivered` matters to the executor)."""
+        if event.event == "delivered" and event.thing != self.thing:
+            self.peers.record(event.thing, event.at)
+
+    def set_connected(self, connected: bool) -> None:
+        """Record the link state; the link publishes the full state itself on connect."""
+        self.state = msgspec.structs.replace(self.state, connected=connected)
+
+    @property
+    def busy(self) -> bool:
+        return self._task is not None and not self._task.done()
+
+    async def wait_idle(self) -> None:
+        """Wait until the current task (if any) has ended."""
+        while self._task is not None and not self._task.done():
+            with contextlib.suppress(asyncio.CancelledError):
+                await asyncio.shield(self._task)
+
+    async def close(self) -> None:
+        """Cancel the running task (it ends `cancelled`) and release the backend."""
+        if self.busy and self._current is not None and self._task is not None:
+            self._emit("cancelled", self._current, reason="the agent is shutting down")
+            self._task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await self._task
+        await self.backend.close()
+
+    # -- tasks --------------------------------------------------------------------------
+
+    async def _run(self, command: Command, previous: asyncio.Task[None] | None) -> None:
+        if previous is not None and not previous.done():
+            # The previous task halts the backend while it unwinds; wait for that.
+            with contextlib.suppress(asyncio.CancelledError):
+                await previous
+        try:
+            if isinstance(command, Stop):
+                await self._stop(command)
+                return
+            if isinstance(command, Navigate):
+                await self._drive(command, self.fleet.zone(command.params.zone))
+                self._update(status="idle")
+            elif isinstance(command, Deliver):
+                await self._deliver(command, self.fleet.zone(command.params.zone))
+            elif isinstance(command, SequentialDelivery):
+                await self._sequential(command)
+            elif isinstance(command, WeatherDelivery):
+                await self._weather(command)
+        except asyncio.CancelledError:
+            # Preempted or stopped: the `cancelled` event went out when it was decided.
+            await self.backend.halt()
+            self._update(pose=_pose(self.backend.pose))
+            raise
+        except TaskFailed as failure:
+            await self.backend.halt()
+            self._close(command, "failed", failure.reason, status=failure.status)
+            return
+        except Exception as err:  # a bug or a backend crash must not kill the agent
+            log.exception("%s: task %s crashed", self.thing, command.id)
+            await self.backend.halt()
+            self._close(command, "failed", f"internal error: {err}", status="error")
+            return
+        self._close(command, "done", None, status=self.state.status)
+
+    async def _stop(self, command: Stop) -> None:
+        await self.backend.halt()
+        self._update(
+            status="stopped",
+            task=None,
+            destination=None,
+            pose=_pose(self.backend.pose),
+            last_command=LastCommand(command.id, command.action, "done"),
+        )
+        self._emit("stopped", command, pose=self.backend.pose)
+        self._emit("done", command)
+
+    async def _drive(self, command: Command, zone: Zone) -> None:
+        self._update(
+            status="navigating", zone=None, destination=zone.id, pose=_pose(self.backend.pose)
+        )
+        if self.backend.pose.distance_to(zone.pose) > zone.radius:
+            await self._navigate_watched(command, zone)
+        self._update(status="navigating", zone=zone.id, pose=_pose(self.backend.pose))
+        self._emit("arrived", command, zone=zone.id, pose=self.backend.pose)
+
+    async def _navigate_watched(self, command: Command, zone: Zone) -> None:
+        """Drive with stuck detection: no progress for `stuck_after_s` ends the task."""
+        last_advance = self.clock.monotonic()
+        last_progress: Progress | None = None
+        last_report = float("-inf")
+
+        def on_progress(progress: Progress) -> None:
+            nonlocal last_advance, last_progress, last_report
+            if last_progress is None or _advanced(last_progress, progress):
+                last_advance = self.clock.monotonic()
+            last_progress = progress
+            now = self.clock.monotonic()
+            if now - last_report >= self.settings.progress_interval_s or progress.fraction >= 1:
+                last_report = now
+                self._emit(
+                    "progress",
+                    command,
+                    zone=zone.id,
+                    progress=round(min(max(progress.fraction, 0.0), 1.0), 3),
+                    pose=progress.pose,
+                )
+
+        drive = asyncio.get_running_loop().create_task(self.backend.go_to(zone, on_progress))
+        check_every = max(self.settings.stuck_after_s / 4, 0.05)
+        try:
+            while not drive.done():
+                await asyncio.wait({drive}, timeout=_wall(self.clock, check_every))
+                if drive.done():
+                    break
+                if self.clock.monotonic() - last_advance > self.settings.stuck_after_s:
+                    drive.cancel()
+                    with contextlib.suppress(asyncio.CancelledError, NavigationFailed):
+                        await drive
+                    reason = f"no progress towards {zone.id} for {self.settings.stuck_after_s:g} s"
+                    self._update(status="stuck", pose=_pose(self.backend.pose))
+                    self._emit(
+                        "stuck", command, zone=zone.id, reason=reason, pose=self.backend.pose
+                    )
+                    raise TaskFailed(f"stuck: {reason}", status="stuck")
+            try:
+                drive.result()
+            except NavigationFailed as err:
+                raise TaskFailed(str(err), status="error") from err
+        finally:
+            if not drive.done():
+                drive.cancel()
+                with contextlib.suppress(asyncio.CancelledError, NavigationFailed):
+                    await drive
+
+    async def _deliver(self, command: Command, zone: Zone) -> None:
+        loading = self.fleet.zone("LOADING")
+        if not self.state.cargo:
+            await self._drive(command, loading)
+            self._update(status="loading")
+            await self.backend.operate_arm(loading)
+            self._update(cargo=True)
+            self._emit("loaded", command, zone=loading.id)
+        self._update(destination=zone.id)
+        await self._drive(command, zone)
+        self._update(status="unloading")
+        await self.backend.operate_arm(zone)
+        self._update(status="idle", cargo=False)
+        self._emit("delivered", command, zone=zone.id, pose=self.backend.pose)
+
+    async def _sequential(self, command: SequentialDelivery) -> None:
+        after = command.params.after
+        zone = self.fleet.zone(command.params.zone)
+        if after is not None and after != self.thing:
+            window = self.settings.peer_delivery_window_s
+            if self.peers.delivered_since(after, command.issued_at, window) is None:
+                timeout = self.settings.sequential_timeout_s
+                self._update(status="waiting")
+                self._emit("waiting", command, reason=f"waiting for {after} to deliver")
+                next_delivery = self.peers.next_delivery(after)
+                waited = await _wait_for(self.clock, next_delivery, timeout)
+                if not waited:
+                    raise TaskFailed(f"{after} did not deliver within {timeout:g} s")
+        await self._deliver(command, zone)
+
+    async def _weather(self, command: WeatherDelivery) -> None:
+        if self.voice is None:
+            raise TaskFailed("voice not configured")
+        self._update(status="waiting", destination=None)
+        intent = None
+        heard_text = ""
+        try:
+            for _attempt in range(2):
+                await self.voice.say(self.settings.weather_question)
+                self._emit("said", command, text=self.settings.weather_question)
+                heard = await self.voice.listen(self.settings.listen_timeout_s)
+                heard_text = heard.text
+                self._emit("heard", command, text=heard.text)
+                self._emit("interpreted", command, intent=heard.intent, confidence=heard.confidence)
+                if heard.intent in WEATHER_ZONES:
+                    intent = heard.intent
+                    break
+            if intent is None:
+                raise TaskFailed(
+                    f"did not understand the weather answer twice (last heard: {heard_text!r})"
+                )
+            zone_id = WEATHER_ZONES[intent]
+            acknowledgment = f"Thank you. It is {intent}, so I am delivering to zone {zone_id}."
+            await self.voice.say(acknowledgment)
+            self._emit("said", command, text=acknowledgment)
+        except VoiceError as err:
+            raise TaskFailed(f"voice failed: {err}") from err
+        await self._deliver(command, self.fleet.zone(zone_id))
+
+    # -- reporting ----------------------------------------------------------------------
+
+    def _finish_ack(self, command: Command) -> None:
+        self._update(last_command=LastCommand(command.id, command.action, "done"))
+        self._emit("done", command)
+
+    def _close(
+        self, command: Command, result: Result, reason: str | None, *, status: Status
+    ) -> None:
+        changes: dict[str, Any] = {"status": status, "task": None, "destination": None}
+        changes["pose"] = _pose(self.backend.pose)
+        # A ping may have become the last command meanwhile; only our own entry is closed.
+        last = self.state.last_command
+        if last is None or last.id == command.id or last.action == "ping":
+            changes["last_command"] = LastCommand(command.id, command.action, result, reason)
+        self._update(**changes)
+        self._emit("done" if result == "done" else "failed", command, reason=reason)
+        if self._current is command:
+            self._current = None
+
+    def _update(self, **changes: Any) -> None:
+        new = msgspec.structs.replace(self.state, **changes)
+        if new != self.state:
+            self.state = new
+            self._publish_state(new)
+
+    def _emit(
+        self, kind: str, command: Command, *, pose: Pose | None = None, **fields: Any
+    ) -> None:
+        event = Event(
+            event=kind,  # type: ignore[arg-type]
+            thing=self.thing,
+            at=self.clock.now(),
+            command_id=command.id,
+            action=command.action,
+            pose=EventPose(pose.x, pose.y, pose.theta) if pose is not None else None,
+            **fields,
+        )
+        self._publish_event(event)
+
+
+def _destination(command: Command) -> str | None:
+    params = command.params
+    zone = getattr(params, "zone", None)
+    return zone if isinstance(zone, str) else None
+
+
+def _pose(pose: Pose) -> ShadowPose:
+    return ShadowPose(round(pose.x, 3), round(pose.y, 3), round(pose.theta, 3))
+
+
+def _advanced(before: Progress, after: Progress) -> bool:
+    moved = before.pose.distance_to(after.pose) > 0.01
+    turned = abs(before.pose.theta - after.pose.theta) > 0.01
+    return moved or turned or after.fraction > before.fraction + 1e-3
+
+
+def _wall(clock: Clock, seconds: float) -> float:
+    to_wall = getattr(clock, "to_wall_seconds", None)
+    return float(to_wall(seconds)) if callable(to_wall) else seconds
+
+
+async def _wait_for(clock: Clock, future: asyncio.Future[Any], timeout_s: float) -> bool:
+    """Wait for `future` up to `timeout_s` of simulated time; False on timeout."""
+    sleeper = asyncio.ensure_future(clock.sleep(timeout_s))
+    try:
+        done, _ = await asyncio.wait({future, sleeper}, return_when=asyncio.FIRST_COMPLETED)
+        return future in done
+    finally:
+        sleeper.cancel()
+        if not future.done():
+            future.cancel()

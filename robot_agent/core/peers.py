@@ -1,0 +1,47 @@
+"""What the robot knows of its peers' deliveries, for `sequential_delivery`.
+
+A peer's `delivered` event may arrive before the wait begins (the peer was faster, or the
+event is the retained one on its events topic), so deliveries are remembered and a wait
+first looks back `window_s` seconds before the command was issued.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from datetime import timedelta
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from datetime import datetime
+
+
+class PeerDeliveries:
+    """The latest `delivered` time of each peer, and waiters for the next one."""
+
+    def __init__(self) -> None:
+        self._latest: dict[str, datetime] = {}
+        self._waiters: dict[str, list[asyncio.Future[datetime]]] = {}
+
+    def record(self, thing: str, at: datetime) -> None:
+        previous = self._latest.get(thing)
+        if previous is None or at > previous:
+            self._latest[thing] = at
+        for waiter in self._waiters.pop(thing, []):
+            if not waiter.done():
+                waiter.set_result(at)
+
+    def latest(self, thing: str) -> datetime | None:
+        return self._latest.get(thing)
+
+    def delivered_since(self, thing: str, since: datetime, window_s: float) -> datetime | None:
+        """The peer's delivery time if it is at or after `since - window_s`, else None."""
+        at = self._latest.get(thing)
+        if at is not None and at >= since - timedelta(seconds=window_s):
+            return at
+        return None
+
+    def next_delivery(self, thing: str) -> asyncio.Future[datetime]:
+        """A future resolved by the peer's next recorded delivery."""
+        future: asyncio.Future[datetime] = asyncio.get_running_loop().create_future()
+        self._waiters.setdefault(thing, []).append(future)
+        return future

@@ -1,0 +1,182 @@
+"""The executor on its own: every action of DESIGN.md on a fast simulated robot."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from robot_agent.backends.sim import SimSettings
+from robot_agent.core.executor import ExecutorSettings
+from tests.unit.agent.conftest import make_executor
+from vahr.protocol import Event, new_command, utc_now
+
+if TYPE_CHECKING:
+    from vahr.protocol import Fleet
+
+
+def cmd(action: str, params: dict[str, object] | None = None, command_id: str | None = None):  # type: ignore[no-untyped-def]
+    return new_command(action, params, source="console", command_id=command_id)
+
+
+async def test_navigate_reports_navigating_then_arrives_idle_in_the_zone(fleet: Fleet) -> None:
+    executor, rec, backend = make_executor(fleet)
+    # When
+    executor.execute(cmd("navigate", {"zone": "B"}, "n1"))
+    await executor.wait_idle()
+    # Then
+    assert rec.kinds("n1")[0] == "accepted"
+    assert rec.kinds("n1")[-2:] == ["arrived", "done"]
+    assert "progress" in rec.kinds("n1")
+    assert (
+        rec.states[0].last_command is not None and rec.states[0].last_command.result == "accepted"
+    )
+    assert any(s.status == "navigating" for s in rec.states)
+    final = rec.states[-1]
+    assert (final.status, final.zone, final.task) == ("idle", "B", None)
+    assert final.last_command is not None and (
+        final.last_command.id,
+        final.last_command.result,
+    ) == ("n1", "done")
+    assert backend.pose.distance_to(fleet.zone("B").pose) < 1e-6
+
+
+async def test_each_state_is_published_once_and_only_on_change(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet)
+    executor.execute(cmd("navigate", {"zone": "A"}, "n1"))
+    await executor.wait_idle()
+    for before, after in zip(rec.states, rec.states[1:], strict=False):
+        assert before != after
+    # Progress ticks are events, not shadow updates.
+    assert len(rec.states) < 8 < len(rec.events)
+
+
+async def test_deliver_loads_at_loading_then_unloads_in_the_zone(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet)
+    executor.execute(cmd("deliver", {"zone": "C"}, "d1"))
+    await executor.wait_idle()
+    milestones = [
+        (e.event, e.zone) for e in rec.events if e.event in {"arrived", "loaded", "delivered"}
+    ]
+    assert milestones == [
+        ("arrived", "LOADING"),
+        ("loaded", "LOADING"),
+        ("arrived", "C"),
+        ("delivered", "C"),
+    ]
+    statuses = [s.status for s in rec.states]
+    assert statuses.index("loading") < statuses.index("unloading")
+    assert any(s.cargo for s in rec.states)
+    final = rec.states[-1]
+    assert (final.status, final.zone, final.cargo) == ("idle", "C", False)
+    assert final.last_command is not None and final.last_command.result == "done"
+
+
+async def test_a_new_motion_command_preempts_and_the_old_task_ends_cancelled(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, speed=50)
+    executor.execute(cmd("deliver", {"zone": "A"}, "old"))
+    await rec.until("progress", "old")
+    executor.execute(cmd("navigate", {"zone": "D"}, "new"))
+    await executor.wait_idle()
+    assert rec.kinds("old")[-1] == "cancelled"
+    assert rec.first("cancelled", "old").reason == "preempted by navigate new"
+    assert "delivered" not in rec.kinds("old")
+    assert rec.kinds("new")[-1] == "done"
+    assert rec.states[-1].zone == "D"
+    assert rec.states[-1].last_command is not None and rec.states[-1].last_command.id == "new"
+
+
+async def test_stop_preempts_everything_and_halts_where_the_robot_is(fleet: Fleet) -> None:
+    executor, rec, backend = make_executor(fleet, speed=50)
+    executor.execute(cmd("navigate", {"zone": "A"}, "go"))
+    await rec.until("progress", "go")
+    executor.execute(cmd("stop", None, "halt"))
+    await executor.wait_idle()
+    where = backend.pose
+    assert rec.kinds("go")[-1] == "cancelled"
+    assert rec.kinds("halt") == ["accepted", "stopped", "done"]
+    final = rec.states[-1]
+    assert final.status == "stopped" and final.task is None
+    assert final.last_command is not None and (
+        final.last_command.id,
+        final.last_command.result,
+    ) == ("halt", "done")
+    # The robot does not keep driving after the stop.
+    await executor.clock.sleep(5)
+    assert backend.pose == where
+
+
+async def test_ping_acknowledges_without_disturbing_a_running_task(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, speed=100)
+    executor.execute(cmd("navigate", {"zone": "B"}, "nav"))
+    executor.execute(cmd("ping", None, "p1"))
+    assert rec.kinds("p1") == ["accepted", "done"]
+    assert rec.states[-1].last_command is not None and rec.states[-1].last_command.id == "p1"
+    await executor.wait_idle()
+    assert rec.kinds("nav")[-1] == "done"
+
+
+async def test_no_progress_for_the_stuck_time_reports_stuck_and_fails(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(
+        fleet, sim=SimSettings(stuck_zones=("D",)), settings=ExecutorSettings(stuck_after_s=5)
+    )
+    executor.execute(cmd("navigate", {"zone": "D"}, "s1"))
+    await executor.wait_idle()
+    stuck = rec.first("stuck", "s1")
+    assert stuck.reason == "no progress towards D for 5 s"
+    assert rec.kinds("s1")[-1] == "failed"
+    final = rec.states[-1]
+    assert final.status == "stuck"
+    assert final.last_command is not None and final.last_command.result == "failed"
+    assert final.last_command.reason == "stuck: no progress towards D for 5 s"
+
+
+async def test_an_aborted_goal_fails_with_the_backend_reason(fleet: Fleet) -> None:
+    executor, rec, backend = make_executor(fleet)
+    backend.inject_failure("the costmap is blocked")
+    executor.execute(cmd("navigate", {"zone": "A"}, "f1"))
+    await executor.wait_idle()
+    failed = rec.first("failed", "f1")
+    assert failed.reason == "goal to A aborted: the costmap is blocked"
+    assert rec.states[-1].status == "error"
+    assert (
+        rec.states[-1].last_command is not None and rec.states[-1].last_command.result == "failed"
+    )
+
+
+async def test_sequential_delivery_waits_for_the_peer_then_delivers(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, thing="placebot2")
+    executor.execute(cmd("sequential_delivery", {"zone": "B", "after": "placebot1"}, "q1"))
+    await rec.until("waiting", "q1")
+    assert rec.states[-1].status == "waiting"
+    assert "loaded" not in rec.kinds("q1")
+    executor.peer_event(Event(event="delivered", thing="placebot1", at=utc_now(), zone="A"))
+    await executor.wait_idle()
+    assert rec.kinds("q1")[-2:] == ["delivered", "done"]
+
+
+async def test_sequential_delivery_counts_a_delivery_seen_before_the_command(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, thing="placebot2")
+    executor.peer_event(Event(event="delivered", thing="placebot1", at=utc_now(), zone="A"))
+    executor.execute(cmd("sequential_delivery", {"zone": "B", "after": "placebot1"}, "q2"))
+    await executor.wait_idle()
+    assert "waiting" not in rec.kinds("q2")
+    assert rec.kinds("q2")[-1] == "done"
+
+
+async def test_sequential_delivery_times_out_with_a_reason(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(
+        fleet, thing="placebot2", settings=ExecutorSettings(sequential_timeout_s=20)
+    )
+    executor.execute(cmd("sequential_delivery", {"zone": "B", "after": "placebot1"}, "q3"))
+    await executor.wait_idle()
+    assert rec.first("failed", "q3").reason == "placebot1 did not deliver within 20 s"
+    final = rec.states[-1]
+    assert final.status == "idle"
+    assert final.last_command is not None and final.last_command.result == "failed"
+
+
+async def test_sequential_delivery_after_itself_is_rejected(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, thing="placebot1")
+    executor.execute(cmd("sequential_delivery", {"zone": "B", "after": "placebot1"}, "q4"))
+    assert rec.kinds("q4") == ["rejected"]
+    assert rec.states[-1].last_command is not None
+    assert rec.states[-1].last_command.reason == "params.after: a robot cannot wait for itself"
