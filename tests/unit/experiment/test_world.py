@@ -1,0 +1,73 @@
+"""The world: arms load and unload, and task III's LED lights only on success."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from vahr.experiment.tasks import TaskGoal
+from vahr.experiment.world import World
+
+if TYPE_CHECKING:
+    from vahr.protocol import Fleet
+
+TASK_III = TaskGoal("III", {"placebot1": "D", "placebot2": "D"}, ("placebot1", "placebot2"))
+
+
+def delivered(thing: str, zone: str) -> dict[str, str]:
+    return {"event": "delivered", "thing": thing, "zone": zone}
+
+
+def test_the_world_has_the_fleets_arms(fleet: Fleet) -> None:
+    world = World.from_fleet(fleet)
+    assert world.arms["LOADING"].role == "loader"
+    assert sorted(z for z, arm in world.arms.items() if arm.role == "unloader") == list("ABCD")
+    assert world.led_on is False
+
+
+def test_loading_and_unloading_move_the_package(fleet: Fleet) -> None:
+    world = World.from_fleet(fleet)
+    changes = world.apply({"event": "loaded", "thing": "placebot1", "zone": "LOADING"})
+    assert changes == [{"what": "loaded", "thing": "placebot1", "zone": "LOADING", "arm": "loader"}]
+    assert world.cargo["placebot1"] is True
+    world.apply(delivered("placebot1", "B"))
+    assert world.cargo["placebot1"] is False
+    assert world.snapshot()["packages"]["B"] == ["placebot1"]
+    assert world.arms["B"].handled == 1
+
+
+def test_the_led_lights_when_both_deliver_to_d_in_order(fleet: Fleet) -> None:
+    world = World.from_fleet(fleet)
+    assert world.arm_led(TASK_III)[0]["on"] is False
+    assert not any(c["what"] == "led" for c in world.apply(delivered("placebot1", "D")))
+    changes = world.apply(delivered("placebot2", "D"))
+    assert {
+        "what": "led",
+        "on": True,
+        "why": "delivered to D in order placebot1, placebot2",
+    } in changes
+    assert world.led_on is True
+
+
+def test_the_led_stays_off_in_the_wrong_order(fleet: Fleet) -> None:
+    world = World.from_fleet(fleet)
+    world.arm_led(TASK_III)
+    world.apply(delivered("placebot2", "D"))
+    world.apply(delivered("placebot1", "D"))
+    assert world.led_on is False
+
+
+def test_the_led_stays_off_when_a_robot_goes_elsewhere(fleet: Fleet) -> None:
+    world = World.from_fleet(fleet)
+    world.arm_led(TASK_III)
+    world.apply(delivered("placebot1", "D"))
+    world.apply(delivered("placebot2", "A"))
+    world.apply(delivered("placebot2", "D"))
+    assert world.led_on is False
+
+
+def test_deliveries_before_task_three_do_not_light_the_led(fleet: Fleet) -> None:
+    world = World.from_fleet(fleet)
+    world.apply(delivered("placebot1", "D"))
+    world.arm_led(TASK_III)
+    world.apply(delivered("placebot2", "D"))
+    assert world.led_on is False

@@ -1,0 +1,191 @@
+"""The results table: one row per participant, method and trial (the report's CSV).
+
+Columns: participant, method, trial, interaction_time_s, neglect_time_s, task_time_s,
+puzzle_parts, and the questionnaire's eight items as levels 1-21 (mental, physical,
+temporal, performance, effort, frustration, confidence, trust). Rows come from a CSV file
+or from session logs (`rows_from_logs`).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from vahr.errors import VahrError
+from vahr.experiment.eventlog import Kind, find_logs, read_log
+from vahr.experiment.measure import measure_session
+from vahr.experiment.metrics import fan_out, rad
+from vahr.experiment.tlx import ITEMS, TlxAnswers, check_level
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from vahr.experiment.eventlog import LogEntry
+
+COLUMNS = (
+    "participant",
+    "method",
+    "trial",
+    "interaction_time_s",
+    "neglect_time_s",
+    "task_time_s",
+    "puzzle_parts",
+    *ITEMS,
+)
+
+
+@dataclass(frozen=True)
+class ResultRow:
+    participant: str
+    method: str
+    trial: int
+    interaction_time_s: float
+    neglect_time_s: float
+    task_time_s: float
+    puzzle_parts: int
+    tlx: TlxAnswers | None
+
+    @property
+    def rad(self) -> float:
+        """RAD of this row: IE / (IE + NT)."""
+        return rad(self.interaction_time_s, self.neglect_time_s)
+
+    @property
+    def fan_out(self) -> float:
+        """Fan-out of this row: task time / RAD."""
+        return fan_out(self.task_time_s, self.rad)
+
+    def to_csv(self) -> dict[str, object]:
+        row: dict[str, object] = {
+            "participant": self.participant,
+            "method": self.method,
+            "trial": self.trial,
+            "interaction_time_s": round(self.interaction_time_s, 3),
+            "neglect_time_s": round(self.neglect_time_s, 3),
+            "task_time_s": round(self.task_time_s, 3),
+            "puzzle_parts": self.puzzle_parts,
+        }
+        levels = self.tlx.levels() if self.tlx is not None else {}
+        for item in ITEMS:
+            row[item] = levels.get(item, "")
+        return row
+
+
+def _number(line: int, column: str, text: str, *, whole: bool = False) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise VahrError(f"row {line}: {column} {text!r} is not a number") from None
+    if not math.isfinite(value) or value < 0 or (whole and not value.is_integer()):
+        kind = "a whole number" if whole else "a number"
+        raise VahrError(f"row {line}: {column} {text!r} is not {kind} >= 0")
+    return value
+
+
+def parse_row(line: int, raw: dict[str, str]) -> ResultRow:
+    """Validate one CSV row (line is its line number in the file, for error messages)."""
+
+    def cell(column: str) -> str:
+        value = raw.get(column)
+        if value is None or not value.strip():
+            raise VahrError(f"row {line}: {column} is empty")
+        return value.strip()
+
+    trial = _number(line, "trial", cell("trial"), whole=True)
+    if trial < 1:
+        raise VahrError(f"row {line}: trial must be 1 or more")
+    try:
+        tlx = TlxAnswers.from_mapping({item: check_level(item, cell(item)) for item in ITEMS})
+    except ValueError as err:
+        raise VahrError(f"row {line}: {err}") from None
+    row = ResultRow(
+        participant=cell("participant"),
+        method=cell("method"),
+        trial=int(trial),
+        interaction_time_s=_number(line, "interaction_time_s", cell("interaction_time_s")),
+        neglect_time_s=_number(line, "neglect_time_s", cell("neglect_time_s")),
+        task_time_s=_number(line, "task_time_s", cell("task_time_s")),
+        puzzle_parts=int(_number(line, "puzzle_parts", cell("puzzle_parts"), whole=True)),
+        tlx=tlx,
+    )
+    if row.interaction_time_s + row.neglect_time_s == 0:
+        raise VahrError(f"row {line}: interaction and neglect time are both 0; RAD is undefined")
+    return row
+
+
+def read_csv(path: Path) -> list[ResultRow]:
+    """Read and validate a results CSV; raise VahrError naming the row and column."""
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as stream:
+            reader = csv.DictReader(stream)
+            missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+            if missing:
+                raise VahrError(f"{path}: missing column(s) {', '.join(missing)}")
+            rows = [parse_row(reader.line_num, raw) for raw in reader]
+    except OSError as err:
+        raise VahrError(f"cannot read {path}: {err.strerror}") from err
+    except csv.Error as err:
+        raise VahrError(f"{path} is not a valid CSV file: {err}") from err
+    if not rows:
+        raise VahrError(f"{path} has no rows")
+    return rows
+
+
+def write_csv(rows: list[ResultRow], path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", newline="", encoding="utf-8") as stream:
+        writer = csv.DictWriter(stream, fieldnames=COLUMNS)
+        writer.writeheader()
+        for row in rows:
+            writer.writerow(row.to_csv())
+
+
+def session_header(entries: list[LogEntry]) -> dict[str, object]:
+    for entry in entries:
+        if entry.kind == Kind.SESSION_STARTED:
+            return entry.data
+    raise VahrError("the log has no session_started event")
+
+
+def latest_tlx(entries: list[LogEntry]) -> TlxAnswers | None:
+    """The last questionnaire entered for the session (a re-entry replaces, never edits)."""
+    answers = [entry for entry in entries if entry.kind == Kind.TLX]
+    return TlxAnswers.from_mapping(answers[-1].data["levels"]) if answers else None
+
+
+def row_from_log(entries: list[LogEntry]) -> ResultRow:
+    header = session_header(entries)
+    times = measure_session(entries)
+    return ResultRow(
+        participant=str(header["participant"]),
+        method=str(header["method"]),
+        trial=int(str(header["trial"])),
+        interaction_time_s=times.interaction_s,
+        neglect_time_s=times.neglect_s,
+        task_time_s=times.time_taken_s,
+        puzzle_parts=times.puzzle_parts,
+        tlx=latest_tlx(entries),
+    )
+
+
+def rows_from_logs(log_dir: Path) -> tuple[list[ResultRow], list[str]]:
+    """A row per session log under `log_dir` with at least one finished task; the second
+    list names the logs left out and why."""
+    rows: list[ResultRow] = []
+    skipped: list[str] = []
+    for path in find_logs(log_dir):
+        entries = read_log(path)
+        try:
+            row = row_from_log(entries)
+        except VahrError as err:
+            skipped.append(f"{path.name}: {err}")
+            continue
+        if row.task_time_s == 0:
+            skipped.append(f"{path.name}: no finished task")
+            continue
+        rows.append(row)
+    if not rows:
+        raise VahrError(f"no finished sessions under {log_dir}")
+    return rows, skipped

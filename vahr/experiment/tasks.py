@@ -1,0 +1,129 @@
+"""The paper's three tasks and the seeded plan of one session.
+
+- Task I: each robot delivers its package to the zone it is assigned (drawn at random).
+- Task II: a robot asks the assistant for the weather and delivers to A if it is sunny, C if
+  it is rainy (the weather is drawn at random and stored in the experiment thing's shadow,
+  which the skill answers from).
+- Task III: both robots deliver to zone D, placebot1 first; the LED lights only on success.
+
+The plan is a pure function of the seed and the fleet, so a session can be replayed and a
+resumed session finds the same assignments.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import random
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
+
+from vahr.protocol import ExperimentState
+
+if TYPE_CHECKING:
+    from vahr.protocol import Fleet
+
+TaskId = Literal["I", "II", "III"]
+TASKS: tuple[TaskId, ...] = ("I", "II", "III")
+METHODS = ("vahr", "keyboard")
+WEATHER_ZONES = {"sunny": "A", "rainy": "C"}
+SEQUENCE_ZONE = "D"
+
+TASK_TITLES = {
+    "I": "deliver each package to its assigned zone",
+    "II": "deliver according to the weather (sunny: A, rainy: C)",
+    "III": "both robots deliver to zone D, placebot1 first",
+}
+
+
+@dataclass(frozen=True)
+class TaskGoal:
+    """What one task asks for: the zone each robot must deliver to, and in which order."""
+
+    task: TaskId
+    zones: dict[str, str]
+    # Robots that must deliver in this order (task III); empty when order does not matter.
+    order: tuple[str, ...] = ()
+
+    def to_json(self) -> dict[str, Any]:
+        return {"task": self.task, "zones": dict(self.zones), "order": list(self.order)}
+
+    @classmethod
+    def from_json(cls, body: dict[str, Any]) -> TaskGoal:
+        return cls(task=body["task"], zones=dict(body["zones"]), order=tuple(body["order"]))
+
+
+@dataclass(frozen=True)
+class Plan:
+    """One session's randomized conditions and the goal of each task."""
+
+    seed: int
+    assignments: dict[str, str]
+    weather: Literal["sunny", "rainy"]
+    weather_robot: str
+    goals: dict[str, TaskGoal] = field(default_factory=dict)
+
+    def goal(self, task: str) -> TaskGoal:
+        return self.goals[task]
+
+    def experiment_state(self, session: str) -> ExperimentState:
+        """The experiment thing's reported state for this plan."""
+        return ExperimentState(weather=self.weather, assignments=self.assignments, session=session)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "seed": self.seed,
+            "assignments": dict(self.assignments),
+            "weather": self.weather,
+            "weather_robot": self.weather_robot,
+            "goals": {task: goal.to_json() for task, goal in self.goals.items()},
+        }
+
+    @classmethod
+    def from_json(cls, body: dict[str, Any]) -> Plan:
+        return cls(
+            seed=int(body["seed"]),
+            assignments=dict(body["assignments"]),
+            weather=body["weather"],
+            weather_robot=body["weather_robot"],
+            goals={task: TaskGoal.from_json(goal) for task, goal in body["goals"].items()},
+        )
+
+
+def default_seed(participant: str, method: str, trial: int) -> int:
+    """A stable seed for a session when none is given, so reruns draw the same plan."""
+    digest = hashlib.sha256(f"{participant}\x00{method}\x00{trial}".encode()).digest()
+    return int.from_bytes(digest[:4], "big")
+
+
+def delivery_zones(fleet: Fleet) -> list[str]:
+    """Zones with an unloading arm: where packages can be delivered."""
+    return [zone.id for zone in fleet.zones if zone.arm == "unloader"]
+
+
+def draw_plan(fleet: Fleet, seed: int) -> Plan:
+    """Draw the zone assignments (distinct zones when there are enough) and the weather."""
+    rng = random.Random(seed)
+    zones = delivery_zones(fleet)
+    for needed in (*WEATHER_ZONES.values(), SEQUENCE_ZONE):
+        if needed not in zones:
+            raise ValueError(f"the experiment needs a delivery zone {needed} in the fleet")
+    robots = list(fleet.robot_things)
+    if len(robots) < 2:
+        raise ValueError("the experiment needs at least two robots in the fleet")
+    if len(zones) >= len(robots):
+        assigned = rng.sample(zones, len(robots))
+    else:
+        assigned = [rng.choice(zones) for _ in robots]
+    assignments = dict(zip(robots, assigned, strict=True))
+    weather: Literal["sunny", "rainy"] = rng.choice(("sunny", "rainy"))
+    first, second = robots[0], robots[1]
+    goals = {
+        "I": TaskGoal(task="I", zones=dict(assignments)),
+        "II": TaskGoal(task="II", zones={first: WEATHER_ZONES[weather]}),
+        "III": TaskGoal(
+            task="III", zones={first: SEQUENCE_ZONE, second: SEQUENCE_ZONE}, order=(first, second)
+        ),
+    }
+    return Plan(
+        seed=seed, assignments=assignments, weather=weather, weather_robot=first, goals=goals
+    )
