@@ -1,0 +1,140 @@
+"""The CDK app's configuration: context values read once into a typed, validated object.
+
+Context comes from `cdk.json` (JSON values) and from `-c key=value` on the command line
+(always strings), so booleans and numbers are parsed from either form here, in one place.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+from vahr.errors import VahrError
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+
+Architecture = Literal["x86_64", "arm64"]
+
+# Log retention periods CloudWatch Logs accepts (days).
+_RETENTION_DAYS = (1, 3, 5, 7, 14, 30, 60, 90, 120, 150, 180, 365, 400, 545, 731, 1096, 1827)
+_SKILL_ID = re.compile(r"^amzn1\.ask\.skill\.[0-9a-f-]{36}$")
+_NAME = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
+
+
+@dataclass(frozen=True, kw_only=True)
+class InfraConfig:
+    """Everything the stacks need to know, validated. Build it with `from_context`."""
+
+    stack_name: str = "Vahr"
+    fleet_file: Path = REPO_ROOT / "fleet.yaml"
+    architecture: Architecture = "x86_64"
+    log_retention_days: int = 30
+    ack_timeout_s: float = 2.5
+    log_level: str = "INFO"
+    robot_policy_name: str = "vahr-robot-policy"
+    thing_group_name: str = "vahr-robots"
+    presence_rule_name: str = "vahr_presence_to_shadow"
+    # Known only after the skill exists (`ask deploy` prints it); when set, only that skill
+    # may invoke the function and the handler checks the applicationId.
+    skill_id: str | None = None
+    skill: bool = False
+    skill_package_dir: Path = REPO_ROOT / "skill-package"
+    lwa_secret_name: str = "vahr/lwa"
+    vendor_id: str | None = None
+    lex: bool = False
+    weather_answers_file: Path = REPO_ROOT / "robot_agent" / "voice" / "weather_answers.yaml"
+    bot_name: str = "vahr-weather-answers"
+    bot_alias_name: str = "live"
+    role_alias_name: str = "vahr-robot-lex"
+
+    @classmethod
+    def from_context(cls, get: Callable[[str], Any]) -> InfraConfig:
+        """Read every known key through `get` (e.g. `app.node.try_get_context`)."""
+        defaults = cls()
+        skill_id = _text(get, "skillId")
+        if skill_id is not None and not _SKILL_ID.match(skill_id):
+            raise VahrError(
+                f"skillId: {skill_id!r} is not an Alexa skill id (amzn1.ask.skill.<uuid>)"
+            )
+        architecture = _text(get, "architecture") or defaults.architecture
+        if architecture not in ("x86_64", "arm64"):
+            raise VahrError(f"architecture: {architecture!r} must be x86_64 or arm64")
+        retention = _number(get, "logRetentionDays", defaults.log_retention_days)
+        if retention not in _RETENTION_DAYS:
+            raise VahrError(
+                f"logRetentionDays: {retention:g} is not a CloudWatch Logs retention "
+                f"({', '.join(str(d) for d in _RETENTION_DAYS)})"
+            )
+        ack_timeout = _number(get, "ackTimeoutS", defaults.ack_timeout_s)
+        if not 0 < ack_timeout <= 6:
+            raise VahrError(
+                f"ackTimeoutS: {ack_timeout:g} must be in (0, 6] (Alexa allows 8 s per answer)"
+            )
+        config = cls(
+            stack_name=_text(get, "stackName") or defaults.stack_name,
+            fleet_file=_path(get, "fleetFile", defaults.fleet_file),
+            architecture=architecture,  # type: ignore[arg-type]
+            log_retention_days=int(retention),
+            ack_timeout_s=ack_timeout,
+            log_level=(_text(get, "logLevel") or defaults.log_level).upper(),
+            robot_policy_name=_text(get, "robotPolicyName") or defaults.robot_policy_name,
+            skill_id=skill_id,
+            skill=_flag(get, "skill"),
+            skill_package_dir=_path(get, "skillPackageDir", defaults.skill_package_dir),
+            lwa_secret_name=_text(get, "lwaSecretName") or defaults.lwa_secret_name,
+            vendor_id=_text(get, "vendorId"),
+            lex=_flag(get, "lex"),
+            weather_answers_file=_path(get, "weatherAnswersFile", defaults.weather_answers_file),
+            role_alias_name=_text(get, "roleAliasName") or defaults.role_alias_name,
+        )
+        for key, value in (
+            ("robotPolicyName", config.robot_policy_name),
+            ("roleAliasName", config.role_alias_name),
+        ):
+            if not _NAME.match(value):
+                raise VahrError(f"{key}: {value!r} must be 1-64 letters, digits, '_' or '-'")
+        if config.log_level not in ("DEBUG", "INFO", "WARNING", "ERROR"):
+            raise VahrError(f"logLevel: {config.log_level!r} must be DEBUG, INFO, WARNING or ERROR")
+        return config
+
+
+def _text(get: Callable[[str], Any], key: str) -> str | None:
+    value = get(key)
+    if value is None or value == "":
+        return None
+    return str(value)
+
+
+def _flag(get: Callable[[str], Any], key: str) -> bool:
+    value = get(key)
+    if value is None or isinstance(value, bool):
+        return bool(value)
+    text = str(value).strip().lower()
+    if text in ("true", "1", "yes", "on"):
+        return True
+    if text in ("false", "0", "no", "off", ""):
+        return False
+    raise VahrError(f"{key}: {value!r} is not true or false")
+
+
+def _number(get: Callable[[str], Any], key: str, default: float) -> float:
+    value = get(key)
+    if value is None:
+        return default
+    try:
+        return float(value)
+    except (TypeError, ValueError) as err:
+        raise VahrError(f"{key}: {value!r} is not a number") from err
+
+
+def _path(get: Callable[[str], Any], key: str, default: Path) -> Path:
+    value = _text(get, key)
+    if value is None:
+        return default
+    path = Path(value)
+    return path if path.is_absolute() else REPO_ROOT / path

@@ -1,0 +1,166 @@
+"""The skill's Lambda function: code built by `infra.lambda_asset`, least-privilege IoT rights.
+
+The function may publish only to the robots' command topics and the fleet topic, read only
+the fleet's shadows, and read and update only the experiment thing's shadow. It logs to its
+own log group with a retention period, and Alexa may invoke it (only the configured skill,
+once its id is known).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import aws_cdk as cdk
+import jsii
+from aws_cdk import aws_iam as iam
+from aws_cdk import aws_lambda as lambda_
+from aws_cdk import aws_logs as logs
+from constructs import Construct
+
+from infra import lambda_asset
+from vahr.protocol import topics
+
+if TYPE_CHECKING:
+    from infra.config import InfraConfig
+    from vahr.protocol import Fleet
+
+HANDLER = "skill.app.lambda_handler"
+# Alexa gives a skill 8 s per answer; the handler bounds its own waits well inside that.
+TIMEOUT = cdk.Duration.seconds(8)
+MEMORY_MB = 512
+
+
+@jsii.implements(cdk.ILocalBundling)
+class LocalBundler:
+    """Runs `infra.lambda_asset.build` on this machine, so synth needs no Docker."""
+
+    def __init__(self, *, architecture: str, fleet_file: Path) -> None:
+        self._architecture = architecture
+        self._fleet_file = fleet_file
+
+    def try_bundle(self, output_dir: str, options: Any = None, **_: Any) -> bool:
+        # jsii passes the bundling options positionally; the build needs none of them.
+        lambda_asset.build(
+            Path(output_dir), architecture=self._architecture, fleet_file=self._fleet_file
+        )
+        return True
+
+
+def skill_code(config: InfraConfig) -> lambda_.Code:
+    """The function's code asset, hashed over everything the build puts into it."""
+    return lambda_.Code.from_asset(
+        str(lambda_asset.REPO_ROOT / lambda_asset.SKILL_DIR),
+        asset_hash_type=cdk.AssetHashType.CUSTOM,
+        asset_hash=lambda_asset.source_hash(
+            architecture=config.architecture, fleet_file=config.fleet_file
+        ),
+        bundling=cdk.BundlingOptions(
+            # Never pulled: local bundling always succeeds or raises.
+            image=lambda_.Runtime.PYTHON_3_12.bundling_image,
+            local=LocalBundler(architecture=config.architecture, fleet_file=config.fleet_file),
+        ),
+    )
+
+
+class SkillFunction(Construct):
+    """The Alexa skill handler (`skill.app.lambda_handler`) and its execution role."""
+
+    def __init__(
+        self,
+        scope: Construct,
+        construct_id: str,
+        *,
+        config: InfraConfig,
+        fleet: Fleet,
+        data_endpoint: str,
+        code: lambda_.Code | None = None,
+    ) -> None:
+        super().__init__(scope, construct_id)
+        stack = cdk.Stack.of(self)
+        self.log_group = logs.LogGroup(
+            self,
+            "Logs",
+            retention=logs.RetentionDays[_retention_name(config.log_retention_days)],
+            removal_policy=cdk.RemovalPolicy.DESTROY,
+        )
+        self.role = iam.Role(
+            self,
+            "Role",
+            assumed_by=iam.ServicePrincipal("lambda.amazonaws.com"),
+            description="VAHR skill handler: robot commands out, shadows in, nothing else",
+        )
+        for statement in skill_statements(stack, fleet):
+            self.role.add_to_policy(statement)
+        environment = {
+            "VAHR_IOT_DATA_ENDPOINT": f"https://{data_endpoint}",
+            "VAHR_ACK_TIMEOUT_S": f"{config.ack_timeout_s:g}",
+            "VAHR_LOG_LEVEL": config.log_level,
+        }
+        if config.skill_id:
+            environment["VAHR_SKILL_ID"] = config.skill_id
+        self.function = lambda_.Function(
+            self,
+            "Function",
+            description="VAHR Alexa skill: voice commands to the robot fleet over AWS IoT",
+            runtime=lambda_.Runtime.PYTHON_3_12,
+            architecture=(
+                lambda_.Architecture.ARM_64
+                if config.architecture == "arm64"
+                else lambda_.Architecture.X86_64
+            ),
+            handler=HANDLER,
+            code=code or skill_code(config),
+            memory_size=MEMORY_MB,
+            timeout=TIMEOUT,
+            role=self.role,
+            log_group=self.log_group,
+            environment=environment,
+        )
+        self.log_group.grant_write(self.role)
+        # Without a skill id (the skill does not exist before its endpoint does) any skill
+        # could call the function; the handler then checks nothing, so set skillId once
+        # `ask deploy` has printed it and deploy again.
+        self.function.add_permission(
+            "AlexaInvoke",
+            principal=iam.ServicePrincipal("alexa-appkit.amazon.com"),
+            action="lambda:InvokeFunction",
+            event_source_token=config.skill_id,
+        )
+
+
+def skill_statements(stack: cdk.Stack, fleet: Fleet) -> list[iam.PolicyStatement]:
+    """The IoT rights of the skill, exactly: publish commands, read shadows, experiment."""
+
+    def arn(resource: str, name: str) -> str:
+        return stack.format_arn(service="iot", resource=resource, resource_name=name)
+
+    robots = fleet.robot_things
+    return [
+        iam.PolicyStatement(
+            sid="PublishCommands",
+            actions=["iot:Publish"],
+            resources=[arn("topic", topics.robot_cmd(thing)) for thing in robots]
+            + [arn("topic", topics.FLEET_CMD)],
+        ),
+        iam.PolicyStatement(
+            sid="ReadRobotShadows",
+            actions=["iot:GetThingShadow"],
+            resources=[arn("thing", thing) for thing in robots],
+        ),
+        iam.PolicyStatement(
+            sid="ReadWriteExperimentShadow",
+            actions=["iot:GetThingShadow", "iot:UpdateThingShadow"],
+            resources=[arn("thing", fleet.experiment_thing)],
+        ),
+    ]
+
+
+def _retention_name(days: int) -> str:
+    names = {
+        1: "ONE_DAY", 3: "THREE_DAYS", 5: "FIVE_DAYS", 7: "ONE_WEEK", 14: "TWO_WEEKS",
+        30: "ONE_MONTH", 60: "TWO_MONTHS", 90: "THREE_MONTHS", 120: "FOUR_MONTHS",
+        150: "FIVE_MONTHS", 180: "SIX_MONTHS", 365: "ONE_YEAR", 400: "THIRTEEN_MONTHS",
+        545: "EIGHTEEN_MONTHS", 731: "TWO_YEARS", 1096: "THREE_YEARS", 1827: "FIVE_YEARS",
+    }  # fmt: skip
+    return names[days]

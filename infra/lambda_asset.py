@@ -1,0 +1,264 @@
+"""Build the skill's Lambda code bundle: the one build used by CDK and by the ASK CLI path.
+
+    python -m infra.lambda_asset OUT_DIR [--architecture x86_64|arm64] [--zip FILE]
+
+The bundle holds `skill/` (from `lambda/skill`, handler `skill.app.lambda_handler`), the
+parts of `vahr` the skill imports (`vahr/__init__.py`, `vahr/errors.py`, `vahr/protocol`),
+`fleet.yaml` at its root (where `vahr.protocol.fleet` looks for it), and the skill's
+runtime dependencies installed from wheels built for the Lambda runtime (CPython 3.12 on
+Amazon Linux), so no Docker is needed. boto3 comes from the Lambda runtime and awscrt
+must stay out: botocore imports awscrt whenever it is present, which costs cold start.
+
+Installed dependencies are cached under `.cache/lambda-deps/<key>`, keyed by the pins and
+the target platform, so a rebuild copies files instead of running pip.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import hashlib
+import importlib.metadata
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from vahr.errors import VahrError
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+LAMBDA_PYTHON = "3.12"
+# The skill's direct runtime dependencies; their versions come from requirements.txt.
+RUNTIME_PACKAGES = ("ask-sdk-core", "ask-sdk-model", "msgspec", "pyyaml")
+PLATFORMS = {"x86_64": "manylinux2014_x86_64", "arm64": "manylinux2014_aarch64"}
+# Provided by the runtime (boto3, botocore) or harmful there (awscrt slows every boto3
+# client's import; awsiot is the robots' SDK).
+FORBIDDEN_TOP_LEVEL = ("awscrt", "awsiot", "boto3", "botocore", "s3transfer")
+# The project files the skill needs, relative to the repository root.
+VAHR_FILES = ("vahr/__init__.py", "vahr/errors.py")
+VAHR_PACKAGES = ("vahr/protocol",)
+SKILL_DIR = "lambda/skill"
+_IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".mypy_cache", ".pytest_cache")
+_REQUIREMENT = re.compile(r"^\s*([A-Za-z0-9][A-Za-z0-9._-]*)\s*==\s*([^\s;#]+)")
+_ZIP_TIME = (1980, 1, 1, 0, 0, 0)
+
+
+@dataclass(frozen=True)
+class BuildResult:
+    """What was built: where, how many files, how many bytes unzipped."""
+
+    out_dir: Path
+    files: int
+    size_bytes: int
+    from_cache: bool
+
+
+def normalize(name: str) -> str:
+    """A distribution name in PEP 503 form (`PyYAML` -> `pyyaml`)."""
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def runtime_pins(requirements: Path = REPO_ROOT / "requirements.txt") -> list[str]:
+    """`name==version` for each runtime package, as pinned in requirements.txt."""
+    pins: dict[str, str] = {}
+    for line in requirements.read_text().splitlines():
+        found = _REQUIREMENT.match(line)
+        if found:
+            pins[normalize(found[1])] = f"{found[1]}=={found[2]}"
+    missing = [name for name in RUNTIME_PACKAGES if normalize(name) not in pins]
+    if missing:
+        raise VahrError(f"{requirements}: no '==' pin for {', '.join(missing)}")
+    return [pins[normalize(name)] for name in RUNTIME_PACKAGES]
+
+
+def constraints() -> list[str]:
+    """The versions installed here, so the bundle's transitive dependencies match what the
+    tests ran against rather than whatever is newest on PyPI today."""
+    lines = set()
+    for dist in importlib.metadata.distributions():
+        name, version = dist.metadata["Name"], dist.version
+        if name and version and "+" not in version and normalize(name) != "vahr":
+            lines.add(f"{normalize(name)}=={version}")
+    return sorted(lines)
+
+
+def _source_files(fleet_file: Path) -> list[tuple[Path, str]]:
+    """(source file, path inside the bundle) for every project file the bundle carries."""
+    pairs: list[tuple[Path, str]] = []
+    skill_root = REPO_ROOT / SKILL_DIR
+    for path in sorted(skill_root.rglob("*")):
+        if path.is_file() and "__pycache__" not in path.parts and path.suffix != ".pyc":
+            pairs.append((path, "skill/" + path.relative_to(skill_root).as_posix()))
+    for name in VAHR_FILES:
+        pairs.append((REPO_ROOT / name, name))
+    for package in VAHR_PACKAGES:
+        for path in sorted((REPO_ROOT / package).rglob("*.py")):
+            if "__pycache__" not in path.parts:
+                pairs.append((path, path.relative_to(REPO_ROOT).as_posix()))
+    pairs.append((fleet_file, "fleet.yaml"))
+    return pairs
+
+
+def _dependency_key(architecture: str) -> str:
+    digest = hashlib.sha256()
+    for part in (LAMBDA_PYTHON, PLATFORMS[architecture], *runtime_pins(), *constraints()):
+        digest.update(part.encode() + b"\0")
+    return digest.hexdigest()[:16]
+
+
+def source_hash(*, architecture: str = "x86_64", fleet_file: Path | None = None) -> str:
+    """A hash of everything that goes into the bundle, for CDK's custom asset hash."""
+    digest = hashlib.sha256(_dependency_key(architecture).encode())
+    for source, name in _source_files(fleet_file or REPO_ROOT / "fleet.yaml"):
+        digest.update(name.encode() + b"\0")
+        if source.exists():
+            digest.update(source.read_bytes())
+    return digest.hexdigest()
+
+
+def _install_dependencies(architecture: str, cache_root: Path) -> tuple[Path, bool]:
+    """The directory holding the installed dependencies; True when it came from the cache."""
+    target = cache_root / "lambda-deps" / f"{architecture}-{_dependency_key(architecture)}"
+    if (target / ".complete").exists():
+        return target, True
+    target.parent.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix="staging-", dir=target.parent))
+    try:
+        constraint_file = staging / "constraints.txt"
+        constraint_file.write_text("\n".join(constraints()) + "\n")
+        site = staging / "site"
+        command = [
+            sys.executable, "-m", "pip", "install", "--quiet", "--disable-pip-version-check",
+            "--no-input", "--no-compile", "--target", str(site),
+            "--platform", PLATFORMS[architecture], "--python-version", LAMBDA_PYTHON,
+            "--implementation", "cp", "--only-binary=:all:",
+            "--cache-dir", str(cache_root / "pip"), "--constraint", str(constraint_file),
+            *runtime_pins(),
+        ]  # fmt: skip
+        try:
+            subprocess.run(command, check=True, capture_output=True, text=True, timeout=600)
+        except subprocess.CalledProcessError as err:
+            reason = (err.stderr or err.stdout).strip().splitlines()
+            raise VahrError(
+                f"pip could not install the skill's dependencies: {reason[-1:]}"
+            ) from err
+        except subprocess.TimeoutExpired as err:
+            raise VahrError("pip took more than 10 minutes to install the dependencies") from err
+        # Console scripts are useless in Lambda and carry the build machine's paths.
+        shutil.rmtree(site / "bin", ignore_errors=True)
+        (site / ".complete").touch()
+        shutil.rmtree(target, ignore_errors=True)
+        site.rename(target)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return target, False
+
+
+def _vahr_imports(skill_dir: Path) -> set[str]:
+    """Every `vahr...` module the skill's code imports (absolute imports only)."""
+    modules: set[str] = set()
+    for path in skill_dir.rglob("*.py"):
+        tree = ast.parse(path.read_text(), filename=str(path))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                modules.update(alias.name for alias in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                modules.add(node.module)
+    return {module for module in modules if module == "vahr" or module.startswith("vahr.")}
+
+
+def _check_bundle(out_dir: Path) -> None:
+    for name in FORBIDDEN_TOP_LEVEL:
+        if (out_dir / name).exists():
+            raise VahrError(f"the Lambda bundle must not contain {name}/ (remove it from the deps)")
+    if not (out_dir / "skill" / "app.py").is_file():
+        raise VahrError(f"{SKILL_DIR}/app.py is missing: the handler is skill.app.lambda_handler")
+    for module in sorted(_vahr_imports(out_dir / "skill")):
+        parts = module.split(".")
+        as_package = out_dir.joinpath(*parts, "__init__.py")
+        as_module = out_dir.joinpath(*parts[:-1], parts[-1] + ".py")
+        if not as_package.exists() and not as_module.exists():
+            raise VahrError(
+                f"the skill imports {module}, which the bundle does not carry "
+                f"(add it to VAHR_FILES or VAHR_PACKAGES in infra/lambda_asset.py)"
+            )
+
+
+def _tree_size(root: Path) -> tuple[int, int]:
+    files = [path for path in root.rglob("*") if path.is_file()]
+    return len(files), sum(path.stat().st_size for path in files)
+
+
+def build(
+    out_dir: Path,
+    *,
+    architecture: str = "x86_64",
+    fleet_file: Path | None = None,
+    cache_root: Path | None = None,
+) -> BuildResult:
+    """Write the bundle into `out_dir` (created if needed; must be empty or absent)."""
+    if architecture not in PLATFORMS:
+        raise VahrError(f"architecture: {architecture!r} must be one of {', '.join(PLATFORMS)}")
+    fleet_file = fleet_file or REPO_ROOT / "fleet.yaml"
+    if not fleet_file.is_file():
+        raise VahrError(f"fleet file {fleet_file} does not exist")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    if any(out_dir.iterdir()):
+        raise VahrError(f"{out_dir} is not empty: give the build an empty directory")
+    deps, from_cache = _install_dependencies(architecture, cache_root or REPO_ROOT / ".cache")
+    shutil.copytree(deps, out_dir, dirs_exist_ok=True, ignore=shutil.ignore_patterns(".complete"))
+    for source, name in _source_files(fleet_file):
+        destination = out_dir / name
+        destination.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(source, destination)
+    _check_bundle(out_dir)
+    files, size = _tree_size(out_dir)
+    return BuildResult(out_dir=out_dir, files=files, size_bytes=size, from_cache=from_cache)
+
+
+def write_zip(bundle: Path, zip_file: Path) -> None:
+    """Zip `bundle` reproducibly (sorted names, fixed times) for uploads outside CDK."""
+    zip_file.parent.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(zip_file, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for path in sorted(p for p in bundle.rglob("*") if p.is_file()):
+            info = zipfile.ZipInfo(path.relative_to(bundle).as_posix(), date_time=_ZIP_TIME)
+            info.external_attr = 0o644 << 16
+            info.compress_type = zipfile.ZIP_DEFLATED
+            archive.writestr(info, path.read_bytes())
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m infra.lambda_asset", description=__doc__.split("\n\n")[0]
+    )
+    parser.add_argument("out_dir", type=Path, help="empty or new directory for the bundle")
+    parser.add_argument("--architecture", choices=sorted(PLATFORMS), default="x86_64")
+    parser.add_argument("--fleet-file", type=Path, help="fleet definition (default fleet.yaml)")
+    parser.add_argument("--zip", type=Path, dest="zip_file", help="also write the bundle as a zip")
+    args = parser.parse_args(argv)
+    try:
+        result = build(args.out_dir, architecture=args.architecture, fleet_file=args.fleet_file)
+        if args.zip_file is not None:
+            write_zip(result.out_dir, args.zip_file)
+    except VahrError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    print(
+        f"{result.out_dir}: {result.files} files, {result.size_bytes / 1e6:.1f} MB unzipped"
+        f"{' (dependencies from cache)' if result.from_cache else ''}"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("PIP_DISABLE_PIP_VERSION_CHECK", "1")
+    sys.exit(main())

@@ -1,0 +1,171 @@
+"""The VAHR stack: composes the constructs, adds outputs and tags. No resource logic here."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import aws_cdk as cdk
+from aws_cdk import aws_logs as logs
+
+from infra.constructs.alexa_skill import AlexaSkill
+from infra.constructs.iot_endpoint import IotEndpoint
+from infra.constructs.iot_fleet import IotFleet
+from infra.constructs.presence_rule import PresenceRule
+from infra.constructs.robot_policy import RobotPolicy
+from infra.constructs.skill_function import SkillFunction
+from infra.constructs.weather_bot import WeatherBot
+
+if TYPE_CHECKING:
+    from aws_cdk import aws_lambda as lambda_
+    from constructs import Construct
+
+    from infra.config import InfraConfig
+    from vahr.protocol import Fleet
+
+
+class VahrStack(cdk.Stack):
+    """IoT fleet, robot policy, presence rule, skill function; optionally skill and Lex bot."""
+
+    def __init__(
+        self,
+        scope: Construct,
+        construct_id: str,
+        *,
+        config: InfraConfig,
+        fleet: Fleet,
+        skill_code: lambda_.Code | None = None,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(scope, construct_id, **kwargs)
+        # The deploy-time lookups share one provider function; its logs expire too.
+        provider_logs = logs.LogGroup(
+            self,
+            "ProviderLogs",
+            retention=logs.RetentionDays.ONE_WEEK,
+            removal_policy=cdk.RemovalPolicy.DESTROY,
+        )
+        self.fleet = IotFleet(
+            self,
+            "Fleet",
+            fleet=fleet,
+            group_name=config.thing_group_name,
+            provider_logs=provider_logs,
+        )
+        self.weather_bot = (
+            WeatherBot(
+                self,
+                "WeatherBot",
+                answers_file=config.weather_answers_file,
+                bot_name=config.bot_name,
+                alias_name=config.bot_alias_name,
+                role_alias_name=config.role_alias_name,
+            )
+            if config.lex
+            else None
+        )
+        self.robot_policy = RobotPolicy(
+            self,
+            "RobotPolicy",
+            policy_name=config.robot_policy_name,
+            role_alias_arn=self.weather_bot.role_alias_arn if self.weather_bot else None,
+        )
+        self.presence = PresenceRule(
+            self, "Presence", rule_name=config.presence_rule_name, things=fleet.robot_things
+        )
+        self.data_endpoint = IotEndpoint(
+            self, "DataEndpoint", endpoint_type="iot:Data-ATS", provider_logs=provider_logs
+        )
+        self.skill_function = SkillFunction(
+            self,
+            "Skill",
+            config=config,
+            fleet=fleet,
+            data_endpoint=self.data_endpoint.address,
+            code=skill_code,
+        )
+        self.credentials_endpoint = (
+            IotEndpoint(
+                self,
+                "CredentialProvider",
+                endpoint_type="iot:CredentialProvider",
+                provider_logs=provider_logs,
+            )
+            if config.lex
+            else None
+        )
+        self.alexa_skill = (
+            AlexaSkill(
+                self,
+                "AlexaSkill",
+                package_dir=config.skill_package_dir,
+                function=self.skill_function.function,
+                lwa_secret_name=config.lwa_secret_name,
+                vendor_id=config.vendor_id,
+            )
+            if config.skill
+            else None
+        )
+        self._outputs(config)
+        self._acknowledge_findings()
+        cdk.Tags.of(self).add("project", "vahr")
+
+    def _acknowledge_findings(self) -> None:
+        """The cdk-nag findings this stack accepts, each for a stated reason."""
+
+        def acknowledge(scope: Construct, finding: str, reason: str) -> None:
+            cdk.Validations.of(scope).acknowledge(
+                cdk.Acknowledgment(id=f"AwsSolutions::AwsSolutions-{finding}", reason=reason)
+            )
+
+        # The provider function that CDK's AwsCustomResource shares across the stack.
+        acknowledge(
+            self,
+            "IAM4[Policy::arn:<AWS::Partition>:iam::aws:policy/service-role/"
+            "AWSLambdaBasicExecutionRole]",
+            "Only the CDK custom-resource provider (endpoint lookups, thing-group membership) "
+            "uses it; it grants writing that function's own CloudWatch logs and nothing else.",
+        )
+        for lookup in (self.data_endpoint, self.credentials_endpoint):
+            if lookup is not None:
+                acknowledge(
+                    lookup,
+                    "IAM5[Resource::*]",
+                    "iot:DescribeEndpoint has no resource type in IAM, so its only valid "
+                    "resource is '*'; the statement allows that one read-only action.",
+                )
+        acknowledge(
+            self.skill_function,
+            "L1",
+            "Pinned to python3.12 on purpose: the bundle's compiled wheels (msgspec, PyYAML) "
+            "are cross-built for cp312 and the handler is tested on 3.12; moving runtimes "
+            "is a deliberate change made together with infra/lambda_asset.py.",
+        )
+
+    def _outputs(self, config: InfraConfig) -> None:
+        def output(name: str, value: str, description: str) -> None:
+            cdk.CfnOutput(self, name, value=value, description=description)
+
+        output(
+            "IotDataEndpoint",
+            self.data_endpoint.address,
+            "AWS IoT data endpoint (ATS): robot-agent run --endpoint",
+        )
+        output(
+            "SkillFunctionArn",
+            self.skill_function.function.function_arn,
+            "Skill endpoint: python -m infra.skill_endpoint writes it into skill.json",
+        )
+        output("ThingNames", ",".join(self.fleet.thing_names), "The robots' thing names")
+        output("ExperimentThing", self.fleet.experiment_thing_name, "The experiment's thing")
+        output("RobotPolicyName", config.robot_policy_name, "IoT policy for robot certificates")
+        if self.weather_bot is not None and self.credentials_endpoint is not None:
+            output(
+                "CredentialsEndpoint",
+                self.credentials_endpoint.address,
+                "AWS IoT credentials provider endpoint for the role alias",
+            )
+            output("RoleAlias", self.weather_bot.role_alias_name, "IoT role alias for Lex")
+            output("BotId", self.weather_bot.bot_id, "Lex V2 bot id (weather answers)")
+            output("BotAliasId", self.weather_bot.alias_id, "Lex V2 bot alias id")
+        if self.alexa_skill is not None:
+            output("SkillId", self.alexa_skill.skill_id, "The Alexa skill id (set -c skillId=)")
