@@ -1,0 +1,100 @@
+"""The Lambda entry point: `skill.app.lambda_handler` (code root `lambda/`).
+
+At cold start the configuration is read once, the fleet is loaded and the iot-data client
+is created; warm invocations reuse them. `make_lambda_handler` builds the same handler
+around another configuration or gateway, for the local stack's Alexa simulator and tests.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from ask_sdk_core.skill_builder import SkillBuilder
+
+from skill import logs
+from skill.config import SkillConfig
+from skill.exceptions import CatchAllExceptionHandler
+from skill.handlers.built_in import (
+    CancelIntentHandler,
+    FallbackIntentHandler,
+    HelpIntentHandler,
+    LaunchRequestHandler,
+    NavigateHomeIntentHandler,
+    SessionEndedRequestHandler,
+    StopIntentHandler,
+)
+from skill.handlers.deliver import DeliverIntentHandler
+from skill.handlers.emergency_stop import EmergencyStopIntentHandler
+from skill.handlers.navigate import NavigateIntentHandler
+from skill.handlers.sequential_delivery import SequentialDeliveryIntentHandler
+from skill.handlers.status import StatusIntentHandler
+from skill.handlers.weather import WeatherIntentHandler
+from skill.handlers.weather_delivery import WeatherDeliveryIntentHandler
+from skill.interceptors import (
+    CorrelationIdInterceptor,
+    RequestLogInterceptor,
+    ResponseLogInterceptor,
+)
+from skill.iot_data import IotDataGateway
+from skill.runtime import SkillRuntime
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from ask_sdk_core.dispatch_components import AbstractRequestHandler
+
+    from skill.gateway import RobotGateway
+
+
+def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
+    """Every request handler, one per intent or request type.
+
+    No two handlers claim the same request, so the order only reads from the most to the
+    least frequent; SessionEndedRequest comes last as it never speaks.
+    """
+    return [
+        NavigateIntentHandler(runtime),
+        DeliverIntentHandler(runtime),
+        WeatherDeliveryIntentHandler(runtime),
+        SequentialDeliveryIntentHandler(runtime),
+        StatusIntentHandler(runtime),
+        EmergencyStopIntentHandler(runtime),
+        WeatherIntentHandler(runtime),
+        LaunchRequestHandler(runtime),
+        HelpIntentHandler(runtime),
+        CancelIntentHandler(),
+        StopIntentHandler(),
+        NavigateHomeIntentHandler(),
+        FallbackIntentHandler(runtime),
+        SessionEndedRequestHandler(),
+    ]
+
+
+def build_skill_builder(runtime: SkillRuntime) -> SkillBuilder:
+    builder = SkillBuilder()
+    if runtime.config.skill_id:
+        builder.skill_id = runtime.config.skill_id  # type: ignore[assignment]
+    for handler in request_handlers(runtime):
+        builder.add_request_handler(handler)
+    # The correlation id is set before anything is logged.
+    builder.add_global_request_interceptor(CorrelationIdInterceptor())
+    builder.add_global_request_interceptor(RequestLogInterceptor())
+    builder.add_global_response_interceptor(ResponseLogInterceptor())
+    builder.add_exception_handler(CatchAllExceptionHandler())
+    return builder
+
+
+def make_lambda_handler(
+    config: SkillConfig | None = None, gateway: RobotGateway | None = None
+) -> Callable[[dict[str, Any], Any], dict[str, Any]]:
+    """A Lambda handler for `config` (default: the environment) and `gateway` (default:
+    boto3's iot-data client for that configuration)."""
+    config = config or SkillConfig.from_env()
+    logs.configure(config.log_level)
+    runtime = SkillRuntime.create(config, gateway or IotDataGateway.from_config(config))
+    handler: Callable[[dict[str, Any], Any], dict[str, Any]]
+    handler = build_skill_builder(runtime).lambda_handler()  # type: ignore[assignment]
+    return handler
+
+
+lambda_handler = make_lambda_handler()

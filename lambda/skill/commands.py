@@ -1,0 +1,56 @@
+"""Which command goes to which topic, and which robots must acknowledge it (pure logic).
+
+A command to one robot goes to `vahr/robots/{thing}/cmd`; a command to the whole fleet is
+published once to `vahr/fleet/cmd`, and every robot then reports the same command id.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from skill.vocabulary import FLEET
+from vahr.protocol import check_against_fleet, new_command, topics
+
+if TYPE_CHECKING:
+    from vahr.protocol import Command, Fleet
+
+SOURCE = "alexa"
+
+
+@dataclass(frozen=True)
+class Dispatch:
+    """One publish: the topic, the command, and the robots expected to acknowledge it."""
+
+    topic: str
+    command: Command
+    recipients: tuple[str, ...]
+    target: str  # a thing name, or FLEET
+
+    @property
+    def to_fleet(self) -> bool:
+        return self.target == FLEET
+
+
+def dispatch(
+    fleet: Fleet, action: str, target: str, params: dict[str, object] | None = None
+) -> Dispatch:
+    """A fresh command for one robot or (target `all`) for the whole fleet."""
+    command = new_command(action, params, source=SOURCE)
+    check_against_fleet(command, fleet)
+    if target == FLEET:
+        return Dispatch(topics.FLEET_CMD, command, fleet.robot_things, FLEET)
+    fleet.robot(target)  # KeyError for a robot the fleet does not have
+    return Dispatch(topics.robot_cmd(target), command, (target,), target)
+
+
+def sequential(
+    fleet: Fleet, first: str, first_zone: str, second: str, second_zone: str
+) -> tuple[Dispatch, Dispatch]:
+    """Task III: `first` delivers at once; `second` delivers once `first` has delivered."""
+    if first == second or FLEET in (first, second):
+        raise ValueError("a sequential delivery needs two different robots")
+    return (
+        dispatch(fleet, "sequential_delivery", first, {"zone": first_zone, "after": None}),
+        dispatch(fleet, "sequential_delivery", second, {"zone": second_zone, "after": first}),
+    )

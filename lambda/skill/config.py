@@ -1,0 +1,87 @@
+"""The skill's configuration, read once from the environment at cold start.
+
+Every setting has a default, so the handler runs with only a region configured:
+
+| variable | default | meaning |
+| --- | --- | --- |
+| `AWS_ENDPOINT_URL_IOT_DATA_PLANE` | unset | iot-data endpoint URL (boto3's own variable) |
+| `VAHR_IOT_DATA_ENDPOINT` | unset | iot-data endpoint set by the CDK stack (URL or host name) |
+| `VAHR_SKILL_ID` | unset | when set, requests for any other skill id are refused |
+| `VAHR_ACK_TIMEOUT_S` | 2.5 | how long to wait for robots to acknowledge a command (0-6 s) |
+| `VAHR_FLEET_FILE` | bundled fleet.yaml | the fleet definition |
+| `VAHR_LOG_LEVEL` | INFO | DEBUG, INFO, WARNING or ERROR |
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from skill.errors import ConfigError
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+# Alexa waits 8 s for an answer; publishing and speaking need some of it.
+MAX_ACK_TIMEOUT_S = 6.0
+LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
+
+
+@dataclass(frozen=True)
+class SkillConfig:
+    """Validated settings; build it with `from_env` (or directly in tests and the simulator)."""
+
+    data_endpoint: str | None = None
+    skill_id: str | None = None
+    ack_timeout_s: float = 2.5
+    fleet_file: str | None = None
+    log_level: str = "INFO"
+    # Where boto3 finds no region (a local endpoint needs none), sign for this one.
+    fallback_region: str = "us-east-1"
+
+    @classmethod
+    def from_env(cls, environ: Mapping[str, str] | None = None) -> SkillConfig:
+        env = os.environ if environ is None else environ
+        endpoint = _blank_to_none(env.get("AWS_ENDPOINT_URL_IOT_DATA_PLANE")) or _blank_to_none(
+            env.get("VAHR_IOT_DATA_ENDPOINT")
+        )
+        return cls(
+            data_endpoint=_as_url(endpoint) if endpoint else None,
+            skill_id=_blank_to_none(env.get("VAHR_SKILL_ID")),
+            ack_timeout_s=_ack_timeout(env.get("VAHR_ACK_TIMEOUT_S")),
+            fleet_file=_blank_to_none(env.get("VAHR_FLEET_FILE")),
+            log_level=_log_level(env.get("VAHR_LOG_LEVEL")),
+        )
+
+
+def _blank_to_none(value: str | None) -> str | None:
+    return value.strip() if value and value.strip() else None
+
+
+def _as_url(endpoint: str) -> str:
+    # IoT's DescribeEndpoint returns a bare host name; boto3 wants a URL.
+    return endpoint if "://" in endpoint else f"https://{endpoint}"
+
+
+def _ack_timeout(raw: str | None) -> float:
+    if _blank_to_none(raw) is None:
+        return SkillConfig.ack_timeout_s
+    assert raw is not None
+    try:
+        value = float(raw)
+    except ValueError:
+        raise ConfigError(f"VAHR_ACK_TIMEOUT_S: {raw!r} is not a number of seconds") from None
+    if not 0 < value <= MAX_ACK_TIMEOUT_S:
+        raise ConfigError(
+            f"VAHR_ACK_TIMEOUT_S: {value:g} is out of range; use more than 0 and at most "
+            f"{MAX_ACK_TIMEOUT_S:g} seconds (Alexa waits 8 s for an answer)"
+        )
+    return value
+
+
+def _log_level(raw: str | None) -> str:
+    level = (_blank_to_none(raw) or SkillConfig.log_level).upper()
+    if level not in LOG_LEVELS:
+        raise ConfigError(f"VAHR_LOG_LEVEL: {raw!r} is not one of {', '.join(LOG_LEVELS)}")
+    return level

@@ -1,0 +1,72 @@
+"""Reading ROBOT and ZONE slots against the fleet, and asking again when they fall short."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from skill import prompts
+from skill.responses import elicit
+from skill.slots import read_slot
+from skill.vocabulary import LOADING
+
+if TYPE_CHECKING:
+    from ask_sdk_core.handler_input import HandlerInput
+    from ask_sdk_model import IntentRequest, Response
+
+    from skill.runtime import SkillRuntime
+    from skill.slots import SlotReading
+
+
+def _intent(handler_input: HandlerInput):  # type: ignore[no-untyped-def]
+    request: IntentRequest = handler_input.request_envelope.request  # type: ignore[assignment]
+    return request.intent
+
+
+def robot(handler_input: HandlerInput, runtime: SkillRuntime, name: str) -> SlotReading:
+    vocabulary = runtime.vocabulary
+    return read_slot(_intent(handler_input), name, vocabulary.robot_ids, vocabulary.robot_id)
+
+
+def zone(handler_input: HandlerInput, runtime: SkillRuntime, name: str) -> SlotReading:
+    vocabulary = runtime.vocabulary
+    return read_slot(_intent(handler_input), name, runtime.fleet.zone_ids, vocabulary.zone_id)
+
+
+def ask_robot(
+    handler_input: HandlerInput,
+    runtime: SkillRuntime,
+    reading: SlotReading,
+    question: str = prompts.ASK_ROBOT,
+    *,
+    include_fleet: bool = True,
+    preface: str = "",
+) -> Response:
+    """Elicit a robot, listing the choices; say first when the last answer was unknown."""
+    if reading.unresolved and not preface:
+        preface = prompts.UNKNOWN_ROBOT.format(heard=reading.heard)
+    choices = runtime.vocabulary.robot_choices(include_fleet=include_fleet)
+    return elicit(handler_input, reading.name, preface + question.format(choices=choices))
+
+
+def delivery_zone_problem(reading: SlotReading) -> bool:
+    """True when a delivery zone is missing, unknown, or the loading zone itself."""
+    return reading.id is None or reading.id == LOADING
+
+
+def ask_zone(
+    handler_input: HandlerInput,
+    runtime: SkillRuntime,
+    reading: SlotReading,
+    question: str = prompts.ASK_ZONE,
+    *,
+    robot_id: str | None = None,
+    deliverable: bool = False,
+    preface: str = "",
+) -> Response:
+    """Elicit a zone, listing the choices (only delivery zones when `deliverable`)."""
+    if reading.unresolved and not preface:
+        preface = prompts.UNKNOWN_ZONE.format(heard=reading.heard)
+    robot_name = runtime.vocabulary.robot(robot_id) if robot_id else ""
+    choices = runtime.vocabulary.zone_choices(deliverable=deliverable)
+    text = question.format(choices=choices, robot=robot_name)
+    return elicit(handler_input, reading.name, preface + text)

@@ -1,0 +1,19 @@
+"""The skill's small exception hierarchy; `skill.exceptions` maps it to speech in one place."""
+
+from __future__ import annotations
+
+
+class SkillError(Exception):
+    """Base of every error the skill raises on purpose."""
+
+
+class ConfigError(SkillError):
+    """A configuration variable is set to a value the skill cannot use (raised at cold start)."""
+
+
+class GatewayError(SkillError):
+    """AWS IoT (or the local data plane) refused or failed a publish or a shadow call."""
+
+
+class ShadowConflict(GatewayError):
+    """A shadow update carried a version that is no longer current (HTTP 409)."""

@@ -1,0 +1,1 @@
+"""One request handler class per intent (and per request type); `skill.app` registers them."""

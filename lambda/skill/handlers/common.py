@@ -1,0 +1,28 @@
+"""The step every robot-command handler ends with: send, wait for robots, speak the outcome."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from skill import speech
+from skill.commands import dispatch
+from skill.responses import answer
+
+if TYPE_CHECKING:
+    from ask_sdk_core.handler_input import HandlerInput
+    from ask_sdk_model import Response
+
+    from skill.runtime import SkillRuntime
+
+
+def send_and_report(
+    handler_input: HandlerInput,
+    runtime: SkillRuntime,
+    action: str,
+    target: str,
+    params: dict[str, object] | None = None,
+) -> Response:
+    """Publish `action` to one robot (or the fleet) and say what the robots answered."""
+    item = dispatch(runtime.fleet, action, target, params)
+    answers = runtime.robots.send([item])
+    return answer(handler_input, speech.command_report(runtime.vocabulary, item, answers))

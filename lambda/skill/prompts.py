@@ -1,0 +1,113 @@
+"""Every sentence the skill speaks, as data. Placeholders are filled with `str.format`.
+
+Robot names come from fleet.yaml (their first spoken name) and zone names from
+`skill.vocabulary`; the code that picks a sentence never spells one out itself.
+"""
+
+from __future__ import annotations
+
+SKILL_NAME = "robot fleet"
+
+WELCOME = (
+    "Welcome to robot fleet. You can send a robot to a zone, have it deliver a package, "
+    "ask where the robots are, or say emergency stop. What would you like to do?"
+)
+WELCOME_REPROMPT = "For example, say: send {robot} to {zone}. What would you like to do?"
+HELP = (
+    "You can say: send {robot} to {zone}; have {robot} deliver a package to {zone}; "
+    "have {robot} deliver based on the weather; {robot} deliver to {zone} then {other} "
+    "deliver to {other_zone}; where are the robots; or emergency stop. "
+    "What would you like to do?"
+)
+HELP_REPROMPT = "What would you like the robots to do?"
+NEXT = "What else would you like the robots to do?"
+GOODBYE = "Goodbye."
+GOODBYE_ROBOTS_KEEP_GOING = "Goodbye. The robots carry on; to halt them, say emergency stop."
+FALLBACK = (
+    "Sorry, robot fleet can't help with that. You can say: send {robot} to {zone}, or: "
+    "where are the robots?"
+)
+FALLBACK_REPROMPT = "What would you like the robots to do?"
+
+# Elicitation: the choices are listed so the person knows what they can say.
+ASK_ROBOT = "Which robot: {choices}?"
+ASK_FIRST_ROBOT = "Which robot delivers first: {choices}?"
+ASK_SECOND_ROBOT = "Which robot delivers second: {choices}?"
+ASK_ZONE = "To which zone: {choices}?"
+ASK_DELIVERY_ZONE = "Where should {robot} deliver the package: {choices}?"
+LOADING_IS_NOT_A_DESTINATION = "Packages are picked up in the loading zone. "
+ASK_FIRST_ZONE = "Where does {robot} deliver: {choices}?"
+ASK_SECOND_ZONE = "Where does {robot} deliver: {choices}?"
+UNKNOWN_ROBOT = "I don't know a robot called {heard}. "
+UNKNOWN_ZONE = "I don't know a zone called {heard}. "
+NEEDS_ONE_ROBOT = "A sequential delivery needs one robot at a time. "
+SAME_ROBOT = "{robot} already delivers first. "
+
+# Acknowledged commands, by action. {robot} is capitalised when it starts the sentence.
+ACKNOWLEDGED = {
+    "navigate": "{robot} is on its way to {zone}.",
+    "deliver": "{robot} is on its way to pick up a package for {zone}.",
+    "weather_delivery": "{robot} will ask me about the weather and deliver accordingly.",
+    "stop": "{robot} has stopped.",
+    "ping": "{robot} is listening.",
+}
+FLEET_ACKNOWLEDGED = {
+    "navigate": "{robots} are on their way to {zone}.",
+    "deliver": "{robots} are on their way to pick up packages for {zone}.",
+    "weather_delivery": "{robots} will ask me about the weather and deliver accordingly.",
+    "stop": "{robots} have stopped.",
+    "ping": "{robots} are listening.",
+}
+BOTH_ROBOTS = "Both robots"
+ALL_ROBOTS = "All {count} robots"
+SEQUENTIAL_ACKNOWLEDGED = (
+    "{first} will deliver to {first_zone}, then {second} will deliver to {second_zone}."
+)
+SEQUENTIAL_PARTIAL = "Only part of the sequential delivery was confirmed: "
+
+# Robots that did not acknowledge.
+REJECTED = "{robot} refused the command: {reason}."
+FAILED = "{robot} could not do it: {reason}."
+CANCELLED = "{robot} cancelled the command at once."
+OFFLINE = "I sent the command, but {robot} seems to be offline."
+NOT_CONFIRMED = "I sent the command, but {robot} did not confirm it in time."
+FLEET_PARTIAL = "{confirmed} of {count} robots confirmed; {problems}."
+FLEET_NONE = "None of the {count} robots confirmed; {problems}."
+PROBLEM_REJECTED = "{robot} refused: {reason}"
+PROBLEM_FAILED = "{robot} failed: {reason}"
+PROBLEM_CANCELLED = "{robot} cancelled it"
+PROBLEM_OFFLINE = "{robot} did not answer and seems to be offline"
+PROBLEM_SILENT = "{robot} did not answer"
+NO_REASON = "no reason given"
+
+# Status, one sentence per robot.
+STATUS_NEVER_REPORTED = "{robot} has not reported yet."
+STATUS_OFFLINE = "{robot} seems to be offline."
+STATUS_OFFLINE_LAST_SEEN = "{robot} seems to be offline; it was last seen in {zone}."
+STATUS_IDLE_IN = "{robot} is idle in {zone}."
+STATUS_IDLE = "{robot} is idle."
+STATUS_CARRYING = "{robot} is carrying a package to {zone}."
+STATUS_FETCHING = "{robot} is on its way to the loading zone to pick up a package."
+STATUS_FETCHING_FOR = "{robot} is on its way to pick up a package for {zone}."
+STATUS_MOVING_TO = "{robot} is on its way to {zone}."
+STATUS_MOVING = "{robot} is moving."
+STATUS_LOADING = "{robot} is being loaded in {zone}."
+STATUS_UNLOADING = "{robot} is being unloaded in {zone}."
+STATUS_WAITING_WEATHER = "{robot} is waiting to hear the weather."
+STATUS_WAITING_TURN = "{robot} is waiting for its turn to deliver to {zone}."
+STATUS_WAITING = "{robot} is waiting."
+STATUS_STOPPED_IN = "{robot} is stopped in {zone}."
+STATUS_STOPPED = "{robot} is stopped."
+STATUS_STUCK_TO = "{robot} is stuck on its way to {zone}."
+STATUS_STUCK = "{robot} is stuck."
+STATUS_ERROR_REASON = "{robot} has a problem: {reason}."
+STATUS_ERROR = "{robot} has a problem."
+STATUS_UNREADABLE = "I could not read the state of {robot}."
+
+# The experiment's weather. The robots recognise these exact openings.
+WEATHER = {"sunny": "The weather is sunny.", "rainy": "The weather is rainy."}
+
+# Errors, spoken by the catch-all exception handler.
+GATEWAY_ERROR = "Sorry, I could not reach the robots just now. Please try again in a moment."
+GENERIC_ERROR = "Sorry, something went wrong on my side. Please try again."
+ERROR_REPROMPT = "What would you like the robots to do?"

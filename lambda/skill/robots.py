@@ -1,0 +1,94 @@
+"""The skill's view of the robots: send commands and confirm them, read their shadows.
+
+It sits between the handlers and the RobotGateway port: the handlers say what to send, this
+module publishes it, waits for the acknowledgments and reads shadows concurrently.
+"""
+
+from __future__ import annotations
+
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from skill.acknowledgment import MAX_WORKERS, await_acknowledgments
+from skill.errors import GatewayError
+from skill.logs import log_event
+from vahr.protocol import ProtocolError, encode, robot_shadow_from_payload
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+
+    from skill.acknowledgment import RobotAnswer
+    from skill.commands import Dispatch
+    from skill.gateway import RobotGateway
+    from vahr.protocol import RobotShadow
+
+
+@dataclass(frozen=True)
+class ShadowRead:
+    """A robot's shadow (None if it has none yet), or the error that kept it from being read."""
+
+    thing: str
+    shadow: RobotShadow | None = None
+    error: str | None = None
+
+
+class Robots:
+    """Publishes commands, awaits acknowledgments, and reads shadows through a gateway."""
+
+    def __init__(
+        self,
+        gateway: RobotGateway,
+        ack_timeout_s: float,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.gateway = gateway
+        self.ack_timeout_s = ack_timeout_s
+        self._clock = clock
+
+    def send(self, dispatches: Sequence[Dispatch]) -> dict[str, RobotAnswer]:
+        """Publish every dispatch, then wait for every recipient; one answer per robot."""
+        started = self._clock()
+        for item in dispatches:
+            self.gateway.publish(item.topic, encode(item.command))
+            log_event(
+                "published",
+                topic=item.topic,
+                command_id=item.command.id,
+                action=item.command.action,
+                recipients=list(item.recipients),
+            )
+        expected = {thing: item.command.id for item in dispatches for thing in item.recipients}
+        answers = await_acknowledgments(
+            self.gateway, expected, self.ack_timeout_s, clock=self._clock
+        )
+        log_event(
+            "acknowledgments",
+            outcomes={thing: answer.outcome for thing, answer in answers.items()},
+            wait_ms=round((self._clock() - started) * 1000, 1),
+        )
+        return answers
+
+    def shadows(self, things: Sequence[str]) -> dict[str, ShadowRead]:
+        """Read the shadows of `things` concurrently; errors are kept per robot."""
+        if not things:
+            return {}
+        with ThreadPoolExecutor(
+            max_workers=min(len(things), MAX_WORKERS), thread_name_prefix="vahr-shadow"
+        ) as pool:
+            reads = dict(zip(things, pool.map(self._read, things), strict=True))
+        return reads
+
+    def _read(self, thing: str) -> ShadowRead:
+        try:
+            payload = self.gateway.get_shadow(thing)
+        except GatewayError as err:
+            return ShadowRead(thing, error=str(err))
+        if payload is None:
+            return ShadowRead(thing)
+        try:
+            return ShadowRead(thing, robot_shadow_from_payload(payload))
+        except ProtocolError as err:
+            return ShadowRead(thing, error=f"its shadow is malformed ({err})")

@@ -1,0 +1,42 @@
+"""Everything a handler needs, built once at cold start: config, fleet, names, robots."""
+
+from __future__ import annotations
+
+import random
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from skill.robots import Robots
+from skill.vocabulary import Vocabulary
+from vahr.protocol import load_fleet
+
+if TYPE_CHECKING:
+    from skill.config import SkillConfig
+    from skill.gateway import RobotGateway
+    from vahr.protocol import Fleet
+
+
+@dataclass(frozen=True)
+class SkillRuntime:
+    """The skill's long-lived collaborators, shared by every request of a Lambda instance."""
+
+    config: SkillConfig
+    fleet: Fleet
+    vocabulary: Vocabulary
+    gateway: RobotGateway
+    robots: Robots
+    rng: random.Random
+
+    @classmethod
+    def create(
+        cls, config: SkillConfig, gateway: RobotGateway, *, fleet: Fleet | None = None
+    ) -> SkillRuntime:
+        fleet = fleet or load_fleet(config.fleet_file)
+        return cls(
+            config=config,
+            fleet=fleet,
+            vocabulary=Vocabulary(fleet),
+            gateway=gateway,
+            robots=Robots(gateway, config.ack_timeout_s),
+            rng=random.Random(),
+        )

@@ -1,0 +1,60 @@
+"""Read a slot from an IntentRequest: what the person said and which id it resolved to.
+
+Alexa's entity resolution is trusted first (ER_SUCCESS_MATCH carries the id). When a
+request carries no resolutions (a hand-built envelope, a test console), the spoken value is
+looked up in the fleet's names, so the same words work either way.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Collection
+
+    from ask_sdk_model import Intent
+
+MATCH = "ER_SUCCESS_MATCH"
+
+
+@dataclass(frozen=True)
+class SlotReading:
+    """One slot as heard: `heard` is None when missing, `id` is None when it did not resolve."""
+
+    name: str
+    heard: str | None
+    id: str | None
+
+    @property
+    def missing(self) -> bool:
+        return self.heard is None
+
+    @property
+    def unresolved(self) -> bool:
+        return self.heard is not None and self.id is None
+
+
+def read_slot(
+    intent: Intent,
+    name: str,
+    known_ids: Collection[str],
+    lookup: Callable[[str], str | None],
+) -> SlotReading:
+    """Read slot `name`; ids outside `known_ids` count as unresolved."""
+    slot = (intent.slots or {}).get(name)
+    heard = (slot.value or "").strip() if slot is not None else ""
+    if slot is None or not heard:
+        return SlotReading(name, None, None)
+    resolutions = slot.resolutions.resolutions_per_authority if slot.resolutions else None
+    if resolutions:
+        for authority in resolutions:
+            code = (
+                authority.status.code.value if authority.status and authority.status.code else None
+            )
+            if code == MATCH and authority.values and authority.values[0].value:
+                resolved = authority.values[0].value.id
+                return SlotReading(name, heard, resolved if resolved in known_ids else None)
+        # Resolutions were present and none matched (ER_SUCCESS_NO_MATCH).
+        return SlotReading(name, heard, None)
+    return SlotReading(name, heard, lookup(heard))

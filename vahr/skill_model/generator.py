@@ -1,0 +1,208 @@
+"""Build the skill package (manifest and en-US interaction model) from fleet.yaml and the intents.
+
+`build_files` returns every file of `skill-package/` as text, so writing and checking for
+drift compare exactly the same bytes.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from vahr.errors import VahrError
+from vahr.skill_model.intents import (
+    BUILT_IN_INTENTS,
+    CUSTOM_INTENTS,
+    INVOCATION_NAME,
+    LOCALE,
+    ROBOT_TYPE,
+    ZONE_TYPE,
+    IntentSpec,
+)
+from vahr.skill_model.manifest import build_manifest
+
+if TYPE_CHECKING:
+    from vahr.protocol import Fleet
+
+# The ROBOT value that means every robot; the skill publishes once on the fleet topic for it.
+FLEET_ROBOT_ID = "all"
+FLEET_GROUP_ID = "all"
+DEFAULT_FLEET_NAMES = ("all robots", "every robot", "everyone")
+
+MODEL_PATH = Path("interactionModels") / "custom" / f"{LOCALE}.json"
+MANIFEST_PATH = Path("skill.json")
+
+# Alexa's rules for sample utterances: lower-case words (apostrophes allowed, numbers spelled
+# out) and slot references, separated by single spaces.
+_WORD_OR_SLOT = r"(?:[a-z']+|\{[A-Za-z]+\})"
+_SAMPLE = re.compile(rf"^{_WORD_OR_SLOT}(?: {_WORD_OR_SLOT})*$")
+_SLOT_REF = re.compile(r"\{([A-Za-z]+)\}")
+
+
+class ModelError(VahrError):
+    """The intents or the fleet would make an interaction model Alexa rejects or confuses."""
+
+
+def build_files(fleet: Fleet) -> dict[Path, str]:
+    """Every file of skill-package/, keyed by its path inside that folder."""
+    return {
+        MANIFEST_PATH: render(build_manifest()),
+        MODEL_PATH: render(build_interaction_model(fleet)),
+    }
+
+
+def render(document: dict[str, Any]) -> str:
+    return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
+
+
+def build_interaction_model(
+    fleet: Fleet, intents: tuple[IntentSpec, ...] = CUSTOM_INTENTS
+) -> dict[str, Any]:
+    """The interaction model for one locale: language model plus a skill-driven dialog."""
+    check_samples(intents)
+    custom = [
+        {
+            "name": intent.name,
+            "slots": [
+                {"name": slot.name, "type": slot.type, "samples": slot.answers}
+                for slot in intent.slots
+            ],
+            "samples": list(intent.samples),
+        }
+        for intent in intents
+    ]
+    built_in = [{"name": name, "samples": []} for name in BUILT_IN_INTENTS]
+    return {
+        "interactionModel": {
+            "languageModel": {
+                "invocationName": INVOCATION_NAME,
+                "modelConfiguration": {"fallbackIntentSensitivity": {"level": "LOW"}},
+                "intents": custom + built_in,
+                "types": [robot_type(fleet), zone_type(fleet)],
+            },
+            # The handlers elicit missing slots themselves (Dialog.ElicitSlot), which needs a
+            # dialog model that lists the slots and leaves delegation to the skill.
+            "dialog": {
+                "delegationStrategy": "SKILL_RESPONSE",
+                "intents": [
+                    {
+                        "name": intent.name,
+                        "delegationStrategy": "SKILL_RESPONSE",
+                        "confirmationRequired": False,
+                        "prompts": {},
+                        "slots": [
+                            {
+                                "name": slot.name,
+                                "type": slot.type,
+                                "elicitationRequired": False,
+                                "confirmationRequired": False,
+                                "prompts": {},
+                            }
+                            for slot in intent.slots
+                        ],
+                    }
+                    for intent in intents
+                    if intent.slots
+                ],
+            },
+            "prompts": [],
+        }
+    }
+
+
+def robot_type(fleet: Fleet) -> dict[str, Any]:
+    """ROBOT: one value per thing (id = thing name) plus the whole fleet (id `all`)."""
+    values = [_value(robot.thing, robot.spoken) for robot in fleet.robots]
+    group = next((group for group in fleet.groups if group.id == FLEET_GROUP_ID), None)
+    values.append(_value(FLEET_ROBOT_ID, group.spoken if group else list(DEFAULT_FLEET_NAMES)))
+    _check_unique_names(ROBOT_TYPE, values)
+    return {"name": ROBOT_TYPE, "values": values}
+
+
+def zone_type(fleet: Fleet) -> dict[str, Any]:
+    """ZONE: one value per zone (id = zone id, names = its spoken names)."""
+    values = [_value(zone.id, zone.spoken) for zone in fleet.zones]
+    _check_unique_names(ZONE_TYPE, values)
+    return {"name": ZONE_TYPE, "values": values}
+
+
+def _value(value_id: str, spoken: list[str]) -> dict[str, Any]:
+    name, *synonyms = [" ".join(words.lower().split()) for words in spoken]
+    return {"id": value_id, "name": {"value": name, "synonyms": synonyms}}
+
+
+def _check_unique_names(type_name: str, values: list[dict[str, Any]]) -> None:
+    # Alexa resolves a name to every value that lists it; one name must mean one thing.
+    owner: dict[str, str] = {}
+    for value in values:
+        for name in [value["name"]["value"], *value["name"]["synonyms"]]:
+            if owner.setdefault(name, value["id"]) != value["id"]:
+                raise ModelError(
+                    f"{type_name}: the name {name!r} is used by both "
+                    f"{owner[name]!r} and {value['id']!r} in fleet.yaml"
+                )
+
+
+def utterance_shape(intent: IntentSpec, sample: str) -> str:
+    """The sample with each slot replaced by its type: what the NLU actually matches."""
+    types = {slot.name: slot.type for slot in intent.slots}
+    return _SLOT_REF.sub(lambda found: "{" + types.get(found[1], found[1]) + "}", sample)
+
+
+def check_samples(intents: tuple[IntentSpec, ...]) -> None:
+    """Refuse malformed samples, unknown slots, and any shape shared by two intents."""
+    seen: dict[str, str] = {}
+    for intent in intents:
+        slot_names = {slot.name for slot in intent.slots}
+        for sample in intent.samples:
+            if not _SAMPLE.match(sample):
+                raise ModelError(
+                    f"{intent.name}: sample {sample!r} must be lower-case words and "
+                    "{slot} references separated by single spaces"
+                )
+            for slot in _SLOT_REF.findall(sample):
+                if slot not in slot_names:
+                    raise ModelError(f"{intent.name}: sample {sample!r} uses unknown slot {slot}")
+            shape = utterance_shape(intent, sample)
+            other = seen.setdefault(shape, intent.name)
+            if other != intent.name:
+                raise ModelError(
+                    f"the utterance {shape!r} appears in both {other} and {intent.name}"
+                )
+        if len(set(intent.samples)) != len(intent.samples):
+            raise ModelError(f"{intent.name}: a sample utterance is listed twice")
+    # An answer to an elicitation must not read like the start of another intent, or the
+    # person answering "which robot?" would launch that intent instead.
+    for intent in intents:
+        for slot in intent.slots:
+            for answer in slot.answers:
+                other = seen.get(utterance_shape(intent, answer), intent.name)
+                if other != intent.name:
+                    raise ModelError(
+                        f"{intent.name}: the answer {answer!r} for slot {slot.name} "
+                        f"is also a sample of {other}"
+                    )
+
+
+def write(package_dir: Path, fleet: Fleet) -> list[Path]:
+    """Write skill-package/ and return the files that changed."""
+    changed = []
+    for relative, text in build_files(fleet).items():
+        target = package_dir / relative
+        if not target.exists() or target.read_text(encoding="utf-8") != text:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_text(text, encoding="utf-8")
+            changed.append(target)
+    return changed
+
+
+def drift(package_dir: Path, fleet: Fleet) -> list[Path]:
+    """The files of skill-package/ that differ from what the generator would write."""
+    return [
+        package_dir / relative
+        for relative, text in build_files(fleet).items()
+        if not (package_dir / relative).exists()
+        or (package_dir / relative).read_text(encoding="utf-8") != text
+    ]

@@ -1,0 +1,60 @@
+"""The skill manifest (`skill-package/skill.json`) as data.
+
+The Lambda endpoint is left out on purpose: `ask deploy` fills it in from
+`ask-resources.json`, and the CDK stack passes it to `CfnSkill` as an override, so the
+same skill package serves both deployment paths.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from vahr.skill_model.intents import INVOCATION_NAME, LOCALE
+
+SKILL_NAME = "VAHR Robot Fleet"
+
+
+def build_manifest() -> dict[str, Any]:
+    """The ASK CLI v2 `skill.json` for the custom skill."""
+    return {
+        "manifest": {
+            "manifestVersion": "1.0",
+            "publishingInformation": {
+                "locales": {
+                    LOCALE: {
+                        "name": SKILL_NAME,
+                        "summary": "Command a fleet of warehouse robots by voice.",
+                        "description": (
+                            "Send robots to zones, have them deliver packages (also based on "
+                            "the weather, or one after the other), ask where they are, and "
+                            "stop them at once. Commands travel through AWS IoT Core; the "
+                            "skill confirms that each robot acknowledged them."
+                        ),
+                        "examplePhrases": [
+                            f"Alexa, open {INVOCATION_NAME}",
+                            f"Alexa, ask {INVOCATION_NAME} to send placebot one to zone a",
+                            f"Alexa, ask {INVOCATION_NAME} where are the robots",
+                        ],
+                        "keywords": ["robots", "fleet", "warehouse", "delivery", "research"],
+                    }
+                },
+                "isAvailableWorldwide": False,
+                "distributionCountries": ["US"],
+                "distributionMode": "PRIVATE",
+                "testingInstructions": (
+                    "Run the robots (robot-agent) or the local stack (vahr up), then say "
+                    "'send placebot one to zone a' and 'where are the robots'."
+                ),
+                "category": "PRODUCTIVITY",
+            },
+            "apis": {"custom": {"interfaces": []}},
+            "privacyAndCompliance": {
+                "allowsPurchases": False,
+                "usesPersonalInfo": False,
+                "isChildDirected": False,
+                "isExportCompliant": True,
+                "containsAds": False,
+                "locales": {LOCALE: {}},
+            },
+        }
+    }
