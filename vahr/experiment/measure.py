@@ -15,6 +15,10 @@ For each task, between its `task_started` and `task_ended` events:
 A session's totals are the sums over its tasks, so IE + NT = T as in the paper's Table II.
 An interaction whose end was never logged (a crash mid-utterance) is not counted, and is
 reported in `unclosed_interactions`.
+
+A rehearsal with simulated robots and a simulated participant may run faster than real
+time; its header then records `speed_factor` (experiment seconds per wall-clock second),
+and every duration measured here is multiplied by it. Sessions with people have factor 1.
 """
 
 from __future__ import annotations
@@ -113,9 +117,18 @@ def union_length_s(
     return total
 
 
+def speed_factor(entries: list[LogEntry]) -> float:
+    """Experiment seconds per wall-clock second, from the session header (1 if absent)."""
+    for entry in entries:
+        if entry.kind == Kind.SESSION_STARTED:
+            return float(entry.data.get("speed_factor", 1.0))
+    return 1.0
+
+
 def measure_session(entries: list[LogEntry]) -> SessionTimes:
     """IE, NT and T of every finished task, and the puzzle parts solved in the session."""
     intervals, unclosed = interaction_intervals(entries)
+    factor = speed_factor(entries)
     tasks: dict[str, TaskTimes] = {}
     for task, window in task_windows(entries).items():
         if window.end is None:
@@ -124,8 +137,8 @@ def measure_session(entries: list[LogEntry]) -> SessionTimes:
         inside = [(a, b) for a, b in intervals if b > start and a < end]
         tasks[task] = TaskTimes(
             task=task,
-            time_taken_s=(end - start).total_seconds(),
-            interaction_s=union_length_s(intervals, start, end),
+            time_taken_s=(end - start).total_seconds() * factor,
+            interaction_s=union_length_s(intervals, start, end) * factor,
             interactions=len(inside),
         )
     puzzle = sum(

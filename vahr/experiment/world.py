@@ -48,10 +48,18 @@ class World:
             cargo={thing: False for thing in fleet.robot_things},
         )
 
-    def arm_led(self, goal: TaskGoal) -> list[dict[str, Any]]:
-        """Watch for `goal` (task III): the LED is off until the goal succeeds."""
+    def arm_led(
+        self, goal: TaskGoal, deliveries: list[Delivery] | None = None
+    ) -> list[dict[str, Any]]:
+        """Watch for `goal` (task III): the LED is off until the goal succeeds.
+
+        `deliveries` are those already made in the task (when a session resumes).
+        """
         self._led_goal = goal
-        self._led_deliveries = []
+        self._led_deliveries = list(deliveries or [])
+        if deliveries and score_goal(goal, self._led_deliveries).success:
+            return self._set_led(True, "resumed after success")
+        self._seq = max((d.seq for d in self._led_deliveries), default=self._seq)
         return self._set_led(False, "armed for task " + goal.task)
 
     def disarm_led(self) -> None:

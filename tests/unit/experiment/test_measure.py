@@ -78,3 +78,17 @@ def test_a_session_log_becomes_a_results_row(script: SessionScript) -> None:
     assert row.rad == 0.25
     assert row.fan_out == 320
     assert row.tlx is not None and row.tlx.percents()["mental"] == 50
+
+
+def test_a_faster_than_real_time_rehearsal_is_measured_in_experiment_seconds(
+    script: SessionScript,
+) -> None:
+    # Given a rehearsal logged at 20 times real time
+    script.log.append(Kind.SESSION_STARTED, {"participant": "SIM", "method": "keyboard",
+                                             "trial": 1, "speed_factor": 20.0})
+    script.start("I", 0)
+    script.interact(1, 2)
+    script.end(5)
+    # Then one wall second of interaction is 20 experiment seconds
+    times = measure_session(script.log.entries())
+    assert (times.interaction_s, times.time_taken_s) == (20, 100)

@@ -1,0 +1,141 @@
+"""The observer's console for sessions with people (`vahr experiment` without --simulate).
+
+The observer sits beside the participant and marks what the log cannot see by itself, one
+short line each (read with a timeout, so the session never blocks on the keyboard):
+
+    u              the participant starts speaking to the assistant (voice method)
+    r              the assistant's reply has ended
+    k              the participant starts a click sequence (keyboard method)
+    send THING ACTION [ZONE] [AFTER]
+                   the console's send button: publishes the command (source "console")
+                   and ends the click sequence
+    p [N]          N puzzle pieces solved (default 1)
+    e              end the task now (the judge scores what happened)
+    ?              show this help
+
+Commands sent by the assistant between `u` and `r` are attributed to that utterance.
+"""
+
+from __future__ import annotations
+
+import itertools
+import select
+import sys
+import time
+from typing import TYPE_CHECKING, Any, TextIO
+
+from vahr.experiment.eventlog import Kind
+from vahr.protocol import ProtocolError
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from vahr.experiment.eventlog import EventLog
+    from vahr.experiment.participant import Console
+
+HELP = (__doc__ or "").split("\n\n", 2)[2].split("\n\nCommands")[0]
+
+
+class ObserverConsole:
+    simulated = False
+
+    def __init__(
+        self,
+        *,
+        log: EventLog,
+        console: Console,
+        stdin: TextIO = sys.stdin,
+        out: Callable[[str], None] = print,
+    ) -> None:
+        self.log = log
+        self.console = console
+        self.stdin = stdin
+        self.out = out
+        self._ids = itertools.count(1)
+        self._open: dict[str, Any] | None = None
+        self._task: str | None = None
+
+    def perform(self, task: str) -> None:
+        self._task = task
+        self.out(
+            "observer: u/r mark an utterance, k + send a click sequence, p a puzzle piece, "
+            "e ends the task, ? help"
+        )
+
+    def _line(self, timeout_s: float) -> str | None:
+        ready, _, _ = select.select([self.stdin], [], [], timeout_s)
+        if not ready:
+            return None
+        line = self.stdin.readline()
+        return line.strip() if line else "e"  # end of input ends the task
+
+    def wait(self, decided: Callable[[], bool], timeout_s: float) -> bool:
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if decided():
+                self._close_open()
+                return True
+            line = self._line(min(0.25, max(0.0, deadline - time.monotonic())))
+            if line is None or not line:
+                continue
+            if line == "e":
+                self._close_open()
+                return decided()
+            try:
+                self.handle(line)
+            except (ValueError, ProtocolError) as err:
+                self.out(f"observer: {err}")
+        self._close_open()
+        return decided()
+
+    def handle(self, line: str) -> None:
+        word, *args = line.split()
+        if word == "?":
+            self.out(HELP)
+        elif word == "p":
+            count = int(args[0]) if args else 1
+            self.log.append(
+                Kind.OBSERVER, {"what": "puzzle_piece", "count": count}, task=self._task
+            )
+        elif word in ("u", "k"):
+            self._close_open()
+            channel = "voice" if word == "u" else "click"
+            entry = self.log.append(
+                Kind.INTERACTION_STARTED,
+                {"id": f"{self._task}-{next(self._ids)}", "channel": channel},
+                task=self._task,
+            )
+            self._open = {"id": entry.data["id"], "channel": channel, "seq": entry.seq}
+        elif word == "r":
+            self._close_open()
+        elif word == "send":
+            if len(args) < 2:
+                raise ValueError("send THING ACTION [ZONE] [AFTER]")
+            thing, action, *rest = args
+            params: dict[str, Any] = {}
+            if rest:
+                params["zone"] = rest[0].upper()
+            if action == "sequential_delivery":
+                params["after"] = rest[1] if len(rest) > 1 else None
+            if self._open is None or self._open["channel"] != "click":
+                self.handle("k")
+            command_id = self.console.send(thing, action, params)
+            self._close_open(commands=[command_id])
+        else:
+            raise ValueError(f"{word!r} is not an observer command; ? shows them")
+
+    def _close_open(self, commands: list[str] | None = None) -> None:
+        if self._open is None:
+            return
+        opened, self._open = self._open, None
+        if commands is None:
+            commands = [
+                str(e.data.get("id"))
+                for e in self.log.entries(Kind.COMMAND)
+                if e.seq > opened["seq"] and e.data.get("source") == "alexa"
+            ]
+        self.log.append(
+            Kind.INTERACTION_ENDED,
+            {"id": opened["id"], "channel": opened["channel"], "commands": commands},
+            task=self._task,
+        )

@@ -1,0 +1,170 @@
+"""Run one experiment session: draw the plan, publish it, run tasks I-III, log everything.
+
+A session is one participant, one method, one trial. Its log lives in
+`LOG_DIR/{participant}-{method}-trial{N}.sqlite`. Starting a session whose log exists
+resumes it: the plan is read back from the log (never redrawn), finished tasks are kept,
+the task in progress continues (its commands are not sent twice), and the world (packages,
+the LED) is rebuilt from the logged robot events.
+
+A task ends as soon as the judge can decide it (every robot delivered, or a wrong delivery)
+or when `task_timeout_s` passes.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol
+
+from vahr.errors import VahrError
+from vahr.experiment.eventlog import EventLog, Kind, session_file, session_name
+from vahr.experiment.judge import deliveries_in, judge_session, score_goal, task_windows
+from vahr.experiment.tasks import TASK_TITLES, TASKS, Plan, draw_plan
+from vahr.experiment.world import World
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from pathlib import Path
+
+    from vahr.experiment.judge import SessionVerdict
+    from vahr.experiment.recorder import Recorder
+    from vahr.protocol import Fleet
+
+log = logging.getLogger(__name__)
+
+
+class Performer(Protocol):
+    """Whoever performs the tasks: the simulated participant, or a person and an observer."""
+
+    simulated: bool
+
+    def perform(self, task: str) -> None: ...
+
+    def wait(self, decided: Callable[[], bool], timeout_s: float) -> bool: ...
+
+
+@dataclass(frozen=True, kw_only=True)
+class SessionSpec:
+    participant: str
+    method: str
+    trial: int
+    seed: int
+    log_dir: Path
+    simulated: bool = False
+    speed_factor: float = 1.0
+    task_timeout_s: float = 600.0
+
+    @property
+    def name(self) -> str:
+        return session_name(self.participant, self.method, self.trial)
+
+    @property
+    def path(self) -> Path:
+        return session_file(self.log_dir, self.participant, self.method, self.trial)
+
+
+@dataclass
+class OpenSession:
+    spec: SessionSpec
+    log: EventLog
+    plan: Plan
+    resumed: bool
+
+
+def open_session(spec: SessionSpec, fleet: Fleet) -> OpenSession:
+    """Create the session's log with a freshly drawn plan, or resume the existing one."""
+    event_log = EventLog.open(spec.path)
+    headers = event_log.entries(Kind.SESSION_STARTED)
+    if not headers:
+        plan = draw_plan(fleet, spec.seed)
+        event_log.append(
+            Kind.SESSION_STARTED,
+            {
+                "session": spec.name,
+                "participant": spec.participant,
+                "method": spec.method,
+                "trial": spec.trial,
+                "seed": spec.seed,
+                "simulated": spec.simulated,
+                "speed_factor": spec.speed_factor,
+                "robots": list(fleet.robot_things),
+                "plan": plan.to_json(),
+            },
+        )
+        return OpenSession(spec, event_log, plan, resumed=False)
+    header = headers[0].data
+    if event_log.entries(Kind.SESSION_ENDED):
+        event_log.close()
+        raise VahrError(
+            f"session {spec.name} is already complete ({spec.path}); use another trial number"
+        )
+    if header.get("seed") != spec.seed:
+        log.warning("resuming %s with its logged seed %s", spec.name, header.get("seed"))
+    event_log.append(Kind.SESSION_RESUMED, {"seed_requested": spec.seed})
+    return OpenSession(spec, event_log, Plan.from_json(header["plan"]), resumed=True)
+
+
+def rebuild_world(fleet: Fleet, session: OpenSession) -> World:
+    """The world as the logged robot events left it (all of them, on resume)."""
+    world = World.from_fleet(fleet)
+    for entry in session.log.entries(Kind.ROBOT_EVENT):
+        world.apply(entry.data)
+    world.led_on = (
+        any(
+            e.data.get("what") == "led" and e.data.get("on")
+            for e in session.log.entries(Kind.WORLD)
+        )
+        and world.led_on
+    )
+    return world
+
+
+def run_tasks(
+    session: OpenSession,
+    recorder: Recorder,
+    performer: Performer,
+    *,
+    announce: Callable[[str], None] = lambda line: None,
+) -> SessionVerdict:
+    """Run every task not yet finished, then end the session and return the judge's verdict."""
+    plan, event_log = session.plan, session.log
+    for task in TASKS:
+        window = task_windows(event_log.entries()).get(task)
+        if window is not None and window.end is not None:
+            continue
+        goal = plan.goal(task)
+        recorder.set_task(task)
+        if window is None:
+            event_log.append(Kind.TASK_STARTED, {"task": task}, task=task)
+            announce(f"task {task}: {TASK_TITLES[task]}")
+        else:
+            announce(f"task {task}: resumed")
+        start_seq = window.start.seq if window else event_log.entries(Kind.TASK_STARTED)[-1].seq
+        if goal.order and window is None:
+            recorder.log_world(recorder.world.arm_led(goal))
+        elif goal.order and window is not None:
+            # Resumed mid-task: watch on from the deliveries already made in this task.
+            recorder.world.arm_led(goal, deliveries_in(window.entries))
+        already_acted = window is not None and any(
+            e.kind == Kind.INTERACTION_ENDED for e in window.entries
+        )
+        if not already_acted:
+            performer.perform(task)
+
+        def decided(goal: Any = goal, start_seq: int = start_seq) -> bool:
+            after = [e for e in event_log.entries(Kind.ROBOT_EVENT) if e.seq > start_seq]
+            return score_goal(goal, deliveries_in(after)).success is not None
+
+        finished = performer.wait(decided, session.spec.task_timeout_s)
+        recorder.world.disarm_led()
+        event_log.append(
+            Kind.TASK_ENDED,
+            {"task": task, "reason": "decided" if finished else "timeout"},
+            task=task,
+        )
+        recorder.set_task(None)
+        outcome = judge_session(event_log.entries(), plan).tasks[task]
+        announce(f"task {task}: {'success' if outcome.success else 'failure'}: {outcome.reason}")
+    verdict = judge_session(event_log.entries(), plan)
+    event_log.append(Kind.SESSION_ENDED, {"verdict": verdict.to_json()})
+    return verdict
