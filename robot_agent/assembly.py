@@ -1,0 +1,149 @@
+"""Build the parts of one robot from its configuration: clock, backend, voice, link, agent.
+
+Adapters are imported only when chosen, so the simulator never loads rospy and the
+plaintext link never reads certificates.
+"""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from robot_agent.agent import RobotAgent
+from robot_agent.backends.sim import SimBackend, SimSettings
+from robot_agent.core.executor import ExecutorSettings
+from robot_agent.core.recent_ids import RecentIds
+from vahr.errors import VahrError
+from vahr.protocol import Presence, encode, load_fleet, topics
+
+if TYPE_CHECKING:
+    import asyncio
+
+    from robot_agent.backends.port import NavigationBackend
+    from robot_agent.config import AgentConfig
+    from robot_agent.core.clock import ScaledClock
+    from robot_agent.link.mqtt5 import Mqtt5Link
+    from robot_agent.voice.port import Voice
+    from vahr.protocol import Fleet
+
+
+def build_backend(config: AgentConfig, fleet: Fleet, clock: ScaledClock) -> NavigationBackend:
+    thing = str(config.thing)
+    if config.backend == "ros1":
+        from robot_agent.backends.ros1 import Ros1Backend, Ros1Settings
+
+        ros = config.ros
+        return Ros1Backend(
+            Ros1Settings(
+                master_uri=ros.master_uri,
+                action=ros.action,
+                frame=ros.frame,
+                node_name=ros.node_name,
+                server_timeout_s=ros.server_timeout_s,
+                loader_delay_s=ros.loader_delay_s,
+                unloader_delay_s=ros.unloader_delay_s,
+            ),
+            start=fleet.robot(thing).start,
+        )
+    sim = config.sim
+    return SimBackend(
+        start=fleet.robot(thing).start,
+        clock=clock,
+        settings=SimSettings(
+            speed_mps=sim.speed_mps,
+            turn_rate_rps=sim.turn_rate_rps,
+            loader_delay_s=sim.loader_delay_s,
+            unloader_delay_s=sim.unloader_delay_s,
+            tick_s=sim.tick_s,
+            stuck_zones=tuple(sim.stuck_zones),
+            fail_zones=tuple(sim.fail_zones),
+        ),
+    )
+
+
+def build_voice(config: AgentConfig) -> Voice | None:
+    """`none`, or `package.module:factory` called with the thing name, returning a Voice."""
+    if config.voice == "none":
+        return None
+    module_name, _, factory_name = config.voice.partition(":")
+    if not factory_name:
+        raise VahrError(f"--voice {config.voice!r}: expected none or package.module:factory")
+    try:
+        factory = getattr(importlib.import_module(module_name), factory_name)
+    except (ImportError, AttributeError) as err:
+        raise VahrError(f"--voice {config.voice!r}: {err}") from err
+    voice: Voice = factory(thing=config.thing)
+    return voice
+
+
+def executor_settings(config: AgentConfig) -> ExecutorSettings:
+    e = config.executor
+    return ExecutorSettings(
+        stuck_after_s=e.stuck_after_s,
+        sequential_timeout_s=e.sequential_timeout_s,
+        peer_delivery_window_s=e.peer_delivery_window_s,
+        listen_timeout_s=e.listen_timeout_s,
+        progress_interval_s=e.progress_interval_s,
+    )
+
+
+def build_link(
+    config: AgentConfig, loop: asyncio.AbstractEventLoop, clock: ScaledClock
+) -> Mqtt5Link:
+    from robot_agent.link.mqtt5 import LinkSettings, Mqtt5Link, MutualTls, Will, plaintext_broker
+
+    thing = str(config.thing)
+    if config.broker:
+        host, port = plaintext_broker(config.broker)
+        tls = None
+    else:
+        host, port = str(config.endpoint), config.port
+        tls = MutualTls(
+            cert=Path(str(config.cert)),
+            key=Path(str(config.key)),
+            ca=Path(config.ca) if config.ca else None,
+        )
+    will = Will(
+        topic=topics.robot_presence(thing),
+        payload=encode(Presence(online=False, at=clock.now())),
+    )
+    mqtt = config.mqtt
+    return Mqtt5Link(
+        LinkSettings(
+            client_id=config.client_id or thing,
+            host=host,
+            port=port,
+            tls=tls,
+            will=will,
+            keep_alive_s=mqtt.keep_alive_s,
+            session_expiry_s=mqtt.session_expiry_s,
+            min_reconnect_delay_ms=mqtt.min_reconnect_delay_ms,
+            max_reconnect_delay_ms=mqtt.max_reconnect_delay_ms,
+        ),
+        loop,
+    )
+
+
+def build_agent(config: AgentConfig, link: Mqtt5Link, clock: ScaledClock) -> RobotAgent:
+    fleet = load_fleet(config.fleet_file)
+    thing = str(config.thing)
+    try:
+        topics.check_thing(thing)
+    except ValueError as err:
+        raise VahrError(str(err)) from err
+    if thing not in fleet.robot_things:
+        raise VahrError(
+            f"--thing {thing}: not a robot of the fleet; robots are {', '.join(fleet.robot_things)}"
+        )
+    state_dir = Path(config.state_dir) / "robots" / thing
+    return RobotAgent(
+        thing=thing,
+        fleet=fleet,
+        link=link,
+        backend=build_backend(config, fleet, clock),
+        clock=clock,
+        recent_ids=RecentIds(state_dir / "recent-ids.json"),
+        voice=build_voice(config),
+        settings=executor_settings(config),
+    )

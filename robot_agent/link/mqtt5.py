@@ -1,0 +1,281 @@
+"""The awsiotsdk (awscrt) MQTT 5 adapter of the `Link` port. awscrt is imported only here.
+
+mTLS to AWS IoT Core or the local stack's mosquitto, or plaintext to a loopback broker in
+development. The session is persistent (clean start false, a session expiry) so QoS 1
+commands sent while the robot was away are delivered when it comes back; awscrt reconnects
+with exponential backoff and jitter. The last will marks the robot offline (retained).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import threading
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+from urllib.parse import urlsplit
+
+from awscrt import io, mqtt5
+
+from robot_agent.link.port import topic_matches
+from vahr.errors import VahrError
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from concurrent.futures import Future
+    from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+LOOPBACK_HOSTS = frozenset({"127.0.0.1", "localhost", "::1"})
+
+
+@dataclass(frozen=True, kw_only=True)
+class MutualTls:
+    cert: Path
+    key: Path
+    ca: Path | None
+
+
+@dataclass(frozen=True, kw_only=True)
+class Will:
+    topic: str
+    payload: bytes
+    retain: bool = True
+
+
+@dataclass(frozen=True, kw_only=True)
+class LinkSettings:
+    client_id: str
+    host: str
+    port: int
+    tls: MutualTls | None = None
+    will: Will | None = None
+    keep_alive_s: int = 60
+    # How long the broker keeps the session (subscriptions, queued QoS 1) while away.
+    session_expiry_s: int = 7 * 24 * 3600
+    min_reconnect_delay_ms: int = 250
+    max_reconnect_delay_ms: int = 30_000
+    connect_timeout_ms: int = 5_000
+
+
+def plaintext_broker(url: str) -> tuple[str, int]:
+    """`mqtt://127.0.0.1:PORT` -> (host, port); any host but loopback is refused."""
+    parts = urlsplit(url)
+    if parts.scheme != "mqtt" or not parts.hostname:
+        raise VahrError(f"--broker {url!r}: expected mqtt://127.0.0.1:PORT")
+    if parts.hostname not in LOOPBACK_HOSTS:
+        raise VahrError(
+            f"--broker {url!r}: plaintext MQTT is allowed only to a loopback broker; "
+            "use --endpoint with --cert, --key and --ca for any other host"
+        )
+    try:
+        port = parts.port or 1883
+    except ValueError as err:
+        raise VahrError(f"--broker {url!r}: {err}") from err
+    return parts.hostname, port
+
+
+class Mqtt5Link:
+    """One MQTT 5 connection; see the module docstring. Start it with `await start()`."""
+
+    def __init__(self, settings: LinkSettings, loop: asyncio.AbstractEventLoop) -> None:
+        self.settings = settings
+        self._loop = loop
+        self._routes: list[tuple[str, Callable[[str, bytes], None]]] = []
+        self._filters: list[str] = []
+        self._connected_callbacks: list[Callable[[bool], None]] = []
+        self._disconnected_callbacks: list[Callable[[str], None]] = []
+        self._connected = threading.Event()
+        self._stopped = threading.Event()
+        self._lock = threading.Lock()
+        self._pending: set[Future[mqtt5.PublishCompletionData]] = set()
+        self.connections = 0
+        self._client = self._build_client()
+
+    # -- the Link port ------------------------------------------------------------------
+
+    def publish(self, topic: str, payload: bytes, *, retain: bool = False) -> None:
+        packet = mqtt5.PublishPacket(
+            topic=topic, payload=payload, qos=mqtt5.QoS.AT_LEAST_ONCE, retain=retain
+        )
+        future = self._client.publish(packet)
+        with self._lock:
+            self._pending.add(future)
+        future.add_done_callback(self._published)
+
+    def add_route(self, topic_filter: str, handler: Callable[[str, bytes], None]) -> None:
+        self._routes.append((topic_filter, handler))
+        if topic_filter not in self._filters:
+            self._filters.append(topic_filter)
+            if self._connected.is_set():
+                self._subscribe([topic_filter])
+
+    def on_connected(self, callback: Callable[[bool], None]) -> None:
+        self._connected_callbacks.append(callback)
+
+    def on_disconnected(self, callback: Callable[[str], None]) -> None:
+        self._disconnected_callbacks.append(callback)
+
+    # -- lifecycle ----------------------------------------------------------------------
+
+    @property
+    def connected(self) -> bool:
+        return self._connected.is_set()
+
+    async def start(self, timeout_s: float | None = None) -> None:
+        """Start connecting; with `timeout_s`, wait that long for the first connection."""
+        self._client.start()
+        if timeout_s is not None:
+            connected = await asyncio.to_thread(self._connected.wait, timeout_s)
+            if not connected:
+                await self.stop()
+                raise VahrError(
+                    f"could not connect to {self.settings.host}:{self.settings.port} "
+                    f"within {timeout_s:g} s"
+                )
+
+    async def flush(self, timeout_s: float = 5.0) -> None:
+        """Wait until every publish so far is acknowledged (or `timeout_s` passes)."""
+        with self._lock:
+            pending = [asyncio.wrap_future(f, loop=self._loop) for f in self._pending]
+        if pending:
+            await asyncio.wait(pending, timeout=timeout_s)
+
+    async def stop(self, timeout_s: float = 5.0) -> None:
+        """Disconnect normally (the broker discards the will) and wait until stopped."""
+        self._client.stop(
+            mqtt5.DisconnectPacket(reason_code=mqtt5.DisconnectReasonCode.NORMAL_DISCONNECTION)
+        )
+        await asyncio.to_thread(self._stopped.wait, timeout_s)
+
+    # -- awscrt callbacks (on awscrt's threads) -----------------------------------------
+
+    def _build_client(self) -> mqtt5.Client:
+        s = self.settings
+        will = None
+        if s.will is not None:
+            will = mqtt5.PublishPacket(
+                topic=s.will.topic,
+                payload=s.will.payload,
+                qos=mqtt5.QoS.AT_LEAST_ONCE,
+                retain=s.will.retain,
+            )
+        socket_options = io.SocketOptions()
+        socket_options.connect_timeout_ms = s.connect_timeout_ms
+        socket_options.domain = io.SocketDomain.IPv6 if ":" in s.host else io.SocketDomain.IPv4
+        options = mqtt5.ClientOptions(
+            host_name=s.host,
+            port=s.port,
+            bootstrap=io.ClientBootstrap.get_or_create_static_default(),
+            socket_options=socket_options,
+            tls_ctx=_tls_context(s.tls, s.port) if s.tls is not None else None,
+            connect_options=mqtt5.ConnectPacket(
+                client_id=s.client_id,
+                keep_alive_interval_sec=s.keep_alive_s,
+                session_expiry_interval_sec=s.session_expiry_s,
+                will=will,
+            ),
+            # Rejoin even on the first connection of a new process, so commands queued by
+            # the broker while the agent was down are delivered after a restart too.
+            session_behavior=mqtt5.ClientSessionBehaviorType.REJOIN_ALWAYS,
+            retry_jitter_mode=mqtt5.ExponentialBackoffJitterMode.FULL,
+            min_reconnect_delay_ms=s.min_reconnect_delay_ms,
+            max_reconnect_delay_ms=s.max_reconnect_delay_ms,
+            ack_timeout_sec=30,
+            on_publish_callback_fn=self._on_publish_received,
+            on_lifecycle_event_connection_success_fn=self._on_lifecycle_connection_success,
+            on_lifecycle_event_connection_failure_fn=self._on_lifecycle_connection_failure,
+            on_lifecycle_event_disconnection_fn=self._on_lifecycle_disconnection,
+            on_lifecycle_event_stopped_fn=self._on_lifecycle_stopped,
+            # The username must stay the plain identity (mosquitto ACLs read it).
+            disable_metrics=True,
+        )
+        return mqtt5.Client(options)
+
+    def _subscribe(self, filters: list[str]) -> None:
+        subscriptions = [
+            mqtt5.Subscription(topic_filter=f, qos=mqtt5.QoS.AT_LEAST_ONCE) for f in filters
+        ]
+        future = self._client.subscribe(mqtt5.SubscribePacket(subscriptions=subscriptions))
+        future.add_done_callback(self._subscribed)
+
+    def _subscribed(self, future: Future[mqtt5.SubackPacket]) -> None:
+        try:
+            suback = future.result()
+        except Exception as err:  # noqa: BLE001 - reported, the next connection retries
+            log.warning("subscribe failed: %s", err)
+            return
+        refused = [c for c in suback.reason_codes if int(c) >= 0x80]
+        if refused:
+            log.warning("broker refused subscriptions: %s", [c.name for c in refused])
+
+    def _published(self, future: Future[mqtt5.PublishCompletionData]) -> None:
+        with self._lock:
+            self._pending.discard(future)
+        try:
+            result = future.result()
+        except Exception as err:  # noqa: BLE001 - a failed publish is logged, not fatal
+            log.warning("publish failed: %s", err)
+            return
+        puback = result.puback
+        if (
+            puback is not None
+            and puback.reason_code is not None
+            and int(puback.reason_code) >= 0x80
+        ):
+            log.warning("broker refused a publish: %s", puback.reason_code.name)
+
+    def _on_publish_received(self, data: mqtt5.PublishReceivedData) -> None:
+        packet = data.publish_packet
+        topic, payload = packet.topic, bytes(packet.payload or b"")
+        for topic_filter, handler in self._routes:
+            if topic_matches(topic_filter, topic):
+                self._loop.call_soon_threadsafe(handler, topic, payload)
+
+    def _on_lifecycle_connection_success(self, data: mqtt5.LifecycleConnectSuccessData) -> None:
+        session_present = bool(data.connack_packet and data.connack_packet.session_present)
+        self.connections += 1
+        self._connected.set()
+        log.info(
+            "connected to %s:%s (session %s)",
+            self.settings.host,
+            self.settings.port,
+            "resumed" if session_present else "new",
+        )
+        # Subscribing again is harmless when the session was resumed and required when
+        # the broker lost it (a crash without persistence).
+        if self._filters:
+            self._subscribe(list(self._filters))
+        for callback in self._connected_callbacks:
+            self._loop.call_soon_threadsafe(callback, session_present)
+
+    def _on_lifecycle_connection_failure(self, data: mqtt5.LifecycleConnectFailureData) -> None:
+        log.warning(
+            "connection to %s:%s failed: %s", self.settings.host, self.settings.port, data.exception
+        )
+
+    def _on_lifecycle_disconnection(self, data: mqtt5.LifecycleDisconnectData) -> None:
+        self._connected.clear()
+        reason = str(data.exception) if data.exception else "disconnected"
+        log.warning("disconnected: %s", reason)
+        for callback in self._disconnected_callbacks:
+            self._loop.call_soon_threadsafe(callback, reason)
+
+    def _on_lifecycle_stopped(self, data: mqtt5.LifecycleStoppedData) -> None:
+        self._stopped.set()
+
+
+def _tls_context(tls: MutualTls, port: int) -> io.ClientTlsContext:
+    try:
+        options = io.TlsContextOptions.create_client_with_mtls_from_path(
+            str(tls.cert), str(tls.key)
+        )
+        if tls.ca is not None:
+            options.override_default_trust_store_from_path(None, str(tls.ca))
+    except Exception as err:
+        raise VahrError(f"cannot load the certificate, key or CA: {err}") from err
+    if port == 443 and io.is_alpn_available():
+        # AWS IoT Core serves MQTT on 443 only with this ALPN protocol name.
+        options.alpn_list = ["x-amzn-mqtt-ca"]
+    return io.ClientTlsContext(options)
