@@ -1,0 +1,130 @@
+"""A whole session over a real broker: the simulated participant clicks in the console,
+real robot cores deliver, the log records the wire, the judge scores, the report follows."""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING
+
+from tests.integration.experiment.conftest import SPEED
+from vahr.cli import main
+from vahr.experiment.eventlog import Kind, read_log
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    import pytest
+
+    from tests.integration.experiment.conftest import RobotsOnBroker
+    from vahr.local.broker import Mosquitto
+
+
+def test_keyboard_session_runs_all_three_tasks_and_reports(
+    tmp_path: Path,
+    mosquitto: Mosquitto,
+    robots_on_broker: RobotsOnBroker,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # Given robots on a real broker and a simulated participant using the console
+    logs = tmp_path / "logs"
+    argv = [
+        "experiment",
+        "--participant",
+        "SIM01",
+        "--method",
+        "keyboard",
+        "--trial",
+        "1",
+        "--seed",
+        "11",
+        "--log-dir",
+        str(logs),
+        "--broker",
+        mosquitto.plain_url,
+        "--no-shadow",
+        "--simulate",
+        "--speed-factor",
+        str(SPEED),
+        "--json",
+    ]
+    # When the session runs
+    assert main(argv) == 0
+    summary = json.loads(capsys.readouterr().out)
+    # Then every task succeeded as the judge defines it, and task III lit the LED
+    tasks = summary["verdict"]["tasks"]
+    assert {task: body["success"] for task, body in tasks.items()} == {
+        "I": True,
+        "II": True,
+        "III": True,
+    }, tasks
+    assert tasks["III"]["led_on"] is True
+    assert summary["verdict"]["command_success"]["success_rate"] == 1.0
+    plan = summary["plan"]
+    assert {d["thing"]: d["zone"] for d in tasks["I"]["deliveries"]} == plan["assignments"]
+    # and the log holds the console's commands as seen on the wire, source "console"
+    entries = read_log(logs / "SIM01-keyboard-trial1.sqlite")
+    commands = [e.data for e in entries if e.kind == Kind.COMMAND]
+    assert [c["action"] for c in commands] == [
+        "deliver",
+        "deliver",
+        "deliver",
+        "deliver",
+        "sequential_delivery",
+    ]
+    assert {c["source"] for c in commands} == {"console"}
+    assert entries[-1].kind == Kind.SESSION_ENDED
+
+    # When the participant's questionnaire is entered and the report is made from the logs
+    levels = [
+        "--mental",
+        "6",
+        "--physical",
+        "3",
+        "--temporal",
+        "9",
+        "--performance",
+        "17",
+        "--effort",
+        "7",
+        "--frustration",
+        "4",
+        "--confidence",
+        "15",
+        "--trust",
+        "14",
+    ]
+    assert (
+        main(
+            [
+                "tlx",
+                "--participant",
+                "SIM01",
+                "--method",
+                "keyboard",
+                "--trial",
+                "1",
+                "--log-dir",
+                str(logs),
+                *levels,
+            ]
+        )
+        == 0
+    )
+    out = tmp_path / "report"
+    assert main(["report", "--from-log", str(logs), "--out", str(out)]) == 0
+    # Then the report has the run's measured times (in experiment seconds) and its figures
+    report = json.loads((out / "report.json").read_text())
+    assert report["simulated"] is True
+    means = report["objective"]
+    ie, nt = (
+        means["interaction_time"]["means"]["keyboard"],
+        means["neglect_time"]["means"]["keyboard"],
+    )
+    # Five commands of four clicks each, by the keystroke-level model: about 6.5 s each.
+    assert 20 < ie < 60
+    assert nt > 0
+    assert means["rad"]["means"]["keyboard"] == ie / (ie + nt)
+    assert report["subjective"]["mental"]["means"]["keyboard"] == 25.0
+    assert "Simulated participants" in (out / "report.md").read_text()
+    for name in ("subjective.png", "tlx_by_trial.png", "objective.png"):
+        assert (out / name).stat().st_size > 1000

@@ -1,0 +1,195 @@
+"""`vahr experiment`: run one session of the paper's experiment (tasks I-III).
+
+Draws (or, when the session's log exists, resumes) the plan, writes it to the experiment
+thing's shadow, records the wire into the session's event log, and runs the tasks with a
+person and an observer, or with the simulated participant (`--simulate`).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from vahr.errors import VahrError
+
+if TYPE_CHECKING:
+    import argparse
+
+DEFAULT_LOG_DIR = Path(".state") / "experiment"
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--participant", required=True, help="participant id, e.g. P01")
+    parser.add_argument(
+        "--method",
+        required=True,
+        choices=["vahr", "keyboard"],
+        help="voice through the assistant, or keyboard and mouse",
+    )
+    parser.add_argument("--trial", required=True, type=int, help="trial number (1, 2, ...)")
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=None,
+        help="seed of the zone assignments and weather "
+        "(default: derived from participant, method and trial)",
+    )
+    parser.add_argument(
+        "--log-dir",
+        type=Path,
+        default=DEFAULT_LOG_DIR,
+        help=f"where session logs live (default: {DEFAULT_LOG_DIR})",
+    )
+    parser.add_argument("--fleet", type=Path, default=None, help="fleet file (default: fleet.yaml)")
+    parser.add_argument(
+        "--broker",
+        default="mqtt://127.0.0.1:1883",
+        help="MQTT broker to record from and send console commands to",
+    )
+    parser.add_argument(
+        "--api",
+        default=None,
+        help="data-plane API URL (`vahr up`'s api) for the experiment shadow "
+        "and the assistant; default: AWS_ENDPOINT_URL_IOT_DATA_PLANE or AWS",
+    )
+    parser.add_argument(
+        "--no-shadow",
+        action="store_true",
+        help="do not write the plan to the experiment thing's shadow",
+    )
+    parser.add_argument(
+        "--simulate",
+        action="store_true",
+        help="the simulated participant performs the tasks (labelled simulated)",
+    )
+    parser.add_argument(
+        "--speed-factor",
+        type=float,
+        default=1.0,
+        help="with --simulate: run this many times faster than real time "
+        "(match the simulated robots' factor)",
+    )
+    parser.add_argument(
+        "--task-timeout",
+        type=float,
+        default=600.0,
+        help="experiment seconds after which a task ends undecided (default 600)",
+    )
+    parser.add_argument(
+        "--plan-only", action="store_true", help="draw and publish the plan, print it, and stop"
+    )
+    parser.add_argument("--json", action="store_true", help="print the result as JSON")
+
+
+def run(args: argparse.Namespace) -> int:
+    from vahr.experiment.session import SessionSpec, open_session
+    from vahr.experiment.tasks import default_seed
+    from vahr.protocol import load_fleet
+
+    if args.speed_factor <= 0 or (args.speed_factor != 1.0 and not args.simulate):
+        raise VahrError("--speed-factor must be > 0 and is only for --simulate")
+    if args.task_timeout <= 0:
+        raise VahrError("--task-timeout must be > 0")
+    fleet = load_fleet(args.fleet)
+    seed = (
+        args.seed
+        if args.seed is not None
+        else default_seed(args.participant, args.method, args.trial)
+    )
+    spec = SessionSpec(
+        participant=args.participant,
+        method=args.method,
+        trial=args.trial,
+        seed=seed,
+        log_dir=args.log_dir,
+        simulated=args.simulate,
+        speed_factor=args.speed_factor,
+        task_timeout_s=args.task_timeout,
+    )
+    session = open_session(spec, fleet)
+    try:
+        plan = session.plan
+        if not args.no_shadow:
+            from vahr.experiment.shadow_store import ExperimentShadow
+
+            ExperimentShadow(fleet, endpoint_url=args.api).write(plan.experiment_state(spec.name))
+        summary: dict[str, Any] = {
+            "session": spec.name,
+            "log": str(spec.path),
+            "resumed": session.resumed,
+            "simulated": args.simulate,
+            "plan": plan.to_json(),
+        }
+        if not args.json:
+            _show_plan(spec.name, plan.to_json(), session.resumed, args.method)
+        if not args.plan_only:
+            summary["verdict"] = _run_session(args, fleet, session).to_json()
+        if args.json:
+            print(json.dumps(summary))
+    finally:
+        session.log.close()
+    return 0
+
+
+def _show_plan(name: str, plan: dict[str, Any], resumed: bool, method: str) -> None:
+    print(f"session {name}{' (resumed)' if resumed else ''}, seed {plan['seed']}")
+    for thing, zone in plan["assignments"].items():
+        print(f"  task I: {thing} delivers to zone {zone}")
+    if method == "keyboard":
+        print(f"  task II: the weather is {plan['weather']}")
+    else:
+        print(f"  task II: {plan['weather_robot']} asks the assistant for the weather")
+    print("  task III: both robots deliver to zone D, the first robot first")
+
+
+def _run_session(args: argparse.Namespace, fleet: Any, session: Any) -> Any:
+    from vahr.experiment.bus import Bus
+    from vahr.experiment.participant import Console
+    from vahr.experiment.recorder import Recorder
+    from vahr.experiment.session import rebuild_world, run_tasks
+
+    recorder = Recorder(session.log, rebuild_world(fleet, session))
+    bus = Bus(args.broker, recorder.on_message, client_id=f"vahr-experiment-{session.spec.name}")
+    bus.start()
+    try:
+        console = Console(bus.publish)
+        performer: Any
+        if args.simulate:
+            from vahr.experiment.assistant import SayCommandAssistant
+            from vahr.experiment.participant import SimulatedParticipant
+            from vahr.experiment.timing import TimingModel
+
+            performer = SimulatedParticipant(
+                method=args.method,
+                fleet=fleet,
+                plan=session.plan,
+                log=session.log,
+                timing=TimingModel(),
+                seed=session.plan.seed,
+                speed_factor=args.speed_factor,
+                assistant=SayCommandAssistant(args.api) if args.method == "vahr" else None,
+                console=console if args.method == "keyboard" else None,
+            )
+        else:
+            from vahr.experiment.observer import ObserverConsole
+
+            performer = ObserverConsole(log=session.log, console=console)
+        announce = (
+            (lambda line: None)
+            if args.json
+            else (lambda line: print(("[simulated] " if args.simulate else "") + line, flush=True))
+        )
+        verdict = run_tasks(session, recorder, performer, announce=announce)
+    finally:
+        bus.stop()
+    if not args.json:
+        for key, tally in (
+            ("commands", verdict.commands),
+            ("communication", verdict.communication),
+            ("tasks", verdict.task_tally),
+        ):
+            print(f"{key}: {tally.successes}/{tally.total} succeeded")
+        print(f"log: {session.spec.path}", file=sys.stderr)
+    return verdict
