@@ -138,6 +138,8 @@ def _fmt(value: float | None, unit: str = "") -> str:
         return "n/a"
     if unit == "s":
         return f"{value:.1f} s"
+    if unit == "%":
+        return f"{value:.1f}"
     return f"{value:.2f}"
 
 
