@@ -40,6 +40,9 @@ LAMBDA_PYTHON = "3.12"
 # The skill's direct runtime dependencies; their versions come from requirements.txt.
 RUNTIME_PACKAGES = ("ask-sdk-core", "ask-sdk-model", "msgspec", "pyyaml")
 PLATFORMS = {"x86_64": "manylinux2014_x86_64", "arm64": "manylinux2014_aarch64"}
+# What the Lambda Python runtime itself provides; installed only by `runtime_site`, to check
+# a bundle outside Lambda the way the runtime would load it.
+RUNTIME_PROVIDED = ("boto3",)
 # Provided by the runtime (boto3, botocore) or harmful there (awscrt slows every boto3
 # client's import; awsiot is the robots' SDK).
 FORBIDDEN_TOP_LEVEL = ("awscrt", "awsiot", "boto3", "botocore", "s3transfer")
@@ -67,17 +70,20 @@ def normalize(name: str) -> str:
     return re.sub(r"[-_.]+", "-", name).lower()
 
 
-def runtime_pins(requirements: Path = REPO_ROOT / "requirements.txt") -> list[str]:
-    """`name==version` for each runtime package, as pinned in requirements.txt."""
+def runtime_pins(
+    requirements: Path = REPO_ROOT / "requirements.txt",
+    packages: Sequence[str] = RUNTIME_PACKAGES,
+) -> list[str]:
+    """`name==version` for each of `packages`, as pinned in requirements.txt."""
     pins: dict[str, str] = {}
     for line in requirements.read_text().splitlines():
         found = _REQUIREMENT.match(line)
         if found:
             pins[normalize(found[1])] = f"{found[1]}=={found[2]}"
-    missing = [name for name in RUNTIME_PACKAGES if normalize(name) not in pins]
+    missing = [name for name in packages if normalize(name) not in pins]
     if missing:
         raise VahrError(f"{requirements}: no '==' pin for {', '.join(missing)}")
-    return [pins[normalize(name)] for name in RUNTIME_PACKAGES]
+    return [pins[normalize(name)] for name in packages]
 
 
 def constraints() -> list[str]:
@@ -108,9 +114,10 @@ def _source_files(fleet_file: Path) -> list[tuple[Path, str]]:
     return pairs
 
 
-def _dependency_key(architecture: str) -> str:
+def _dependency_key(architecture: str, packages: Sequence[str] = RUNTIME_PACKAGES) -> str:
     digest = hashlib.sha256()
-    for part in (LAMBDA_PYTHON, PLATFORMS[architecture], *runtime_pins(), *constraints()):
+    pins = runtime_pins(packages=packages)
+    for part in (LAMBDA_PYTHON, PLATFORMS[architecture], *pins, *constraints()):
         digest.update(part.encode() + b"\0")
     return digest.hexdigest()[:16]
 
@@ -125,9 +132,12 @@ def source_hash(*, architecture: str = "x86_64", fleet_file: Path | None = None)
     return digest.hexdigest()
 
 
-def _install_dependencies(architecture: str, cache_root: Path) -> tuple[Path, bool]:
-    """The directory holding the installed dependencies; True when it came from the cache."""
-    target = cache_root / "lambda-deps" / f"{architecture}-{_dependency_key(architecture)}"
+def _install_dependencies(
+    architecture: str, cache_root: Path, packages: Sequence[str] = RUNTIME_PACKAGES
+) -> tuple[Path, bool]:
+    """The directory holding the installed `packages`; True when it came from the cache."""
+    key = _dependency_key(architecture, packages)
+    target = cache_root / "lambda-deps" / f"{architecture}-{key}"
     if (target / ".complete").exists():
         return target, True
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -142,7 +152,7 @@ def _install_dependencies(architecture: str, cache_root: Path) -> tuple[Path, bo
             "--platform", PLATFORMS[architecture], "--python-version", LAMBDA_PYTHON,
             "--implementation", "cp", "--only-binary=:all:",
             "--cache-dir", str(cache_root / "pip"), "--constraint", str(constraint_file),
-            *runtime_pins(),
+            *runtime_pins(packages=packages),
         ]  # fmt: skip
         try:
             subprocess.run(command, check=True, capture_output=True, text=True, timeout=600)
@@ -198,14 +208,44 @@ def _tree_size(root: Path) -> tuple[int, int]:
     return len(files), sum(path.stat().st_size for path in files)
 
 
+def precompile(bundle: Path, python: Path) -> None:
+    """Write byte code for every module with `python` (a CPython 3.12).
+
+    The Lambda runtime cannot write `__pycache__` in its read-only code directory, so
+    without this every cold start compiles each imported module again (measured here:
+    importing skill.app took 0.53-0.68 s from source and 0.31-0.39 s with byte code).
+    """
+    try:
+        found = subprocess.run(
+            [str(python), "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
+            check=True, capture_output=True, text=True, timeout=30,
+        ).stdout.strip()  # fmt: skip
+    except (OSError, subprocess.SubprocessError) as err:
+        raise VahrError(f"cannot run {python} to precompile the bundle ({err})") from err
+    if found != LAMBDA_PYTHON:
+        raise VahrError(f"{python} is Python {found}; byte code must come from {LAMBDA_PYTHON}")
+    # unchecked-hash: the runtime uses the .pyc without comparing source timestamps, which
+    # the zip upload does not keep anyway.
+    command = [str(python), "-m", "compileall", "-q", "-j", "0", "--invalidation-mode",
+               "unchecked-hash", str(bundle)]  # fmt: skip
+    try:
+        subprocess.run(command, check=True, capture_output=True, timeout=300)
+    except (OSError, subprocess.SubprocessError) as err:
+        raise VahrError(f"precompiling the bundle with {python} failed ({err})") from err
+
+
 def build(
     out_dir: Path,
     *,
     architecture: str = "x86_64",
     fleet_file: Path | None = None,
     cache_root: Path | None = None,
+    compile_with: Path | None = None,
 ) -> BuildResult:
-    """Write the bundle into `out_dir` (created if needed; must be empty or absent)."""
+    """Write the bundle into `out_dir` (created if needed; must be empty or absent).
+
+    With `compile_with` (a CPython 3.12 interpreter) the bundle also carries byte code.
+    """
     if architecture not in PLATFORMS:
         raise VahrError(f"architecture: {architecture!r} must be one of {', '.join(PLATFORMS)}")
     fleet_file = fleet_file or REPO_ROOT / "fleet.yaml"
@@ -221,8 +261,19 @@ def build(
         destination.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(source, destination)
     _check_bundle(out_dir)
+    if compile_with is not None:
+        precompile(out_dir, compile_with)
     files, size = _tree_size(out_dir)
     return BuildResult(out_dir=out_dir, files=files, size_bytes=size, from_cache=from_cache)
+
+
+def runtime_site(*, architecture: str = "x86_64", cache_root: Path | None = None) -> Path:
+    """A directory holding what the Lambda runtime provides (boto3 at the pinned version),
+    to put on `sys.path` after a bundle when checking it outside Lambda."""
+    site, _ = _install_dependencies(
+        architecture, cache_root or REPO_ROOT / ".cache", packages=RUNTIME_PROVIDED
+    )
+    return site
 
 
 def write_zip(bundle: Path, zip_file: Path) -> None:
@@ -244,9 +295,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--architecture", choices=sorted(PLATFORMS), default="x86_64")
     parser.add_argument("--fleet-file", type=Path, help="fleet definition (default fleet.yaml)")
     parser.add_argument("--zip", type=Path, dest="zip_file", help="also write the bundle as a zip")
+    parser.add_argument(
+        "--compile-with",
+        type=Path,
+        metavar="PYTHON3.12",
+        help="precompile the bundle with this CPython 3.12 (faster cold starts, ~5 MB more)",
+    )
     args = parser.parse_args(argv)
     try:
-        result = build(args.out_dir, architecture=args.architecture, fleet_file=args.fleet_file)
+        result = build(
+            args.out_dir,
+            architecture=args.architecture,
+            fleet_file=args.fleet_file,
+            compile_with=args.compile_with,
+        )
         if args.zip_file is not None:
             write_zip(result.out_dir, args.zip_file)
     except VahrError as err:

@@ -1,0 +1,102 @@
+"""The skill's Lambda function: runtime, configuration, and exactly its IAM rights."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import pytest
+from aws_cdk.assertions import Template
+from template_tools import bare_stack, only, resources, role_grants
+
+from infra.config import InfraConfig
+from infra.constructs.skill_function import SkillFunction
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from vahr.protocol import Fleet
+
+PREFIX = "arn:aws:iot:us-east-1:123456789012"
+SKILL_ID = "amzn1.ask.skill.0d5c1d3e-52b4-4a53-9f0e-6f1a2b3c4d5e"
+DATA_HOST = "a1b2c3d4e5f6g7-ats.iot.us-east-1.amazonaws.com"
+
+
+def synth(outdir: Path, fleet: Fleet, config: InfraConfig) -> dict[str, Any]:
+    stack = bare_stack(outdir)
+    SkillFunction(stack, "Skill", config=config, fleet=fleet, data_endpoint=DATA_HOST)
+    return Template.from_stack(stack).to_json()
+
+
+@pytest.fixture(scope="module")
+def template(tmp_path_factory: pytest.TempPathFactory, fleet: Fleet) -> dict[str, Any]:
+    return synth(tmp_path_factory.mktemp("skill"), fleet, InfraConfig())
+
+
+def test_the_function_runs_the_skill_handler_on_python_3_12(template: dict[str, Any]) -> None:
+    function = only(template, "AWS::Lambda::Function")
+    assert function["Runtime"] == "python3.12"
+    assert function["Handler"] == "skill.app.lambda_handler"
+    assert function["Architectures"] == ["x86_64"]
+    assert function["Timeout"] <= 8  # Alexa waits 8 s for an answer
+    assert function["MemorySize"] == 512
+
+
+def test_the_function_is_configured_through_the_agreed_environment(
+    template: dict[str, Any],
+) -> None:
+    variables = only(template, "AWS::Lambda::Function")["Environment"]["Variables"]
+    assert variables == {
+        "VAHR_IOT_DATA_ENDPOINT": f"https://{DATA_HOST}",
+        "VAHR_ACK_TIMEOUT_S": "2.5",
+        "VAHR_LOG_LEVEL": "INFO",
+    }
+
+
+def test_logs_go_to_its_own_group_with_a_retention(template: dict[str, Any]) -> None:
+    [(group_id, group)] = resources(template, "AWS::Logs::LogGroup").items()
+    assert group["RetentionInDays"] == 30
+    assert only(template, "AWS::Lambda::Function")["LoggingConfig"] == {"LogGroup": f"<{group_id}>"}
+
+
+def test_the_role_has_exactly_the_skill_rights(template: dict[str, Any]) -> None:
+    # Given the function's execution role
+    function = only(template, "AWS::Lambda::Function")
+    role_id = function["Role"].strip("<>").split(".")[0]
+    role = resources(template, "AWS::IAM::Role")[role_id]
+    # Then it has no managed policies, and its inline rights are exactly these
+    assert "ManagedPolicyArns" not in role
+    [group_id] = resources(template, "AWS::Logs::LogGroup")
+    assert role_grants(template, role_id) == {
+        ("Allow", "iot:Publish", f"{PREFIX}:topic/vahr/robots/placebot1/cmd"),
+        ("Allow", "iot:Publish", f"{PREFIX}:topic/vahr/robots/placebot2/cmd"),
+        ("Allow", "iot:Publish", f"{PREFIX}:topic/vahr/fleet/cmd"),
+        ("Allow", "iot:GetThingShadow", f"{PREFIX}:thing/placebot1"),
+        ("Allow", "iot:GetThingShadow", f"{PREFIX}:thing/placebot2"),
+        ("Allow", "iot:GetThingShadow", f"{PREFIX}:thing/vahr-experiment"),
+        ("Allow", "iot:UpdateThingShadow", f"{PREFIX}:thing/vahr-experiment"),
+        ("Allow", "logs:CreateLogStream", f"<{group_id}.Arn>"),
+        ("Allow", "logs:PutLogEvents", f"<{group_id}.Arn>"),
+    }
+
+
+def test_alexa_may_invoke_it_and_without_a_skill_id_any_skill_can(
+    template: dict[str, Any],
+) -> None:
+    permission = only(template, "AWS::Lambda::Permission")
+    assert permission["Principal"] == "alexa-appkit.amazon.com"
+    assert permission["Action"] == "lambda:InvokeFunction"
+    assert "EventSourceToken" not in permission
+
+
+def test_with_a_skill_id_only_that_skill_may_invoke_and_the_handler_checks_it(
+    tmp_path: Path, fleet: Fleet
+) -> None:
+    # Given a configuration that knows the skill id
+    config = InfraConfig(skill_id=SKILL_ID, architecture="arm64", log_level="DEBUG")
+    template = synth(tmp_path, fleet, config)
+    # Then the invoke permission is conditioned on it and the handler is told it
+    assert only(template, "AWS::Lambda::Permission")["EventSourceToken"] == SKILL_ID
+    function = only(template, "AWS::Lambda::Function")
+    assert function["Environment"]["Variables"]["VAHR_SKILL_ID"] == SKILL_ID
+    assert function["Environment"]["Variables"]["VAHR_LOG_LEVEL"] == "DEBUG"
+    assert function["Architectures"] == ["arm64"]
