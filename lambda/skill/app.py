@@ -1,8 +1,10 @@
 """The Lambda entry point: `skill.app.lambda_handler` (code root `lambda/`).
 
 At cold start the configuration is read once, the fleet is loaded and the iot-data client
-is created; warm invocations reuse them. `make_lambda_handler` builds the same handler
-around another configuration or gateway, for the local stack's Alexa simulator and tests.
+is created; warm invocations reuse them. That happens when `lambda_handler` is first looked
+up (Lambda's runtime does so while initialising), not on import, so tools that import this
+module without AWS settings (the local stack, the tests) do not fail or pay for it.
+`make_lambda_handler` builds the same handler around another configuration or gateway.
 """
 
 from __future__ import annotations
@@ -97,4 +99,13 @@ def make_lambda_handler(
     return handler
 
 
-lambda_handler = make_lambda_handler()
+lambda_handler: Callable[[dict[str, Any], Any], dict[str, Any]]
+
+
+def __getattr__(name: str) -> Any:
+    # PEP 562: build the environment's handler once, on first access, then keep it.
+    if name == "lambda_handler":
+        handler = make_lambda_handler()
+        globals()["lambda_handler"] = handler
+        return handler
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -16,7 +16,6 @@ from tests.conftest import load_event
 from vahr.protocol import decode_command
 
 if TYPE_CHECKING:
-
     from skill_testkit import RobotDoubles
 
     from vahr.protocol import Fleet

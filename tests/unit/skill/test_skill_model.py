@@ -1,0 +1,246 @@
+"""The interaction model: generated from fleet.yaml without drift, valid for ASK, and in
+step with the handlers."""
+
+from __future__ import annotations
+
+import copy
+import json
+import re
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import pytest
+from ask_sdk_core.serialize import DefaultSerializer
+from skill_testkit import speech
+
+from skill.app import request_handlers
+from skill.config import SkillConfig
+from skill.runtime import SkillRuntime
+from skill.vocabulary import FLEET
+from tests.conftest import EVENTS_DIR, load_event
+from vahr.protocol import Fleet
+from vahr.skill_model import FLEET_ROBOT_ID, ModelError, build_files, build_interaction_model
+from vahr.skill_model.__main__ import main as skill_model_main
+from vahr.skill_model.generator import MANIFEST_PATH, MODEL_PATH, utterance_shape
+from vahr.skill_model.intents import CUSTOM_INTENTS, IntentSpec, SlotSpec
+
+if TYPE_CHECKING:
+    from ask_sdk_core.dispatch_components import AbstractRequestHandler
+
+PACKAGE = Path(__file__).resolve().parents[3] / "skill-package"
+MODEL_TYPE = (
+    "ask_smapi_model.v1.skill.interaction_model.interaction_model_data.InteractionModelData"
+)
+MANIFEST_TYPE = "ask_smapi_model.v1.skill.manifest.skill_manifest_envelope.SkillManifestEnvelope"
+
+
+@pytest.fixture(scope="module")
+def model() -> dict[str, Any]:
+    loaded: dict[str, Any] = json.loads((PACKAGE / MODEL_PATH).read_text())
+    return loaded
+
+
+def language_model(model: dict[str, Any]) -> dict[str, Any]:
+    result: dict[str, Any] = model["interactionModel"]["languageModel"]
+    return result
+
+
+def test_committed_skill_package_matches_the_generator(fleet: Fleet) -> None:
+    # Given fleet.yaml and the intent definitions, when the generator runs, then it would
+    # write exactly the committed files (run `make skill-model` after editing either)
+    for relative, text in build_files(fleet).items():
+        assert (PACKAGE / relative).read_text() == text, f"{relative} drifted from fleet.yaml"
+
+
+def test_check_flag_reports_drift_and_exits_non_zero(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Given a copy of the package and a fleet with one more zone
+    fleet_file = tmp_path / "fleet.yaml"
+    text = (PACKAGE.parent / "fleet.yaml").read_text()
+    fleet_file.write_text(
+        text.replace(
+            "\ngroups:",
+            "  - id: E\n    spoken: [zone e, echo]\n    pose: {x: 9.0, y: 9.0}\n\ngroups:",
+        )
+    )
+    out = tmp_path / "skill-package"
+    assert skill_model_main(["--fleet", str(PACKAGE.parent / "fleet.yaml"), "--out", str(out)]) == 0
+    # When --check runs against the changed fleet
+    assert skill_model_main(["--fleet", str(fleet_file), "--out", str(out), "--check"]) == 1
+    # Then it names the stale file, and regenerating makes the check pass
+    assert "en-US.json is out of date" in capsys.readouterr().err
+    assert skill_model_main(["--fleet", str(fleet_file), "--out", str(out)]) == 0
+    assert skill_model_main(["--fleet", str(fleet_file), "--out", str(out), "--check"]) == 0
+    zones = json.loads((out / MODEL_PATH).read_text())["interactionModel"]["languageModel"]
+    assert "E" in [value["id"] for value in zones["types"][1]["values"]]
+
+
+def test_bad_fleet_file_is_one_line_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    missing = tmp_path / "nope.yaml"
+    assert skill_model_main(["--fleet", str(missing), "--out", str(tmp_path), "--check"]) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith("python -m vahr.skill_model: error: fleet: cannot read")
+
+
+def test_interaction_model_deserializes_with_ask_smapi_model_classes(model: dict[str, Any]) -> None:
+    serializer = DefaultSerializer()
+    parsed = serializer.deserialize(json.dumps(model), MODEL_TYPE)
+    # A round trip loses any field the ASK schema does not know, so equality proves every
+    # key and enum value is one ASK accepts.
+    assert serializer.serialize(parsed) == model
+
+
+def test_a_misspelled_field_would_not_survive_the_round_trip(model: dict[str, Any]) -> None:
+    broken = copy.deepcopy(model)
+    broken["interactionModel"]["languageModel"]["invocationNmae"] = "robot fleet"
+    serializer = DefaultSerializer()
+    assert serializer.serialize(serializer.deserialize(json.dumps(broken), MODEL_TYPE)) != broken
+
+
+def test_manifest_deserializes_with_ask_smapi_model_classes() -> None:
+    manifest = json.loads((PACKAGE / MANIFEST_PATH).read_text())
+    serializer = DefaultSerializer()
+    assert (
+        serializer.serialize(serializer.deserialize(json.dumps(manifest), MANIFEST_TYPE))
+        == manifest
+    )
+    assert manifest["manifest"]["apis"]["custom"] == {"interfaces": []}
+
+
+def test_invocation_name_is_two_speakable_words(model: dict[str, Any]) -> None:
+    name = language_model(model)["invocationName"]
+    assert name == "robot fleet"
+    assert re.fullmatch(r"[a-z]+ [a-z]+", name)
+
+
+def test_slot_types_come_from_the_fleet(model: dict[str, Any], fleet: Fleet) -> None:
+    types = {slot_type["name"]: slot_type["values"] for slot_type in language_model(model)["types"]}
+    robots = {
+        value["id"]: [value["name"]["value"], *value["name"]["synonyms"]]
+        for value in types["ROBOT"]
+    }
+    assert robots == {
+        **{robot.thing: robot.spoken for robot in fleet.robots},
+        FLEET_ROBOT_ID: next(group.spoken for group in fleet.groups if group.id == "all"),
+    }
+    zones = {
+        value["id"]: [value["name"]["value"], *value["name"]["synonyms"]] for value in types["ZONE"]
+    }
+    assert zones == {zone.id: zone.spoken for zone in fleet.zones}
+    assert FLEET == FLEET_ROBOT_ID
+
+
+def test_robot_command_intents_have_at_least_fifteen_samples(model: dict[str, Any]) -> None:
+    intents = {intent["name"]: intent for intent in language_model(model)["intents"]}
+    for name in (
+        "NavigateIntent",
+        "DeliverIntent",
+        "WeatherDeliveryIntent",
+        "SequentialDeliveryIntent",
+        "EmergencyStopIntent",
+    ):
+        samples = intents[name]["samples"]
+        assert len(set(samples)) >= 15, name
+
+
+def test_no_utterance_is_shared_between_intents(model: dict[str, Any]) -> None:
+    owners: dict[str, str] = {}
+    for intent in language_model(model)["intents"]:
+        types = {slot["name"]: slot["type"] for slot in intent.get("slots", [])}
+        for sample in intent["samples"]:
+            shape = sample
+            for name, slot_type in types.items():
+                shape = shape.replace("{" + name + "}", "{" + slot_type + "}")
+            assert owners.setdefault(shape, intent["name"]) == intent["name"], shape
+
+
+def test_samples_follow_alexas_rules(model: dict[str, Any]) -> None:
+    for intent in language_model(model)["intents"]:
+        slot_names = {slot["name"] for slot in intent.get("slots", [])}
+        for sample in intent["samples"]:
+            assert re.fullmatch(r"(?:[a-z']+|\{\w+\})(?: (?:[a-z']+|\{\w+\}))*", sample), sample
+            assert set(re.findall(r"\{(\w+)\}", sample)) <= slot_names, sample
+
+
+def test_every_model_intent_has_exactly_one_handler_and_every_handler_an_intent(
+    model: dict[str, Any], aws: None
+) -> None:
+    runtime = SkillRuntime.create(SkillConfig(), gateway=None)  # type: ignore[arg-type]
+    handlers = request_handlers(runtime)
+    template = load_event("alexa_weather")
+    used: set[type[AbstractRequestHandler]] = set()
+    from ask_sdk_core.handler_input import HandlerInput
+
+    serializer = DefaultSerializer()
+    for intent in language_model(model)["intents"]:
+        event = copy.deepcopy(template)
+        event["request"]["intent"]["name"] = intent["name"]
+        envelope = serializer.deserialize(json.dumps(event), "ask_sdk_model.RequestEnvelope")
+        claimed = [h for h in handlers if h.can_handle(HandlerInput(request_envelope=envelope))]
+        assert len(claimed) == 1, (intent["name"], claimed)
+        used.add(type(claimed[0]))
+    for request_type in ("alexa_launch", "alexa_session_ended"):
+        envelope = serializer.deserialize(
+            json.dumps(load_event(request_type)), "ask_sdk_model.RequestEnvelope"
+        )
+        claimed = [h for h in handlers if h.can_handle(HandlerInput(request_envelope=envelope))]
+        assert len(claimed) == 1
+        used.add(type(claimed[0]))
+    assert {type(handler) for handler in handlers} == used
+
+
+def test_every_event_has_the_full_ask_shape_and_a_known_intent(model: dict[str, Any]) -> None:
+    known = {intent["name"] for intent in language_model(model)["intents"]}
+    for path in sorted(EVENTS_DIR.glob("alexa_*.json")):
+        event = json.loads(path.read_text())
+        system = event["context"]["System"]
+        assert system["application"]["applicationId"].startswith("amzn1.ask.skill.")
+        assert {"user", "device", "apiEndpoint", "apiAccessToken"} <= system.keys()
+        assert event["request"]["requestId"].startswith("amzn1.echo-api.request.")
+        assert event["request"]["locale"] == "en-US"
+        if event["request"]["type"] == "IntentRequest" and path.stem != "alexa_unknown_intent":
+            assert event["request"]["intent"]["name"] in known, path.name
+
+
+def test_generator_refuses_an_utterance_shared_between_intents(fleet: Fleet) -> None:
+    robot = SlotSpec("robot", "ROBOT")
+    first = IntentSpec("GoIntent", (robot,), ("move {robot}",))
+    other = SlotSpec("who", "ROBOT")
+    second = IntentSpec("HaltIntent", (other,), ("move {who}",))
+    with pytest.raises(
+        ModelError, match="'move \\{ROBOT\\}' appears in both GoIntent and HaltIntent"
+    ):
+        build_interaction_model(fleet, (first, second))
+
+
+def test_generator_refuses_a_sample_with_digits_or_punctuation(fleet: Fleet) -> None:
+    bad = IntentSpec("GoIntent", (SlotSpec("robot", "ROBOT"),), ("send {robot} to zone 5!",))
+    with pytest.raises(ModelError, match="lower-case words"):
+        build_interaction_model(fleet, (bad,))
+
+
+def test_generator_refuses_a_name_given_to_two_zones(fleet: Fleet) -> None:
+    text = (PACKAGE.parent / "fleet.yaml").read_text().replace("[zone b, b,", "[zone b, a,")
+    with pytest.raises(ModelError, match="the name 'a' is used by both 'A' and 'B'"):
+        build_interaction_model(Fleet.from_yaml(text), CUSTOM_INTENTS)
+
+
+def test_elicitation_answers_never_read_as_another_intent() -> None:
+    shapes = {
+        utterance_shape(intent, sample): intent.name
+        for intent in CUSTOM_INTENTS
+        for sample in intent.samples
+    }
+    for intent in CUSTOM_INTENTS:
+        for slot in intent.slots:
+            for answer in slot.answers:
+                assert shapes.get(utterance_shape(intent, answer), intent.name) == intent.name
+
+
+def test_weather_answer_is_the_sentence_robots_listen_for(skill: Any, aws: None) -> None:
+    # The robots' interpreter recognises answers that start with exactly this sentence.
+    text = speech(skill(load_event("alexa_weather"), None))
+    assert text in ("The weather is sunny.", "The weather is rainy.")
