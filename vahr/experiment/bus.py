@@ -1,7 +1,10 @@
 """The paho-mqtt adapter of the session: records the wire into the log and sends commands.
 
 It subscribes to every robot's events and to every command topic (robot and fleet), and
-hands each message to a callback; the keyboard-and-mouse method's console publishes its
+hands each message to a callback. The MQTT session is persistent (clean session off, a
+client id fixed per experiment session), so while the recorder is down after a crash the
+broker queues the QoS 1 messages it misses and delivers them when the session resumes.
+The keyboard-and-mouse method's console publishes its
 commands here too (QoS 1, source "console"), exactly as the skill would.
 """
 
@@ -41,7 +44,10 @@ class Bus:
         self._on_message = on_message
         self._subscribed = threading.Event()
         self._client = mqtt.Client(
-            mqtt.CallbackAPIVersion.VERSION2, client_id=client_id, protocol=mqtt.MQTTv311
+            mqtt.CallbackAPIVersion.VERSION2,
+            client_id=client_id,
+            protocol=mqtt.MQTTv311,
+            clean_session=False,
         )
         self._client.on_connect = self._on_connect
         self._client.on_message = self._on_message_raw

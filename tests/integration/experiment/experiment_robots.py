@@ -1,4 +1,4 @@
-"""Fixtures for the experiment's integration tests: robots on a real mosquitto.
+"""Robots on a real mosquitto for the experiment's integration tests (a fixture module).
 
 `robots_on_broker` runs the real robot core (`robot_agent.core.Executor` with the simulator
 backend) for every robot of the fleet, linked to the broker by a minimal paho bridge, so a

@@ -6,16 +6,18 @@ from __future__ import annotations
 import json
 from typing import TYPE_CHECKING
 
-from tests.integration.experiment.conftest import SPEED
+from tests.integration.experiment.experiment_robots import SPEED, robots_on_broker
 from vahr.cli import main
 from vahr.experiment.eventlog import Kind, read_log
+
+__all__ = ["robots_on_broker"]  # the fixture, used by name
 
 if TYPE_CHECKING:
     from pathlib import Path
 
     import pytest
 
-    from tests.integration.experiment.conftest import RobotsOnBroker
+    from tests.integration.experiment.experiment_robots import RobotsOnBroker
     from vahr.local.broker import Mosquitto
 
 
@@ -128,3 +130,61 @@ def test_keyboard_session_runs_all_three_tasks_and_reports(
     assert "Simulated participants" in (out / "report.md").read_text()
     for name in ("subjective.png", "tlx_by_trial.png", "objective.png"):
         assert (out / name).stat().st_size > 1000
+
+
+def test_a_session_cut_mid_task_resumes_without_repeating_or_losing_anything(
+    tmp_path: Path,
+    mosquitto: Mosquitto,
+    robots_on_broker: RobotsOnBroker,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from vahr.experiment.participant import SimulatedParticipant
+
+    logs = tmp_path / "logs"
+    argv = [
+        "experiment",
+        "--participant",
+        "SIM02",
+        "--method",
+        "keyboard",
+        "--trial",
+        "1",
+        "--seed",
+        "5",
+        "--log-dir",
+        str(logs),
+        "--broker",
+        mosquitto.plain_url,
+        "--no-shadow",
+        "--simulate",
+        "--speed-factor",
+        str(SPEED),
+        "--json",
+    ]
+    # Given a session that is interrupted (Ctrl-C) while task II is being performed
+    original = SimulatedParticipant.perform
+
+    def interrupted(self: SimulatedParticipant, task: str) -> None:
+        original(self, task)
+        if task == "II":
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(SimulatedParticipant, "perform", interrupted)
+    assert main(argv) == 130
+    path = logs / "SIM02-keyboard-trial1.sqlite"
+    before = read_log(path)
+    assert [e.data["task"] for e in before if e.kind == Kind.TASK_ENDED] == ["I"]
+    # When it is started again
+    monkeypatch.setattr(SimulatedParticipant, "perform", original)
+    capsys.readouterr()
+    assert main(argv) == 0
+    summary = json.loads(capsys.readouterr().out)
+    # Then it resumed: task II was not performed twice, and every task succeeded
+    after = read_log(path)
+    assert after[: len(before)] == before
+    assert summary["resumed"] is True
+    assert [e.kind for e in after].count(Kind.SESSION_RESUMED) == 1
+    sent = [e.data["action"] for e in after if e.kind == Kind.COMMAND]
+    assert sent == ["deliver", "deliver", "deliver", "deliver", "sequential_delivery"]
+    assert all(body["success"] for body in summary["verdict"]["tasks"].values()), summary
