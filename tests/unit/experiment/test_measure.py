@@ -84,8 +84,10 @@ def test_a_faster_than_real_time_rehearsal_is_measured_in_experiment_seconds(
     script: SessionScript,
 ) -> None:
     # Given a rehearsal logged at 20 times real time
-    script.log.append(Kind.SESSION_STARTED, {"participant": "SIM", "method": "keyboard",
-                                             "trial": 1, "speed_factor": 20.0})
+    script.log.append(
+        Kind.SESSION_STARTED,
+        {"participant": "SIM", "method": "keyboard", "trial": 1, "speed_factor": 20.0},
+    )
     script.start("I", 0)
     script.interact(1, 2)
     script.end(5)
