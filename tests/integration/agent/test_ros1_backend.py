@@ -1,0 +1,183 @@
+"""The ros1 backend drives move_base goals through a real ROS master and action server.
+
+The test starts `rosmaster --core` on a free loopback port and a fake `move_base`
+(`SimpleActionServer` with `MoveBaseAction`) that glides towards the goal with feedback,
+aborts goals into zone D (as a blocked planner would), and honours preemption.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import os
+import signal
+import subprocess
+import time
+from typing import TYPE_CHECKING, Any
+
+import pytest
+
+from robot_agent.core.clock import ScaledClock
+from robot_agent.core.executor import Executor, ExecutorSettings
+from tests.unit.agent.conftest import Recorder
+from vahr.local.ports import free_port, wait_for_listener
+from vahr.protocol import new_command
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+
+    from vahr.protocol import Fleet
+
+pytestmark = pytest.mark.ros
+
+STEPS = 8
+STEP_S = 0.03
+
+
+def _die_with_parent() -> None:
+    # PR_SET_PDEATHSIG: the master dies with the test run even if pytest is killed.
+    ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)
+
+
+@pytest.fixture(scope="session")
+def ros_master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    port = free_port()
+    home = tmp_path_factory.mktemp("ros-home")
+    env = dict(
+        os.environ,
+        ROS_IP="127.0.0.1",
+        ROS_HOME=str(home),
+        ROS_MASTER_URI=f"http://127.0.0.1:{port}",
+    )
+    process = subprocess.Popen(
+        ["rosmaster", "--core", "-p", str(port), "-w", "3"],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        preexec_fn=_die_with_parent,
+    )
+    try:
+        wait_for_listener(port, 10, "ROS master")
+        # rospy reads these when the node starts (once per process).
+        for name in ("ROS_IP", "ROS_HOME", "ROS_MASTER_URI"):
+            os.environ[name] = env[name]
+        yield env["ROS_MASTER_URI"]
+    finally:
+        process.send_signal(signal.SIGTERM)
+        try:
+            process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=5)
+
+
+@pytest.fixture(scope="session")
+def move_base(ros_master: str) -> Iterator[dict[str, Any]]:
+    """A fake move_base in this process; records the goals it received."""
+    from robot_agent.backends.ros1 import Ros1Settings, ensure_node
+
+    ensure_node(Ros1Settings(master_uri=ros_master, node_name="vahr_agent_test"))
+    import actionlib
+    from move_base_msgs.msg import MoveBaseAction, MoveBaseFeedback
+
+    seen: dict[str, Any] = {"goals": [], "preempted": 0}
+    position = {"x": 1.0, "y": 3.0}
+
+    def execute(goal: Any) -> None:
+        seen["goals"].append(goal)
+        target = goal.target_pose.pose.position
+        x0, y0 = position["x"], position["y"]
+        for step in range(1, STEPS + 1):
+            if server.is_preempt_requested():
+                seen["preempted"] += 1
+                server.set_preempted(text="cancelled by the client")
+                return
+            if target.y < 2 and step == STEPS // 2:
+                server.set_aborted(text="no path through the costmap")
+                return
+            feedback = MoveBaseFeedback()
+            feedback.base_position.header.frame_id = "map"
+            position["x"] = x0 + (target.x - x0) * step / STEPS
+            position["y"] = y0 + (target.y - y0) * step / STEPS
+            feedback.base_position.pose.position.x = position["x"]
+            feedback.base_position.pose.position.y = position["y"]
+            feedback.base_position.pose.orientation.w = 1.0
+            server.publish_feedback(feedback)
+            time.sleep(STEP_S)
+        server.set_succeeded(text="goal reached")
+
+    server = actionlib.SimpleActionServer(
+        "move_base", MoveBaseAction, execute_cb=execute, auto_start=False
+    )
+    server.start()
+    yield seen
+
+
+def ros_executor(fleet: Fleet, ros_master: str) -> tuple[Executor, Recorder]:
+    from robot_agent.backends.ros1 import Ros1Backend, Ros1Settings
+
+    backend = Ros1Backend(
+        Ros1Settings(
+            master_uri=ros_master, loader_delay_s=0.05, unloader_delay_s=0.05, server_timeout_s=10
+        ),
+        start=fleet.robot("placebot1").start,
+    )
+    recorder = Recorder()
+    executor = Executor(
+        thing="placebot1",
+        fleet=fleet,
+        backend=backend,
+        clock=ScaledClock(1.0),
+        publish_state=recorder.states.append,
+        publish_event=recorder.events.append,
+        settings=ExecutorSettings(progress_interval_s=0.0, stuck_after_s=5),
+    )
+    return executor, recorder
+
+
+async def test_a_navigate_command_becomes_a_move_base_goal_in_the_map_frame(
+    fleet: Fleet, ros_master: str, move_base: dict[str, Any]
+) -> None:
+    executor, rec = ros_executor(fleet, ros_master)
+    before = len(move_base["goals"])
+    executor.execute(new_command("navigate", {"zone": "B"}, source="console", command_id="r1"))
+    await executor.wait_idle()
+    goal = move_base["goals"][before]
+    assert goal.target_pose.header.frame_id == "map"
+    assert (goal.target_pose.pose.position.x, goal.target_pose.pose.position.y) == (9.0, 5.0)
+    assert math.isclose(goal.target_pose.pose.orientation.w, 1.0)
+    progress = [e.progress for e in rec.events if e.event == "progress"]
+    assert len(progress) >= STEPS // 2 and progress == sorted(progress)
+    assert rec.kinds("r1")[-2:] == ["arrived", "done"]
+    assert rec.states[-1].zone == "B"
+
+
+async def test_an_aborted_goal_fails_with_move_base_s_reason(
+    fleet: Fleet, ros_master: str, move_base: dict[str, Any]
+) -> None:
+    executor, rec = ros_executor(fleet, ros_master)
+    executor.execute(new_command("navigate", {"zone": "D"}, source="console", command_id="r2"))
+    await executor.wait_idle()
+    assert (
+        rec.first("failed", "r2").reason
+        == "move_base goal to D aborted: no path through the costmap"
+    )
+    assert rec.states[-1].status == "error"
+
+
+async def test_stop_preempts_the_active_goal(
+    fleet: Fleet, ros_master: str, move_base: dict[str, Any]
+) -> None:
+    import asyncio
+
+    executor, rec = ros_executor(fleet, ros_master)
+    preempted = move_base["preempted"]
+    executor.execute(new_command("navigate", {"zone": "A"}, source="console", command_id="r3"))
+    await rec.until("progress", "r3")
+    executor.execute(new_command("stop", None, source="console", command_id="r4"))
+    await executor.wait_idle()
+    async with asyncio.timeout(5):
+        while move_base["preempted"] == preempted:
+            await asyncio.sleep(0.01)
+    assert rec.kinds("r3")[-1] == "cancelled"
+    assert rec.states[-1].status == "stopped"
