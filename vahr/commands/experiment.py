@@ -145,45 +145,28 @@ def _show_plan(name: str, plan: dict[str, Any], resumed: bool, method: str) -> N
 
 
 def _run_session(args: argparse.Namespace, fleet: Any, session: Any) -> Any:
-    from vahr.experiment.bus import Bus
-    from vahr.experiment.participant import Console
-    from vahr.experiment.recorder import Recorder
-    from vahr.experiment.session import rebuild_world, run_tasks
+    from vahr.experiment.rehearsal import run_live, simulated_performer
 
-    recorder = Recorder(session.log, rebuild_world(fleet, session))
-    bus = Bus(args.broker, recorder.on_message, client_id=f"vahr-experiment-{session.spec.name}")
-    bus.start()
-    try:
-        console = Console(bus.publish)
-        performer: Any
-        if args.simulate:
-            from vahr.experiment.assistant import SayCommandAssistant
-            from vahr.experiment.participant import SimulatedParticipant
-            from vahr.experiment.timing import TimingModel
+    performer_for: Any
+    if args.simulate:
+        from vahr.experiment.assistant import SayCommandAssistant
 
-            performer = SimulatedParticipant(
-                method=args.method,
-                fleet=fleet,
-                plan=session.plan,
-                log=session.log,
-                timing=TimingModel(),
-                seed=session.plan.seed,
-                speed_factor=args.speed_factor,
-                assistant=SayCommandAssistant(args.api) if args.method == "vahr" else None,
-                console=console if args.method == "keyboard" else None,
-            )
-        else:
-            from vahr.experiment.observer import ObserverConsole
+        performer_for = simulated_performer(session, fleet, SayCommandAssistant(args.api))
+    else:
+        from vahr.experiment.observer import ObserverConsole
 
-            performer = ObserverConsole(log=session.log, console=console)
-        announce = (
-            (lambda line: None)
-            if args.json
-            else (lambda line: print(("[simulated] " if args.simulate else "") + line, flush=True))
-        )
-        verdict = run_tasks(session, recorder, performer, announce=announce)
-    finally:
-        bus.stop()
+        def performer_for(console: Any) -> Any:
+            return ObserverConsole(log=session.log, console=console)
+
+    prefix = "[simulated] " if args.simulate else ""
+
+    def announce(line: str) -> None:
+        if not args.json:
+            print(prefix + line, flush=True)
+
+    verdict = run_live(
+        session, fleet, broker_url=args.broker, performer_for=performer_for, announce=announce
+    )
     if not args.json:
         for key, tally in (
             ("commands", verdict.commands),

@@ -1,0 +1,116 @@
+"""Run a session against a live system: the entry points for `vahr experiment` and `vahr demo`.
+
+`run_live` connects the recorder to the broker and lets a performer (the simulated
+participant or the observer's console) run the tasks. `rehearse` is the one call a demo
+needs: open (or resume) a simulated session, publish its plan to the experiment shadow, run
+it, and return the judge's verdict with the log's path.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from vahr.experiment.bus import Bus
+from vahr.experiment.participant import Console, SimulatedParticipant
+from vahr.experiment.recorder import Recorder
+from vahr.experiment.session import SessionSpec, open_session, rebuild_world, run_tasks
+from vahr.experiment.tasks import default_seed
+from vahr.experiment.timing import TimingModel
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from pathlib import Path
+
+    from vahr.experiment.assistant import Assistant
+    from vahr.experiment.judge import SessionVerdict
+    from vahr.experiment.session import OpenSession, Performer
+    from vahr.protocol import Fleet
+
+
+def run_live(
+    session: OpenSession,
+    fleet: Fleet,
+    *,
+    broker_url: str,
+    performer_for: Callable[[Console], Performer],
+    announce: Callable[[str], None] = lambda line: None,
+) -> SessionVerdict:
+    """Record the wire into the session's log while `performer_for(console)` runs the tasks."""
+    recorder = Recorder(session.log, rebuild_world(fleet, session))
+    bus = Bus(broker_url, recorder.on_message, client_id=f"vahr-experiment-{session.spec.name}")
+    bus.start()
+    try:
+        return run_tasks(session, recorder, performer_for(Console(bus.publish)), announce=announce)
+    finally:
+        bus.stop()
+
+
+def simulated_performer(
+    session: OpenSession,
+    fleet: Fleet,
+    assistant: Assistant | None,
+    timing: TimingModel | None = None,
+) -> Callable[[Console], Performer]:
+    """A factory of the simulated participant for `run_live`."""
+
+    def build(console: Console) -> Performer:
+        method = session.spec.method
+        return SimulatedParticipant(
+            method=method,
+            fleet=fleet,
+            plan=session.plan,
+            log=session.log,
+            timing=timing or TimingModel(),
+            seed=session.plan.seed,
+            speed_factor=session.spec.speed_factor,
+            assistant=assistant if method == "vahr" else None,
+            console=console if method == "keyboard" else None,
+        )
+
+    return build
+
+
+def rehearse(
+    *,
+    fleet: Fleet,
+    method: str,
+    log_dir: Path,
+    broker_url: str,
+    assistant: Assistant | None = None,
+    participant: str = "SIM",
+    trial: int = 1,
+    seed: int | None = None,
+    speed_factor: float = 1.0,
+    task_timeout_s: float = 600.0,
+    data_plane_url: str | None = None,
+    write_shadow: bool = True,
+    announce: Callable[[str], None] = lambda line: None,
+) -> tuple[SessionVerdict, Path]:
+    """Run (or resume) one simulated session end to end; return the verdict and the log."""
+    spec = SessionSpec(
+        participant=participant,
+        method=method,
+        trial=trial,
+        seed=seed if seed is not None else default_seed(participant, method, trial),
+        log_dir=log_dir,
+        simulated=True,
+        speed_factor=speed_factor,
+        task_timeout_s=task_timeout_s,
+    )
+    session = open_session(spec, fleet)
+    try:
+        if write_shadow:
+            from vahr.experiment.shadow_store import ExperimentShadow
+
+            shadow = ExperimentShadow(fleet, endpoint_url=data_plane_url)
+            shadow.write(session.plan.experiment_state(spec.name))
+        verdict = run_live(
+            session,
+            fleet,
+            broker_url=broker_url,
+            performer_for=simulated_performer(session, fleet, assistant),
+            announce=announce,
+        )
+    finally:
+        session.log.close()
+    return verdict, spec.path
