@@ -48,6 +48,8 @@ ACKNOWLEDGED = {
     "navigate": "{robot} is on its way to {zone}.",
     "deliver": "{robot} is on its way to pick up a package for {zone}.",
     "weather_delivery": "{robot} will ask me about the weather and deliver accordingly.",
+    "sequential_delivery": "{robot} will deliver to {zone} first.",
+    "sequential_delivery_after": "{robot} will deliver to {zone} once {after} has delivered.",
     "stop": "{robot} has stopped.",
     "ping": "{robot} is listening.",
 }
@@ -55,6 +57,7 @@ FLEET_ACKNOWLEDGED = {
     "navigate": "{robots} are on their way to {zone}.",
     "deliver": "{robots} are on their way to pick up packages for {zone}.",
     "weather_delivery": "{robots} will ask me about the weather and deliver accordingly.",
+    "sequential_delivery": "{robots} will deliver to {zone}.",
     "stop": "{robots} have stopped.",
     "ping": "{robots} are listening.",
 }

@@ -43,7 +43,12 @@ def command_report(
         answer = mine[0]
         robot = vocabulary.robot(answer.thing)
         if answer.confirmed:
-            return capitalise(prompts.ACKNOWLEDGED[action].format(robot=robot, zone=zone_name))
+            after = getattr(item.command.params, "after", None)
+            key = f"{action}_after" if isinstance(after, str) else action
+            sentence = prompts.ACKNOWLEDGED[key].format(
+                robot=robot, zone=zone_name, after=vocabulary.robot(after) if after else ""
+            )
+            return capitalise(sentence)
         return capitalise(_single_problem(robot, answer))
     confirmed = [answer for answer in mine if answer.confirmed]
     if len(confirmed) == len(mine):
