@@ -20,6 +20,7 @@ import statistics
 import warnings
 from typing import TYPE_CHECKING, Any
 
+from vahr.experiment.metrics import rate
 from vahr.experiment.results import ResultRow, write_csv
 from vahr.experiment.tasks import METHODS
 from vahr.experiment.tlx import ITEMS, SUBSCALES
@@ -118,9 +119,31 @@ def build_report(
             change[item][m] = {
                 f"{a}->{b}": means[b] - means[a] for a, b in zip(ordered, ordered[1:], strict=False)
             }
+    trust_adjusted = _summary(
+        {
+            m: [v for r in rows if r.method == m and (v := r.trust_adjusted) is not None]
+            for m in methods
+        }
+    )
+    success: dict[str, dict[str, Any]] = {}
+    for kind in ("task", "command", "communication"):
+        pooled = {}
+        for m in methods:
+            counted = [r.tallies[kind] for r in rows if r.method == m and r.tallies]
+            total = sum(t for _, t in counted)
+            if counted:
+                pooled[m] = {
+                    "successes": sum(s for s, _ in counted),
+                    "total": total,
+                    "success_rate": rate(sum(s for s, _ in counted), total),
+                }
+        if pooled:
+            success[kind] = pooled
     return {
         "objective": objective,
         "subjective": subjective,
+        "trust_adjusted_rad": trust_adjusted,
+        "success": success,
         "tlx_by_trial": by_trial,
         "tlx_change": change,
         "methods": methods,
@@ -176,6 +199,33 @@ def render_markdown(report: dict[str, Any]) -> str:
         entry = report["objective"][metric]
         cells = [_fmt(entry["means"].get(m), unit) for m in methods]
         lines.append(f"| {label} | " + " | ".join(cells) + f" | {_p(entry['p_value'])} |")
+    trust = report["trust_adjusted_rad"]
+    if trust["means"]:
+        cells = [_fmt(trust["means"].get(m), "s") for m in methods]
+        lines.append(
+            "| Trust-adjusted demand = IE + NT x (1 - trust) | "
+            + " | ".join(cells)
+            + f" | {_p(trust['p_value'])} |"
+        )
+    if report["success"]:
+        lines += [
+            "",
+            "## Success rates",
+            "",
+            "Pooled over the runs' logs.",
+            "",
+            "| | " + " | ".join(methods) + " |",
+            "|---|" + "---|" * len(methods),
+        ]
+        for kind, pooled in report["success"].items():
+            cells = [
+                f"{p['success_rate']:.0%} ({p['successes']}/{p['total']})"
+                if m in pooled and p["success_rate"] is not None
+                else "n/a"
+                for m in methods
+                for p in [pooled.get(m, {"success_rate": None})]
+            ]
+            lines.append(f"| {kind.capitalize()} success | " + " | ".join(cells) + " |")
     lines += [
         "",
         "## Subjective results",

@@ -15,8 +15,10 @@ from typing import TYPE_CHECKING
 
 from vahr.errors import VahrError
 from vahr.experiment.eventlog import Kind, find_logs, read_log
+from vahr.experiment.judge import judge_session
 from vahr.experiment.measure import measure_session
-from vahr.experiment.metrics import fan_out, rad
+from vahr.experiment.metrics import fan_out, rad, trust_adjusted_rad
+from vahr.experiment.tasks import Plan
 from vahr.experiment.tlx import ITEMS, TlxAnswers, check_level
 
 if TYPE_CHECKING:
@@ -46,6 +48,8 @@ class ResultRow:
     task_time_s: float
     puzzle_parts: int
     tlx: TlxAnswers | None
+    # (successes, total) of tasks, commands and communication, when measured from a log.
+    tallies: dict[str, tuple[int, int]] | None = None
 
     @property
     def rad(self) -> float:
@@ -56,6 +60,14 @@ class ResultRow:
     def fan_out(self) -> float:
         """Fan-out of this row: task time / RAD."""
         return fan_out(self.task_time_s, self.rad)
+
+    @property
+    def trust_adjusted(self) -> float | None:
+        """DIT + NT x (1 - Tr) with the row's trust answer, or None without a questionnaire."""
+        if self.tlx is None:
+            return None
+        trust = self.tlx.percents()["trust"] / 100
+        return trust_adjusted_rad(self.interaction_time_s, self.neglect_time_s, trust)
 
     def to_csv(self) -> dict[str, object]:
         row: dict[str, object] = {
@@ -158,6 +170,14 @@ def latest_tlx(entries: list[LogEntry]) -> TlxAnswers | None:
 def row_from_log(entries: list[LogEntry]) -> ResultRow:
     header = session_header(entries)
     times = measure_session(entries)
+    tallies = None
+    if isinstance(header.get("plan"), dict):
+        verdict = judge_session(entries, Plan.from_json(header["plan"]))  # type: ignore[arg-type]
+        tallies = {
+            "task": (verdict.task_tally.successes, verdict.task_tally.total),
+            "command": (verdict.commands.successes, verdict.commands.total),
+            "communication": (verdict.communication.successes, verdict.communication.total),
+        }
     return ResultRow(
         participant=str(header["participant"]),
         method=str(header["method"]),
@@ -167,6 +187,7 @@ def row_from_log(entries: list[LogEntry]) -> ResultRow:
         task_time_s=times.time_taken_s,
         puzzle_parts=times.puzzle_parts,
         tlx=latest_tlx(entries),
+        tallies=tallies,
     )
 
 

@@ -127,6 +127,12 @@ def test_keyboard_session_runs_all_three_tasks_and_reports(
     assert nt > 0
     assert means["rad"]["means"]["keyboard"] == ie / (ie + nt)
     assert report["subjective"]["mental"]["means"]["keyboard"] == 25.0
+    assert report["success"]["task"]["keyboard"] == {
+        "successes": 3,
+        "total": 3,
+        "success_rate": 1.0,
+    }
+    assert report["success"]["command"]["keyboard"]["success_rate"] == 1.0
     assert "Simulated participants" in (out / "report.md").read_text()
     for name in ("subjective.png", "tlx_by_trial.png", "objective.png"):
         assert (out / name).stat().st_size > 1000

@@ -169,3 +169,17 @@ def test_missing_columns_are_named(tmp_path: Path) -> None:
     path.write_text("participant,method,trial\nP1,vahr,1\n")
     with pytest.raises(VahrError, match="missing column"):
         read_csv(path)
+
+
+def test_trust_adjusted_demand_is_averaged_per_row(tmp_path: Path) -> None:
+    data = generated_csv(tmp_path / "results.csv", participants=3, trials=1)
+    report = build_report(read_csv(data))
+    ie, nt = (
+        column(data, "keyboard", "interaction_time_s"),
+        column(data, "keyboard", "neglect_time_s"),
+    )
+    trust = [(v - 1) * 5 / 100 for v in column(data, "keyboard", "trust")]
+    want = [i + n * (1 - t) for i, n, t in zip(ie, nt, trust, strict=True)]
+    assert report["trust_adjusted_rad"]["means"]["keyboard"] == pytest.approx(sum(want) / len(want))
+    # A CSV carries no verdicts, so there are no success rates to pool
+    assert report["success"] == {}
