@@ -28,6 +28,7 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 LOOPBACK_HOSTS = frozenset({"127.0.0.1", "localhost", "::1"})
+SUBSCRIBE_CHUNK = 100
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -82,8 +83,12 @@ class Mqtt5Link:
     def __init__(self, settings: LinkSettings, loop: asyncio.AbstractEventLoop) -> None:
         self.settings = settings
         self._loop = loop
-        self._routes: list[tuple[str, Callable[[str, bytes], None]]] = []
+        # Exact topics are looked up directly; only wildcard filters are matched one by one,
+        # so a swarm of hundreds of robots on one link dispatches in constant time.
+        self._exact: dict[str, list[Callable[[str, bytes], None]]] = {}
+        self._wildcards: list[tuple[str, Callable[[str, bytes], None]]] = []
         self._filters: list[str] = []
+        self._known_filters: set[str] = set()
         self._connected_callbacks: list[Callable[[bool], None]] = []
         self._disconnected_callbacks: list[Callable[[str], None]] = []
         self._connected = threading.Event()
@@ -91,6 +96,7 @@ class Mqtt5Link:
         self._lock = threading.Lock()
         self._pending: set[Future[mqtt5.PublishCompletionData]] = set()
         self.connections = 0
+        self._stopping = False
         self._client = self._build_client()
 
     # -- the Link port ------------------------------------------------------------------
@@ -105,8 +111,12 @@ class Mqtt5Link:
         future.add_done_callback(self._published)
 
     def add_route(self, topic_filter: str, handler: Callable[[str, bytes], None]) -> None:
-        self._routes.append((topic_filter, handler))
-        if topic_filter not in self._filters:
+        if "+" in topic_filter or "#" in topic_filter:
+            self._wildcards.append((topic_filter, handler))
+        else:
+            self._exact.setdefault(topic_filter, []).append(handler)
+        if topic_filter not in self._known_filters:
+            self._known_filters.add(topic_filter)
             self._filters.append(topic_filter)
             if self._connected.is_set():
                 self._subscribe([topic_filter])
@@ -144,6 +154,7 @@ class Mqtt5Link:
 
     async def stop(self, timeout_s: float = 5.0) -> None:
         """Disconnect normally (the broker discards the will) and wait until stopped."""
+        self._stopping = True
         self._client.stop(
             mqtt5.DisconnectPacket(reason_code=mqtt5.DisconnectReasonCode.NORMAL_DISCONNECTION)
         )
@@ -194,11 +205,14 @@ class Mqtt5Link:
         return mqtt5.Client(options)
 
     def _subscribe(self, filters: list[str]) -> None:
-        subscriptions = [
-            mqtt5.Subscription(topic_filter=f, qos=mqtt5.QoS.AT_LEAST_ONCE) for f in filters
-        ]
-        future = self._client.subscribe(mqtt5.SubscribePacket(subscriptions=subscriptions))
-        future.add_done_callback(self._subscribed)
+        # Chunks keep each SUBSCRIBE packet small when a swarm subscribes thousands of topics.
+        for start in range(0, len(filters), SUBSCRIBE_CHUNK):
+            subscriptions = [
+                mqtt5.Subscription(topic_filter=f, qos=mqtt5.QoS.AT_LEAST_ONCE)
+                for f in filters[start : start + SUBSCRIBE_CHUNK]
+            ]
+            future = self._client.subscribe(mqtt5.SubscribePacket(subscriptions=subscriptions))
+            future.add_done_callback(self._subscribed)
 
     def _subscribed(self, future: Future[mqtt5.SubackPacket]) -> None:
         try:
@@ -229,9 +243,10 @@ class Mqtt5Link:
     def _on_publish_received(self, data: mqtt5.PublishReceivedData) -> None:
         packet = data.publish_packet
         topic, payload = packet.topic, bytes(packet.payload or b"")
-        for topic_filter, handler in self._routes:
-            if topic_matches(topic_filter, topic):
-                self._loop.call_soon_threadsafe(handler, topic, payload)
+        handlers = list(self._exact.get(topic, ()))
+        handlers += [h for f, h in self._wildcards if topic_matches(f, topic)]
+        if handlers:
+            self._loop.call_soon_threadsafe(_dispatch, handlers, topic, payload)
 
     def _on_lifecycle_connection_success(self, data: mqtt5.LifecycleConnectSuccessData) -> None:
         session_present = bool(data.connack_packet and data.connack_packet.session_present)
@@ -258,12 +273,24 @@ class Mqtt5Link:
     def _on_lifecycle_disconnection(self, data: mqtt5.LifecycleDisconnectData) -> None:
         self._connected.clear()
         reason = str(data.exception) if data.exception else "disconnected"
-        log.warning("disconnected: %s", reason)
+        if self._stopping:
+            log.info("disconnected on request")
+        else:
+            log.warning("disconnected: %s", reason)
         for callback in self._disconnected_callbacks:
             self._loop.call_soon_threadsafe(callback, reason)
 
     def _on_lifecycle_stopped(self, data: mqtt5.LifecycleStoppedData) -> None:
         self._stopped.set()
+
+
+def _dispatch(handlers: list[Callable[[str, bytes], None]], topic: str, payload: bytes) -> None:
+    for handler in handlers:
+        try:
+            handler(topic, payload)
+        except Exception:
+            # One robot's bug must not starve the others sharing this link.
+            log.exception("handler for %s failed", topic)
 
 
 def _tls_context(tls: MutualTls, port: int) -> io.ClientTlsContext:
