@@ -46,8 +46,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--broker",
         default="mqtt://127.0.0.1:1883",
-        help="MQTT broker to record from and send console commands to",
+        help="MQTT broker to record from and send console commands to: mqtt://HOST:PORT, "
+        "or mqtts://HOST:PORT with --cert, --key and --ca (AWS IoT Core, vahr up's mqtts)",
     )
+    parser.add_argument("--cert", type=Path, help="client certificate for an mqtts:// broker")
+    parser.add_argument("--key", type=Path, help="client private key for an mqtts:// broker")
+    parser.add_argument("--ca", type=Path, help="CA certificate for an mqtts:// broker")
     parser.add_argument(
         "--api",
         default=None,
@@ -164,8 +168,20 @@ def _run_session(args: argparse.Namespace, fleet: Any, session: Any) -> Any:
         if not args.json:
             print(prefix + line, flush=True)
 
+    tls = None
+    if args.cert or args.key or args.ca:
+        from vahr.experiment.bus import TlsFiles
+
+        if not (args.cert and args.key and args.ca):
+            raise VahrError("--cert, --key and --ca go together")
+        tls = TlsFiles(cert_file=args.cert, key_file=args.key, ca_file=args.ca)
     verdict = run_live(
-        session, fleet, broker_url=args.broker, performer_for=performer_for, announce=announce
+        session,
+        fleet,
+        broker_url=args.broker,
+        performer_for=performer_for,
+        announce=announce,
+        tls=tls,
     )
     if not args.json:
         for key, tally in (

@@ -11,7 +11,9 @@ commands here too (QoS 1, source "console"), exactly as the skill would.
 from __future__ import annotations
 
 import socket
+import ssl
 import threading
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 from urllib.parse import urlparse
 
@@ -22,25 +24,44 @@ from vahr.protocol import topics
 
 if TYPE_CHECKING:
     from collections.abc import Callable
+    from pathlib import Path
 
 CONNECT_TIMEOUT_S = 10.0
 PUBLISH_TIMEOUT_S = 5.0
 WIRE_TOPICS = (topics.ALL_EVENTS, "vahr/robots/+/cmd", topics.FLEET_CMD)
 
 
-def parse_broker_url(url: str) -> tuple[str, int]:
-    """`mqtt://HOST:PORT` -> (host, port); a one-line VahrError otherwise."""
+@dataclass(frozen=True)
+class TlsFiles:
+    """Client certificate, key and CA for an mTLS broker (AWS IoT Core, `vahr up`'s mqtts)."""
+
+    cert_file: Path
+    key_file: Path
+    ca_file: Path
+
+
+def parse_broker_url(url: str) -> tuple[str, int, bool]:
+    """`mqtt://HOST[:PORT]` or `mqtts://HOST[:PORT]` -> (host, port, tls)."""
     parsed = urlparse(url)
-    if parsed.scheme != "mqtt" or not parsed.hostname:
-        raise VahrError(f"broker {url!r} is not an mqtt://HOST:PORT URL")
-    return parsed.hostname, parsed.port or 1883
+    if parsed.scheme not in ("mqtt", "mqtts") or not parsed.hostname:
+        raise VahrError(f"broker {url!r} is not an mqtt:// or mqtts://HOST:PORT URL")
+    tls = parsed.scheme == "mqtts"
+    return parsed.hostname, parsed.port or (8883 if tls else 1883), tls
 
 
 class Bus:
     """One MQTT connection: subscribed to the wire topics, able to publish commands."""
 
-    def __init__(self, url: str, on_message: Callable[[str, bytes], None], client_id: str) -> None:
-        self._host, self._port = parse_broker_url(url)
+    def __init__(
+        self,
+        url: str,
+        on_message: Callable[[str, bytes], None],
+        client_id: str,
+        tls: TlsFiles | None = None,
+    ) -> None:
+        self._host, self._port, secure = parse_broker_url(url)
+        if secure and tls is None:
+            raise VahrError(f"broker {url} needs --cert, --key and --ca for mTLS")
         self._on_message = on_message
         self._subscribed = threading.Event()
         self._client = mqtt.Client(
@@ -52,10 +73,21 @@ class Bus:
         self._client.on_connect = self._on_connect
         self._client.on_message = self._on_message_raw
         self._client.on_subscribe = self._on_subscribe
+        if secure and tls is not None:
+            for name in ("cert_file", "key_file", "ca_file"):
+                if not getattr(tls, name).is_file():
+                    raise VahrError(f"{name.replace('_', ' ')} {getattr(tls, name)} does not exist")
+            self._client.tls_set(
+                ca_certs=str(tls.ca_file), certfile=str(tls.cert_file), keyfile=str(tls.key_file)
+            )
 
     def start(self) -> None:
         try:
             self._client.connect(self._host, self._port, keepalive=30)
+        except ssl.SSLError as err:
+            raise VahrError(
+                f"TLS handshake with {self._host}:{self._port} failed: {err.reason or err}"
+            ) from err
         except OSError as err:
             raise VahrError(f"cannot reach the broker at {self._host}:{self._port}: {err}") from err
         sock = self._client.socket()

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from vahr.experiment.bus import Bus
+from vahr.experiment.bus import Bus, TlsFiles
 from vahr.experiment.participant import Console, SimulatedParticipant
 from vahr.experiment.recorder import Recorder
 from vahr.experiment.session import SessionSpec, open_session, rebuild_world, run_tasks
@@ -34,10 +34,13 @@ def run_live(
     broker_url: str,
     performer_for: Callable[[Console], Performer],
     announce: Callable[[str], None] = lambda line: None,
+    tls: TlsFiles | None = None,
 ) -> SessionVerdict:
     """Record the wire into the session's log while `performer_for(console)` runs the tasks."""
     recorder = Recorder(session.log, rebuild_world(fleet, session))
-    bus = Bus(broker_url, recorder.on_message, client_id=f"vahr-experiment-{session.spec.name}")
+    bus = Bus(
+        broker_url, recorder.on_message, client_id=f"vahr-experiment-{session.spec.name}", tls=tls
+    )
     bus.start()
     try:
         return run_tasks(session, recorder, performer_for(Console(bus.publish)), announce=announce)
@@ -85,6 +88,7 @@ def rehearse(
     data_plane_url: str | None = None,
     write_shadow: bool = True,
     announce: Callable[[str], None] = lambda line: None,
+    tls: TlsFiles | None = None,
 ) -> tuple[SessionVerdict, Path]:
     """Run (or resume) one simulated session end to end; return the verdict and the log."""
     spec = SessionSpec(
@@ -110,6 +114,7 @@ def rehearse(
             broker_url=broker_url,
             performer_for=simulated_performer(session, fleet, assistant),
             announce=announce,
+            tls=tls,
         )
     finally:
         session.log.close()
