@@ -264,6 +264,12 @@ class Executor:
                 if drive.done():
                     break
                 if self.clock.monotonic() - last_advance > self.settings.stuck_after_s:
+                    # A starved process wakes this watchdog and the backend at the same
+                    # moment; let the backend report first so starvation is not "stuck".
+                    for _ in range(3):
+                        await asyncio.sleep(0)
+                    if self.clock.monotonic() - last_advance <= self.settings.stuck_after_s:
+                        continue
                     drive.cancel()
                     with contextlib.suppress(asyncio.CancelledError, NavigationFailed):
                         await drive

@@ -82,7 +82,8 @@ def make_executor(
         publish_state=recorder.states.append,
         publish_event=recorder.events.append,
         voice=voice,
-        settings=settings,
+        # Generous stuck time: at this speed 10 simulated seconds are 25 ms of a busy machine.
+        settings=settings or ExecutorSettings(stuck_after_s=120),
     )
     return executor, recorder, backend
 

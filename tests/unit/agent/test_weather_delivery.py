@@ -1,0 +1,113 @@
+"""weather_delivery: the conversation the executor holds through the Voice port.
+
+The voice here is a scripted stand-in for the assistant on the other side of the room
+(the real audio path belongs to the voice adapters and has its own tests): it records what
+the robot said and answers with what a person would hear from the assistant.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from robot_agent.core.executor import WEATHER_QUESTION
+from robot_agent.voice.port import Heard, VoiceError
+from tests.unit.agent.conftest import make_executor
+from vahr.protocol import new_command
+
+if TYPE_CHECKING:
+    from vahr.protocol import Fleet
+
+
+class ScriptedAssistant:
+    """Answers each question with the next scripted `Heard` (or raises a VoiceError)."""
+
+    def __init__(self, *answers: Heard | VoiceError) -> None:
+        self.answers = list(answers)
+        self.said: list[str] = []
+        self.listens: list[float] = []
+
+    async def say(self, text: str) -> None:
+        self.said.append(text)
+
+    async def listen(self, timeout_s: float) -> Heard:
+        self.listens.append(timeout_s)
+        answer = self.answers.pop(0)
+        if isinstance(answer, VoiceError):
+            raise answer
+        return answer
+
+
+SUNNY = Heard("The weather is sunny.", "sunny", 0.93)
+RAINY = Heard("The weather is rainy. Take an umbrella.", "rainy", 0.88)
+MUMBLE = Heard("the whether is funny", "unknown", 0.21)
+
+
+def weather() -> object:
+    return new_command("weather_delivery", None, source="alexa", command_id="w1")
+
+
+async def test_sunny_means_a_delivery_to_a(fleet: Fleet) -> None:
+    assistant = ScriptedAssistant(SUNNY)
+    executor, rec, _ = make_executor(fleet, voice=assistant)
+    executor.execute(weather())  # type: ignore[arg-type]
+    await executor.wait_idle()
+    assert assistant.said == [
+        WEATHER_QUESTION,
+        "Thank you. It is sunny, so I am delivering to zone A.",
+    ]
+    said = [e.text for e in rec.events if e.event == "said"]
+    assert said == assistant.said
+    assert rec.first("heard").text == "The weather is sunny."
+    interpreted = rec.first("interpreted")
+    assert (interpreted.intent, interpreted.confidence) == ("sunny", 0.93)
+    assert rec.first("delivered").zone == "A"
+    assert rec.states[-1].last_command is not None and rec.states[-1].last_command.result == "done"
+
+
+async def test_rainy_means_a_delivery_to_c(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, voice=ScriptedAssistant(RAINY))
+    executor.execute(weather())  # type: ignore[arg-type]
+    await executor.wait_idle()
+    assert rec.first("delivered").zone == "C"
+
+
+async def test_one_unknown_answer_is_asked_again(fleet: Fleet) -> None:
+    assistant = ScriptedAssistant(MUMBLE, RAINY)
+    executor, rec, _ = make_executor(fleet, voice=assistant)
+    executor.execute(weather())  # type: ignore[arg-type]
+    await executor.wait_idle()
+    assert assistant.said[:2] == [WEATHER_QUESTION, WEATHER_QUESTION]
+    assert [e.intent for e in rec.events if e.event == "interpreted"] == ["unknown", "rainy"]
+    assert rec.first("delivered").zone == "C"
+
+
+async def test_two_unknown_answers_fail_with_a_reason_and_nothing_moves(fleet: Fleet) -> None:
+    executor, rec, backend = make_executor(fleet, voice=ScriptedAssistant(MUMBLE, MUMBLE))
+    start = backend.pose
+    executor.execute(weather())  # type: ignore[arg-type]
+    await executor.wait_idle()
+    reason = "did not understand the weather answer twice (last heard: 'the whether is funny')"
+    assert rec.first("failed").reason == reason
+    assert rec.states[-1].last_command is not None and rec.states[-1].last_command.reason == reason
+    assert backend.pose == start
+
+
+async def test_without_a_voice_it_fails_with_voice_not_configured(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, voice=None)
+    executor.execute(weather())  # type: ignore[arg-type]
+    await executor.wait_idle()
+    assert rec.first("failed").reason == "voice not configured"
+    assert "said" not in rec.kinds()
+    final = rec.states[-1]
+    assert final.last_command is not None
+    assert (final.last_command.result, final.last_command.reason) == (
+        "failed",
+        "voice not configured",
+    )
+
+
+async def test_a_broken_voice_path_fails_with_its_reason(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, voice=ScriptedAssistant(VoiceError("no audio device")))
+    executor.execute(weather())  # type: ignore[arg-type]
+    await executor.wait_idle()
+    assert rec.first("failed").reason == "voice failed: no audio device"
