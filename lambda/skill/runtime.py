@@ -6,9 +6,9 @@ import random
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from skill import fleet_source
 from skill.robots import Robots
 from skill.vocabulary import Vocabulary
-from vahr.protocol import load_fleet
 
 if TYPE_CHECKING:
     from skill.config import SkillConfig
@@ -31,7 +31,7 @@ class SkillRuntime:
     def create(
         cls, config: SkillConfig, gateway: RobotGateway, *, fleet: Fleet | None = None
     ) -> SkillRuntime:
-        fleet = fleet or load_fleet(config.fleet_file)
+        fleet = fleet or fleet_source.load(config.fleet_file)
         return cls(
             config=config,
             fleet=fleet,

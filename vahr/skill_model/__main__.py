@@ -1,4 +1,4 @@
-"""`python -m vahr.skill_model`: regenerate skill-package/, or with `--check` report drift."""
+"""`python -m vahr.skill_model`: regenerate the skill's files, or with `--check` report drift."""
 
 from __future__ import annotations
 
@@ -7,34 +7,44 @@ import sys
 from pathlib import Path
 
 from vahr.errors import VahrError
-from vahr.protocol import DEFAULT_FLEET_FILE, ProtocolError, load_fleet
+from vahr.protocol import DEFAULT_FLEET_FILE, Fleet, ProtocolError
 from vahr.skill_model.generator import drift, write
 
-DEFAULT_PACKAGE_DIR = Path(DEFAULT_FLEET_FILE).parent / "skill-package"
+DEFAULT_ROOT = Path(DEFAULT_FLEET_FILE).parent
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m vahr.skill_model",
-        description="Write skill-package/ from fleet.yaml and the skill's intent definitions.",
+        description=(
+            "Write skill-package/ (skill.json, the en-US interaction model) and "
+            "lambda/skill/fleet.json from fleet.yaml and the skill's intent definitions."
+        ),
     )
     parser.add_argument(
-        "--fleet", default=DEFAULT_FLEET_FILE, help="fleet file (default: %(default)s)"
-    )
-    parser.add_argument(
-        "--out",
+        "--fleet",
         type=Path,
-        default=DEFAULT_PACKAGE_DIR,
-        help="skill package folder (default: %(default)s)",
+        default=Path(DEFAULT_FLEET_FILE),
+        help="fleet file (default: %(default)s)",
+    )
+    parser.add_argument(
+        "--root",
+        type=Path,
+        default=DEFAULT_ROOT,
+        help="repository root to write under (default: %(default)s)",
     )
     parser.add_argument(
         "--check", action="store_true", help="write nothing; exit 1 if any file would change"
     )
     args = parser.parse_args(argv)
     try:
-        fleet = load_fleet(args.fleet)
+        try:
+            source = args.fleet.read_bytes()
+        except OSError as err:
+            raise VahrError(f"fleet: cannot read {args.fleet}: {err.strerror}") from err
+        fleet = Fleet.from_yaml(source)
         if args.check:
-            stale = drift(args.out, fleet)
+            stale = drift(args.root, fleet, source)
             for path in stale:
                 print(f"{path} is out of date with {args.fleet}", file=sys.stderr)
             if stale:
@@ -43,16 +53,16 @@ def main(argv: list[str] | None = None) -> int:
                     file=sys.stderr,
                 )
                 return 1
-            print(f"{args.out} is up to date")
+            print("the skill package is up to date")
             return 0
-        changed = write(args.out, fleet)
+        changed = write(args.root, fleet, source)
     except (VahrError, ProtocolError) as err:
         print(f"python -m vahr.skill_model: error: {err}", file=sys.stderr)
         return 2
     for path in changed:
         print(f"wrote {path}")
     if not changed:
-        print(f"{args.out} is up to date")
+        print("the skill package is up to date")
     return 0
 
 

@@ -1,11 +1,14 @@
-"""Build the skill package (manifest and en-US interaction model) from fleet.yaml and the intents.
+"""Build the skill's generated files from fleet.yaml and the intent definitions.
 
-`build_files` returns every file of `skill-package/` as text, so writing and checking for
-drift compare exactly the same bytes.
+They are the skill package (manifest and en-US interaction model) and the fleet's JSON
+twin inside the Lambda code (`lambda/skill/fleet.json`), which spares the skill's cold
+start PyYAML. `build_files` returns every file as text, so writing and checking for drift
+compare exactly the same bytes.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import re
 from pathlib import Path
@@ -31,8 +34,10 @@ FLEET_ROBOT_ID = "all"
 FLEET_GROUP_ID = "all"
 DEFAULT_FLEET_NAMES = ("all robots", "every robot", "everyone")
 
-MODEL_PATH = Path("interactionModels") / "custom" / f"{LOCALE}.json"
-MANIFEST_PATH = Path("skill.json")
+PACKAGE_DIR = Path("skill-package")
+MODEL_PATH = PACKAGE_DIR / "interactionModels" / "custom" / f"{LOCALE}.json"
+MANIFEST_PATH = PACKAGE_DIR / "skill.json"
+FLEET_TWIN_PATH = Path("lambda") / "skill" / "fleet.json"
 
 # Alexa's rules for sample utterances: lower-case words (apostrophes allowed, numbers spelled
 # out) and slot references, separated by single spaces.
@@ -45,11 +50,27 @@ class ModelError(VahrError):
     """The intents or the fleet would make an interaction model Alexa rejects or confuses."""
 
 
-def build_files(fleet: Fleet) -> dict[Path, str]:
-    """Every file of skill-package/, keyed by its path inside that folder."""
+def build_files(fleet: Fleet, source: bytes) -> dict[Path, str]:
+    """Every generated file, keyed by its path from the repository root.
+
+    `source` is the fleet file's bytes: the twin records their hash, so the skill can tell
+    when fleet.yaml changed after the twin was written and read the YAML instead.
+    """
     return {
         MANIFEST_PATH: render(build_manifest()),
         MODEL_PATH: render(build_interaction_model(fleet)),
+        FLEET_TWIN_PATH: render(fleet_twin(fleet, source)),
+    }
+
+
+def fleet_twin(fleet: Fleet, source: bytes) -> dict[str, Any]:
+    """The fleet as JSON plus the hash of the YAML it came from."""
+    import msgspec
+
+    return {
+        "generated_from": "fleet.yaml by python -m vahr.skill_model; do not edit",
+        "source_sha256": hashlib.sha256(source).hexdigest(),
+        "fleet": msgspec.to_builtins(fleet),
     }
 
 
@@ -186,11 +207,11 @@ def check_samples(intents: tuple[IntentSpec, ...]) -> None:
                     )
 
 
-def write(package_dir: Path, fleet: Fleet) -> list[Path]:
-    """Write skill-package/ and return the files that changed."""
+def write(root: Path, fleet: Fleet, source: bytes) -> list[Path]:
+    """Write the generated files under `root` and return those that changed."""
     changed = []
-    for relative, text in build_files(fleet).items():
-        target = package_dir / relative
+    for relative, text in build_files(fleet, source).items():
+        target = root / relative
         if not target.exists() or target.read_text(encoding="utf-8") != text:
             target.parent.mkdir(parents=True, exist_ok=True)
             target.write_text(text, encoding="utf-8")
@@ -198,11 +219,10 @@ def write(package_dir: Path, fleet: Fleet) -> list[Path]:
     return changed
 
 
-def drift(package_dir: Path, fleet: Fleet) -> list[Path]:
-    """The files of skill-package/ that differ from what the generator would write."""
+def drift(root: Path, fleet: Fleet, source: bytes) -> list[Path]:
+    """The generated files under `root` that differ from what the generator would write."""
     return [
-        package_dir / relative
-        for relative, text in build_files(fleet).items()
-        if not (package_dir / relative).exists()
-        or (package_dir / relative).read_text(encoding="utf-8") != text
+        root / relative
+        for relative, text in build_files(fleet, source).items()
+        if not (root / relative).exists() or (root / relative).read_text(encoding="utf-8") != text
     ]

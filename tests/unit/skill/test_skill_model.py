@@ -21,13 +21,19 @@ from tests.conftest import EVENTS_DIR, load_event
 from vahr.protocol import Fleet
 from vahr.skill_model import FLEET_ROBOT_ID, ModelError, build_files, build_interaction_model
 from vahr.skill_model.__main__ import main as skill_model_main
-from vahr.skill_model.generator import MANIFEST_PATH, MODEL_PATH, utterance_shape
+from vahr.skill_model.generator import (
+    FLEET_TWIN_PATH,
+    MANIFEST_PATH,
+    MODEL_PATH,
+    utterance_shape,
+)
 from vahr.skill_model.intents import CUSTOM_INTENTS, IntentSpec, SlotSpec
 
 if TYPE_CHECKING:
     from ask_sdk_core.dispatch_components import AbstractRequestHandler
 
-PACKAGE = Path(__file__).resolve().parents[3] / "skill-package"
+ROOT = Path(__file__).resolve().parents[3]
+FLEET_FILE = ROOT / "fleet.yaml"
 MODEL_TYPE = (
     "ask_smapi_model.v1.skill.interaction_model.interaction_model_data.InteractionModelData"
 )
@@ -36,7 +42,7 @@ MANIFEST_TYPE = "ask_smapi_model.v1.skill.manifest.skill_manifest_envelope.Skill
 
 @pytest.fixture(scope="module")
 def model() -> dict[str, Any]:
-    loaded: dict[str, Any] = json.loads((PACKAGE / MODEL_PATH).read_text())
+    loaded: dict[str, Any] = json.loads((ROOT / MODEL_PATH).read_text())
     return loaded
 
 
@@ -48,8 +54,8 @@ def language_model(model: dict[str, Any]) -> dict[str, Any]:
 def test_committed_skill_package_matches_the_generator(fleet: Fleet) -> None:
     # Given fleet.yaml and the intent definitions, when the generator runs, then it would
     # write exactly the committed files (run `make skill-model` after editing either)
-    for relative, text in build_files(fleet).items():
-        assert (PACKAGE / relative).read_text() == text, f"{relative} drifted from fleet.yaml"
+    for relative, text in build_files(fleet, FLEET_FILE.read_bytes()).items():
+        assert (ROOT / relative).read_text() == text, f"{relative} drifted from fleet.yaml"
 
 
 def test_check_flag_reports_drift_and_exits_non_zero(
@@ -57,21 +63,23 @@ def test_check_flag_reports_drift_and_exits_non_zero(
 ) -> None:
     # Given a copy of the package and a fleet with one more zone
     fleet_file = tmp_path / "fleet.yaml"
-    text = (PACKAGE.parent / "fleet.yaml").read_text()
+    text = FLEET_FILE.read_text()
     fleet_file.write_text(
         text.replace(
             "\ngroups:",
             "  - id: E\n    spoken: [zone e, echo]\n    pose: {x: 9.0, y: 9.0}\n\ngroups:",
         )
     )
-    out = tmp_path / "skill-package"
-    assert skill_model_main(["--fleet", str(PACKAGE.parent / "fleet.yaml"), "--out", str(out)]) == 0
+    out = tmp_path / "checkout"
+    assert skill_model_main(["--fleet", str(FLEET_FILE), "--root", str(out)]) == 0
     # When --check runs against the changed fleet
-    assert skill_model_main(["--fleet", str(fleet_file), "--out", str(out), "--check"]) == 1
-    # Then it names the stale file, and regenerating makes the check pass
-    assert "en-US.json is out of date" in capsys.readouterr().err
-    assert skill_model_main(["--fleet", str(fleet_file), "--out", str(out)]) == 0
-    assert skill_model_main(["--fleet", str(fleet_file), "--out", str(out), "--check"]) == 0
+    assert skill_model_main(["--fleet", str(fleet_file), "--root", str(out), "--check"]) == 1
+    # Then it names the stale files, and regenerating makes the check pass
+    err = capsys.readouterr().err
+    assert "en-US.json is out of date" in err and "fleet.json is out of date" in err
+    assert "skill.json" not in err
+    assert skill_model_main(["--fleet", str(fleet_file), "--root", str(out)]) == 0
+    assert skill_model_main(["--fleet", str(fleet_file), "--root", str(out), "--check"]) == 0
     zones = json.loads((out / MODEL_PATH).read_text())["interactionModel"]["languageModel"]
     assert "E" in [value["id"] for value in zones["types"][1]["values"]]
 
@@ -80,7 +88,7 @@ def test_bad_fleet_file_is_one_line_error(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     missing = tmp_path / "nope.yaml"
-    assert skill_model_main(["--fleet", str(missing), "--out", str(tmp_path), "--check"]) == 2
+    assert skill_model_main(["--fleet", str(missing), "--root", str(tmp_path), "--check"]) == 2
     [line] = capsys.readouterr().err.strip().splitlines()
     assert line.startswith("python -m vahr.skill_model: error: fleet: cannot read")
 
@@ -101,7 +109,7 @@ def test_a_misspelled_field_would_not_survive_the_round_trip(model: dict[str, An
 
 
 def test_manifest_deserializes_with_ask_smapi_model_classes() -> None:
-    manifest = json.loads((PACKAGE / MANIFEST_PATH).read_text())
+    manifest = json.loads((ROOT / MANIFEST_PATH).read_text())
     serializer = DefaultSerializer()
     assert (
         serializer.serialize(serializer.deserialize(json.dumps(manifest), MANIFEST_TYPE))
@@ -223,7 +231,7 @@ def test_generator_refuses_a_sample_with_digits_or_punctuation(fleet: Fleet) -> 
 
 
 def test_generator_refuses_a_name_given_to_two_zones(fleet: Fleet) -> None:
-    text = (PACKAGE.parent / "fleet.yaml").read_text().replace("[zone b, b,", "[zone b, a,")
+    text = FLEET_FILE.read_text().replace("[zone b, b,", "[zone b, a,")
     with pytest.raises(ModelError, match="the name 'a' is used by both 'A' and 'B'"):
         build_interaction_model(Fleet.from_yaml(text), CUSTOM_INTENTS)
 
@@ -244,3 +252,37 @@ def test_weather_answer_is_the_sentence_robots_listen_for(skill: Any, aws: None)
     # The robots' interpreter recognises answers that start with exactly this sentence.
     text = speech(skill(load_event("alexa_weather"), None))
     assert text in ("The weather is sunny.", "The weather is rainy.")
+
+
+def test_the_fleet_twin_is_the_bundled_fleet(fleet: Fleet) -> None:
+    from skill import fleet_source
+
+    assert fleet_source.load() == fleet
+
+
+def test_a_stale_fleet_twin_is_ignored(tmp_path: Path, fleet: Fleet) -> None:
+    # Given a twin written from another fleet file than the bundled one
+    from skill import fleet_source
+
+    other = FLEET_FILE.read_bytes().replace(b"[zone d, d,", b"[zone d, dee, d,")
+    twin = tmp_path / "fleet.json"
+    twin.write_text(build_files(Fleet.from_yaml(other), other)[FLEET_TWIN_PATH])
+    # When the skill loads its fleet
+    loaded = fleet_source.load(twin_file=str(twin))
+    # Then it reads the bundled fleet.yaml itself
+    assert loaded == fleet
+    assert "dee" not in loaded.zone("D").spoken
+
+
+def test_a_missing_fleet_twin_falls_back_to_the_yaml(tmp_path: Path, fleet: Fleet) -> None:
+    from skill import fleet_source
+
+    assert fleet_source.load(twin_file=str(tmp_path / "none.json")) == fleet
+
+
+def test_a_configured_fleet_file_wins(tmp_path: Path) -> None:
+    from skill import fleet_source
+
+    custom = tmp_path / "fleet.yaml"
+    custom.write_text(FLEET_FILE.read_text().replace("placebot2", "placebot9"))
+    assert fleet_source.load(str(custom)).robot_things == ("placebot1", "placebot9")
