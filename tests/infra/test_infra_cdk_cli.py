@@ -1,0 +1,83 @@
+"""`cdk synth` as a user runs it: the pinned CLI, no AWS credentials, no network needed,
+the Lambda bundle built locally (no Docker), with and without the optional parts."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from typing import TYPE_CHECKING
+
+import pytest
+from template_tools import REPO_ROOT
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+CDK_CLI = REPO_ROOT / "node_modules" / "aws-cdk" / "bin" / "cdk"
+
+
+def cdk_synth(outdir: Path, *context: str) -> subprocess.CompletedProcess[str]:
+    # The environment a first-time user has: no credentials, no profile, no region.
+    environment = {
+        key: value for key, value in os.environ.items() if not key.startswith(("AWS_", "CDK_"))
+    }
+    environment.update(
+        AWS_CONFIG_FILE=str(outdir / "no-config"),
+        AWS_SHARED_CREDENTIALS_FILE=str(outdir / "no-credentials"),
+        CDK_DISABLE_CLI_TELEMETRY="true",
+        JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION="20",
+        JSII_RUNTIME_PACKAGE_CACHE_ROOT=str(REPO_ROOT / ".cache" / "jsii"),
+    )
+    flags = [arg for pair in context for arg in ("-c", pair)]
+    return subprocess.run(
+        ["node", str(CDK_CLI), "synth", "--quiet", "--no-notices", "-o", str(outdir), *flags],
+        capture_output=True, text=True, timeout=300, cwd=REPO_ROOT, env=environment,
+    )  # fmt: skip
+
+
+@pytest.mark.slow
+def test_cdk_synth_works_offline_without_credentials_with_and_without_options(
+    tmp_path: Path,
+) -> None:
+    assert CDK_CLI.is_file(), "run `make setup` (npm ci) to install the pinned CDK CLI"
+    outdir = tmp_path / "cdk.out"
+    # Given no credentials, When the default app is synthesized
+    lean = cdk_synth(outdir)
+    assert lean.returncode == 0, lean.stderr[-3000:]
+    lean_template = json.loads((outdir / "Vahr.template.json").read_text())
+    # Then the skill's code was bundled locally from the one build script
+    assets = json.loads((outdir / "Vahr.assets.json").read_text())["files"]
+    bundles = [
+        outdir / f["source"]["path"]
+        for f in assets.values()
+        if f["source"]["path"].startswith("asset.")
+    ]
+    skill_bundle = next(path for path in bundles if (path / "skill" / "app.py").exists())
+    assert (skill_bundle / "fleet.yaml").is_file()
+    assert (skill_bundle / "vahr" / "protocol" / "__init__.py").is_file()
+    # And cdk-nag passed with only acknowledged findings
+    [nag] = json.loads((outdir / "validation-report.json").read_text())["pluginReports"]
+    assert (nag["pluginName"], nag["conclusion"], nag["violations"]) == (
+        "AwsSolutions",
+        "success",
+        [],
+    )
+
+    # When the optional parts are switched on from the command line
+    full = cdk_synth(outdir, "skill=true", "lex=true")
+    assert full.returncode == 0, full.stderr[-3000:]
+    full_template = json.loads((outdir / "Vahr.template.json").read_text())
+
+    # Then the skill, the bot and the role alias appear, and only then
+    def types(template: dict[str, object]) -> set[str]:
+        return {r["Type"] for r in template["Resources"].values()}  # type: ignore[attr-defined]
+
+    optional = {"Alexa::ASK::Skill", "AWS::Lex::Bot", "AWS::Lex::BotAlias", "AWS::IoT::RoleAlias"}
+    assert optional <= types(full_template)
+    assert not optional & types(lean_template)
+
+    # And a bad flag is refused in one line, before anything is synthesized
+    bad = cdk_synth(tmp_path / "bad", "architecture=mips")
+    assert bad.returncode != 0
+    assert "error: architecture: 'mips' must be x86_64 or arm64" in bad.stderr
