@@ -10,8 +10,9 @@ from __future__ import annotations
 import threading
 import time
 from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
+
+import msgspec
 
 from skill.errors import GatewayError
 from vahr.protocol import ProtocolError, robot_shadow_from_payload
@@ -31,8 +32,7 @@ MAX_WORKERS = 8
 GRACE_S = 0.3
 
 
-@dataclass(frozen=True)
-class RobotAnswer:
+class RobotAnswer(msgspec.Struct, frozen=True):
     """What became of one command at one robot when the wait ended."""
 
     thing: str

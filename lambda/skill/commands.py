@@ -6,8 +6,9 @@ published once to `vahr/fleet/cmd`, and every robot then reports the same comman
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from skill.vocabulary import FLEET
 from vahr.protocol import check_against_fleet, new_command, topics
@@ -18,8 +19,7 @@ if TYPE_CHECKING:
 SOURCE = "alexa"
 
 
-@dataclass(frozen=True)
-class Dispatch:
+class Dispatch(msgspec.Struct, frozen=True):
     """One publish: the topic, the command, and the robots expected to acknowledge it."""
 
     topic: str

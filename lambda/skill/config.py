@@ -15,8 +15,9 @@ Every setting has a default, so the handler runs with only a region configured:
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from skill.errors import ConfigError
 
@@ -25,18 +26,19 @@ if TYPE_CHECKING:
 
 # Alexa waits 8 s for an answer; publishing and speaking need some of it.
 MAX_ACK_TIMEOUT_S = 6.0
+DEFAULT_ACK_TIMEOUT_S = 2.5
+DEFAULT_LOG_LEVEL = "INFO"
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
 
 
-@dataclass(frozen=True)
-class SkillConfig:
+class SkillConfig(msgspec.Struct, frozen=True):
     """Validated settings; build it with `from_env` (or directly in tests and the simulator)."""
 
     data_endpoint: str | None = None
     skill_id: str | None = None
-    ack_timeout_s: float = 2.5
+    ack_timeout_s: float = DEFAULT_ACK_TIMEOUT_S
     fleet_file: str | None = None
-    log_level: str = "INFO"
+    log_level: str = DEFAULT_LOG_LEVEL
     # Where boto3 finds no region (a local endpoint needs none), sign for this one.
     fallback_region: str = "us-east-1"
 
@@ -66,7 +68,7 @@ def _as_url(endpoint: str) -> str:
 
 def _ack_timeout(raw: str | None) -> float:
     if _blank_to_none(raw) is None:
-        return SkillConfig.ack_timeout_s
+        return DEFAULT_ACK_TIMEOUT_S
     assert raw is not None
     try:
         value = float(raw)
@@ -81,7 +83,7 @@ def _ack_timeout(raw: str | None) -> float:
 
 
 def _log_level(raw: str | None) -> str:
-    level = (_blank_to_none(raw) or SkillConfig.log_level).upper()
+    level = (_blank_to_none(raw) or DEFAULT_LOG_LEVEL).upper()
     if level not in LOG_LEVELS:
         raise ConfigError(f"VAHR_LOG_LEVEL: {raw!r} is not one of {', '.join(LOG_LEVELS)}")
     return level

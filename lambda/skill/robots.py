@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from skill.acknowledgment import MAX_WORKERS, await_acknowledgments
 from skill.errors import GatewayError
@@ -25,8 +26,7 @@ if TYPE_CHECKING:
     from vahr.protocol import RobotShadow
 
 
-@dataclass(frozen=True)
-class ShadowRead:
+class ShadowRead(msgspec.Struct, frozen=True):
     """A robot's shadow (None if it has none yet), or the error that kept it from being read."""
 
     thing: str

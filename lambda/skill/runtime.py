@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import random
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from skill import fleet_source
 from skill.robots import Robots
@@ -16,8 +17,7 @@ if TYPE_CHECKING:
     from vahr.protocol import Fleet
 
 
-@dataclass(frozen=True)
-class SkillRuntime:
+class SkillRuntime(msgspec.Struct, frozen=True):
     """The skill's long-lived collaborators, shared by every request of a Lambda instance."""
 
     config: SkillConfig

@@ -7,8 +7,9 @@ looked up in the fleet's names, so the same words work either way.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Collection
@@ -18,8 +19,7 @@ if TYPE_CHECKING:
 MATCH = "ER_SUCCESS_MATCH"
 
 
-@dataclass(frozen=True)
-class SlotReading:
+class SlotReading(msgspec.Struct, frozen=True):
     """One slot as heard: `heard` is None when missing, `id` is None when it did not resolve."""
 
     name: str
