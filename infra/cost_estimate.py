@@ -1,0 +1,160 @@
+"""The monthly AWS cost of a VAHR lab, computed from billable operation counts.
+
+    python -m infra.cost_estimate [--lex] [--skill]
+
+Every count comes from what the code does on the wire (DESIGN.md's loop, the robot's
+events and shadow updates, the skill's publish-then-poll), multiplied out for the usage
+below; every price is a us-east-1 list price. docs/deploy.md shows this script's output,
+and a test keeps the two in step.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+PRICES_AS_OF = "2026-11-22"
+
+
+@dataclass(frozen=True)
+class Prices:
+    """us-east-1 list prices, USD."""
+
+    connection_minute: float = 0.08 / 1e6  # AWS IoT Core connectivity
+    message: float = 1.00 / 1e6  # AWS IoT Core messaging, per 5 KB message (first billion)
+    shadow_operation: float = 1.25 / 1e6  # Device Shadow and registry, per 1 KB operation
+    rule_triggered: float = 0.15 / 1e6
+    rule_action: float = 0.15 / 1e6
+    lambda_request: float = 0.20 / 1e6
+    lambda_gb_second: float = 0.0000166667  # x86_64 (arm64: 0.0000133334)
+    lex_text_request: float = 0.00075  # Lex V2 RecognizeText
+    log_ingestion_gb: float = 0.50  # CloudWatch Logs
+    secret_month: float = 0.40  # Secrets Manager, the Login-with-Amazon secret
+
+
+@dataclass(frozen=True)
+class LabUsage:
+    """The paper's usage: two robots, a study of voice and keyboard sessions in one month."""
+
+    robots: int = 2
+    lab_days: int = 22
+    robot_hours_per_day: float = 8.0
+    # 20 participants x 2 trials with each method, plus 20 rehearsal and demo runs by voice.
+    voice_sessions: int = 60
+    keyboard_sessions: int = 40
+    session_minutes: float = 15.0
+    # Per session: task I two deliveries, task II one, task III two (DESIGN.md, docs/experiment.md).
+    deliveries_per_session: int = 5
+    # Voice: four commands, the robot's weather question, three status questions, and one
+    # in four utterances repeated (misheard, or asked again).
+    skill_requests_per_voice_session: float = 10.0
+    # The robot asks the weather once per session, sometimes twice.
+    weather_questions_per_session: float = 1.25
+    # A delivery drives ~16 m at 0.5 m/s: a progress event each second plus accepted,
+    # arrived (x2), loaded, delivered and done; about ten shadow updates (status,
+    # destination, zone, cargo, last_command) as its state changes.
+    events_per_delivery: int = 40
+    shadow_updates_per_delivery: int = 10
+    # Who receives a robot's event: its peer and the experiment recorder.
+    event_subscribers: int = 2
+    # A command reaches its robot and the recorder.
+    command_subscribers: int = 2
+    # The skill polls the shadow until acknowledged (about four reads), each document
+    # with its metadata is 1-2 KB: 2 units per read.
+    shadow_reads_per_skill_request: float = 4.0
+    shadow_units_per_read: int = 2
+    skill_seconds: float = 0.7
+    skill_memory_gb: float = 0.5
+    log_bytes_per_skill_request: int = 2_000
+    # Per robot per lab day: CONNECT, retained presence (publish + retained), twelve
+    # SUBSCRIBEs, and the last will on shutdown.
+    session_messages_per_robot_day: int = 17
+
+
+@dataclass(frozen=True)
+class Line:
+    item: str
+    quantity: float
+    unit: str
+    cost: float
+
+
+def estimate(usage: LabUsage, prices: Prices, *, lex: bool, skill: bool) -> list[Line]:
+    """One line per billable dimension."""
+    sessions = usage.voice_sessions + usage.keyboard_sessions
+    deliveries = sessions * usage.deliveries_per_session
+    skill_requests = usage.voice_sessions * usage.skill_requests_per_voice_session
+    commands = sessions * usage.deliveries_per_session  # one command per delivery
+    connection_minutes = (
+        usage.robots * usage.lab_days * usage.robot_hours_per_day * 60
+        + sessions * usage.session_minutes  # the experiment recorder
+    )
+    # Every metered message: an inbound PUBLISH (or HTTP publish) counts once, each
+    # delivery to a QoS 1 subscriber twice (the PUBLISH out and the device's PUBACK).
+    messages = (
+        commands * (1 + 2 * usage.command_subscribers)
+        + deliveries * usage.events_per_delivery * (1 + 2 * usage.event_subscribers)
+        # A shadow update over MQTT: the request in, update/accepted out and its PUBACK.
+        + deliveries * usage.shadow_updates_per_delivery * 3
+        + usage.robots * usage.lab_days * usage.session_messages_per_robot_day
+    )
+    presence_changes = usage.robots * usage.lab_days * 2  # online in the morning, offline
+    shadow_units = (
+        deliveries * usage.shadow_updates_per_delivery
+        + skill_requests * usage.shadow_reads_per_skill_request * usage.shadow_units_per_read
+        + presence_changes  # the presence rule's shadow update
+        + sessions  # the experiment plan written to the experiment thing's shadow
+    )
+    gb_seconds = skill_requests * usage.skill_seconds * usage.skill_memory_gb
+    lines = [
+        Line("IoT connectivity", connection_minutes, "connection-minutes",
+             connection_minutes * prices.connection_minute),
+        Line("IoT messages", messages, "messages (5 KB)", messages * prices.message),
+        Line("Device Shadow operations", shadow_units, "operations (1 KB)",
+             shadow_units * prices.shadow_operation),
+        Line("Rules (presence)", presence_changes, "rules + actions",
+             presence_changes * (prices.rule_triggered + prices.rule_action)),
+        Line("Lambda requests", skill_requests, "requests", skill_requests * prices.lambda_request),
+        Line("Lambda compute", gb_seconds, "GB-seconds", gb_seconds * prices.lambda_gb_second),
+        Line("CloudWatch Logs", skill_requests * usage.log_bytes_per_skill_request / 1e9,
+             "GB ingested",
+             skill_requests * usage.log_bytes_per_skill_request / 1e9 * prices.log_ingestion_gb),
+    ]  # fmt: skip
+    if lex:
+        questions = sessions * usage.weather_questions_per_session
+        lines.append(
+            Line("Lex text requests", questions, "requests", questions * prices.lex_text_request)
+        )
+    if skill:
+        lines.append(Line("Secrets Manager", 1, "secret-month", prices.secret_month))
+    return lines
+
+
+def markdown(lines: list[Line]) -> str:
+    """The estimate as a Markdown table with a total."""
+    rows = ["| item | quantity per month | unit | USD |", "| --- | ---: | --- | ---: |"]
+    for line in lines:
+        quantity = f"{line.quantity:,.0f}" if line.quantity >= 10 else f"{line.quantity:.3g}"
+        rows.append(f"| {line.item} | {quantity} | {line.unit} | {line.cost:.4f} |")
+    total = math.fsum(line.cost for line in lines)
+    rows.append(f"| **total** | | | **{total:.2f}** |")
+    return "\n".join(rows)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m infra.cost_estimate", description=__doc__)
+    parser.add_argument("--lex", action="store_true", help="robots interpret answers with Lex")
+    parser.add_argument("--skill", action="store_true", help="the skill is deployed by CDK")
+    args = parser.parse_args(argv)
+    print(markdown(estimate(LabUsage(), Prices(), lex=args.lex, skill=args.skill)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
