@@ -19,6 +19,7 @@ Commands sent by the assistant between `u` and `r` are attributed to that uttera
 from __future__ import annotations
 
 import itertools
+import os
 import select
 import sys
 import time
@@ -45,15 +46,18 @@ class ObserverConsole:
         log: EventLog,
         console: Console,
         stdin: TextIO = sys.stdin,
-        out: Callable[[str], None] = print,
+        out: Callable[[str], None] | None = None,
     ) -> None:
         self.log = log
         self.console = console
         self.stdin = stdin
-        self.out = out
+        # Prompts go to stderr, so `--json` output on stdout stays one clean document.
+        self.out = out or (lambda line: print(line, file=sys.stderr, flush=True))
         self._ids = itertools.count(1)
         self._open: dict[str, Any] | None = None
         self._task: str | None = None
+        self._buffer = ""
+        self._closed = False
 
     def perform(self, task: str) -> None:
         self._task = task
@@ -63,11 +67,27 @@ class ObserverConsole:
         )
 
     def _line(self, timeout_s: float) -> str | None:
-        ready, _, _ = select.select([self.stdin], [], [], timeout_s)
-        if not ready:
-            return None
-        line = self.stdin.readline()
-        return line.strip() if line else "e"  # end of input ends the task
+        """The next line typed, or None after `timeout_s`; "e" once input has ended.
+
+        Reads the file descriptor directly: a buffered readline could swallow several lines
+        while select() then reports nothing more to read.
+        """
+        if "\n" not in self._buffer and not self._closed:
+            ready, _, _ = select.select([self.stdin], [], [], timeout_s)
+            if ready:
+                chunk = os.read(self.stdin.fileno(), 4096)
+                self._buffer += chunk.decode("utf-8", "replace")
+                self._closed = not chunk
+        if "\n" in self._buffer:
+            line, self._buffer = self._buffer.split("\n", 1)
+            return line.strip()
+        if self._closed:
+            if self._buffer:
+                line, self._buffer = self._buffer, ""
+                return line.strip()
+            time.sleep(timeout_s)  # input ended: nothing more will come, keep waiting politely
+            return "e"
+        return None
 
     def wait(self, decided: Callable[[], bool], timeout_s: float) -> bool:
         deadline = time.monotonic() + timeout_s

@@ -194,3 +194,85 @@ def test_a_session_cut_mid_task_resumes_without_repeating_or_losing_anything(
     sent = [e.data["action"] for e in after if e.kind == Kind.COMMAND]
     assert sent == ["deliver", "deliver", "deliver", "deliver", "sequential_delivery"]
     assert all(body["success"] for body in summary["verdict"]["tasks"].values()), summary
+
+
+def test_an_observed_keyboard_session_with_a_person_at_the_console(
+    tmp_path: Path,
+    mosquitto: Mosquitto,
+    robot_agents: RobotAgents,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import os
+    import threading
+    import time
+
+    from vahr.experiment.tasks import draw_plan
+    from vahr.protocol import load_fleet
+
+    logs = tmp_path / "logs"
+    plan = draw_plan(load_fleet(), 21)
+    path = logs / "P05-keyboard-trial2.sqlite"
+    # What the observer types during each task: the participant's clicks and puzzle pieces
+    typed = {
+        "I": ["p", *[f"send {t} deliver {z}" for t, z in plan.assignments.items()], "p 2"],
+        "II": [f"send placebot1 deliver {'A' if plan.weather == 'sunny' else 'C'}"],
+        "III": ["k", "send placebot1 deliver D", "send placebot2 sequential_delivery D placebot1"],
+    }
+    read_end, write_end = os.pipe()
+    stop = threading.Event()
+
+    def observer_types() -> None:
+        done: set[str] = set()
+        while not stop.is_set() and len(done) < 3:
+            started = (
+                [e.data["task"] for e in read_log(path) if e.kind == Kind.TASK_STARTED]
+                if path.exists()
+                else []
+            )
+            for task in started:
+                if task not in done:
+                    done.add(task)
+                    os.write(write_end, "".join(f"{line}\n" for line in typed[task]).encode())
+            time.sleep(0.05)
+
+    typist = threading.Thread(target=observer_types)
+    typist.start()
+    try:
+        with os.fdopen(read_end) as keyboard:
+            monkeypatch.setattr("sys.stdin", keyboard)
+            # When a session with a person runs (no --simulate), the observer at the keyboard
+            code = main(
+                [
+                    "experiment",
+                    "--participant",
+                    "P05",
+                    "--method",
+                    "keyboard",
+                    "--trial",
+                    "2",
+                    "--seed",
+                    "21",
+                    "--log-dir",
+                    str(logs),
+                    "--broker",
+                    str(mosquitto.plain_url),
+                    "--no-shadow",
+                    "--task-timeout",
+                    "30",
+                    "--json",
+                ]
+            )
+    finally:
+        stop.set()
+        typist.join(10)
+        os.close(write_end)
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out)
+    # Then the console's clicks drove the robots and every task succeeded
+    assert summary["simulated"] is False
+    assert all(body["success"] for body in summary["verdict"]["tasks"].values()), summary
+    entries = read_log(path)
+    assert sum(e.data.get("count", 0) for e in entries if e.kind == Kind.OBSERVER) == 3
+    clicks = [e.data for e in entries if e.kind == Kind.INTERACTION_ENDED]
+    assert len(clicks) == 5 and all(c["channel"] == "click" and c["commands"] for c in clicks)
