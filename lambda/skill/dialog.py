@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from skill import prompts
-from skill.responses import elicit
+from skill.responses import answer, elicit, may_ask_again
 from skill.slots import read_slot
 from skill.vocabulary import LOADING
 
@@ -45,7 +45,14 @@ def ask_robot(
     if reading.unresolved and not preface:
         preface = prompts.UNKNOWN_ROBOT.format(heard=reading.heard)
     choices = runtime.vocabulary.robot_choices(include_fleet=include_fleet)
-    return elicit(handler_input, reading.name, preface + question.format(choices=choices))
+    return _ask(handler_input, runtime, reading.name, preface + question.format(choices=choices))
+
+
+def _ask(handler_input: HandlerInput, runtime: SkillRuntime, slot: str, question: str) -> Response:
+    # A person who keeps being misheard needs a way out, not a fourth question.
+    if not may_ask_again(handler_input):
+        return answer(handler_input, prompts.GIVE_UP.format(**runtime.vocabulary.examples()))
+    return elicit(handler_input, slot, question)
 
 
 def delivery_zone_problem(reading: SlotReading) -> bool:
@@ -69,4 +76,4 @@ def ask_zone(
     robot_name = runtime.vocabulary.robot(robot_id) if robot_id else ""
     choices = runtime.vocabulary.zone_choices(deliverable=deliverable)
     text = question.format(choices=choices, robot=robot_name)
-    return elicit(handler_input, reading.name, preface + text)
+    return _ask(handler_input, runtime, reading.name, preface + text)

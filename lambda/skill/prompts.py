@@ -42,6 +42,9 @@ UNKNOWN_ROBOT = "I don't know a robot called {heard}. "
 UNKNOWN_ZONE = "I don't know a zone called {heard}. "
 NEEDS_ONE_ROBOT = "A sequential delivery needs one robot at a time. "
 SAME_ROBOT = "{robot} already delivers first. "
+GIVE_UP = (
+    "Sorry, I still did not get that, so I sent nothing. Try, for example: send {robot} to {zone}."
+)
 
 # Acknowledged commands, by action. {robot} is capitalised when it starts the sentence.
 ACKNOWLEDGED = {

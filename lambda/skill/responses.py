@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from ask_sdk_model import Slot, SlotConfirmationStatus
 from ask_sdk_model.dialog import ElicitSlotDirective
 
 from skill import prompts
@@ -19,27 +20,39 @@ if TYPE_CHECKING:
 
 # Set by the LaunchRequest handler: the person opened the skill and expects a conversation.
 CONVERSATION = "conversation"
+# How many questions in a row the skill has asked for one command. After MAX_QUESTIONS it
+# stops asking: a person who keeps being misheard needs a way out, not another question.
+QUESTIONS = "questions"
+MAX_QUESTIONS = 3
+
+
+def _attributes(handler_input: HandlerInput) -> dict[str, object] | None:
+    if handler_input.request_envelope.session is None:
+        return None
+    manager = handler_input.attributes_manager
+    if manager.session_attributes is None:
+        manager.session_attributes = {}
+    attributes: dict[str, object] | None = manager.session_attributes
+    return attributes
 
 
 def in_conversation(handler_input: HandlerInput) -> bool:
-    if handler_input.request_envelope.session is None:
-        return False
-    attributes = handler_input.attributes_manager.session_attributes or {}
+    attributes = _attributes(handler_input) or {}
     return bool(attributes.get(CONVERSATION))
 
 
 def start_conversation(handler_input: HandlerInput) -> None:
     """Remember, for the rest of the session, that the person opened the skill."""
-    if handler_input.request_envelope.session is None:
-        return
-    attributes = handler_input.attributes_manager.session_attributes
-    if attributes is None:
-        attributes = handler_input.attributes_manager.session_attributes = {}
-    attributes[CONVERSATION] = True
+    attributes = _attributes(handler_input)
+    if attributes is not None:
+        attributes[CONVERSATION] = True
 
 
 def answer(handler_input: HandlerInput, speech: str) -> Response:
     """Speak `speech`; in a conversation, also ask what is next and keep listening."""
+    attributes = _attributes(handler_input)
+    if attributes is not None:
+        attributes.pop(QUESTIONS, None)
     builder = handler_input.response_builder
     if in_conversation(handler_input):
         return builder.speak(f"{speech} {prompts.NEXT}").ask(prompts.NEXT).response
@@ -55,16 +68,30 @@ def end(handler_input: HandlerInput, speech: str) -> Response:
     return handler_input.response_builder.speak(speech).set_should_end_session(True).response
 
 
+def may_ask_again(handler_input: HandlerInput) -> bool:
+    """Count one more question for this command; False once MAX_QUESTIONS were asked."""
+    attributes = _attributes(handler_input)
+    if attributes is None:
+        return True
+    asked = int(str(attributes.get(QUESTIONS, 0))) + 1
+    attributes[QUESTIONS] = asked
+    return asked <= MAX_QUESTIONS
+
+
 def elicit(handler_input: HandlerInput, slot_name: str, question: str) -> Response:
     """Ask for one slot (Dialog.ElicitSlot), forgetting any value that did not resolve."""
     request: IntentRequest = handler_input.request_envelope.request  # type: ignore[assignment]
     intent = request.intent
     assert intent is not None
-    slot = (intent.slots or {}).get(slot_name)
-    if slot is not None:
-        slot.value = None
-        slot.resolutions = None
-        slot.slot_value = None
+    if intent.slots is None:
+        intent.slots = {}
+    # The updated intent must carry the slot being asked for, even if the request left it out.
+    slot = intent.slots.setdefault(
+        slot_name, Slot(name=slot_name, confirmation_status=SlotConfirmationStatus.NONE)
+    )
+    slot.value = None
+    slot.resolutions = None
+    slot.slot_value = None
     return (
         handler_input.response_builder.speak(question)
         .ask(question)

@@ -105,3 +105,16 @@ class Vocabulary:
         """The zones to choose from; `deliverable` leaves out the loading zone."""
         zone_ids = [z for z in self.fleet.zone_ids if not (deliverable and z == LOADING)]
         return join_choices([self.zone(zone_id) for zone_id in zone_ids])
+
+    def examples(self) -> dict[str, str]:
+        """Real names for example sentences: two robots and two delivery zones."""
+        things = self.fleet.robot_things
+        zones = [zone for zone in self.fleet.zone_ids if zone != LOADING] or list(
+            self.fleet.zone_ids
+        )
+        return {
+            "robot": self.robot(things[0]),
+            "other": self.robot(things[1 % len(things)]),
+            "zone": self.zone(zones[0]),
+            "other_zone": self.zone(zones[1 % len(zones)]),
+        }

@@ -19,19 +19,6 @@ if TYPE_CHECKING:
     from skill.runtime import SkillRuntime
 
 
-def _examples(runtime: SkillRuntime) -> dict[str, str]:
-    """Real names from the fleet for the example sentences in help and fallback."""
-    vocabulary, fleet = runtime.vocabulary, runtime.fleet
-    things = fleet.robot_things
-    zones = [zone for zone in fleet.zone_ids if zone != "LOADING"] or list(fleet.zone_ids)
-    return {
-        "robot": vocabulary.robot(things[0]),
-        "other": vocabulary.robot(things[1 % len(things)]),
-        "zone": vocabulary.zone(zones[0]),
-        "other_zone": vocabulary.zone(zones[1 % len(zones)]),
-    }
-
-
 class LaunchRequestHandler(AbstractRequestHandler):
     """ "Alexa, open robot fleet": greet and keep the conversation open."""
 
@@ -43,7 +30,7 @@ class LaunchRequestHandler(AbstractRequestHandler):
 
     def handle(self, handler_input: HandlerInput) -> Response:
         start_conversation(handler_input)
-        reprompt = prompts.WELCOME_REPROMPT.format(**_examples(self.runtime))
+        reprompt = prompts.WELCOME_REPROMPT.format(**self.runtime.vocabulary.examples())
         return ask(handler_input, prompts.WELCOME, reprompt)
 
 
@@ -58,7 +45,7 @@ class HelpIntentHandler(AbstractRequestHandler):
 
     def handle(self, handler_input: HandlerInput) -> Response:
         start_conversation(handler_input)
-        speech = prompts.HELP.format(**_examples(self.runtime))
+        speech = prompts.HELP.format(**self.runtime.vocabulary.examples())
         return ask(handler_input, speech, prompts.HELP_REPROMPT)
 
 
@@ -102,7 +89,7 @@ class FallbackIntentHandler(AbstractRequestHandler):
         return bool(is_intent_name("AMAZON.FallbackIntent")(handler_input))
 
     def handle(self, handler_input: HandlerInput) -> Response:
-        speech = prompts.FALLBACK.format(**_examples(self.runtime))
+        speech = prompts.FALLBACK.format(**self.runtime.vocabulary.examples())
         return ask(handler_input, speech, prompts.FALLBACK_REPROMPT)
 
 

@@ -122,3 +122,32 @@ def test_answered_elicitation_completes_the_command(skill: Any, robots: Any) -> 
     assert [topic for topic, _ in published()] == ["vahr/robots/placebot2/cmd"]
     assert speech(response) == "Placebot two is on its way to zone D."
     assert "directives" not in response["response"]
+
+
+def test_after_three_questions_the_skill_stops_asking(skill: Any, aws: None) -> None:
+    # Given a person whose zone is misheard again and again
+    request = load_event("alexa_navigate_zone_no_match")
+    questions = []
+    for _ in range(4):
+        response = skill(request, None)
+        questions.append(speech(response))
+        request["session"]["attributes"] = response["sessionAttributes"]
+    # Then the skill asked three times, then gave up with a hint and sent nothing
+    assert questions[:3] == [questions[0]] * 3
+    assert questions[3] == (
+        "Sorry, I still did not get that, so I sent nothing. Try, for example: send placebot "
+        "one to zone A."
+    )
+    assert response["response"]["shouldEndSession"] is True
+    assert "directives" not in response["response"]
+    assert published() == []
+
+
+def test_a_slot_left_out_of_the_request_is_added_to_the_updated_intent(
+    skill: Any, aws: None
+) -> None:
+    request = load_event("alexa_navigate_missing_zone")
+    del request["request"]["intent"]["slots"]["zone"]
+    slot, updated_intent = elicited(skill(request, None))
+    assert slot == "zone"
+    assert updated_intent["slots"]["zone"] == {"name": "zone", "confirmationStatus": "NONE"}
