@@ -45,12 +45,12 @@ class ObserverConsole:
         *,
         log: EventLog,
         console: Console,
-        stdin: TextIO = sys.stdin,
+        stdin: TextIO | None = None,
         out: Callable[[str], None] | None = None,
     ) -> None:
         self.log = log
         self.console = console
-        self.stdin = stdin
+        self.stdin = stdin if stdin is not None else sys.stdin  # looked up now, not at import
         # Prompts go to stderr, so `--json` output on stdout stays one clean document.
         self.out = out or (lambda line: print(line, file=sys.stderr, flush=True))
         self._ids = itertools.count(1)
