@@ -3,7 +3,8 @@
 Context flags (cdk.json or `-c key=value`): `skill=true` adds the Alexa skill, `lex=true`
 the Lex bot and the robots' role alias; `skillId`, `vendorId`, `lwaSecretName`,
 `architecture`, `fleetFile`, `logRetentionDays`, `ackTimeoutS`, `logLevel`, `stackName`,
-`robotPolicyName`, `roleAliasName`, `weatherAnswersFile` (docs/deploy.md lists them all).
+`robotPolicyName`, `operatorPolicyName`, `roleAliasName`, `weatherAnswersFile`
+(docs/deploy.md lists them all).
 cdk-nag's AwsSolutions checks run on the whole app; synth fails on any finding that the
 stack has not acknowledged with a reason.
 """

@@ -37,6 +37,7 @@ class InfraConfig:
     ack_timeout_s: float = 2.5
     log_level: str = "INFO"
     robot_policy_name: str = "vahr-robot-policy"
+    operator_policy_name: str = "vahr-operator-policy"
     thing_group_name: str = "vahr-robots"
     presence_rule_name: str = "vahr_presence_to_shadow"
     # Known only after the skill exists (`ask deploy` prints it); when set, only that skill
@@ -83,6 +84,9 @@ class InfraConfig:
             ack_timeout_s=ack_timeout,
             log_level=(_text(get, "logLevel") or defaults.log_level).upper(),
             robot_policy_name=_text(get, "robotPolicyName") or defaults.robot_policy_name,
+            operator_policy_name=(
+                _text(get, "operatorPolicyName") or defaults.operator_policy_name
+            ),
             skill_id=skill_id,
             skill=_flag(get, "skill"),
             skill_package_dir=_path(get, "skillPackageDir", defaults.skill_package_dir),
@@ -94,6 +98,7 @@ class InfraConfig:
         )
         for key, value in (
             ("robotPolicyName", config.robot_policy_name),
+            ("operatorPolicyName", config.operator_policy_name),
             ("roleAliasName", config.role_alias_name),
         ):
             if not _NAME.match(value):

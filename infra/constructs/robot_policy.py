@@ -51,8 +51,10 @@ def robot_topics() -> dict[str, list[str]]:
     ]
     return {
         "publish": publish,
-        # Presence is retained so a peer that connects later still learns who is online.
-        "retain": [_own(topics.robot_presence(_MARK))],
+        # Retained so a peer that connects later still learns who is online (presence,
+        # also the last will) and who has already delivered (the `delivered` event, which
+        # a sequential delivery waits for).
+        "retain": [_own(topics.robot_events(_MARK)), _own(topics.robot_presence(_MARK))],
         "subscribe": listen,
         "receive": listen,
     }
@@ -81,7 +83,7 @@ def robot_policy_document(*, arn_prefix: str, role_alias_arn: str | None = None)
             "Resource": arns("topic", allowed["publish"]),
         },
         {
-            "Sid": "RetainOwnPresence",
+            "Sid": "RetainOwnEventsPresence",
             "Effect": "Allow",
             "Action": "iot:RetainPublish",
             "Resource": arns("topic", allowed["retain"]),

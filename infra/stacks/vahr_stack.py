@@ -10,6 +10,7 @@ from aws_cdk import aws_logs as logs
 from infra.constructs.alexa_skill import AlexaSkill
 from infra.constructs.iot_endpoint import IotEndpoint
 from infra.constructs.iot_fleet import IotFleet
+from infra.constructs.operator_policy import OperatorPolicy
 from infra.constructs.presence_rule import PresenceRule
 from infra.constructs.robot_policy import RobotPolicy
 from infra.constructs.skill_function import SkillFunction
@@ -24,7 +25,8 @@ if TYPE_CHECKING:
 
 
 class VahrStack(cdk.Stack):
-    """IoT fleet, robot policy, presence rule, skill function; optionally skill and Lex bot."""
+    """IoT fleet, robot and operator policies, presence rule, skill function; optionally the
+    Alexa skill and the Lex bot."""
 
     def __init__(
         self,
@@ -68,6 +70,12 @@ class VahrStack(cdk.Stack):
             "RobotPolicy",
             policy_name=config.robot_policy_name,
             role_alias_arn=self.weather_bot.role_alias_arn if self.weather_bot else None,
+        )
+        self.operator_policy = OperatorPolicy(
+            self,
+            "OperatorPolicy",
+            policy_name=config.operator_policy_name,
+            things=fleet.robot_things,
         )
         self.presence = PresenceRule(
             self, "Presence", rule_name=config.presence_rule_name, things=fleet.robot_things
@@ -158,6 +166,11 @@ class VahrStack(cdk.Stack):
         output("ThingNames", ",".join(self.fleet.thing_names), "The robots' thing names")
         output("ExperimentThing", self.fleet.experiment_thing_name, "The experiment's thing")
         output("RobotPolicyName", config.robot_policy_name, "IoT policy for robot certificates")
+        output(
+            "OperatorPolicyName",
+            config.operator_policy_name,
+            "IoT policy for the experiment recorder's and console's certificates",
+        )
         if self.weather_bot is not None and self.credentials_endpoint is not None:
             output(
                 "CredentialsEndpoint",

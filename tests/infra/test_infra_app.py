@@ -35,6 +35,7 @@ def test_the_lean_app_has_the_core_and_no_optional_parts(lean_app: Synthesized) 
     assert not found & set(OPTIONAL_TYPES)
     assert set(lean_app.template["Outputs"]) == {
         "IotDataEndpoint", "SkillFunctionArn", "ThingNames", "ExperimentThing", "RobotPolicyName",
+        "OperatorPolicyName",
     }  # fmt: skip
 
 
@@ -44,7 +45,11 @@ def test_the_full_app_adds_the_skill_the_bot_and_the_role_alias(full_app: Synthe
         full_app.template["Outputs"]
     )
     # The robot policy gains the right to use the role alias
-    policy = only(full_app.template, "AWS::IoT::Policy")["PolicyDocument"]
+    policy = next(
+        p["PolicyDocument"]
+        for p in resources(full_app.template, "AWS::IoT::Policy").values()
+        if p["PolicyName"] == "vahr-robot-policy"
+    )
     assert "ExchangeCertificateForLexCredentials" in {s["Sid"] for s in policy["Statement"]}
 
 

@@ -55,6 +55,7 @@ def test_the_policy_states_exactly_the_robot_rights(document: dict[str, Any]) ->
             f"$aws/things/{me}/shadow/update", f"$aws/things/{me}/shadow/get",
             f"$aws/things/{me}/shadow/delete",
         ]),
+        ("Allow", "iot:RetainPublish", f"{PREFIX}:topic/vahr/robots/{me}/events"),
         ("Allow", "iot:RetainPublish", f"{PREFIX}:topic/vahr/robots/{me}/presence"),
         *(("Allow", "iot:Subscribe", f"{PREFIX}:topicfilter/{t}") for t in listen),
         *(("Allow", "iot:Receive", f"{PREFIX}:topic/{t}") for t in listen),
@@ -89,12 +90,14 @@ def test_a_robot_uses_its_own_topics_and_is_denied_its_peers(
     assert not robot.can_subscribe(topics.robot_cmd(peer))
     assert not robot.can_receive(topics.robot_cmd(peer))
     assert not robot.can_publish(topics.robot_cmd(peer))
-    # Its own events and presence (retained): publish; the peer's: read only
-    assert robot.can_publish(topics.robot_events(me))
+    # Its own events and presence, also retained: publish; the peer's: read only
+    assert robot.can_publish(topics.robot_events(me), retain=True)
     assert robot.can_publish(topics.robot_presence(me), retain=True)
-    assert not robot.can_publish(topics.robot_events(me), retain=True)
     assert not robot.can_publish(topics.robot_events(peer))
-    assert not robot.can_publish(topics.robot_presence(peer))
+    assert not robot.can_publish(topics.robot_events(peer), retain=True)
+    assert not robot.can_publish(topics.robot_presence(peer), retain=True)
+    # Retaining is for its events and presence only, not for shadow requests
+    assert not robot.can_publish(topics.shadow(me, "update"), retain=True)
     for topic in (topics.robot_events(peer), topics.robot_presence(peer)):
         assert robot.can_subscribe(topic) and robot.can_receive(topic)
     assert robot.can_subscribe(topics.ALL_EVENTS) and robot.can_subscribe(topics.ALL_PRESENCE)
