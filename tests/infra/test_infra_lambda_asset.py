@@ -49,7 +49,8 @@ def bundle(tmp_path_factory: pytest.TempPathFactory) -> lambda_asset.BuildResult
 def run_in_lambda_python(bundle: Path, script: str, **env: str) -> subprocess.CompletedProcess[str]:
     """Run `script` in an isolated 3.12 interpreter that sees only the bundle and boto3."""
     path = [str(bundle), str(lambda_asset.runtime_site())]
-    prologue = f"import sys; sys.path[:0] = {path!r}\n"
+    # Lambda's code directory is read-only: nothing may be compiled into it on the way.
+    prologue = f"import sys; sys.dont_write_bytecode = True; sys.path[:0] = {path!r}\n"
     environment = {
         "PATH": "/usr/bin:/bin", "AWS_REGION": "us-east-1", "AWS_DEFAULT_REGION": "us-east-1",
         "AWS_ACCESS_KEY_ID": "testing", "AWS_SECRET_ACCESS_KEY": "testing",
@@ -222,3 +223,28 @@ def test_the_command_line_prints_one_summary_line(tmp_path: Path) -> None:
     assert result.stdout.startswith(f"{tmp_path / 'out'}: ")
     assert "MB unzipped" in result.stdout
     assert (tmp_path / "skill.zip").stat().st_size > 0
+
+
+def test_an_arm64_bundle_carries_aarch64_extensions(tmp_path: Path) -> None:
+    # Given -c architecture=arm64, When the bundle is built on this x86_64 machine
+    arm = lambda_asset.build(tmp_path / "arm64", architecture="arm64")
+    # Then its compiled modules are for Graviton, not for this machine
+    extensions = [path.name for path in arm.out_dir.rglob("*.so")]
+    assert extensions
+    assert all("cpython-312-aarch64-linux-gnu" in name for name in extensions), extensions
+
+
+def test_a_precompiled_bundle_loads_from_byte_code_and_stays_under_the_limit(
+    tmp_path: Path,
+) -> None:
+    # Given a bundle precompiled by CPython 3.12
+    compiled = lambda_asset.build(tmp_path / "compiled", compile_with=lambda_python())
+    assert compiled.size_bytes < MAX_UNZIPPED_BYTES
+    # When a clean 3.12 that may not write byte code imports the handler
+    script = "import skill.app, ask_sdk_model, sys; print(skill.app.__cached__)"
+    result = run_in_lambda_python(compiled.out_dir, script)
+    # Then it loads, and its byte code is the bundle's own
+    assert result.returncode == 0, result.stderr
+    cached = Path(result.stdout.strip())
+    assert cached.name == "app.cpython-312.pyc" and cached.is_file()
+    assert cached.is_relative_to(compiled.out_dir)
