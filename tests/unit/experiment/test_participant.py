@@ -12,9 +12,15 @@ from typing import TYPE_CHECKING
 
 import pytest
 
+from vahr.experiment.assistant import AssistantReply
 from vahr.experiment.eventlog import EventLog, Kind
 from vahr.experiment.observer import ObserverConsole
-from vahr.experiment.participant import Console, keyboard_script, voice_script
+from vahr.experiment.participant import (
+    Console,
+    SimulatedParticipant,
+    keyboard_script,
+    voice_script,
+)
 from vahr.experiment.tasks import draw_plan
 from vahr.experiment.timing import TimingModel
 from vahr.protocol import decode_command
@@ -130,3 +136,59 @@ def test_the_observer_ends_a_task_on_e(tmp_path: Path) -> None:
         # When the task is waited for, Then "e" ends it undecided after one puzzle piece
         assert observer.wait(lambda: False, timeout_s=5) is False
         assert [e.kind for e in log.entries()] == [Kind.OBSERVER]
+
+
+class ScriptedAssistant:
+    """Stands in for the Alexa simulator in this unit test only: it answers at once."""
+
+    def __init__(self) -> None:
+        self.heard: list[str] = []
+
+    def ask(self, utterance: str) -> AssistantReply:
+        self.heard.append(utterance)
+        if "weather" in utterance:
+            return AssistantReply("Sorry, I did not get that.", intent="AMAZON.FallbackIntent")
+        return AssistantReply(
+            "Okay, placebot one is on its way.",
+            intent="DeliverIntent",
+            commands=[f"c{len(self.heard)}"],
+        )
+
+
+def test_the_voice_participant_logs_each_exchange_as_speaking_plus_listening(
+    fleet: Fleet, tmp_path: Path
+) -> None:
+    # Given a voice participant running 100 times faster than real time, with no jitter
+    plan = draw_plan(fleet, 3)
+    assistant = ScriptedAssistant()
+    timing = TimingModel(jitter=0.0)
+    with EventLog.open(tmp_path / "log.sqlite") as log:
+        participant = SimulatedParticipant(
+            method="vahr",
+            fleet=fleet,
+            plan=plan,
+            log=log,
+            timing=timing,
+            seed=3,
+            speed_factor=100.0,
+            assistant=assistant,
+        )
+        # When it performs tasks I and II
+        participant.perform("I")
+        participant.perform("II")
+        entries = log.entries()
+    # Then it said the scripted sentences, in order, to the assistant
+    assert assistant.heard == voice_script("I", plan, fleet) + voice_script("II", plan, fleet)
+    started = [e for e in entries if e.kind == Kind.INTERACTION_STARTED]
+    ended = [e for e in entries if e.kind == Kind.INTERACTION_ENDED]
+    assert len(started) == len(ended) == 3
+    # and each exchange lasted at least its speaking and listening time (in wall seconds)
+    rng = random.Random(0)
+    for start, end in zip(started, ended, strict=True):
+        model_s = timing.speaking_s(rng, start.data["text"]) + timing.listening_s(
+            rng, end.data["speech"]
+        )
+        assert (end.at - start.at).total_seconds() >= model_s / 100 * 0.95
+    # and what the assistant did with each utterance is kept for the judge
+    assert ended[0].data["commands"] == ["c1"] and ended[0].data["intent"] == "DeliverIntent"
+    assert ended[2].data["commands"] == [] and ended[2].data["speech"].startswith("Sorry")
