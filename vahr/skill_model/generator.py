@@ -50,14 +50,17 @@ class ModelError(VahrError):
     """The intents or the fleet would make an interaction model Alexa rejects or confuses."""
 
 
-def build_files(fleet: Fleet, source: bytes) -> dict[Path, str]:
+def build_files(
+    fleet: Fleet, source: bytes, endpoint: dict[str, Any] | None = None
+) -> dict[Path, str]:
     """Every generated file, keyed by its path from the repository root.
 
     `source` is the fleet file's bytes: the twin records their hash, so the skill can tell
     when fleet.yaml changed after the twin was written and read the YAML instead.
+    `endpoint` is a deployed skill endpoint to keep in skill.json.
     """
     return {
-        MANIFEST_PATH: render(build_manifest()),
+        MANIFEST_PATH: render(build_manifest(endpoint)),
         MODEL_PATH: render(build_interaction_model(fleet)),
         FLEET_TWIN_PATH: render(fleet_twin(fleet, source)),
     }
@@ -207,10 +210,20 @@ def check_samples(intents: tuple[IntentSpec, ...]) -> None:
                     )
 
 
+def deployed_endpoint(root: Path) -> dict[str, Any] | None:
+    """The `apis.custom.endpoint` of the skill.json under `root`, if a deployment wrote one."""
+    try:
+        manifest = json.loads((root / MANIFEST_PATH).read_text(encoding="utf-8"))
+        endpoint = manifest["manifest"]["apis"]["custom"].get("endpoint")
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+    return endpoint if isinstance(endpoint, dict) else None
+
+
 def write(root: Path, fleet: Fleet, source: bytes) -> list[Path]:
     """Write the generated files under `root` and return those that changed."""
     changed = []
-    for relative, text in build_files(fleet, source).items():
+    for relative, text in build_files(fleet, source, deployed_endpoint(root)).items():
         target = root / relative
         if not target.exists() or target.read_text(encoding="utf-8") != text:
             target.parent.mkdir(parents=True, exist_ok=True)
@@ -223,6 +236,6 @@ def drift(root: Path, fleet: Fleet, source: bytes) -> list[Path]:
     """The generated files under `root` that differ from what the generator would write."""
     return [
         root / relative
-        for relative, text in build_files(fleet, source).items()
+        for relative, text in build_files(fleet, source, deployed_endpoint(root)).items()
         if not (root / relative).exists() or (root / relative).read_text(encoding="utf-8") != text
     ]

@@ -1,8 +1,9 @@
 """The skill manifest (`skill-package/skill.json`) as data.
 
-The Lambda endpoint is left out on purpose: `ask deploy` fills it in from
-`ask-resources.json`, and the CDK stack passes it to `CfnSkill` as an override, so the
-same skill package serves both deployment paths.
+The Lambda endpoint is not generated: `python -m infra.skill_endpoint` writes the deployed
+function's ARN into skill.json for `ask deploy`, and the CDK stack passes it to `CfnSkill`
+as an override. The generator keeps an endpoint it finds in the existing skill.json, so
+regenerating after a deployment does not undo it.
 """
 
 from __future__ import annotations
@@ -14,8 +15,11 @@ from vahr.skill_model.intents import INVOCATION_NAME, LOCALE
 SKILL_NAME = "VAHR Robot Fleet"
 
 
-def build_manifest() -> dict[str, Any]:
-    """The ASK CLI v2 `skill.json` for the custom skill."""
+def build_manifest(endpoint: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The ASK CLI v2 `skill.json` for the custom skill, with `endpoint` if one is deployed."""
+    custom: dict[str, Any] = {"interfaces": []}
+    if endpoint is not None:
+        custom["endpoint"] = endpoint
     return {
         "manifest": {
             "manifestVersion": "1.0",
@@ -40,14 +44,13 @@ def build_manifest() -> dict[str, Any]:
                 },
                 "isAvailableWorldwide": False,
                 "distributionCountries": ["US"],
-                "distributionMode": "PRIVATE",
                 "testingInstructions": (
                     "Run the robots (robot-agent) or the local stack (vahr up), then say "
                     "'send placebot one to zone a' and 'where are the robots'."
                 ),
                 "category": "PRODUCTIVITY",
             },
-            "apis": {"custom": {"interfaces": []}},
+            "apis": {"custom": custom},
             "privacyAndCompliance": {
                 "allowsPurchases": False,
                 "usesPersonalInfo": False,

@@ -25,6 +25,7 @@ from vahr.skill_model.generator import (
     FLEET_TWIN_PATH,
     MANIFEST_PATH,
     MODEL_PATH,
+    deployed_endpoint,
     utterance_shape,
 )
 from vahr.skill_model.intents import CUSTOM_INTENTS, IntentSpec, SlotSpec
@@ -54,7 +55,8 @@ def language_model(model: dict[str, Any]) -> dict[str, Any]:
 def test_committed_skill_package_matches_the_generator(fleet: Fleet) -> None:
     # Given fleet.yaml and the intent definitions, when the generator runs, then it would
     # write exactly the committed files (run `make skill-model` after editing either)
-    for relative, text in build_files(fleet, FLEET_FILE.read_bytes()).items():
+    endpoint = deployed_endpoint(ROOT)
+    for relative, text in build_files(fleet, FLEET_FILE.read_bytes(), endpoint).items():
         assert (ROOT / relative).read_text() == text, f"{relative} drifted from fleet.yaml"
 
 
@@ -82,6 +84,24 @@ def test_check_flag_reports_drift_and_exits_non_zero(
     assert skill_model_main(["--fleet", str(fleet_file), "--root", str(out), "--check"]) == 0
     zones = json.loads((out / MODEL_PATH).read_text())["interactionModel"]["languageModel"]
     assert "E" in [value["id"] for value in zones["types"][1]["values"]]
+
+
+def test_a_deployed_endpoint_in_skill_json_survives_regeneration(tmp_path: Path) -> None:
+    # Given a checkout whose skill.json got the deployed function's ARN
+    out = tmp_path / "checkout"
+    assert skill_model_main(["--root", str(out)]) == 0
+    manifest_file = out / MANIFEST_PATH
+    manifest = json.loads(manifest_file.read_text())
+    endpoint = {"uri": "arn:aws:lambda:us-east-1:123456789012:function:vahr-skill"}
+    manifest["manifest"]["apis"]["custom"]["endpoint"] = endpoint
+    manifest_file.write_text(json.dumps(manifest, indent=2) + "\n")
+    # When the generator checks and runs again
+    assert skill_model_main(["--root", str(out), "--check"]) == 0
+    assert skill_model_main(["--root", str(out)]) == 0
+    # Then the endpoint is still there
+    assert (
+        json.loads(manifest_file.read_text())["manifest"]["apis"]["custom"]["endpoint"] == endpoint
+    )
 
 
 def test_bad_fleet_file_is_one_line_error(
@@ -115,7 +135,7 @@ def test_manifest_deserializes_with_ask_smapi_model_classes() -> None:
         serializer.serialize(serializer.deserialize(json.dumps(manifest), MANIFEST_TYPE))
         == manifest
     )
-    assert manifest["manifest"]["apis"]["custom"] == {"interfaces": []}
+    assert manifest["manifest"]["apis"]["custom"]["interfaces"] == []
 
 
 def test_invocation_name_is_two_speakable_words(model: dict[str, Any]) -> None:
