@@ -122,9 +122,12 @@ def _dependency_key(architecture: str, packages: Sequence[str] = RUNTIME_PACKAGE
     return digest.hexdigest()[:16]
 
 
-def source_hash(*, architecture: str = "x86_64", fleet_file: Path | None = None) -> str:
+def source_hash(
+    *, architecture: str = "x86_64", fleet_file: Path | None = None, precompiled: bool = False
+) -> str:
     """A hash of everything that goes into the bundle, for CDK's custom asset hash."""
     digest = hashlib.sha256(_dependency_key(architecture).encode())
+    digest.update(b"precompiled" if precompiled else b"source")
     for source, name in _source_files(fleet_file or REPO_ROOT / "fleet.yaml"):
         digest.update(name.encode() + b"\0")
         if source.exists():
@@ -213,7 +216,7 @@ def precompile(bundle: Path, python: Path) -> None:
 
     The Lambda runtime cannot write `__pycache__` in its read-only code directory, so
     without this every cold start compiles each imported module again (measured here:
-    importing skill.app took 0.53-0.68 s from source and 0.31-0.39 s with byte code).
+    importing skill.app took a median 0.74 s from source and 0.29 s from byte code).
     """
     try:
         found = subprocess.run(

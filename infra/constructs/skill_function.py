@@ -35,14 +35,20 @@ MEMORY_MB = 512
 class LocalBundler:
     """Runs `infra.lambda_asset.build` on this machine, so synth needs no Docker."""
 
-    def __init__(self, *, architecture: str, fleet_file: Path) -> None:
+    def __init__(
+        self, *, architecture: str, fleet_file: Path, compile_with: Path | None = None
+    ) -> None:
         self._architecture = architecture
         self._fleet_file = fleet_file
+        self._compile_with = compile_with
 
     def try_bundle(self, output_dir: str, options: Any = None, **_: Any) -> bool:
         # jsii passes the bundling options positionally; the build needs none of them.
         lambda_asset.build(
-            Path(output_dir), architecture=self._architecture, fleet_file=self._fleet_file
+            Path(output_dir),
+            architecture=self._architecture,
+            fleet_file=self._fleet_file,
+            compile_with=self._compile_with,
         )
         return True
 
@@ -53,12 +59,18 @@ def skill_code(config: InfraConfig) -> lambda_.Code:
         str(lambda_asset.REPO_ROOT / lambda_asset.SKILL_DIR),
         asset_hash_type=cdk.AssetHashType.CUSTOM,
         asset_hash=lambda_asset.source_hash(
-            architecture=config.architecture, fleet_file=config.fleet_file
+            architecture=config.architecture,
+            fleet_file=config.fleet_file,
+            precompiled=config.lambda_python is not None,
         ),
         bundling=cdk.BundlingOptions(
             # Never pulled: local bundling always succeeds or raises.
             image=lambda_.Runtime.PYTHON_3_12.bundling_image,
-            local=LocalBundler(architecture=config.architecture, fleet_file=config.fleet_file),
+            local=LocalBundler(
+                architecture=config.architecture,
+                fleet_file=config.fleet_file,
+                compile_with=config.lambda_python,
+            ),
         ),
     )
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -51,3 +53,9 @@ def test_bad_values_are_refused_with_the_key_and_the_reason(
         config(**context)
     assert str(raised.value).startswith(message)
     assert "\n" not in str(raised.value)
+
+
+def test_lambda_python_must_exist(tmp_path: Path) -> None:
+    with pytest.raises(VahrError, match=r"^lambdaPython: '.*missing' is not a file$"):
+        config(lambdaPython=str(tmp_path / "missing"))
+    assert config(lambdaPython=sys.executable).lambda_python == Path(sys.executable)

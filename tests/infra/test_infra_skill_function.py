@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import pytest
@@ -12,8 +14,6 @@ from infra.config import InfraConfig
 from infra.constructs.skill_function import SkillFunction
 
 if TYPE_CHECKING:
-    from pathlib import Path
-
     from vahr.protocol import Fleet
 
 PREFIX = "arn:aws:iot:us-east-1:123456789012"
@@ -100,3 +100,14 @@ def test_with_a_skill_id_only_that_skill_may_invoke_and_the_handler_checks_it(
     assert function["Environment"]["Variables"]["VAHR_SKILL_ID"] == SKILL_ID
     assert function["Environment"]["Variables"]["VAHR_LOG_LEVEL"] == "DEBUG"
     assert function["Architectures"] == ["arm64"]
+
+
+def test_a_precompiling_build_is_a_different_asset(tmp_path: Path, fleet: Fleet) -> None:
+    # Given the same sources, with and without -c lambdaPython
+    plain = only(synth(tmp_path / "plain", fleet, InfraConfig()), "AWS::Lambda::Function")
+    compiled = only(
+        synth(tmp_path / "compiled", fleet, InfraConfig(lambda_python=Path(sys.executable))),
+        "AWS::Lambda::Function",
+    )
+    # Then CDK sees two different code assets, so switching it redeploys the code
+    assert plain["Code"]["S3Key"] != compiled["Code"]["S3Key"]
