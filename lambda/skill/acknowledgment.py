@@ -7,6 +7,7 @@ slow robot does not delay the others. A robot counts as having answered when
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
@@ -15,6 +16,7 @@ from typing import TYPE_CHECKING, Literal
 import msgspec
 
 from skill.errors import GatewayError
+from skill.logs import log_event
 from vahr.protocol import ProtocolError, robot_shadow_from_payload
 
 if TYPE_CHECKING:
@@ -96,8 +98,12 @@ def await_acknowledgments(
     for thing, future in futures.items():
         if future.done() and not future.cancelled() and future.exception() is None:
             answers[thing] = future.result()
-        else:
-            answers[thing] = RobotAnswer(thing, expected[thing], "unconfirmed", error="no answer")
+            continue
+        error = "no answer within the budget"
+        if future.done() and not future.cancelled():
+            error = f"{type(future.exception()).__name__}: {future.exception()}"
+            log_event("acknowledgment_worker_failed", logging.ERROR, thing=thing, error=error)
+        answers[thing] = RobotAnswer(thing, expected[thing], "unconfirmed", error=error)
     return answers
 
 

@@ -135,3 +135,16 @@ def test_shadows_of_several_robots_are_read_concurrently(
         "placebot2": "unconfirmed",
     }
     assert all(answer.shadow is not None for answer in answers.values())
+
+
+def test_a_reader_that_breaks_is_logged_and_counts_as_unconfirmed(
+    iot_data: Any, caplog: Any
+) -> None:
+    class Exploding(IotDataGateway):
+        def get_shadow(self, thing: str) -> bytes | None:
+            raise RuntimeError("socket closed")
+
+    answers = await_acknowledgments(Exploding(iot_data), {"placebot1": "c9"}, 0.3)
+    assert answers["placebot1"].outcome == "unconfirmed"
+    assert answers["placebot1"].error == "RuntimeError: socket closed"
+    assert '"event": "acknowledgment_worker_failed"' in caplog.text
