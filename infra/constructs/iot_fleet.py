@@ -87,6 +87,8 @@ class IotFleet(Construct):
                 service="Iot",
                 action="removeThingFromThingGroup",
                 parameters=parameters,
+                # Already gone (deleted by hand) must not block deleting the stack.
+                ignore_error_codes_matching="ResourceNotFoundException",
             ),
             policy=cr.AwsCustomResourcePolicy.from_statements(
                 [

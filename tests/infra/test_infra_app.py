@@ -140,3 +140,14 @@ def test_skill_without_a_package_is_refused_in_one_line(tmp_path: Path) -> None:
         VahrError, match=r"^skill=true needs .*skill\.json \(run `make skill-model`"
     ):
         synth_app(tmp_path, skill="true", skillPackageDir=str(tmp_path / "missing"))
+
+
+def test_an_unreadable_fleet_file_is_refused_in_one_line(tmp_path: Path) -> None:
+    broken = tmp_path / "fleet.yaml"
+    broken.write_text("robots: []\nzones: []\n")
+    with pytest.raises(VahrError) as raised:
+        build_app(cdk.App(context=cdk_context(fleetFile=str(broken)), outdir=str(tmp_path)))
+    assert str(raised.value).startswith(f"{broken}: ")
+    assert "\n" not in str(raised.value)
+    with pytest.raises(VahrError, match="cannot read"):
+        build_app(cdk.App(context=cdk_context(fleetFile=str(tmp_path / "none.yaml"))))
