@@ -50,6 +50,15 @@ class Ros1Settings:
     server_timeout_s: float = 10.0
     loader_delay_s: float = 3.0
     unloader_delay_s: float = 3.0
+    # rospy's threads keep a process alive until the node shuts down; the agent's one
+    # backend owns the node. Tests that build several backends in one process keep it.
+    shutdown_node_on_close: bool = True
+
+
+def shutdown_node(reason: str = "robot-agent stopping") -> None:
+    """Shut this process's ROS node down (it cannot be started again in this process)."""
+    if rospy.core.is_initialized() and not rospy.is_shutdown():
+        rospy.signal_shutdown(reason)
 
 
 def ensure_node(settings: Ros1Settings) -> None:
@@ -141,6 +150,8 @@ class Ros1Backend:
 
     async def close(self) -> None:
         await self.halt()
+        if self.settings.shutdown_node_on_close:
+            shutdown_node()
 
 
 def _settle(future: asyncio.Future[int], state: int) -> None:

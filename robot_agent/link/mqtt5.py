@@ -10,8 +10,12 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import os
+import socket
+import stat
 import threading
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
@@ -23,7 +27,6 @@ from vahr.errors import VahrError
 if TYPE_CHECKING:
     from collections.abc import Callable
     from concurrent.futures import Future
-    from pathlib import Path
 
 log = logging.getLogger(__name__)
 
@@ -251,6 +254,7 @@ class Mqtt5Link:
     def _on_lifecycle_connection_success(self, data: mqtt5.LifecycleConnectSuccessData) -> None:
         session_present = bool(data.connack_packet and data.connack_packet.session_present)
         self.connections += 1
+        disable_nagle(self.settings.port)
         self._connected.set()
         log.info(
             "connected to %s:%s (session %s)",
@@ -282,6 +286,38 @@ class Mqtt5Link:
 
     def _on_lifecycle_stopped(self, data: mqtt5.LifecycleStoppedData) -> None:
         self._stopped.set()
+
+
+def disable_nagle(port: int) -> int:
+    """Set TCP_NODELAY on this process's TCP sockets connected to `port`; returns how many.
+
+    awscrt exposes no TCP_NODELAY option, and without it the agent's PUBACK for a command
+    followed at once by its shadow update stalls about 40 ms on Nagle's algorithm plus the
+    broker's delayed ACK (FIELD-NOTES). A duplicate of the descriptor shares the socket,
+    so setting the option on the duplicate sets it on awscrt's socket.
+    """
+    fd_dir = Path("/proc/self/fd")
+    if not fd_dir.is_dir():  # not Linux: nothing to find this way
+        return 0
+    changed = 0
+    for entry in fd_dir.iterdir():
+        try:
+            fd = int(entry.name)
+            if not stat.S_ISSOCK(os.fstat(fd).st_mode):
+                continue
+            sock = socket.socket(fileno=os.dup(fd))
+        except (OSError, ValueError):
+            continue
+        try:
+            if sock.type == socket.SOCK_STREAM and sock.family in (socket.AF_INET, socket.AF_INET6):
+                if sock.getpeername()[1] == port:
+                    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                    changed += 1
+        except OSError:
+            pass
+        finally:
+            sock.close()
+    return changed
 
 
 def _dispatch(handlers: list[Callable[[str, bytes], None]], topic: str, payload: bytes) -> None:

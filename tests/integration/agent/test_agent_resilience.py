@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import signal
+import socket
 import time
 from typing import TYPE_CHECKING
 
@@ -98,12 +99,27 @@ def test_a_command_sent_while_the_robot_was_away_arrives_when_it_returns(
         tap2.close()
 
 
+def _free_for_mosquitto(port: int, what: str) -> None:
+    """`ensure_free` as mosquitto itself binds: with SO_REUSEADDR.
+
+    A broker killed with open connections leaves them in TIME_WAIT on its port for a
+    minute; mosquitto restarts on it regardless, but a plain bind() check would refuse.
+    """
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind(("127.0.0.1", port))
+
+
 @pytest.mark.slow
 def test_the_broker_killed_mid_task_the_agent_reconnects_and_keeps_serving(
-    mosquitto: Mosquitto, tmp_path: Path, start_agent: Callable[..., AgentProcess]
+    mosquitto: Mosquitto,
+    tmp_path: Path,
+    start_agent: Callable[..., AgentProcess],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     from tests.integration.agent.harness import WireTap as Tap
 
+    monkeypatch.setattr("vahr.local.broker.ensure_free", _free_for_mosquitto)
     port = mosquitto.config.plain_port or 0
     tap, shadows = Tap(port), ShadowResponder(port)
     agent = start_agent("placebot1", "--sim-speed-factor", "10")

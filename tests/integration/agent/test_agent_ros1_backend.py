@@ -111,6 +111,10 @@ def move_base(ros_master: str) -> Iterator[dict[str, Any]]:
     )
     server.start()
     yield seen
+    from robot_agent.backends.ros1 import shutdown_node
+
+    # rospy's threads would keep the test process alive after the session otherwise.
+    shutdown_node("tests done")
 
 
 def ros_executor(fleet: Fleet, ros_master: str) -> tuple[Executor, Recorder]:
