@@ -26,6 +26,11 @@ QUESTIONS = "questions"
 MAX_QUESTIONS = 3
 
 
+def plain_text(speech: str) -> str:
+    """Escape text for SSML: a robot's reason or a heard value may hold `&`, `<` or `>`."""
+    return speech.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
 def _attributes(handler_input: HandlerInput) -> dict[str, object] | None:
     if handler_input.request_envelope.session is None:
         return None
@@ -55,17 +60,19 @@ def answer(handler_input: HandlerInput, speech: str) -> Response:
         attributes.pop(QUESTIONS, None)
     builder = handler_input.response_builder
     if in_conversation(handler_input):
-        return builder.speak(f"{speech} {prompts.NEXT}").ask(prompts.NEXT).response
-    return builder.speak(speech).set_should_end_session(True).response
+        return builder.speak(plain_text(f"{speech} {prompts.NEXT}")).ask(prompts.NEXT).response
+    return builder.speak(plain_text(speech)).set_should_end_session(True).response
 
 
 def ask(handler_input: HandlerInput, speech: str, reprompt: str) -> Response:
     """Speak and keep the session open for the answer."""
-    return handler_input.response_builder.speak(speech).ask(reprompt).response
+    builder = handler_input.response_builder
+    return builder.speak(plain_text(speech)).ask(plain_text(reprompt)).response
 
 
 def end(handler_input: HandlerInput, speech: str) -> Response:
-    return handler_input.response_builder.speak(speech).set_should_end_session(True).response
+    builder = handler_input.response_builder
+    return builder.speak(plain_text(speech)).set_should_end_session(True).response
 
 
 def may_ask_again(handler_input: HandlerInput) -> bool:
@@ -93,8 +100,8 @@ def elicit(handler_input: HandlerInput, slot_name: str, question: str) -> Respon
     slot.resolutions = None
     slot.slot_value = None
     return (
-        handler_input.response_builder.speak(question)
-        .ask(question)
+        handler_input.response_builder.speak(plain_text(question))
+        .ask(plain_text(question))
         .add_directive(ElicitSlotDirective(updated_intent=intent, slot_to_elicit=slot_name))
         .response
     )

@@ -148,3 +148,14 @@ def test_a_reader_that_breaks_is_logged_and_counts_as_unconfirmed(
     assert answers["placebot1"].outcome == "unconfirmed"
     assert answers["placebot1"].error == "RuntimeError: socket closed"
     assert '"event": "acknowledgment_worker_failed"' in caplog.text
+
+
+def test_a_reason_with_markup_characters_is_spoken_as_text(
+    make_skill: Any, robots: RobotDoubles
+) -> None:
+    robots.behave("placebot1", RobotBehaviour(result="rejected", reason="speed <0.1 & >2 m/s"))
+    response = make_skill()(load_event("alexa_navigate"), None)
+    ssml = response["response"]["outputSpeech"]["ssml"]
+    assert ssml == (
+        "<speak>Placebot one refused the command: speed &lt;0.1 &amp; &gt;2 m/s.</speak>"
+    )
