@@ -137,3 +137,29 @@ def test_missing_or_broken_files_are_named(tmp_path: Path, skill_json: Path) -> 
     assert (
         result.stderr == "error: skill.json has no manifest.apis.custom: it is not a custom skill\n"
     )
+
+
+def test_a_deployed_endpoint_does_not_count_as_drift_of_the_generated_package(
+    tmp_path: Path,
+) -> None:
+    # Given a copy of the generated files, and the deployed ARN written into skill.json
+    root = tmp_path / "checkout"
+    shutil.copytree(REPO_ROOT / "skill-package", root / "skill-package")
+    generated_fleet = REPO_ROOT / "lambda" / "skill" / "fleet.json"
+    if generated_fleet.exists():
+        (root / "lambda" / "skill").mkdir(parents=True)
+        shutil.copy(generated_fleet, root / "lambda" / "skill" / "fleet.json")
+    outputs = outputs_file(tmp_path, {"Vahr": {"SkillFunctionArn": ARN}})
+    assert (
+        run(
+            "--outputs", str(outputs), "--skill-json", str(root / "skill-package" / "skill.json")
+        ).returncode
+        == 0
+    )
+    # When the skill model's drift check runs on it
+    check = subprocess.run(
+        [sys.executable, "-m", "vahr.skill_model", "--check", "--root", str(root)],
+        capture_output=True, text=True, timeout=60, cwd=REPO_ROOT,
+    )  # fmt: skip
+    # Then the package is still up to date: `make test` passes after a deployment
+    assert check.returncode == 0, check.stderr
