@@ -8,7 +8,7 @@ from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_intent_name
 
 from skill import dialog
-from skill.handlers.common import send_and_report
+from skill.handlers.send import send_and_report
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
