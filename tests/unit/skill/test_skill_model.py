@@ -158,7 +158,14 @@ def test_slot_types_come_from_the_fleet(model: dict[str, Any], fleet: Fleet) -> 
         value["id"]: [value["name"]["value"], *value["name"]["synonyms"]] for value in types["ZONE"]
     }
     assert zones == {zone.id: zone.spoken for zone in fleet.zones}
+    # The skill cannot import the generator (it is not in the Lambda bundle), so the two
+    # spellings of the fleet value are held equal here.
+    from skill import vocabulary
+    from vahr.skill_model import generator
+
     assert FLEET == FLEET_ROBOT_ID
+    assert vocabulary.DEFAULT_FLEET_NAMES == generator.DEFAULT_FLEET_NAMES
+    assert vocabulary.FLEET_GROUP == generator.FLEET_GROUP_ID
 
 
 def test_robot_command_intents_have_at_least_fifteen_samples(model: dict[str, Any]) -> None:
