@@ -85,3 +85,20 @@ def test_one_unreadable_shadow_does_not_hide_the_others(make_skill: Any, robots:
     assert speech(response) == (
         "Placebot one is idle in the loading zone. I could not read the state of placebot two."
     )
+
+
+def test_the_endpoint_variable_reaches_the_iot_data_client(
+    aws: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Given AWS_ENDPOINT_URL_IOT_DATA_PLANE pointing at a port where nothing listens
+    from vahr.local.ports import free_port
+
+    url = f"http://127.0.0.1:{free_port()}"
+    monkeypatch.setenv("AWS_ENDPOINT_URL_IOT_DATA_PLANE", url)
+    # When the handler is built from the environment, as at cold start
+    config = SkillConfig.from_env()
+    skill = make_lambda_handler()
+    # Then it talks to that endpoint (and not to moto, which would have answered)
+    assert config.data_endpoint == url
+    assert speech(skill(load_event("alexa_navigate"), None)) == GATEWAY_SPEECH
+    assert published() == []
