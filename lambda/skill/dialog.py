@@ -11,15 +11,18 @@ from skill.vocabulary import LOADING
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
-    from ask_sdk_model import IntentRequest, Response
+    from ask_sdk_model import Intent, IntentRequest, Response
 
     from skill.runtime import SkillRuntime
     from skill.slots import SlotReading
 
 
-def _intent(handler_input: HandlerInput):  # type: ignore[no-untyped-def]
+def _intent(handler_input: HandlerInput) -> Intent:
     request: IntentRequest = handler_input.request_envelope.request  # type: ignore[assignment]
-    return request.intent
+    intent = request.intent
+    if intent is None:  # an IntentRequest always names its intent; this is for the types
+        raise ValueError("the IntentRequest carries no intent")
+    return intent
 
 
 def robot(handler_input: HandlerInput, runtime: SkillRuntime, name: str) -> SlotReading:
