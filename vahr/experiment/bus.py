@@ -127,7 +127,11 @@ class Bus:
     ) -> None:
         self._subscribed.set()
 
+    # Robots retain their last `delivered` event; a retained message replays the past when
+    # the recorder (re)subscribes, and logging it inside a task would count an old delivery.
     def _on_message_raw(
         self, client: mqtt.Client, userdata: object, message: mqtt.MQTTMessage
     ) -> None:
+        if message.retain:
+            return
         self._on_message(message.topic, bytes(message.payload))

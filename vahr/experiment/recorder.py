@@ -77,6 +77,17 @@ class Recorder:
         with self._lock:
             self.task = task
 
+    def end_task(self, task: str, reason: str) -> None:
+        """Log the end of `task` after any robot event being logged, with its world changes.
+
+        The runner decides a task from the logged robot events; without the lock, the LED
+        change caused by the deciding delivery could land after `task_ended`, outside the task.
+        """
+        with self._lock:
+            self.world.disarm_led()
+            self.log.append(Kind.TASK_ENDED, {"task": task, "reason": reason}, task=task)
+            self.task = None
+
     def log_world(self, changes: list[dict[str, Any]]) -> None:
         with self._lock:
             for change in changes:

@@ -156,13 +156,7 @@ def run_tasks(
             return score_goal(goal, deliveries_in(after)).success is not None
 
         finished = performer.wait(decided, session.spec.task_timeout_s)
-        recorder.world.disarm_led()
-        event_log.append(
-            Kind.TASK_ENDED,
-            {"task": task, "reason": "decided" if finished else "timeout"},
-            task=task,
-        )
-        recorder.set_task(None)
+        recorder.end_task(task, "decided" if finished else "timeout")
         outcome = judge_session(event_log.entries(), plan).tasks[task]
         announce(f"task {task}: {'success' if outcome.success else 'failure'}: {outcome.reason}")
     verdict = judge_session(event_log.entries(), plan)
