@@ -125,7 +125,8 @@ def build_link(
     )
 
 
-def build_agent(config: AgentConfig, link: Mqtt5Link, clock: ScaledClock) -> RobotAgent:
+def load_robot_fleet(config: AgentConfig) -> Fleet:
+    """The fleet, checked to contain this robot (before anything connects)."""
     fleet = load_fleet(config.fleet_file)
     thing = str(config.thing)
     try:
@@ -136,6 +137,17 @@ def build_agent(config: AgentConfig, link: Mqtt5Link, clock: ScaledClock) -> Rob
         raise VahrError(
             f"--thing {thing}: not a robot of the fleet; robots are {', '.join(fleet.robot_things)}"
         )
+    return fleet
+
+
+def build_agent(
+    config: AgentConfig,
+    fleet: Fleet,
+    link: Mqtt5Link,
+    clock: ScaledClock,
+    voice: Voice | None = None,
+) -> RobotAgent:
+    thing = str(config.thing)
     state_dir = Path(config.state_dir) / "robots" / thing
     return RobotAgent(
         thing=thing,
@@ -144,6 +156,6 @@ def build_agent(config: AgentConfig, link: Mqtt5Link, clock: ScaledClock) -> Rob
         backend=build_backend(config, fleet, clock),
         clock=clock,
         recent_ids=RecentIds(state_dir / "recent-ids.json"),
-        voice=build_voice(config),
+        voice=voice,
         settings=executor_settings(config),
     )

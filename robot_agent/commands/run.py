@@ -62,13 +62,16 @@ def run(args: argparse.Namespace) -> int:
 
 
 async def serve(config: AgentConfig) -> int:
-    from robot_agent.assembly import build_agent, build_link
+    from robot_agent.assembly import build_agent, build_link, build_voice, load_robot_fleet
     from robot_agent.core.clock import ScaledClock
 
+    # Everything that can be wrong in the settings fails before anything connects.
+    fleet = load_robot_fleet(config)
+    voice = build_voice(config)
     loop = asyncio.get_running_loop()
     clock = ScaledClock(config.sim_speed_factor)
     link = build_link(config, loop, clock)
-    agent = build_agent(config, link, clock)
+    agent = build_agent(config, fleet, link, clock, voice)
     agent.attach()
     stopping = asyncio.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):

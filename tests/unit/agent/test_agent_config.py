@@ -1,0 +1,148 @@
+"""`robot-agent run` configuration: precedence, --print-config, and one-line errors."""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING
+
+import pytest
+
+from robot_agent.cli import main
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+
+@pytest.fixture(autouse=True)
+def clean_environment(monkeypatch: pytest.MonkeyPatch) -> None:
+    import os
+
+    for name in list(os.environ):
+        if name.startswith("VAHR_AGENT_"):
+            monkeypatch.delenv(name)
+
+
+def printed_config(capsys: pytest.CaptureFixture[str], *argv: str) -> dict[str, object]:
+    assert main(["run", *argv, "--print-config"]) == 0
+    loaded: dict[str, object] = json.loads(capsys.readouterr().out)
+    return loaded
+
+
+def error_of(capsys: pytest.CaptureFixture[str], *argv: str) -> str:
+    assert main(["run", *argv]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1, lines
+    return lines[0]
+
+
+def test_flags_beat_environment_beat_file_beat_defaults(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = tmp_path / "agent.yaml"
+    config.write_text(
+        "thing: placebot2\nbroker: mqtt://127.0.0.1:1999\nsim_speed_factor: 3\n"
+        "log_level: DEBUG\nexecutor:\n  stuck_after_s: 42\n"
+    )
+    monkeypatch.setenv("VAHR_AGENT_SIM_SPEED_FACTOR", "7")
+    monkeypatch.setenv("VAHR_AGENT_LOG_LEVEL", "WARNING")
+    shown = printed_config(capsys, "--config", str(config), "--log-level", "ERROR")
+    assert shown["thing"] == "placebot2"  # file
+    assert shown["sim_speed_factor"] == 7.0  # environment over file
+    assert shown["log_level"] == "ERROR"  # flag over environment
+    assert shown["executor"] == {
+        "stuck_after_s": 42.0,
+        "sequential_timeout_s": 300.0,
+        "peer_delivery_window_s": 120.0,
+        "listen_timeout_s": 8.0,
+        "progress_interval_s": 1.0,
+    }
+    assert shown["backend"] == "sim" and shown["port"] == 8883  # defaults
+
+
+def test_an_unknown_key_in_the_file_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = tmp_path / "agent.yaml"
+    config.write_text("thing: placebot1\nsim:\n  warp: 9\n")
+    assert error_of(capsys, "--config", str(config)) == (
+        "robot-agent run: error: configuration: sim.warp: is not a known field"
+    )
+
+
+def test_a_bad_environment_value_is_named(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setenv("VAHR_AGENT_SIM_SPEED_FACTOR", "fast")
+    assert error_of(capsys, "--thing", "placebot1").startswith(
+        "robot-agent run: error: configuration: sim_speed_factor: expected float"
+    )
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        ((), "--thing is required (or `thing` in --config, or VAHR_AGENT_THING)"),
+        (
+            ("--thing", "placebot1"),
+            "give --endpoint with --cert, --key and --ca, or --broker mqtt://127.0.0.1:PORT",
+        ),
+        (
+            ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--endpoint", "x"),
+            "give either --broker (plaintext loopback) or --endpoint (mTLS), not both",
+        ),
+        (
+            ("--thing", "placebot1", "--endpoint", "example.com"),
+            "--endpoint needs --cert and --key",
+        ),
+        (
+            (
+                "--thing",
+                "placebot1",
+                "--endpoint",
+                "example.com",
+                "--cert",
+                "/no/cert.pem",
+                "--key",
+                "/no/key",
+            ),
+            "--cert /no/cert.pem: no such file",
+        ),
+        (
+            ("--thing", "placebot1", "--broker", "mqtt://10.0.0.5:1883"),
+            "--broker 'mqtt://10.0.0.5:1883': plaintext MQTT is allowed only to a loopback broker; use --endpoint with --cert, --key and --ca for any other host",
+        ),
+        (
+            ("--thing", "placebot1", "--broker", "http://127.0.0.1:1883"),
+            "--broker 'http://127.0.0.1:1883': expected mqtt://127.0.0.1:PORT",
+        ),
+        (
+            ("--thing", "robot9", "--broker", "mqtt://127.0.0.1:1"),
+            "--thing robot9: not a robot of the fleet; robots are placebot1, placebot2",
+        ),
+        (
+            ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--sim-speed-factor", "0"),
+            "--sim-speed-factor must be greater than 0",
+        ),
+        (
+            (
+                "--thing",
+                "placebot1",
+                "--broker",
+                "mqtt://127.0.0.1:1",
+                "--backend",
+                "ros1",
+                "--sim-speed-factor",
+                "5",
+            ),
+            "--sim-speed-factor applies to the sim backend only; ROS runs in real time",
+        ),
+        (
+            ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--voice", "nonsense"),
+            "--voice 'nonsense': expected none or package.module:factory",
+        ),
+    ],
+)
+def test_bad_settings_are_one_line_errors(
+    argv: tuple[str, ...], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert error_of(capsys, *argv) == f"robot-agent run: error: {message}"
