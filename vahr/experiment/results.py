@@ -192,12 +192,15 @@ def row_from_log(entries: list[LogEntry]) -> ResultRow:
 
 
 def rows_from_logs(log_dir: Path) -> tuple[list[ResultRow], list[str]]:
-    """A row per session log under `log_dir` with at least one finished task; the second
-    list names the logs left out and why."""
+    """A row per finished session log under `log_dir`; the second list names the logs left
+    out and why (an unfinished session would bias the sums of its task times: resume it)."""
     rows: list[ResultRow] = []
     skipped: list[str] = []
     for path in find_logs(log_dir):
         entries = read_log(path)
+        if not any(entry.kind == Kind.SESSION_ENDED for entry in entries):
+            skipped.append(f"{path.name}: the session is not finished; resume it to include it")
+            continue
         try:
             row = row_from_log(entries)
         except VahrError as err:

@@ -12,6 +12,8 @@ from vahr.experiment.measure import measure_session
 from vahr.experiment.results import row_from_log
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from tests.unit.experiment.conftest import SessionScript
 
 
@@ -94,3 +96,24 @@ def test_a_faster_than_real_time_rehearsal_is_measured_in_experiment_seconds(
     # Then one wall second of interaction is 20 experiment seconds
     times = measure_session(script.log.entries())
     assert (times.interaction_s, times.time_taken_s) == (20, 100)
+
+
+def test_only_finished_sessions_become_rows(tmp_path: Path) -> None:
+    from tests.unit.experiment.conftest import SessionScript as Story
+    from vahr.experiment.eventlog import EventLog
+    from vahr.experiment.results import rows_from_logs
+
+    for name, finished in (("P01-vahr-trial1", True), ("P02-vahr-trial1", False)):
+        with EventLog.open(tmp_path / f"{name}.sqlite") as log:
+            story = Story(log)
+            story.start_session(plan(), participant=name[:3])
+            story.start("I", 0)
+            story.interact(0, 10)
+            story.end(40)
+            if finished:
+                log.append(Kind.SESSION_ENDED, {})
+    rows, skipped = rows_from_logs(tmp_path)
+    assert [row.participant for row in rows] == ["P01"]
+    assert skipped == [
+        "P02-vahr-trial1.sqlite: the session is not finished; resume it to include it"
+    ]
