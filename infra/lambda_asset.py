@@ -169,8 +169,15 @@ def _install_dependencies(
         # Console scripts are useless in Lambda and carry the build machine's paths.
         shutil.rmtree(site / "bin", ignore_errors=True)
         (site / ".complete").touch()
-        shutil.rmtree(target, ignore_errors=True)
-        site.rename(target)
+        # Another build (a parallel test, a second synth) may have finished first: keep
+        # its complete copy; only a half-written one from a killed build is replaced.
+        if not (target / ".complete").exists():
+            shutil.rmtree(target, ignore_errors=True)
+            try:
+                site.rename(target)
+            except OSError:
+                if not (target / ".complete").exists():
+                    raise
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return target, False
