@@ -81,24 +81,29 @@ class SimBackend:
         heading = math.atan2(goal.y - start.y, goal.x - start.x) if total > 1e-6 else start.theta
         await self._turn_to(heading)
         tick = self.settings.tick_s
-        step = self.settings.speed_mps * tick
         travelled = 0.0
+        last = self._clock.monotonic()
         while travelled < total:
+            await self._clock.sleep(tick)
+            # Integrate over the time that really passed, so a busy machine (or a high
+            # speed factor) changes how often the pose is updated, never the robot's speed.
+            now = self._clock.monotonic()
+            elapsed, last = now - last, now
             if (stuck or failure) and travelled >= total / 2:
                 if failure:
                     raise NavigationFailed(f"goal to {zone.id} aborted: {failure}")
                 # Stuck: the robot holds its place and keeps reporting the same progress,
                 # which is what the executor's stuck detection must notice.
                 on_progress(Progress(travelled / total, self._pose))
-                await self._clock.sleep(tick)
                 continue
-            travelled = min(total, travelled + step)
+            travelled = min(total, travelled + self.settings.speed_mps * elapsed)
+            if stuck or failure:
+                travelled = min(travelled, total / 2)
             self._pose = Pose(
                 start.x + (goal.x - start.x) * travelled / total,
                 start.y + (goal.y - start.y) * travelled / total,
                 heading,
             )
-            await self._clock.sleep(tick)
             on_progress(Progress(travelled / total, self._pose))
         await self._turn_to(goal.theta)
         self._pose = Pose(goal.x, goal.y, goal.theta)

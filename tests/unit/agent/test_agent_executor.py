@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 from typing import TYPE_CHECKING
 
 from robot_agent.backends.sim import SimSettings
@@ -180,3 +181,48 @@ async def test_sequential_delivery_after_itself_is_rejected(fleet: Fleet) -> Non
     assert rec.kinds("q4") == ["rejected"]
     assert rec.states[-1].last_command is not None
     assert rec.states[-1].last_command.reason == "params.after: a robot cannot wait for itself"
+
+
+async def test_stop_while_waiting_for_a_peer_cancels_the_wait(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, thing="placebot2")
+    executor.execute(cmd("sequential_delivery", {"zone": "B", "after": "placebot1"}, "wait"))
+    await rec.until("waiting", "wait")
+    executor.execute(cmd("stop", None, "halt"))
+    await executor.wait_idle()
+    assert rec.kinds("wait")[-1] == "cancelled"
+    # A late delivery by the peer no longer starts anything.
+    executor.peer_event(Event(event="delivered", thing="placebot1", at=utc_now(), zone="A"))
+    await asyncio.sleep(0.05)
+    assert "loaded" not in rec.kinds("wait")
+    assert rec.states[-1].status == "stopped"
+
+
+async def test_a_delivery_cut_short_after_loading_keeps_the_cargo_for_the_next_one(
+    fleet: Fleet,
+) -> None:
+    executor, rec, _ = make_executor(fleet, speed=50)
+    executor.execute(cmd("deliver", {"zone": "A"}, "first"))
+    await rec.until("loaded", "first", timeout_s=10)
+    executor.execute(cmd("deliver", {"zone": "D"}, "second"))
+    await executor.wait_idle()
+    assert rec.kinds("first")[-1] == "cancelled"
+    assert "loaded" not in rec.kinds("second")
+    assert rec.first("delivered", "second").zone == "D"
+    assert rec.states[-1].cargo is False
+
+
+async def test_navigating_to_the_zone_it_is_in_arrives_at_once(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet)
+    executor.execute(cmd("navigate", {"zone": "C"}, "go"))
+    await executor.wait_idle()
+    executor.execute(cmd("navigate", {"zone": "C"}, "again"))
+    await executor.wait_idle()
+    assert rec.kinds("again") == ["accepted", "arrived", "done"]
+
+
+async def test_close_cancels_the_running_task(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, speed=20)
+    executor.execute(cmd("navigate", {"zone": "A"}, "going"))
+    await rec.until("progress", "going")
+    await executor.close()
+    assert rec.first("cancelled", "going").reason == "the agent is shutting down"

@@ -1,0 +1,115 @@
+"""The executor's small parts: recent ids on disk, peer deliveries, topic matching, the sim."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import time
+from datetime import timedelta
+from typing import TYPE_CHECKING
+
+import pytest
+
+from robot_agent.backends.port import NavigationFailed, Progress
+from robot_agent.backends.sim import SimBackend, SimSettings
+from robot_agent.core.clock import ScaledClock
+from robot_agent.core.peers import PeerDeliveries
+from robot_agent.core.recent_ids import RecentIds
+from robot_agent.link.port import topic_matches
+from vahr.protocol import Pose, utc_now
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from vahr.protocol import Fleet
+
+
+def test_recent_ids_remember_across_instances_and_forget_the_oldest(tmp_path: Path) -> None:
+    path = tmp_path / "robots" / "placebot1" / "recent-ids.json"
+    ids = RecentIds(path, capacity=3)
+    assert ids.add("a") and ids.add("b") and not ids.add("a")
+    reopened = RecentIds(path, capacity=3)
+    assert "a" in reopened and "b" in reopened
+    for command_id in ("c", "d"):
+        reopened.add(command_id)
+    assert "a" not in RecentIds(path, capacity=3)
+    assert json.loads(path.read_text()) == ["b", "c", "d"]
+
+
+def test_a_torn_recent_id_file_does_not_stop_the_robot(tmp_path: Path) -> None:
+    path = tmp_path / "recent-ids.json"
+    path.write_text('["a", "b"')
+    ids = RecentIds(path)
+    assert len(ids) == 0 and ids.add("a")
+
+
+def test_a_peer_delivery_counts_within_the_window_before_the_command() -> None:
+    peers = PeerDeliveries()
+    issued = utc_now()
+    peers.record("placebot1", issued - timedelta(seconds=30))
+    assert peers.delivered_since("placebot1", issued, window_s=60) is not None
+    assert peers.delivered_since("placebot1", issued, window_s=10) is None
+    assert peers.delivered_since("placebot2", issued, window_s=60) is None
+
+
+async def test_a_waiter_is_woken_by_the_next_delivery() -> None:
+    peers = PeerDeliveries()
+    waiter = peers.next_delivery("placebot1")
+    at = utc_now()
+    peers.record("placebot1", at)
+    assert await asyncio.wait_for(waiter, 1) == at
+    # An older event arriving late does not move the latest delivery back.
+    peers.record("placebot1", at - timedelta(minutes=5))
+    assert peers.latest("placebot1") == at
+
+
+@pytest.mark.parametrize(
+    ("topic_filter", "topic", "matches"),
+    [
+        ("vahr/robots/+/events", "vahr/robots/placebot1/events", True),
+        ("vahr/robots/+/events", "vahr/robots/placebot1/cmd", False),
+        ("vahr/#", "vahr/fleet/cmd", True),
+        ("#", "$aws/things/placebot1/shadow/update", False),
+        ("$aws/things/placebot1/shadow/#", "$aws/things/placebot1/shadow/update/delta", True),
+        ("vahr/fleet/cmd", "vahr/fleet/cmd/extra", False),
+        ("vahr/robots/+", "vahr/robots", False),
+    ],
+)
+def test_topic_matching_follows_mqtt(topic_filter: str, topic: str, matches: bool) -> None:
+    assert topic_matches(topic_filter, topic) is matches
+
+
+async def test_the_simulator_takes_distance_over_speed_in_simulated_time(fleet: Fleet) -> None:
+    clock = ScaledClock(200)
+    start = Pose(0.0, 4.0, 0.0)
+    sim = SimBackend(
+        start=start, clock=clock, settings=SimSettings(speed_mps=1.0, turn_rate_rps=2.0)
+    )
+    zone = fleet.zone("B")  # (9, 5): 9.06 m away, a small turn
+    seen: list[Progress] = []
+    began = clock.monotonic()
+    await sim.go_to(zone, seen.append)
+    elapsed = clock.monotonic() - began
+    assert 9.0 <= elapsed <= 9.0 + 3.0  # driving plus turning, within scheduling slack
+    assert sim.pose == zone.pose
+    fractions = [p.fraction for p in seen]
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+
+
+async def test_an_injected_failure_aborts_half_way(fleet: Fleet) -> None:
+    sim = SimBackend(start=fleet.robot("placebot1").start, clock=ScaledClock(500))
+    sim.inject_failure("a person stands in the corridor")
+    with pytest.raises(NavigationFailed, match="a person stands in the corridor"):
+        await sim.go_to(fleet.zone("A"), lambda progress: None)
+    # The fault was for one goal only.
+    await sim.go_to(fleet.zone("A"), lambda progress: None)
+    assert sim.pose == fleet.zone("A").pose
+
+
+async def test_a_scaled_clock_sleeps_less_on_the_wall() -> None:
+    clock = ScaledClock(100)
+    began = time.monotonic()
+    await clock.sleep(5)
+    assert time.monotonic() - began < 1.0
+    with pytest.raises(ValueError, match="speed_factor"):
+        ScaledClock(0)
