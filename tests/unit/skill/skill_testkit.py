@@ -7,6 +7,7 @@ reported state through the same iot-data API a real robot's shadow update would 
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 from dataclasses import dataclass, field
@@ -112,8 +113,18 @@ def _fields(state: Reported) -> dict[str, Any]:
     return {name: getattr(state, name) for name in state.__struct_fields__}
 
 
+def check_response(response: dict[str, Any]) -> None:
+    """The response is a valid ASK response envelope: ask-sdk-model reads it back unchanged."""
+    from ask_sdk_core.serialize import DefaultSerializer
+
+    serializer = DefaultSerializer()
+    parsed = serializer.deserialize(json.dumps(response), "ask_sdk_model.ResponseEnvelope")
+    assert serializer.serialize(parsed) == response
+
+
 def speech(response: dict[str, Any]) -> str:
-    """The words Alexa would speak for a skill response."""
+    """The words Alexa would speak for a (checked) skill response."""
+    check_response(response)
     ssml: str = response["response"]["outputSpeech"]["ssml"]
     assert ssml.startswith("<speak>") and ssml.endswith("</speak>")
     return ssml.removeprefix("<speak>").removesuffix("</speak>")

@@ -10,7 +10,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 import pytest
-from skill_testkit import published, reprompt, speech
+from skill_testkit import check_response, published, reprompt, speech
 
 from tests.conftest import load_event
 from vahr.protocol import decode_command
@@ -213,6 +213,7 @@ def test_built_in_intents(skill: Any, aws: None, event: str, spoken: str, ends: 
 
 def test_session_ended_request_returns_an_empty_response(skill: Any, aws: None) -> None:
     response = skill(load_event("alexa_session_ended"), None)
+    check_response(response)
     assert "outputSpeech" not in response["response"]
     assert published() == []
 
