@@ -313,3 +313,30 @@ def test_a_configured_fleet_file_wins(tmp_path: Path) -> None:
     custom = tmp_path / "fleet.yaml"
     custom.write_text(FLEET_FILE.read_text().replace("placebot2", "placebot9"))
     assert fleet_source.load(str(custom)).robot_things == ("placebot1", "placebot9")
+
+
+def test_example_phrases_are_sample_utterances(model: dict[str, Any]) -> None:
+    # Certification rejects example phrases the model does not understand.
+    lm = language_model(model)
+    names = {
+        slot_type["name"]: "|".join(
+            re.escape(name)
+            for value in slot_type["values"]
+            for name in [value["name"]["value"], *value["name"]["synonyms"]]
+        )
+        for slot_type in lm["types"]
+    }
+    patterns = []
+    for intent in lm["intents"]:
+        types = {slot["name"]: slot["type"] for slot in intent.get("slots", [])}
+        for sample in intent["samples"]:
+            regex = re.escape(sample)
+            for slot, slot_type in types.items():
+                regex = regex.replace(re.escape("{" + slot + "}"), f"(?:{names[slot_type]})")
+            patterns.append(re.compile(f"^{regex}$"))
+    manifest = json.loads((ROOT / MANIFEST_PATH).read_text())
+    phrases = manifest["manifest"]["publishingInformation"]["locales"]["en-US"]["examplePhrases"]
+    assert phrases[0] == f"Alexa, open {lm['invocationName']}"
+    for phrase in phrases[1:]:
+        spoken = re.sub(rf"^Alexa, ask {lm['invocationName']} (to )?", "", phrase)
+        assert spoken != phrase and any(p.match(spoken) for p in patterns), phrase
