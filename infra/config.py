@@ -6,6 +6,7 @@ Context comes from `cdk.json` (JSON values) and from `-c key=value` on the comma
 
 from __future__ import annotations
 
+import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,8 +43,9 @@ class InfraConfig:
     operator_policy_name: str = "vahr-operator-policy"
     thing_group_name: str = "vahr-robots"
     presence_rule_name: str = "vahr_presence_to_shadow"
-    # Known only after the skill exists (`ask deploy` prints it); when set, only that skill
-    # may invoke the function and the handler checks the applicationId.
+    # Known only after the skill exists (`ask deploy` prints it and keeps it in
+    # .ask/ask-states.json, read when no skillId is given); when set, only that skill may
+    # invoke the function and the handler checks the applicationId.
     skill_id: str | None = None
     skill: bool = False
     skill_package_dir: Path = REPO_ROOT / "skill-package"
@@ -59,7 +61,10 @@ class InfraConfig:
     def from_context(cls, get: Callable[[str], Any]) -> InfraConfig:
         """Read every known key through `get` (e.g. `app.node.try_get_context`)."""
         defaults = cls()
-        skill_id = _text(get, "skillId")
+        skill_id = _text(get, "skillId") or ask_states_skill_id(
+            _path(get, "askStatesFile", REPO_ROOT / ".ask" / "ask-states.json"),
+            _text(get, "askProfile") or "default",
+        )
         if skill_id is not None and not _SKILL_ID.match(skill_id):
             raise VahrError(
                 f"skillId: {skill_id!r} is not an Alexa skill id (amzn1.ask.skill.<uuid>)"
@@ -109,6 +114,22 @@ class InfraConfig:
         if config.log_level not in ("DEBUG", "INFO", "WARNING", "ERROR"):
             raise VahrError(f"logLevel: {config.log_level!r} must be DEBUG, INFO, WARNING or ERROR")
         return config
+
+
+def ask_states_skill_id(states_file: Path, profile: str) -> str | None:
+    """The skill id `ask deploy` recorded for `profile`, or None before the first deploy."""
+    try:
+        states = json.loads(states_file.read_text())
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError) as err:
+        raise VahrError(f"{states_file}: cannot read the ASK CLI's state ({err})") from err
+    skill_id = (
+        states.get("profiles", {}).get(profile, {}).get("skillId")
+        if isinstance(states, dict)
+        else None
+    )
+    return skill_id if isinstance(skill_id, str) and skill_id else None
 
 
 def _text(get: Callable[[str], Any], key: str) -> str | None:

@@ -13,10 +13,16 @@ PARTITION, REGION, ACCOUNT = "aws", "us-east-1", "123456789012"
 PSEUDO = {"AWS::Partition": PARTITION, "AWS::Region": REGION, "AWS::AccountId": ACCOUNT}
 
 
+# A developer's own `ask deploy` state must not change what the tests synthesize.
+NO_ASK_STATES = str(REPO_ROOT / ".ask" / "absent-in-tests.json")
+
+
 def cdk_context(**overrides: Any) -> dict[str, Any]:
     """cdk.json's context (pytest's `cdk.App()` does not read it), bundling skipped."""
     context: dict[str, Any] = json.loads((REPO_ROOT / "cdk.json").read_text())["context"]
-    return {**context, "aws:cdk:bundling-stacks": [], **overrides}
+    return {
+        **context, "aws:cdk:bundling-stacks": [], "askStatesFile": NO_ASK_STATES, **overrides,
+    }  # fmt: skip
 
 
 def bare_stack(outdir: Path, **context: Any) -> cdk.Stack:

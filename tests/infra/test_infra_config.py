@@ -2,18 +2,20 @@
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 from typing import Any
 
 import pytest
+from template_tools import NO_ASK_STATES
 
 from infra.config import REPO_ROOT, InfraConfig
 from vahr.errors import VahrError
 
 
 def config(**context: Any) -> InfraConfig:
-    return InfraConfig.from_context(context.get)
+    return InfraConfig.from_context({"askStatesFile": NO_ASK_STATES, **context}.get)
 
 
 def test_defaults_are_the_lean_deployment() -> None:
@@ -59,3 +61,33 @@ def test_lambda_python_must_exist(tmp_path: Path) -> None:
     with pytest.raises(VahrError, match=r"^lambdaPython: '.*missing' is not a file$"):
         config(lambdaPython=str(tmp_path / "missing"))
     assert config(lambdaPython=sys.executable).lambda_python == Path(sys.executable)
+
+
+SKILL_ID = "amzn1.ask.skill.0d5c1d3e-52b4-4a53-9f0e-6f1a2b3c4d5e"
+
+
+def ask_states(tmp_path: Path, profiles: object) -> str:
+    states = tmp_path / "ask-states.json"
+    states.write_text(json.dumps({"askcliStatesVersion": "2020-03-31", "profiles": profiles}))
+    return str(states)
+
+
+def test_after_ask_deploy_the_skill_id_comes_from_its_state_file(tmp_path: Path) -> None:
+    # Given `ask deploy` recorded the skill id for the default profile
+    states = ask_states(tmp_path, {"default": {"skillId": SKILL_ID, "skillMetadata": {}}})
+    # Then the next synth locks the function to that skill without -c skillId
+    assert config(askStatesFile=states).skill_id == SKILL_ID
+    # And an explicit skillId still wins; another ASK profile is read when named
+    other = SKILL_ID.replace("0d5c", "1e6d")
+    assert config(askStatesFile=states, skillId=other).skill_id == other
+    assert config(askStatesFile=states, askProfile="lab").skill_id is None
+
+
+def test_a_broken_ask_state_file_is_reported_in_one_line(tmp_path: Path) -> None:
+    broken = tmp_path / "ask-states.json"
+    broken.write_text("{")
+    with pytest.raises(VahrError, match=r"ask-states\.json: cannot read the ASK CLI's state"):
+        config(askStatesFile=str(broken))
+    bad_id = ask_states(tmp_path, {"default": {"skillId": "nope"}})
+    with pytest.raises(VahrError, match=r"^skillId: 'nope' is not an Alexa skill id"):
+        config(askStatesFile=bad_id)
