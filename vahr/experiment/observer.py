@@ -59,7 +59,7 @@ class ObserverConsole:
         self._buffer = ""
         self._closed = False
 
-    def perform(self, task: str) -> None:
+    def perform(self, task: str, done: list[str] | None = None) -> None:
         self._task = task
         self.out(
             "observer: u/r mark an utterance, k + send a click sequence, p a puzzle piece, "

@@ -83,6 +83,12 @@ def keyboard_script(task: str, plan: Plan) -> list[Click]:
     return clicks
 
 
+def click_label(click: Click) -> str:
+    """How a click sequence is named in the log: `placebot1 deliver zone=B`."""
+    thing, action, params = click
+    return " ".join([thing, action, *(f"{k}={v}" for k, v in params.items())])
+
+
 class SimulatedParticipant:
     """Performs each task with one method, following the timing model."""
 
@@ -122,13 +128,21 @@ class SimulatedParticipant:
     def _new_id(self, task: str) -> str:
         return f"{task}-{next(self._ids)}"
 
-    def perform(self, task: str) -> None:
-        """Issue the task's commands, one interaction at a time."""
+    def perform(self, task: str, done: list[str] | None = None) -> None:
+        """Issue the task's commands, one interaction at a time, skipping those in `done`
+        (completed before the session was interrupted)."""
+        remaining = list(done or [])
         if self.method == "vahr":
             for utterance in voice_script(task, self.plan, self.fleet):
+                if utterance in remaining:
+                    remaining.remove(utterance)
+                    continue
                 self._speak(task, utterance)
         else:
             for click in keyboard_script(task, self.plan):
+                if click_label(click) in remaining:
+                    remaining.remove(click_label(click))
+                    continue
                 self._click(task, click)
 
     def _speak(self, task: str, utterance: str) -> None:
@@ -158,16 +172,16 @@ class SimulatedParticipant:
         assert self.console is not None
         thing, action, params = click
         ident = self._new_id(task)
-        label = f"{thing} {action} " + " ".join(f"{k}={v}" for k, v in params.items())
+        label = click_label(click)
         self.log.append(
             Kind.INTERACTION_STARTED,
-            {"id": ident, "channel": "click", "text": label.strip()},
+            {"id": ident, "channel": "click", "text": label},
             task=task,
         )
         self._sleep(self.timing.first_click_s(self.rng))  # the robot's button
         for _ in range(3):  # action, zone, send
             self._sleep(self.timing.next_click_s(self.rng))
-        body: dict[str, Any] = {"id": ident, "channel": "click", "text": label.strip(), "clicks": 4}
+        body: dict[str, Any] = {"id": ident, "channel": "click", "text": label, "clicks": 4}
         try:
             body["commands"] = [self.console.send(thing, action, params)]
         except Exception as err:  # noqa: BLE001 - any publish failure is the interaction's outcome

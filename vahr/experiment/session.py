@@ -38,7 +38,8 @@ class Performer(Protocol):
 
     simulated: bool
 
-    def perform(self, task: str) -> None: ...
+    def perform(self, task: str, done: list[str]) -> None:
+        """Start the task; `done` lists the interactions (by text) already completed in it."""
 
     def wait(self, decided: Callable[[], bool], timeout_s: float) -> bool: ...
 
@@ -145,11 +146,13 @@ def run_tasks(
         elif goal.order and window is not None:
             # Resumed mid-task: watch on from the deliveries already made in this task.
             recorder.world.arm_led(goal, deliveries_in(window.entries))
-        already_acted = window is not None and any(
-            e.kind == Kind.INTERACTION_ENDED for e in window.entries
-        )
-        if not already_acted:
-            performer.perform(task)
+        # On resume, what was already said or clicked in this task is not done again.
+        done = [
+            str(e.data.get("text"))
+            for e in (window.entries if window is not None else [])
+            if e.kind == Kind.INTERACTION_ENDED
+        ]
+        performer.perform(task, done)
 
         def decided(goal: Any = goal, start_seq: int = start_seq) -> bool:
             after = [e for e in event_log.entries(Kind.ROBOT_EVENT) if e.seq > start_seq]

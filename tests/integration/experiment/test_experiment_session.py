@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import json
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from tests.integration.experiment.experiment_robots import SPEED, robot_agents
 from vahr.cli import main
@@ -168,25 +168,28 @@ def test_a_session_cut_mid_task_resumes_without_repeating_or_losing_anything(
         str(SPEED),
         "--json",
     ]
-    # Given a session that is interrupted (Ctrl-C) while task II is being performed
-    original = SimulatedParticipant.perform
+    # Given a session interrupted (Ctrl-C) in task I, after its first click sequence
+    original = SimulatedParticipant._click
+    clicks: list[str] = []
 
-    def interrupted(self: SimulatedParticipant, task: str) -> None:
-        original(self, task)
-        if task == "II":
+    def interrupted(self: SimulatedParticipant, task: str, click: Any) -> None:
+        clicks.append(task)
+        if clicks.count("I") == 2:
             raise KeyboardInterrupt
+        original(self, task, click)
 
-    monkeypatch.setattr(SimulatedParticipant, "perform", interrupted)
+    monkeypatch.setattr(SimulatedParticipant, "_click", interrupted)
     assert main(argv) == 130
     path = logs / "SIM02-keyboard-trial1.sqlite"
     before = read_log(path)
-    assert [e.data["task"] for e in before if e.kind == Kind.TASK_ENDED] == ["I"]
+    assert [e.data["task"] for e in before if e.kind == Kind.TASK_ENDED] == []
+    assert [e.kind for e in before].count(Kind.INTERACTION_ENDED) == 1
     # When it is started again
-    monkeypatch.setattr(SimulatedParticipant, "perform", original)
+    monkeypatch.setattr(SimulatedParticipant, "_click", original)
     capsys.readouterr()
     assert main(argv) == 0
     summary = json.loads(capsys.readouterr().out)
-    # Then it resumed: task II was not performed twice, and every task succeeded
+    # Then it resumed: task I's first click was not repeated, and every task succeeded
     after = read_log(path)
     assert after[: len(before)] == before
     assert summary["resumed"] is True
