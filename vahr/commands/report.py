@@ -2,7 +2,8 @@
 
 `vahr report FILE.csv --out DIR` reads one row per participant, method and trial;
 `vahr report --from-log DIR --out DIR` measures the rows from the session logs under DIR.
-Both write DIR/report.json, DIR/report.md, DIR/results.csv and PNG figures.
+Both write DIR/report.json, DIR/report.md, DIR/results.csv and PNG figures; from logs also
+DIR/sessions.json (each session's plan, measured times and the judge's verdict).
 """
 
 from __future__ import annotations
@@ -53,9 +54,16 @@ def run(args: argparse.Namespace) -> int:
             if entry.kind == Kind.SESSION_STARTED
         )
     report = write_report(rows, args.out, source=source, simulated=simulated)
+    files = ["report.json", "report.md", "results.csv", *FIGURES]
+    if args.from_log is not None:
+        from vahr.experiment.eventlog import find_logs, read_log
+        from vahr.experiment.results import session_summary
+
+        sessions = [session_summary(read_log(path)) for path in find_logs(args.from_log)]
+        (args.out / "sessions.json").write_text(json.dumps(sessions, indent=2) + "\n")
+        files.append("sessions.json")
     if args.json:
         print(json.dumps(report))
     else:
-        files = ["report.json", "report.md", "results.csv", *FIGURES]
         print(f"report of {report['rows']} runs written to {args.out}: {', '.join(files)}")
     return 0

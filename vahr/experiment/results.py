@@ -213,3 +213,19 @@ def rows_from_logs(log_dir: Path) -> tuple[list[ResultRow], list[str]]:
     if not rows:
         raise VahrError(f"no finished sessions under {log_dir}")
     return rows, skipped
+
+
+def session_summary(entries: list[LogEntry]) -> dict[str, object]:
+    """One session's header, measured times and the judge's verdict, for sessions.json."""
+    header = session_header(entries)
+    summary: dict[str, object] = {
+        key: header.get(key)
+        for key in ("session", "participant", "method", "trial", "seed", "simulated")
+    }
+    summary["finished"] = any(entry.kind == Kind.SESSION_ENDED for entry in entries)
+    summary["times"] = measure_session(entries).to_json()
+    if isinstance(header.get("plan"), dict):
+        plan = Plan.from_json(header["plan"])  # type: ignore[arg-type]
+        summary["plan"] = plan.to_json()
+        summary["verdict"] = judge_session(entries, plan).to_json()
+    return summary

@@ -133,6 +133,10 @@ def test_keyboard_session_runs_all_three_tasks_and_reports(
         "success_rate": 1.0,
     }
     assert report["success"]["command"]["keyboard"]["success_rate"] == 1.0
+    (session,) = json.loads((out / "sessions.json").read_text())
+    assert session["session"] == "SIM01-keyboard-trial1" and session["finished"] is True
+    assert session["verdict"]["tasks"]["III"]["led_on"] is True
+    assert set(session["times"]["tasks"]) == {"I", "II", "III"}
     assert "Simulated participants" in (out / "report.md").read_text()
     for name in ("subjective.png", "tlx_by_trial.png", "objective.png"):
         assert (out / name).stat().st_size > 1000
