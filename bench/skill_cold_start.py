@@ -179,7 +179,7 @@ robots acknowledge at once, so these are the skill's own costs per request:
 {rows}
 
 On AWS the acknowledgment wait adds the robot's round trip (publish, robot, shadow update,
-first matching shadow read: the backoff polls at 0, 50, 150, 350, 750 ms and then every
+first matching shadow read: the skill reads at 50, 150, 350, 750 ms and then every
 400 ms), and each iot-data call costs a few milliseconds inside the region.
 """
     write_section("skill_cold_start", "Alexa skill: cold start and warm invocations", body)

@@ -1,7 +1,8 @@
 """Wait, within a budget, until robots report a command id in their shadows.
 
-Each robot's shadow is polled in its own worker with a short exponential backoff, so one
-slow robot does not delay the others. A robot counts as having answered when
+Each robot's shadow is polled in its own worker with a short exponential backoff (reads at
+50, 150, 350 and 750 ms, then every 400 ms, and once more at the deadline), so one slow
+robot does not delay the others. A robot counts as having answered when
 `reported.last_command.id` equals the command id; its `result` says how.
 """
 
@@ -119,6 +120,11 @@ def _poll(
     shadow: RobotShadow | None = None
     error: str | None = None
     while True:
+        # Wait before each read, the first included: a robot cannot have answered a command
+        # published a moment ago, and every read is billed. With no time left, read once.
+        remaining = deadline - clock()
+        if remaining > 0 and stop.wait(min(delay, remaining)):
+            return RobotAnswer(thing, command_id, "unconfirmed", shadow=shadow, error=error)
         try:
             payload = gateway.get_shadow(thing)
             shadow = robot_shadow_from_payload(payload) if payload is not None else None
@@ -127,7 +133,6 @@ def _poll(
             error = str(err)
         if shadow is not None and (answer := classify(thing, command_id, shadow)) is not None:
             return answer
-        remaining = deadline - clock()
-        if remaining <= 0 or stop.wait(min(delay, remaining)):
+        if deadline - clock() <= 0:
             return RobotAnswer(thing, command_id, "unconfirmed", shadow=shadow, error=error)
         delay = min(delay * 2, MAX_DELAY_S)

@@ -181,3 +181,22 @@ def test_a_slow_publish_shortens_the_wait_so_alexa_still_gets_an_answer(
     # Then the wait only used what was left of the reply budget
     assert time.monotonic() - started < 1.0
     assert answers["placebot1"].outcome == "unconfirmed"
+
+
+def test_a_silent_robot_is_read_a_handful_of_times_not_continuously(
+    iot_data: Any, robots: RobotDoubles
+) -> None:
+    # Given a robot that never answers, and a gateway that counts shadow reads (each billed)
+    class Counting(IotDataGateway):
+        reads = 0
+
+        def get_shadow(self, thing: str) -> bytes | None:
+            Counting.reads += 1
+            return super().get_shadow(thing)
+
+    # When the skill waits one second for it
+    answers = await_acknowledgments(Counting(iot_data), {"placebot1": "c5"}, 1.0)
+    # Then it read at 50, 150, 350 and 750 ms and at the deadline: five reads at most (fewer
+    # when reads are slow on a busy machine)
+    assert answers["placebot1"].outcome == "unconfirmed"
+    assert 3 <= Counting.reads <= 5
