@@ -15,13 +15,16 @@ import time
 
 from _results import median, percentile, write_section
 
-TIMER = "import time; t = time.perf_counter(); import {module}; print((time.perf_counter() - t) * 1000)"
+TIMER = (
+    "import time; t = time.perf_counter(); import {module}; print((time.perf_counter() - t) * 1000)"
+)
 
 
 def import_ms(module: str, preload: str = "", runs: int = 25) -> list[float]:
     code = (f"import {preload}; " if preload else "") + TIMER.format(module=module)
+    command = [sys.executable, "-c", code]
     return [
-        float(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout)
+        float(subprocess.run(command, check=True, capture_output=True, text=True).stdout)
         for _ in range(runs)
     ]
 
@@ -53,20 +56,28 @@ def main() -> None:
     args = parser.parse_args()
     alone = import_ms("vahr.protocol", runs=args.runs)
     msgspec_alone = import_ms("msgspec", runs=args.runs)
-    after_skill_deps = import_ms("vahr.protocol", preload="boto3, ask_sdk_core.skill_builder", runs=args.runs)
+    after_skill_deps = import_ms(
+        "vahr.protocol", preload="boto3, ask_sdk_core.skill_builder", runs=args.runs
+    )
     good, bad = decode_rate()
-    body = f"""
-Import time of `vahr.protocol` in a fresh interpreter ({args.runs} runs each; target under 30 ms):
-
-| what is imported | median ms | p90 ms |
-| --- | ---: | ---: |
-| `vahr.protocol` alone | {median(alone):.1f} | {percentile(alone, 90):.1f} |
-| `msgspec` alone (the validation library it is built on) | {median(msgspec_alone):.1f} | {percentile(msgspec_alone, 90):.1f} |
-| `vahr.protocol` after `boto3` and `ask_sdk_core` (what the skill's cold start adds) | {median(after_skill_deps):.1f} | {percentile(after_skill_deps, 90):.1f} |
-
-Decode and validate against the fleet (one process): {good:,.0f} valid commands/s;
-{bad:,.0f} rejected commands/s (bad zone, error message built).
-"""
+    rows = [
+        ("`vahr.protocol` alone", alone),
+        ("`msgspec` alone (the validation library it is built on)", msgspec_alone),
+        (
+            "`vahr.protocol` after `boto3` and `ask_sdk_core` (what the skill adds)",
+            after_skill_deps,
+        ),
+    ]
+    table = "\n".join(
+        f"| {what} | {median(ms):.1f} | {percentile(ms, 90):.1f} |" for what, ms in rows
+    )
+    body = (
+        f"Import time in a fresh interpreter ({args.runs} runs each; target under 30 ms):\n\n"
+        "| what is imported | median ms | p90 ms |\n| --- | ---: | ---: |\n"
+        f"{table}\n\n"
+        f"Decode and validate against the fleet (one process): {good:,.0f} valid commands/s;\n"
+        f"{bad:,.0f} rejected commands/s (bad zone, error message built).\n"
+    )
     write_section("protocol_import", "Wire contract: import cost and decode throughput", body)
 
 
