@@ -211,7 +211,8 @@ def rows_from_logs(log_dir: Path) -> tuple[list[ResultRow], list[str]]:
             continue
         rows.append(row)
     if not rows:
-        raise VahrError(f"no finished sessions under {log_dir}")
+        why = f" ({'; '.join(skipped)})" if skipped else ""
+        raise VahrError(f"no finished sessions under {log_dir}{why}")
     return rows, skipped
 
 

@@ -52,7 +52,12 @@ class ExperimentShadow:
     def write(self, state: ExperimentState) -> None:
         try:
             self._client.update_thing_shadow(thingName=self.thing, payload=state.to_payload())
-        except (ClientError, BotoCoreError, NoCredentialsError) as err:
+        except NoCredentialsError as err:
+            raise VahrError(
+                f"cannot write the experiment state to the shadow of {self.thing}: no AWS "
+                "credentials (give --api URL for the local stack, or --no-shadow)"
+            ) from err
+        except (ClientError, BotoCoreError) as err:
             raise VahrError(
                 f"cannot write the experiment state to the shadow of {self.thing}: {err}"
             ) from err

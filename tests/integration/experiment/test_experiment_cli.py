@@ -230,3 +230,25 @@ def test_report_from_a_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     assert report["rows"] == 16
     assert report["objective"]["rad"]["p_value"] is not None
     assert (tmp_path / "out" / "report.md").is_file()
+
+
+def test_no_aws_credentials_says_what_to_do(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    for name in (
+        "AWS_ACCESS_KEY_ID",
+        "AWS_SECRET_ACCESS_KEY",
+        "AWS_SESSION_TOKEN",
+        "AWS_PROFILE",
+        "AWS_ENDPOINT_URL_IOT_DATA_PLANE",
+    ):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("AWS_SHARED_CREDENTIALS_FILE", str(tmp_path / "none"))
+    monkeypatch.setenv("AWS_CONFIG_FILE", str(tmp_path / "none"))
+    monkeypatch.setenv("AWS_EC2_METADATA_DISABLED", "true")
+    assert main(plan_only(tmp_path)) == 2
+    assert (
+        capsys.readouterr()
+        .err.strip()
+        .endswith("no AWS credentials (give --api URL for the local stack, or --no-shadow)")
+    )
