@@ -9,10 +9,10 @@ with exponential backoff and jitter. The last will marks the robot offline (reta
 from __future__ import annotations
 
 import asyncio
+import fcntl
 import logging
 import os
 import socket
-import stat
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -289,35 +289,52 @@ class Mqtt5Link:
 
 
 def disable_nagle(port: int) -> int:
-    """Set TCP_NODELAY on this process's TCP sockets connected to `port`; returns how many.
+    """Set TCP_NODELAY on this process's TCP connections to `port`; returns how many.
 
     awscrt exposes no TCP_NODELAY option, and without it the agent's PUBACK for a command
     followed at once by its shadow update stalls about 40 ms on Nagle's algorithm plus the
-    broker's delayed ACK (FIELD-NOTES). A duplicate of the descriptor shares the socket,
-    so setting the option on the duplicate sets it on awscrt's socket.
+    broker's delayed ACK (FIELD-NOTES). The connections are found through /proc (Linux):
+    the socket inodes whose remote port is `port`, then this process's descriptors of
+    those inodes. A duplicate descriptor shares the socket, so the option set on it holds
+    for awscrt's descriptor; the file status flags (blocking mode) are restored after.
     """
-    fd_dir = Path("/proc/self/fd")
-    if not fd_dir.is_dir():  # not Linux: nothing to find this way
+    inodes = _connection_inodes(port)
+    if not inodes:
         return 0
     changed = 0
-    for entry in fd_dir.iterdir():
+    for entry in Path("/proc/self/fd").iterdir():
         try:
-            fd = int(entry.name)
-            if not stat.S_ISSOCK(os.fstat(fd).st_mode):
+            if str(entry.readlink()) not in inodes:
                 continue
+            fd = int(entry.name)
+            flags = fcntl.fcntl(fd, fcntl.F_GETFL)
             sock = socket.socket(fileno=os.dup(fd))
         except (OSError, ValueError):
             continue
         try:
-            if sock.type == socket.SOCK_STREAM and sock.family in (socket.AF_INET, socket.AF_INET6):
-                if sock.getpeername()[1] == port:
-                    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-                    changed += 1
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            changed += 1
         except OSError:
             pass
         finally:
             sock.close()
+            fcntl.fcntl(fd, fcntl.F_SETFL, flags)
     return changed
+
+
+def _connection_inodes(port: int) -> set[str]:
+    """`socket:[inode]` names of established TCP connections whose remote port is `port`."""
+    found: set[str] = set()
+    for table in (Path("/proc/net/tcp"), Path("/proc/net/tcp6")):
+        try:
+            lines = table.read_text().splitlines()[1:]
+        except OSError:
+            continue
+        for line in lines:
+            fields = line.split()
+            if len(fields) > 9 and int(fields[2].rsplit(":", 1)[1], 16) == port:
+                found.add(f"socket:[{fields[9]}]")
+    return found
 
 
 def _dispatch(handlers: list[Callable[[str, bytes], None]], topic: str, payload: bytes) -> None:

@@ -25,6 +25,7 @@ from vahr.protocol import new_command
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
+    from pathlib import Path
 
     from vahr.protocol import Fleet
 
@@ -185,3 +186,51 @@ async def test_stop_preempts_the_active_goal(
             await asyncio.sleep(0.01)
     assert rec.kinds("r3")[-1] == "cancelled"
     assert rec.states[-1].status == "stopped"
+
+
+def test_robot_agent_run_with_the_ros1_backend_drives_move_base_from_mqtt(
+    ros_master: str, move_base: dict[str, Any], mosquitto: Any, tmp_path: Path
+) -> None:
+    from tests.integration.agent.harness import AgentProcess, ShadowResponder, WireTap, command
+
+    port = mosquitto.config.plain_port
+    tap, shadows = WireTap(port), ShadowResponder(port)
+    config = tmp_path / "ros.yaml"
+    config.write_text(
+        f"ros:\n  master_uri: {ros_master}\n  loader_delay_s: 0.05\n  unloader_delay_s: 0.05\n"
+    )
+    agent = AgentProcess(
+        "--thing",
+        "placebot1",
+        "--broker",
+        str(mosquitto.plain_url),
+        "--backend",
+        "ros1",
+        "--config",
+        str(config),
+        state_dir=tmp_path / "state",
+        log_file=tmp_path / "agent.log",
+    )
+    try:
+        tap.reported("placebot1", lambda r: r["connected"] is True, timeout_s=20)
+        goals = len(move_base["goals"])
+        # When a deliver command arrives over MQTT
+        tap.publish("vahr/robots/placebot1/cmd", command("ros-deliver", "deliver", {"zone": "C"}))
+        # Then move_base gets a goal for LOADING, then one for zone C, and the robot delivers
+        tap.event("placebot1", "delivered", "ros-deliver", timeout_s=20)
+        targets = [
+            (g.target_pose.pose.position.x, g.target_pose.pose.position.y)
+            for g in move_base["goals"][goals:]
+        ]
+        assert targets == [(1.5, 4.0), (9.0, 3.0)]
+        state = tap.reported(
+            "placebot1", lambda r: (r["last_command"] or {}).get("result") == "done"
+        )
+        assert state["zone"] == "C"
+        # and it stops cleanly (its ROS node too), exit code 0
+        assert agent.stop(signal.SIGTERM, timeout_s=15) == 0, agent.log()
+    finally:
+        if agent.process.poll() is None:
+            agent.kill()
+        tap.close()
+        shadows.close()

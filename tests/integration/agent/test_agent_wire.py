@@ -56,6 +56,11 @@ def test_a_command_reaches_the_agent_and_state_and_events_appear_on_the_wire(
     )
     assert offline.json()["online"] is False
     assert (tap.retained("vahr/robots/placebot1/presence") or {}).get("online") is False
+    # and its log has one line per event
+    log = agent.log()
+    assert "placebot1: accepted navigate nav-1" in log
+    assert "placebot1: arrived navigate nav-1 zone=B" in log
+    assert log.count("placebot1: done navigate nav-1") == 1
 
 
 def test_the_fleet_topic_reaches_every_robot(
@@ -164,3 +169,36 @@ def test_plaintext_to_a_non_loopback_host_is_refused_in_one_line(
     assert result.stderr.strip().splitlines() == [
         "robot-agent run: error: --broker 'mqtt://example.com:1883': plaintext MQTT is allowed only to a loopback broker; use --endpoint with --cert, --key and --ca for any other host"
     ]
+
+
+def test_sigint_stops_the_agent_cleanly_too(
+    tap: WireTap, shadows: ShadowResponder, start_agent: Callable[..., AgentProcess]
+) -> None:
+    agent = start_agent("placebot2")
+    tap.reported("placebot2", lambda r: r["connected"] is True)
+    tap.publish("vahr/robots/placebot2/cmd", command("cut", "navigate", {"zone": "A"}))
+    tap.event("placebot2", "accepted", "cut")
+    mark = tap.mark()
+    assert agent.stop(signal.SIGINT) == 0
+    cancelled = tap.event("placebot2", "cancelled", "cut", after=mark)
+    assert cancelled["reason"] == "the agent is shutting down"
+    final = tap.reported("placebot2", lambda r: r["connected"] is False, after=mark)
+    assert final["last_command"]["id"] == "cut"
+
+
+def test_a_robot_that_gets_stuck_says_so_in_its_shadow(
+    tap: WireTap, shadows: ShadowResponder, start_agent: Callable[..., AgentProcess], tmp_path
+) -> None:  # type: ignore[no-untyped-def]
+    # Given a robot whose way to zone D is blocked half way
+    config = tmp_path / "stuck.yaml"
+    config.write_text("sim:\n  stuck_zones: [D]\nexecutor:\n  stuck_after_s: 5\n")
+    start_agent("placebot1", "--config", str(config))
+    tap.reported("placebot1", lambda r: r["connected"] is True)
+    # When it is sent there
+    tap.publish(CMD, command("blocked", "navigate", {"zone": "D"}))
+    # Then it reports stuck, and the command failed with the reason
+    stuck = tap.event("placebot1", "stuck", "blocked", timeout_s=20)
+    assert stuck["reason"] == "no progress towards D for 5 s"
+    state = tap.reported("placebot1", lambda r: (r["last_command"] or {}).get("result") == "failed")
+    assert state["status"] == "stuck"
+    assert state["last_command"]["reason"] == "stuck: no progress towards D for 5 s"
