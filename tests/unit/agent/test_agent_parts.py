@@ -113,3 +113,22 @@ async def test_a_scaled_clock_sleeps_less_on_the_wall() -> None:
     assert time.monotonic() - began < 1.0
     with pytest.raises(ValueError, match="speed_factor"):
         ScaledClock(0)
+
+
+def test_nagle_is_disabled_only_on_connections_to_the_broker_port() -> None:
+    import socket
+
+    from robot_agent.link.mqtt5 import disable_nagle
+
+    with (
+        socket.create_server(("127.0.0.1", 0)) as server,
+        socket.create_server(("127.0.0.1", 0)) as other,
+    ):
+        to_broker = socket.create_connection(server.getsockname())
+        elsewhere = socket.create_connection(other.getsockname())
+        with to_broker, elsewhere:
+            assert disable_nagle(server.getsockname()[1]) == 1
+            assert to_broker.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 1
+            assert elsewhere.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 0
+            # Blocking mode is the socket owner's business and stays as it was.
+            assert to_broker.getblocking() and server.getblocking()
