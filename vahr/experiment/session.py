@@ -110,13 +110,9 @@ def rebuild_world(fleet: Fleet, session: OpenSession) -> World:
     world = World.from_fleet(fleet)
     for entry in session.log.entries(Kind.ROBOT_EVENT):
         world.apply(entry.data)
-    world.led_on = (
-        any(
-            e.data.get("what") == "led" and e.data.get("on")
-            for e in session.log.entries(Kind.WORLD)
-        )
-        and world.led_on
-    )
+    # The LED is as it was last logged: only a running task III may switch it.
+    leds = [e for e in session.log.entries(Kind.WORLD) if e.data.get("what") == "led"]
+    world.led_on = bool(leds[-1].data.get("on")) if leds else False
     return world
 
 

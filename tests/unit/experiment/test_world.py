@@ -8,6 +8,8 @@ from vahr.experiment.tasks import TaskGoal
 from vahr.experiment.world import World
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from vahr.protocol import Fleet
 
 TASK_III = TaskGoal("III", {"placebot1": "D", "placebot2": "D"}, ("placebot1", "placebot2"))
@@ -71,3 +73,18 @@ def test_deliveries_before_task_three_do_not_light_the_led(fleet: Fleet) -> None
     world.arm_led(TASK_III)
     world.apply(delivered("placebot2", "D"))
     assert world.led_on is False
+
+
+def test_a_resumed_session_rebuilds_the_world_from_its_log(fleet: Fleet, tmp_path: Path) -> None:
+    from vahr.experiment.eventlog import EventLog, Kind
+    from vahr.experiment.session import OpenSession, SessionSpec, rebuild_world
+    from vahr.experiment.tasks import draw_plan
+
+    spec = SessionSpec(participant="P1", method="vahr", trial=1, seed=1, log_dir=tmp_path)
+    with EventLog.open(spec.path) as log:
+        log.append(Kind.ROBOT_EVENT, delivered("placebot1", "D"))
+        log.append(Kind.ROBOT_EVENT, delivered("placebot2", "D"))
+        log.append(Kind.WORLD, {"what": "led", "on": True})
+        world = rebuild_world(fleet, OpenSession(spec, log, draw_plan(fleet, 1), resumed=True))
+    assert world.led_on is True
+    assert world.snapshot()["packages"]["D"] == ["placebot1", "placebot2"]
