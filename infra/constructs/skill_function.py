@@ -133,6 +133,13 @@ class SkillFunction(Construct):
         # Without a skill id (the skill does not exist before its endpoint does) any skill
         # could call the function; the handler then checks nothing, so set skillId once
         # `ask deploy` has printed it and deploy again.
+        if not config.skill_id:
+            cdk.Annotations.of(self.function).add_warning_v2(
+                "vahr:skill-id-unknown",
+                "No skill id yet: any Alexa skill may invoke this function. After `ask deploy` "
+                "(or with -c skill=true), deploy again; the id is read from "
+                ".ask/ask-states.json or given with -c skillId=...",
+            )
         self.function.add_permission(
             "AlexaInvoke",
             principal=iam.ServicePrincipal("alexa-appkit.amazon.com"),

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import pytest
-from aws_cdk.assertions import Template
+from aws_cdk.assertions import Annotations, Match, Template
 from template_tools import bare_stack, only, resources, role_grants
 
 from infra.config import InfraConfig
@@ -111,3 +111,15 @@ def test_a_precompiling_build_is_a_different_asset(tmp_path: Path, fleet: Fleet)
     )
     # Then CDK sees two different code assets, so switching it redeploys the code
     assert plain["Code"]["S3Key"] != compiled["Code"]["S3Key"]
+
+
+def test_synth_warns_while_the_function_is_open_to_any_skill(tmp_path: Path, fleet: Fleet) -> None:
+    def warnings(config: InfraConfig, outdir: Path) -> list[str]:
+        stack = bare_stack(outdir)
+        SkillFunction(stack, "Skill", config=config, fleet=fleet, data_endpoint=DATA_HOST)
+        found = Annotations.from_stack(stack).find_warning("*", Match.any_value())
+        return [str(entry.entry.data) for entry in found]
+
+    assert any("any Alexa skill may invoke" in w for w in warnings(InfraConfig(), tmp_path / "a"))
+    locked = warnings(InfraConfig(skill_id=SKILL_ID), tmp_path / "b")
+    assert not any("any Alexa skill" in w for w in locked)
