@@ -11,7 +11,6 @@ matching event because the skill waits on the shadow, not on events.
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import logging
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -47,6 +46,8 @@ log = logging.getLogger(__name__)
 
 WEATHER_QUESTION = "Alexa, ask robot fleet what the weather is"
 WEATHER_ZONES = {"sunny": "A", "rainy": "C"}
+# How long shutting down waits for the running task to unwind (halt the backend).
+CLOSE_TIMEOUT_S = 5.0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -165,16 +166,14 @@ class Executor:
     async def wait_idle(self) -> None:
         """Wait until the current task (if any) has ended."""
         while self._task is not None and not self._task.done():
-            with contextlib.suppress(asyncio.CancelledError):
-                await asyncio.shield(self._task)
+            await asyncio.wait({self._task})
 
     async def close(self) -> None:
         """Cancel the running task (it ends `cancelled`) and release the backend."""
         if self.busy and self._current is not None and self._task is not None:
             self._emit("cancelled", self._current, reason="the agent is shutting down")
             self._task.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await self._task
+            await asyncio.wait({self._task}, timeout=CLOSE_TIMEOUT_S)
         await self.backend.close()
 
     # -- tasks --------------------------------------------------------------------------
@@ -182,8 +181,10 @@ class Executor:
     async def _run(self, command: Command, previous: asyncio.Task[None] | None) -> None:
         if previous is not None and not previous.done():
             # The previous task halts the backend while it unwinds; wait for that.
-            with contextlib.suppress(asyncio.CancelledError):
-                await previous
+            # asyncio.wait, not `await previous`: the previous task's cancellation must not
+            # be raised here, and this task's own cancellation (a third command came in
+            # meanwhile) must not be swallowed, or two tasks would drive at once.
+            await asyncio.wait({previous})
         try:
             if isinstance(command, Stop):
                 await self._stop(command)
@@ -271,8 +272,7 @@ class Executor:
                     if self.clock.monotonic() - last_advance <= self.settings.stuck_after_s:
                         continue
                     drive.cancel()
-                    with contextlib.suppress(asyncio.CancelledError, NavigationFailed):
-                        await drive
+                    await asyncio.wait({drive})
                     reason = f"no progress towards {zone.id} for {self.settings.stuck_after_s:g} s"
                     self._update(status="stuck", pose=_pose(self.backend.pose))
                     self._emit(
@@ -286,8 +286,7 @@ class Executor:
         finally:
             if not drive.done():
                 drive.cancel()
-                with contextlib.suppress(asyncio.CancelledError, NavigationFailed):
-                    await drive
+                await asyncio.wait({drive})
 
     async def _deliver(self, command: Command, zone: Zone) -> None:
         loading = self.fleet.zone("LOADING")

@@ -226,3 +226,28 @@ async def test_close_cancels_the_running_task(fleet: Fleet) -> None:
     await rec.until("progress", "going")
     await executor.close()
     assert rec.first("cancelled", "going").reason == "the agent is shutting down"
+
+
+async def test_a_burst_of_commands_runs_only_the_last_and_never_two_at_once(fleet: Fleet) -> None:
+    executor, rec, backend = make_executor(fleet, speed=50)
+    # When three motion commands arrive back to back (no time in between)
+    executor.execute(cmd("navigate", {"zone": "A"}, "b1"))
+    executor.execute(cmd("deliver", {"zone": "B"}, "b2"))
+    executor.execute(cmd("navigate", {"zone": "D"}, "b3"))
+    await executor.wait_idle()
+    # Then the first two end cancelled without moving, and only the last one drives
+    assert rec.kinds("b1") == ["accepted", "cancelled"]
+    assert rec.kinds("b2") == ["accepted", "cancelled"]
+    assert rec.kinds("b3")[-2:] == ["arrived", "done"]
+    assert rec.states[-1].zone == "D" and backend.pose == fleet.zone("D").pose
+    await asyncio.sleep(0.1)
+    assert backend.pose == fleet.zone("D").pose
+
+
+async def test_close_during_a_burst_returns_promptly(fleet: Fleet) -> None:
+    executor, rec, _ = make_executor(fleet, speed=1)
+    for index in range(20):
+        executor.execute(cmd("navigate", {"zone": "ABCD"[index % 4]}, f"c{index}"))
+    async with asyncio.timeout(2):
+        await executor.close()
+    assert rec.kinds("c19")[-1] == "cancelled"
