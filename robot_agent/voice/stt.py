@@ -1,0 +1,178 @@
+"""Speech recognition: pocketsphinx offline with a grammar of the expected answers.
+
+Free-form recognition of synthetic speech is poor, so the decoder is constrained to a JSGF
+grammar of the expected phrases. A grammar always yields an in-grammar guess, so each
+result is checked two ways before it is accepted:
+
+- the hypothesis must be a whole phrase (a decoder that ran out of grammar stops early);
+- a likelihood ratio: the grammar path's acoustic score per frame against an
+  unconstrained phone loop over the same audio (all senones scored, so both are measured
+  against the same per-frame best). In-grammar speech follows the phone loop closely;
+  anything else falls far behind it. The ratio is mapped to a 0..1 confidence.
+
+Silence never reaches the decoder: an energy detector finds no speech first. When the
+audio holds several sentences (the skill may add one after its answer), the prefixes
+ending at each pause are tried as well and the most confident accepted one wins.
+pocketsphinx is imported here and nowhere else.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
+
+from robot_agent.voice.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio, SpeechDetector
+from robot_agent.voice.port import VoiceError
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+# Logistic mapping of the per-frame log-likelihood ratio (pocketsphinx log units, base
+# 1.0001) to a confidence. Measured on espeak-ng speech in two voices, clean and at 20 dB
+# SNR: in-grammar answers scored -6 to +40, unrelated sentences -31 to -18. The midpoint
+# sits between the two; see docs/voice.md.
+RATIO_MIDPOINT = -12.0
+RATIO_SCALE = 4.0
+DEFAULT_MIN_CONFIDENCE = 0.5
+MAX_PREFIXES = 3
+# Speech runs at about 10-15 phones a second; a short phrase stretched over much longer
+# speech ("sunny" for "I am going to zone B") is a forced guess, not an answer.
+MIN_PHONES_PER_SECOND = 4.0
+# Context kept around a sentence cut at a pause: the decoder expects some silence.
+_MARGIN_SAMPLES = SAMPLE_RATE * 150 // 1000
+
+
+@dataclass(frozen=True)
+class Recognition:
+    """What was heard: `text` is the best guess, `accepted` says whether to trust it."""
+
+    text: str
+    confidence: float
+    accepted: bool
+
+
+NOTHING_HEARD = Recognition("", 0.0, False)
+
+
+class Recognizer(Protocol):
+    def recognize(self, audio: Audio) -> Recognition: ...
+
+
+def jsgf_grammar(phrases: Iterable[str], name: str = "answers") -> str:
+    """A JSGF grammar whose one public rule is any of `phrases` (already normalized)."""
+    alternatives = " | ".join(dict.fromkeys(phrases))
+    if not alternatives:
+        raise VoiceError("the recognizer needs at least one phrase")
+    return f"#JSGF V1.0;\ngrammar {name};\npublic <utterance> = {alternatives};\n"
+
+
+class GrammarRecognizer:
+    """pocketsphinx with a phrase grammar, phone-loop verification and energy gating."""
+
+    def __init__(
+        self,
+        phrases: Iterable[str],
+        *,
+        min_confidence: float = DEFAULT_MIN_CONFIDENCE,
+        detector: SpeechDetector | None = None,
+    ) -> None:
+        from pocketsphinx import Decoder, get_model_path
+
+        self.phrases = frozenset(phrases)
+        self.min_confidence = min_confidence
+        self.detector = detector or SpeechDetector()
+        model = Path(get_model_path())
+        # compallsen: score every senone each frame, so the per-frame normalization (and
+        # with it the ratio below) is the same for the grammar and the phone loop.
+        self._decoder = Decoder(
+            lm=None, loglevel="FATAL", compallsen=True, samprate=float(SAMPLE_RATE)
+        )
+        missing = sorted(
+            {w for p in self.phrases for w in p.split() if self._decoder.lookup_word(w) is None}
+        )
+        if missing:
+            raise VoiceError(f"words missing from the pronunciation dictionary: {missing}")
+        self._decoder.add_jsgf_string("grammar", jsgf_grammar(sorted(self.phrases)))
+        self._decoder.add_allphone_file("phones", str(model / "en-us" / "en-us-phone.lm.bin"))
+        self._logmath = self._decoder.get_logmath()
+        # One decoder, one utterance at a time.
+        self._lock = threading.Lock()
+
+    def recognize(self, audio: Audio) -> Recognition:
+        segments = self.detector.segments(audio)
+        if not segments:
+            return NOTHING_HEARD
+        candidates = [audio]
+        total = len(audio.pcm) // SAMPLE_WIDTH
+        for _, end in segments[: MAX_PREFIXES + 1][:-1]:
+            stop = min(total, end + _MARGIN_SAMPLES)
+            candidates.append(Audio(audio.pcm[: stop * SAMPLE_WIDTH]))
+        with self._lock:
+            results = [self._decode(candidate) for candidate in candidates]
+        accepted = [r for r in results if r.accepted]
+        if accepted:
+            return max(accepted, key=lambda r: r.confidence)
+        return results[0]
+
+    def _decode(self, audio: Audio) -> Recognition:
+        phone_score = self._score_per_frame("phones", audio)
+        grammar_score = self._score_per_frame("grammar", audio)
+        hypothesis = self._decoder.hyp()
+        text = hypothesis.hypstr if hypothesis is not None else ""
+        if grammar_score is None or phone_score is None or not text:
+            return Recognition(text, 0.0, False)
+        if text not in self.phrases or self._too_slow(text, audio):
+            return Recognition(text, 0.0, False)
+        ratio = grammar_score - phone_score
+        confidence = 1.0 / (1.0 + math.exp(-(ratio - RATIO_MIDPOINT) / RATIO_SCALE))
+        return Recognition(text, round(confidence, 3), confidence >= self.min_confidence)
+
+    def _too_slow(self, text: str, audio: Audio) -> bool:
+        voiced = sum(end - start for start, end in self.detector.segments(audio)) / SAMPLE_RATE
+        phones = sum(len((self._decoder.lookup_word(w) or "").split()) for w in text.split())
+        return voiced > 0 and phones / voiced < MIN_PHONES_PER_SECOND
+
+    def _score_per_frame(self, search: str, audio: Audio) -> float | None:
+        decoder = self._decoder
+        decoder.activate_search(search)
+        decoder.start_utt()
+        decoder.process_raw(audio.pcm, full_utt=True)
+        decoder.end_utt()
+        hypothesis = decoder.hyp()
+        frames = decoder.n_frames()
+        if hypothesis is None or hypothesis.score <= 0.0 or frames == 0:
+            return None
+        # The binding hands the score back exponentiated; take the log again.
+        return float(self._logmath.log(hypothesis.score)) / frames
+
+
+class GoogleRecognizer:
+    """Google's web speech API through SpeechRecognition (needs the network and
+    `pip install SpeechRecognition`); its own confidence is used as is."""
+
+    def __init__(self, language: str = "en-US") -> None:
+        try:
+            import speech_recognition
+        except ImportError as err:
+            raise VoiceError("the google recognizer needs `pip install SpeechRecognition`") from err
+        self._sr = speech_recognition
+        self._recognizer = speech_recognition.Recognizer()
+        self.language = language
+
+    def recognize(self, audio: Audio) -> Recognition:
+        if not SpeechDetector().has_speech(audio):
+            return NOTHING_HEARD
+        data = self._sr.AudioData(audio.pcm, SAMPLE_RATE, SAMPLE_WIDTH)
+        try:
+            result = self._recognizer.recognize_google(data, language=self.language, show_all=True)
+        except self._sr.RequestError as err:
+            raise VoiceError(f"Google speech recognition is unreachable: {err}") from err
+        alternatives = result.get("alternative", []) if isinstance(result, dict) else []
+        if not alternatives:
+            return NOTHING_HEARD
+        best = alternatives[0]
+        confidence = float(best.get("confidence", 0.5))
+        return Recognition(str(best.get("transcript", "")), confidence, True)

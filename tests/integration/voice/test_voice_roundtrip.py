@@ -1,0 +1,83 @@
+"""Acceptance: espeak-ng speaks the assistant's answers, pocketsphinx and the local
+interpreter understand every one, clean and with white noise at 20 dB SNR, in two voices;
+silence and an unrelated sentence come back unknown."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pytest
+
+from robot_agent.voice.audio import SAMPLE_RATE, Audio, add_white_noise, concatenate
+from robot_agent.voice.tts import EspeakSynthesizer
+
+if TYPE_CHECKING:
+    from robot_agent.voice.understanding import Understanding
+
+VOICES = ("en-us+f2", "en-us+m3")
+SUNNY = (
+    "The weather is sunny.",
+    "It is sunny today.",
+    "The sun is shining.",
+    "Today will be sunny.",
+    "It is a sunny day.",
+)
+RAINY = ("The weather is rainy.", "It is raining.", "It will rain today.",
+         "Today will be rainy.", "Bring an umbrella.")  # fmt: skip
+UNRELATED = "Please deliver the package to the loading zone."
+ANSWERS = [(text, "sunny") for text in SUNNY] + [(text, "rainy") for text in RAINY]
+
+
+@pytest.mark.parametrize("voice", VOICES)
+@pytest.mark.parametrize("snr_db", [None, 20.0], ids=["clean", "snr20"])
+def test_every_phrasing_is_understood(
+    understanding: Understanding, voice: str, snr_db: float | None
+) -> None:
+    # Given the answers spoken by espeak-ng at 16 kHz, with or without white noise
+    tts = EspeakSynthesizer(voice)
+    rng = np.random.default_rng(20)
+    wrong = []
+    for text, intent in ANSWERS:
+        audio = tts.synthesize(text)
+        assert len(audio.pcm) % 2 == 0 and audio.seconds > 0.3
+        if snr_db is not None:
+            audio = add_white_noise(audio, snr_db, rng)
+        # When the robot hears them
+        heard = understanding.hear(audio)
+        # Then each is recognized and interpreted as its intent
+        if heard.intent != intent or heard.confidence < 0.5:
+            wrong.append((text, heard))
+    assert wrong == []
+
+
+@pytest.mark.parametrize("voice", VOICES)
+def test_silence_and_an_unrelated_sentence_are_unknown(
+    understanding: Understanding, voice: str
+) -> None:
+    tts = EspeakSynthesizer(voice)
+    rng = np.random.default_rng(3)
+    unrelated = tts.synthesize(UNRELATED)
+    cases = {
+        "silence": Audio.silence(2.0),
+        "quiet room noise": add_white_noise(Audio.from_samples(np.full(SAMPLE_RATE, 20.0)), 0, rng),
+        "unrelated": unrelated,
+        "unrelated, 20 dB SNR": add_white_noise(unrelated, 20.0, rng),
+    }
+    heard = {name: understanding.hear(audio) for name, audio in cases.items()}
+    assert {name: (h.intent, h.text) for name, h in heard.items()} == {
+        name: ("unknown", "") for name in cases
+    }
+
+
+def test_a_sentence_after_the_answer_does_not_hide_it(understanding: Understanding) -> None:
+    # Given the skill's answer followed by a second sentence after a pause
+    tts = EspeakSynthesizer("en-us+f2")
+    audio = concatenate(
+        tts.synthesize("The weather is rainy."),
+        Audio.silence(0.5),
+        tts.synthesize("Is there anything else I can help with?"),
+    )
+    # Then the answer is still understood
+    heard = understanding.hear(audio)
+    assert (heard.intent, heard.text) == ("rainy", "the weather is rainy")
