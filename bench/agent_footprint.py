@@ -6,6 +6,7 @@ one core), (2) its resident memory (target <= 80 MB), and (3) the time from a te
 publishing a command to the same client receiving the agent's shadow update that
 acknowledges it (target p50 <= 10 ms), for `ping` and for preempting `navigate` commands.
 The latency includes two broker hops, so it is an upper bound on the agent's own time.
+Finally (4) a swarm of `--swarm` robots in this process answers fleet-wide pings.
 """
 
 from __future__ import annotations
@@ -114,10 +115,63 @@ class Probe:
         self._client.loop_stop()
 
 
+def swarm_fan_out(port: int, count: int, rounds: int) -> list[float]:
+    """Fleet-wide ping to a swarm of `count` robots: ms until every robot's shadow acked it."""
+    from robot_agent.swarm import SwarmThread
+
+    acked: dict[str, set[str]] = {}
+    done: dict[str, threading.Event] = {}
+    arrived: dict[str, float] = {}
+
+    def on_message(client: Any, userdata: Any, message: paho.MQTTMessage) -> None:
+        body = json.loads(message.payload)
+        last = (body.get("state", {}).get("reported") or {}).get("last_command") or {}
+        command_id = last.get("id", "")
+        if command_id in acked:
+            acked[command_id].add(message.topic)
+            if len(acked[command_id]) == count and not done[command_id].is_set():
+                arrived[command_id] = time.perf_counter()
+                done[command_id].set()
+
+    client = paho.Client(CallbackAPIVersion.VERSION2, protocol=MQTTProtocolVersion.MQTTv5)
+    client.on_socket_open = Probe._nodelay
+    client.on_message = on_message
+    client.connect("127.0.0.1", port)
+    client.loop_start()
+    client.subscribe("$aws/things/+/shadow/update", qos=1)
+    times: list[float] = []
+    try:
+        with SwarmThread(broker=f"mqtt://127.0.0.1:{port}", count=count):
+            time.sleep(1)
+            for _ in range(rounds):
+                command_id = uuid.uuid4().hex
+                acked[command_id], done[command_id] = set(), threading.Event()
+                payload = json.dumps(
+                    {
+                        "id": command_id,
+                        "action": "ping",
+                        "params": {},
+                        "source": "console",
+                        "issued_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                    }
+                )
+                sent = time.perf_counter()
+                client.publish("vahr/fleet/cmd", payload, qos=1)
+                if not done[command_id].wait(30):
+                    raise RuntimeError("the swarm did not acknowledge a fleet ping")
+                times.append((arrived[command_id] - sent) * 1000)
+    finally:
+        client.disconnect()
+        client.loop_stop()
+    return times
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--idle-seconds", type=float, default=60.0)
     parser.add_argument("--commands", type=int, default=300, help="round trips per action")
+    parser.add_argument("--swarm", type=int, default=100, help="robots in the swarm run")
+    parser.add_argument("--swarm-rounds", type=int, default=20)
     parser.add_argument("--no-write", action="store_true", help="print, do not update docs")
     args = parser.parse_args()
 
@@ -161,8 +215,11 @@ def main() -> int:
                 probe.round_trip("navigate", {"zone": zones[i % 4]}) for i in range(args.commands)
             ]
             rss_busy = rss_mb(agent.pid)
+            agent.terminate()
+            agent.wait(timeout=10)
+            fan_out = swarm_fan_out(port, args.swarm, args.swarm_rounds)
         finally:
-            if agent is not None:
+            if agent is not None and agent.poll() is None:
                 agent.terminate()
                 agent.wait(timeout=10)
             if probe is not None:
@@ -177,6 +234,10 @@ def main() -> int:
 
     idle_cell = (
         f"{idle_pct:.3f} % of one core ({idle_cpu * 1000:.0f} ms CPU in {args.idle_seconds:g} s)"
+    )
+    swarm_row = (
+        f"| {args.swarm} | {len(fan_out)} | {median(fan_out):.1f} "
+        f"| {percentile(fan_out, 99):.1f} | {max(fan_out):.1f} |"
     )
     body = f"""
 Idle: one `robot-agent run` (sim backend, plaintext loopback broker) doing nothing for
@@ -195,6 +256,13 @@ same client (two broker hops on loopback, QoS 1, sequential):
 | --- | --- | --- | --- | --- |
 {row("ping", pings)}
 {row("navigate (each preempts the previous)", navigates)}
+
+Swarm mode (`robot_agent.swarm`, one process, one connection): one publish on
+`vahr/fleet/cmd` -> every robot's acknowledging shadow update received:
+
+| robots | rounds | p50 ms | p99 ms | max ms |
+| --- | --- | --- | --- | --- |
+{swarm_row}
 """
     if args.no_write:
         print(body)
