@@ -10,7 +10,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 import pytest
-from skill_testkit import check_response, published, reprompt, speech
+from skill_testkit import RobotBehaviour, check_response, published, reprompt, speech
 
 from tests.conftest import load_event
 from vahr.protocol import decode_command
@@ -231,3 +231,26 @@ def test_the_module_level_lambda_handler_serves_requests(
     assert time.perf_counter() - started < 2.5
     assert [topic for topic, _ in commands_sent(fleet)] == ["vahr/robots/placebot1/cmd"]
     assert speech(response) == "Placebot one is on its way to zone A."
+
+
+def test_concurrent_requests_do_not_mix_their_answers(skill: Any, robots: RobotDoubles) -> None:
+    # Given one handler serving several people at once (the local simulator may do this)
+    from concurrent.futures import ThreadPoolExecutor
+
+    from vahr.protocol import Reported
+
+    robots.behave(
+        "placebot2",
+        RobotBehaviour(
+            reported=lambda _: Reported(status="waiting", task="weather_delivery", connected=True)
+        ),
+    )
+    events = ["alexa_navigate", "alexa_weather_delivery", "alexa_weather", "alexa_status_robot"]
+    # When a command to each robot, a weather question and a status question arrive together
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        spoken = list(pool.map(lambda name: speech(skill(load_event(name), None)), events))
+    # Then each request got its own answer
+    assert spoken[0] == "Placebot one is on its way to zone A."
+    assert spoken[1] == "Placebot two will ask me about the weather and deliver accordingly."
+    assert spoken[2] in ("The weather is sunny.", "The weather is rainy.")
+    assert spoken[3].startswith("Placebot one is ")
