@@ -301,6 +301,8 @@ class AgentProcess:
             stdout=self._log,
             stderr=subprocess.STDOUT,
             cwd=ROOT,
+            # The checkout on the path, so `--voice tests....:factory` can name a test double.
+            env={**os.environ, "PYTHONPATH": str(ROOT)},
         )
 
     def log(self) -> str:

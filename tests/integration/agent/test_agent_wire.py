@@ -202,3 +202,41 @@ def test_a_robot_that_gets_stuck_says_so_in_its_shadow(
     state = tap.reported("placebot1", lambda r: (r["last_command"] or {}).get("result") == "failed")
     assert state["status"] == "stuck"
     assert state["last_command"]["reason"] == "stuck: no progress towards D for 5 s"
+
+
+def test_weather_delivery_talks_to_the_assistant_and_delivers_on_the_wire(
+    tap: WireTap, shadows: ShadowResponder, start_agent: Callable[..., AgentProcess]
+) -> None:
+    # Given a robot whose voice reaches an assistant that answers "rainy"
+    voice = "tests.unit.agent.test_agent_weather_delivery:scripted_rainy_assistant"
+    start_agent("placebot1", "--voice", voice)
+    tap.reported("placebot1", lambda r: r["connected"] is True)
+    # When it is asked to do the weather delivery
+    tap.publish(CMD, command("weather", "weather_delivery"))
+    # Then the conversation is on the wire, and it delivers to C
+    delivered = tap.event("placebot1", "delivered", "weather", timeout_s=30)
+    assert delivered["zone"] == "C"
+    said = [e["text"] for e in tap.events("placebot1", "weather") if e["event"] == "said"]
+    assert said == [
+        "Alexa, ask robot fleet what the weather is",
+        "Thank you. It is rainy, so I am delivering to zone C.",
+    ]
+    heard = tap.event("placebot1", "heard", "weather")
+    assert heard["text"] == "The weather is rainy, placebot1."
+    interpreted = tap.event("placebot1", "interpreted", "weather")
+    assert (interpreted["intent"], interpreted["confidence"]) == ("rainy", 0.9)
+
+
+def test_weather_delivery_without_a_voice_fails_with_the_reason(
+    tap: WireTap, shadows: ShadowResponder, start_agent: Callable[..., AgentProcess]
+) -> None:
+    start_agent("placebot2")
+    tap.reported("placebot2", lambda r: r["connected"] is True)
+    tap.publish("vahr/robots/placebot2/cmd", command("no-voice", "weather_delivery"))
+    state = tap.reported("placebot2", lambda r: (r["last_command"] or {}).get("result") == "failed")
+    assert state["last_command"] == {
+        "id": "no-voice",
+        "action": "weather_delivery",
+        "result": "failed",
+        "reason": "voice not configured",
+    }

@@ -111,3 +111,23 @@ async def test_a_broken_voice_path_fails_with_its_reason(fleet: Fleet) -> None:
     executor.execute(weather())  # type: ignore[arg-type]
     await executor.wait_idle()
     assert rec.first("failed").reason == "voice failed: no audio device"
+
+
+def scripted_rainy_assistant(thing: str) -> ScriptedAssistant:
+    """A `--voice` factory for tests of the CLI path: the assistant says it is rainy."""
+    return ScriptedAssistant(Heard(f"The weather is rainy, {thing}.", "rainy", 0.9))
+
+
+def test_the_voice_factory_named_in_the_config_is_built_with_the_thing() -> None:
+    from robot_agent.assembly import build_voice
+    from robot_agent.config import AgentConfig
+
+    config = AgentConfig(
+        thing="placebot1",
+        voice="tests.unit.agent.test_agent_weather_delivery:scripted_rainy_assistant",
+    )
+    voice = build_voice(config)
+    # pytest imports this file under another module name, so compare by behaviour.
+    assert voice is not None and type(voice).__name__ == "ScriptedAssistant"
+    assert voice.answers[0].text == "The weather is rainy, placebot1."  # type: ignore[attr-defined]
+    assert build_voice(AgentConfig(thing="placebot1")) is None
