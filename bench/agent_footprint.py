@@ -216,12 +216,17 @@ def main() -> int:
             ]
             rss_busy = rss_mb(agent.pid)
             agent.terminate()
-            agent.wait(timeout=10)
+            if agent.wait(timeout=20) != 0:
+                raise RuntimeError("robot-agent did not exit cleanly on SIGTERM")
             fan_out = swarm_fan_out(port, args.swarm, args.swarm_rounds)
         finally:
             if agent is not None and agent.poll() is None:
                 agent.terminate()
-                agent.wait(timeout=10)
+                try:
+                    agent.wait(timeout=20)
+                except subprocess.TimeoutExpired:
+                    agent.kill()
+                    agent.wait(timeout=5)
             if probe is not None:
                 probe.close()
             broker.stop()
