@@ -88,3 +88,25 @@ def parse_shadow_topic(topic: str) -> tuple[str, str | None, str] | None:
     if not found or found["op"] not in SHADOW_OPERATIONS:
         return None
     return found["thing"], found["name"], found["op"]
+
+
+# The local stack's room channel (docs/voice.md): speech as audio between a robot and the
+# local assistant, standing in for the air between a robot's speaker and an Echo.
+ROOM_ROBOT_SPEECH = "vahr/room/+/robot"
+_ROOM_TOPIC = re.compile(r"^vahr/room/(?P<thing>[^/]+)/(?P<speaker>robot|assistant)$")
+
+
+def room_robot_speech(thing: str) -> str:
+    """What one robot says into the room (to the assistant)."""
+    return f"vahr/room/{check_thing(thing)}/robot"
+
+
+def room_assistant_speech(thing: str) -> str:
+    """What the assistant says back to one robot."""
+    return f"vahr/room/{check_thing(thing)}/assistant"
+
+
+def parse_room_topic(topic: str) -> tuple[str, str] | None:
+    """`vahr/room/{thing}/{robot|assistant}` -> (thing, speaker), else None."""
+    found = _ROOM_TOPIC.match(topic)
+    return (found["thing"], found["speaker"]) if found else None

@@ -1,0 +1,155 @@
+"""The local stack's room: the assistant that robots talk to by voice over the broker.
+
+A robot's speech arrives as audio on `vahr/room/{thing}/robot`. The assistant recognizes it
+with the robot's own offline recognizer, constrained to the questions robots ask (wake word
+included); speech it does not recognize gets no answer, as an Echo ignores talk not meant
+for it (the robot's acknowledgment, for one). A recognized question goes, without the wake
+word, to `ask` (the Alexa simulator and the skill's weather intent), and the spoken answer
+is synthesized and published as audio on `vahr/room/{thing}/assistant`.
+
+Recognition and synthesis take tens of milliseconds, so they run on a worker thread, not
+on the MQTT client's network thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from robot_agent.voice.port import VoiceError
+from robot_agent.voice.room_message import Utterance
+from vahr.protocol import topics
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from robot_agent.voice.room import RoomChannel
+    from robot_agent.voice.stt import Recognizer
+    from robot_agent.voice.tts import Synthesizer
+
+log = logging.getLogger(__name__)
+
+WAKE_WORD = "alexa"
+INVOCATION = "robot fleet"
+# What robots say to the assistant (normalized); the executor asks the first one.
+QUESTIONS = tuple(
+    f"{WAKE_WORD} ask {INVOCATION} {question}"
+    for question in (
+        "what the weather is",
+        "what is the weather",
+        "what's the weather",
+        "for the weather",
+        "about the weather",
+        "how is the weather",
+    )
+)
+STOP_TIMEOUT_S = 5.0
+
+
+@dataclass(frozen=True)
+class Exchange:
+    """One question heard and answered, for logs, tests and the dashboard."""
+
+    thing: str
+    heard: str
+    answer: str | None
+
+
+class RoomAssistant:
+    """Listens to every robot in the room and answers what it understands."""
+
+    def __init__(
+        self,
+        channel: RoomChannel,
+        ask: Callable[[str], str | None],
+        synthesizer: Synthesizer,
+        recognizer: Recognizer,
+        *,
+        on_exchange: Callable[[Exchange], None] | None = None,
+    ) -> None:
+        self.channel = channel
+        self.ask = ask
+        self.synthesizer = synthesizer
+        self.recognizer = recognizer
+        self.on_exchange = on_exchange
+        self._inbox: queue.Queue[Utterance | None] = queue.Queue(maxsize=64)
+        self._worker: threading.Thread | None = None
+
+    def start(self) -> RoomAssistant:
+        self._worker = threading.Thread(target=self._serve, name="vahr-room", daemon=True)
+        self._worker.start()
+        self.channel.subscribe(topics.ROOM_ROBOT_SPEECH, self._on_message)
+        return self
+
+    def stop(self) -> None:
+        if self._worker is None:
+            return
+        self._inbox.put(None)
+        self._worker.join(STOP_TIMEOUT_S)
+        if self._worker.is_alive():
+            log.warning("the room assistant did not stop within %s s", STOP_TIMEOUT_S)
+        self._worker = None
+
+    def __enter__(self) -> RoomAssistant:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def _on_message(self, topic: str, payload: bytes) -> None:
+        parsed = topics.parse_room_topic(topic)
+        try:
+            utterance = Utterance.decode(payload)
+        except VoiceError as err:
+            log.warning("ignoring a room message on %s: %s", topic, err)
+            return
+        if parsed is None or parsed[0] != utterance.thing or utterance.speaker != "robot":
+            log.warning("ignoring a room message on %s from %s", topic, utterance.thing)
+            return
+        try:
+            self._inbox.put_nowait(utterance)
+        except queue.Full:
+            log.warning("the room assistant is behind; dropped speech from %s", utterance.thing)
+
+    def _serve(self) -> None:
+        while True:
+            utterance = self._inbox.get()
+            if utterance is None:
+                return
+            try:
+                self._answer(utterance)
+            except Exception:  # one bad exchange must not silence the room
+                log.exception("answering %s failed", utterance.thing)
+
+    def _answer(self, utterance: Utterance) -> None:
+        recognition = self.recognizer.recognize(utterance.audio)
+        if not recognition.accepted:
+            log.info("%s said something not for the assistant", utterance.thing)
+            self._report(Exchange(utterance.thing, "", None))
+            return
+        request = recognition.text.removeprefix(WAKE_WORD).strip()
+        speech = self.ask(request)
+        self._report(Exchange(utterance.thing, recognition.text, speech))
+        if not speech:
+            return
+        audio = self.synthesizer.synthesize(speech)
+        reply = Utterance.new(utterance.thing, "assistant", audio, in_reply_to=utterance.id)
+        self.channel.publish(topics.room_assistant_speech(utterance.thing), reply.encode())
+
+    def _report(self, exchange: Exchange) -> None:
+        log.info("room: %s asked %r, answered %r", exchange.thing, exchange.heard, exchange.answer)
+        if self.on_exchange is not None:
+            self.on_exchange(exchange)
+
+
+def offline_room_assistant(
+    channel: RoomChannel, ask: Callable[[str], str | None], *, voice: str = "en-us+f4"
+) -> RoomAssistant:
+    """The room assistant with espeak-ng (a voice unlike the robots') and pocketsphinx."""
+    from robot_agent.voice.stt import GrammarRecognizer
+    from robot_agent.voice.tts import EspeakSynthesizer
+
+    return RoomAssistant(channel, ask, EspeakSynthesizer(voice), GrammarRecognizer(QUESTIONS))
