@@ -16,7 +16,7 @@ ROS_SITE := $(VENV)/ros-site
 export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
 export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 
-.PHONY: demo test lint typecheck pytest setup system-packages bench synth skill-model clean
+.PHONY: demo test lint typecheck pytest setup system-packages bench synth deploy skill-model clean
 
 demo: setup
 	$(BIN)/vahr demo
@@ -69,6 +69,12 @@ bench: setup
 
 synth: setup
 	npx cdk synth --quiet
+
+# Deploy to the AWS account of the current credentials; CDK_ARGS takes context flags such as
+# `-c lex=true -c skill=true` (see docs/deploy.md), then point skill.json at the function.
+deploy: setup
+	npx cdk deploy --outputs-file cdk-outputs.json $(CDK_ARGS)
+	$(BIN)/python -m infra.skill_endpoint --outputs cdk-outputs.json
 
 skill-model: setup
 	$(BIN)/python -m vahr.skill_model
