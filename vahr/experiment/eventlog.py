@@ -165,13 +165,14 @@ class EventLog:
             seq=seq, at=parse_time(format_time(when)), kind=kind, task=task, data=json.loads(body)
         )
 
-    def entries(self, kind: str | None = None) -> list[LogEntry]:
-        """Every logged event in the order it was logged (optionally of one kind)."""
-        query = "SELECT seq, at, kind, task, data FROM events"
-        params: tuple[str, ...] = ()
+    def entries(self, kind: str | None = None, *, after: int = 0) -> list[LogEntry]:
+        """Logged events in the order they were logged: optionally only of one kind, and only
+        those after sequence number `after` (to follow the log as it grows)."""
+        query = "SELECT seq, at, kind, task, data FROM events WHERE seq > ?"
+        params: tuple[int | str, ...] = (after,)
         if kind is not None:
-            query += " WHERE kind = ?"
-            params = (kind,)
+            query += " AND kind = ?"
+            params = (after, kind)
         with self._lock:
             rows = self._connection.execute(query + " ORDER BY seq", params).fetchall()
         return [

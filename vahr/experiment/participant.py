@@ -193,7 +193,9 @@ class SimulatedParticipant:
         pass; True if it was decided."""
         elapsed = 0.0
         next_piece = self.timing.puzzle_piece_s(self.rng)
-        step = 0.25  # experiment seconds between looks at the robots
+        # Look at the robots every 0.25 experiment seconds, but not more often than every
+        # 20 ms of wall time: a fast rehearsal must not spin on the shared CPU.
+        step = max(0.25, 0.02 * self.speed_factor)
         while elapsed < timeout_s:
             if decided():
                 return True

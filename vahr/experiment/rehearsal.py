@@ -13,7 +13,13 @@ from typing import TYPE_CHECKING
 from vahr.experiment.bus import Bus, TlsFiles
 from vahr.experiment.participant import Console, SimulatedParticipant
 from vahr.experiment.recorder import Recorder
-from vahr.experiment.session import SessionSpec, open_session, rebuild_world, run_tasks
+from vahr.experiment.session import (
+    SessionSpec,
+    end_session,
+    open_session,
+    rebuild_world,
+    run_tasks,
+)
 from vahr.experiment.tasks import default_seed
 from vahr.experiment.timing import TimingModel
 
@@ -36,16 +42,18 @@ def run_live(
     announce: Callable[[str], None] = lambda line: None,
     tls: TlsFiles | None = None,
 ) -> SessionVerdict:
-    """Record the wire into the session's log while `performer_for(console)` runs the tasks."""
+    """Record the wire into the session's log while `performer_for(console)` runs the tasks,
+    then end the session; return the judge's verdict."""
     recorder = Recorder(session.log, rebuild_world(fleet, session))
     bus = Bus(
         broker_url, recorder.on_message, client_id=f"vahr-experiment-{session.spec.name}", tls=tls
     )
     bus.start()
     try:
-        return run_tasks(session, recorder, performer_for(Console(bus.publish)), announce=announce)
+        run_tasks(session, recorder, performer_for(Console(bus.publish)), announce=announce)
     finally:
         bus.stop()
+    return end_session(session)
 
 
 def simulated_performer(

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from vahr.errors import VahrError
 from vahr.experiment.eventlog import EventLog, Kind, session_file, session_name
@@ -26,8 +26,9 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-    from vahr.experiment.judge import SessionVerdict
+    from vahr.experiment.judge import Delivery, SessionVerdict
     from vahr.experiment.recorder import Recorder
+    from vahr.experiment.tasks import TaskGoal
     from vahr.protocol import Fleet
 
 log = logging.getLogger(__name__)
@@ -116,6 +117,25 @@ def rebuild_world(fleet: Fleet, session: OpenSession) -> World:
     return world
 
 
+def _decision_watch(event_log: EventLog, goal: TaskGoal, start_seq: int) -> Callable[[], bool]:
+    """A cheap, repeatable check: has the task been decided by the robots' deliveries?
+
+    It reads only the events logged since its last look, so polling it often costs little.
+    """
+    deliveries: list[Delivery] = []
+    seen = start_seq
+
+    def decided() -> bool:
+        nonlocal seen
+        fresh = event_log.entries(Kind.ROBOT_EVENT, after=seen)
+        if fresh:
+            seen = fresh[-1].seq
+            deliveries.extend(deliveries_in(fresh))
+        return score_goal(goal, deliveries).success is not None
+
+    return decided
+
+
 def run_tasks(
     session: OpenSession,
     recorder: Recorder,
@@ -123,7 +143,7 @@ def run_tasks(
     *,
     announce: Callable[[str], None] = lambda line: None,
 ) -> SessionVerdict:
-    """Run every task not yet finished, then end the session and return the judge's verdict."""
+    """Run every task not yet finished and return the judge's verdict (see `end_session`)."""
     plan, event_log = session.plan, session.log
     for task in TASKS:
         window = task_windows(event_log.entries()).get(task)
@@ -150,14 +170,20 @@ def run_tasks(
         ]
         performer.perform(task, done)
 
-        def decided(goal: Any = goal, start_seq: int = start_seq) -> bool:
-            after = [e for e in event_log.entries(Kind.ROBOT_EVENT) if e.seq > start_seq]
-            return score_goal(goal, deliveries_in(after)).success is not None
-
-        finished = performer.wait(decided, session.spec.task_timeout_s)
+        finished = performer.wait(
+            _decision_watch(event_log, goal, start_seq), session.spec.task_timeout_s
+        )
         recorder.end_task(task, "decided" if finished else "timeout")
         outcome = judge_session(event_log.entries(), plan).tasks[task]
         announce(f"task {task}: {'success' if outcome.success else 'failure'}: {outcome.reason}")
-    verdict = judge_session(event_log.entries(), plan)
-    event_log.append(Kind.SESSION_ENDED, {"verdict": verdict.to_json()})
+    return judge_session(event_log.entries(), plan)
+
+
+def end_session(session: OpenSession) -> SessionVerdict:
+    """Close the session for good: the judge's final verdict is the log's last event.
+
+    Call it once the recorder has stopped, so no late robot event follows the end.
+    """
+    verdict = judge_session(session.log.entries(), session.plan)
+    session.log.append(Kind.SESSION_ENDED, {"verdict": verdict.to_json()})
     return verdict
