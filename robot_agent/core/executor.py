@@ -171,9 +171,18 @@ class Executor:
     async def close(self) -> None:
         """Cancel the running task (it ends `cancelled`) and release the backend."""
         if self.busy and self._current is not None and self._task is not None:
-            self._emit("cancelled", self._current, reason="the agent is shutting down")
+            current, reason = self._current, "the agent is shutting down"
+            self._emit("cancelled", current, reason=reason)
             self._task.cancel()
             await asyncio.wait({self._task}, timeout=CLOSE_TIMEOUT_S)
+            # The final shadow state says the task did not finish and the robot halted.
+            changes: dict[str, Any] = {"status": "stopped", "task": None, "destination": None}
+            last = self.state.last_command
+            if last is not None and last.id == current.id:
+                changes["last_command"] = LastCommand(
+                    current.id, current.action, "cancelled", reason
+                )
+            self._update(**changes)
         await self.backend.close()
 
     # -- tasks --------------------------------------------------------------------------

@@ -123,11 +123,13 @@ def test_a_version_conflict_is_answered_by_reading_and_reporting_again(
 ) -> None:
     shadows.conflicts_to_inject = 1
     start_agent("placebot1")
-    tap.wait_for(lambda m: m.topic == "$aws/things/placebot1/shadow/update/rejected")
+    rejected = tap.wait_for(lambda m: m.topic == "$aws/things/placebot1/shadow/update/rejected")
+    assert rejected.json()["code"] == 409
     # The agent re-reads (get) and sends its state again, which is then accepted.
-    mark = tap.mark()
-    tap.wait_for(lambda m: m.topic == "$aws/things/placebot1/shadow/get", after=mark - 3)
-    tap.reported("placebot1", lambda r: r["connected"] is True, after=mark)
+    after = tap.messages.index(rejected)
+    tap.wait_for(lambda m: m.topic == "$aws/things/placebot1/shadow/get", after=after)
+    tap.reported("placebot1", lambda r: r["connected"] is True, after=after)
+    tap.wait_for(lambda m: m.topic == "$aws/things/placebot1/shadow/update/accepted", after=after)
     assert shadows.documents["placebot1"]["reported"]["connected"] is True
 
 
@@ -183,7 +185,13 @@ def test_sigint_stops_the_agent_cleanly_too(
     cancelled = tap.event("placebot2", "cancelled", "cut", after=mark)
     assert cancelled["reason"] == "the agent is shutting down"
     final = tap.reported("placebot2", lambda r: r["connected"] is False, after=mark)
-    assert final["last_command"]["id"] == "cut"
+    assert final["last_command"] == {
+        "id": "cut",
+        "action": "navigate",
+        "result": "cancelled",
+        "reason": "the agent is shutting down",
+    }
+    assert final["status"] == "stopped" and final["task"] is None
 
 
 def test_a_robot_that_gets_stuck_says_so_in_its_shadow(

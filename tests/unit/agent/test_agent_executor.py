@@ -226,6 +226,9 @@ async def test_close_cancels_the_running_task(fleet: Fleet) -> None:
     await rec.until("progress", "going")
     await executor.close()
     assert rec.first("cancelled", "going").reason == "the agent is shutting down"
+    final = rec.states[-1]
+    assert final.status == "stopped"
+    assert final.last_command is not None and final.last_command.result == "cancelled"
 
 
 async def test_a_burst_of_commands_runs_only_the_last_and_never_two_at_once(fleet: Fleet) -> None:
