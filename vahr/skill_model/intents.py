@@ -230,6 +230,10 @@ WEATHER = IntentSpec(
         "is it rainy",
         "is it raining",
         "what's the weather for the experiment",
+        # The robots' own question (robot_agent's WEATHER_QUESTION) and its variants.
+        "what the weather is",
+        "what the weather is like",
+        "tell me what the weather is",
     ),
 )
 

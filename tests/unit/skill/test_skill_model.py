@@ -340,3 +340,13 @@ def test_example_phrases_are_sample_utterances(model: dict[str, Any]) -> None:
     for phrase in phrases[1:]:
         spoken = re.sub(rf"^Alexa, ask {lm['invocationName']} (to )?", "", phrase)
         assert spoken != phrase and any(p.match(spoken) for p in patterns), phrase
+
+
+def test_the_robots_weather_question_is_a_weather_intent_sample(model: dict[str, Any]) -> None:
+    # The robots ask the assistant themselves (task II); the skill must understand them.
+    from robot_agent.core.executor import WEATHER_QUESTION
+
+    invocation = language_model(model)["invocationName"]
+    asked = re.sub(rf"^Alexa, ask {invocation} (to )?", "", WEATHER_QUESTION).rstrip("?.").lower()
+    [weather] = [i for i in language_model(model)["intents"] if i["name"] == "WeatherIntent"]
+    assert asked in weather["samples"]
