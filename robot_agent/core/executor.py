@@ -173,6 +173,7 @@ class Executor:
         if self.busy and self._current is not None and self._task is not None:
             current, reason = self._current, "the agent is shutting down"
             self._emit("cancelled", current, reason=reason)
+            self._current = None
             self._task.cancel()
             await asyncio.wait({self._task}, timeout=CLOSE_TIMEOUT_S)
             # The final shadow state says the task did not finish and the robot halted.
@@ -250,8 +251,14 @@ class Executor:
         last_progress: Progress | None = None
         last_report = float("-inf")
 
+        active = True
+
         def on_progress(progress: Progress) -> None:
             nonlocal last_advance, last_progress, last_report
+            if not active or self._current is not command:
+                # Feedback a backend queued before the goal ended (ROS threads) comes late;
+                # after `cancelled` or `arrived` the task has nothing more to say.
+                return
             if last_progress is None or _advanced(last_progress, progress):
                 last_advance = self.clock.monotonic()
             last_progress = progress
@@ -293,6 +300,7 @@ class Executor:
             except NavigationFailed as err:
                 raise TaskFailed(str(err), status="error") from err
         finally:
+            active = False
             if not drive.done():
                 drive.cancel()
                 await asyncio.wait({drive})
