@@ -5,10 +5,11 @@ from __future__ import annotations
 import asyncio
 from typing import TYPE_CHECKING
 
+from robot_agent.backends.port import Progress
 from robot_agent.backends.sim import SimSettings
 from robot_agent.core.executor import ExecutorSettings
 from tests.unit.agent.conftest import make_executor
-from vahr.protocol import Event, new_command, utc_now
+from vahr.protocol import Event, Pose, new_command, utc_now
 
 if TYPE_CHECKING:
     from vahr.protocol import Fleet
@@ -254,3 +255,68 @@ async def test_close_during_a_burst_returns_promptly(fleet: Fleet) -> None:
     async with asyncio.timeout(2):
         await executor.close()
     assert rec.kinds("c19")[-1] == "cancelled"
+
+
+class ThreadedFeedbackBackend:
+    """A backend whose feedback arrives from another thread, as rospy's does."""
+
+    name = "threaded"
+
+    def __init__(self, start: Pose) -> None:
+        self.pose = start
+
+    async def go_to(self, zone, on_progress):  # type: ignore[no-untyped-def]
+        import threading
+
+        loop = asyncio.get_running_loop()
+        stop = threading.Event()
+
+        def feedback() -> None:
+            fraction = 0.0
+            while not stop.is_set():
+                fraction += 0.001
+                loop.call_soon_threadsafe(on_progress, Progress(fraction, Pose(fraction, 0.0)))
+                stop.wait(0.0005)
+
+        thread = threading.Thread(target=feedback)
+        thread.start()
+        try:
+            await asyncio.sleep(30)
+        finally:
+            # Like actionlib, the goal is cancelled but feedback already queued still lands.
+            await asyncio.sleep(0.01)
+            stop.set()
+            thread.join(1)
+
+    async def operate_arm(self, zone):  # type: ignore[no-untyped-def]
+        return None
+
+    async def halt(self) -> None:
+        return None
+
+    async def close(self) -> None:
+        return None
+
+
+async def test_no_progress_is_reported_for_a_task_after_its_cancelled_event(fleet: Fleet) -> None:
+    from robot_agent.core.clock import ScaledClock
+    from robot_agent.core.executor import Executor
+    from tests.unit.agent.conftest import Recorder
+
+    rec = Recorder()
+    executor = Executor(
+        thing="placebot1",
+        fleet=fleet,
+        backend=ThreadedFeedbackBackend(fleet.robot("placebot1").start),
+        clock=ScaledClock(1),
+        publish_state=rec.states.append,
+        publish_event=rec.events.append,
+        settings=ExecutorSettings(progress_interval_s=0),
+    )
+    executor.execute(cmd("navigate", {"zone": "A"}, "first"))
+    await rec.until("progress", "first")
+    executor.execute(cmd("stop", None, "halt"))
+    await executor.wait_idle()
+    await asyncio.sleep(0.05)
+    kinds = rec.kinds("first")
+    assert kinds[-1] == "cancelled", kinds[-5:]
