@@ -133,3 +133,22 @@ def test_a_bad_thing_name_is_refused(
 ) -> None:
     assert main(["provision", "--thing", "robot/1", "--aws", "--out", str(tmp_path)]) == 2
     assert "is not a valid thing name" in capsys.readouterr().err
+
+
+def test_the_plain_output_names_every_file_and_a_given_ca_is_used(
+    iot: object, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    ca = tmp_path / "my-ca.pem"
+    ca.write_text("-----BEGIN CERTIFICATE-----\nMIIB\n-----END CERTIFICATE-----\n")
+    out = tmp_path / "p1"
+    assert (
+        main(
+            ["provision", "--thing", "placebot1", "--aws", "--out", str(out), "--ca-file", str(ca)]
+        )
+        == 0
+    )
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split(":", 1)[0] for line in lines] == ["cert", "key", "ca", "config", "endpoint"]
+    assert lines[2] == f"ca:     {out / 'ca.pem'}"
+    assert (out / "ca.pem").read_text() == ca.read_text()
+    assert yaml.safe_load((out / "agent.yaml").read_text())["ca"] == str((out / "ca.pem").resolve())
