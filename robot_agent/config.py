@@ -85,6 +85,8 @@ class AgentConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, froz
         """The rules that span fields; raises VahrError naming the flag to fix."""
         if not self.thing:
             raise VahrError("--thing is required (or `thing` in --config, or VAHR_AGENT_THING)")
+        if not 0 < self.port < 65536:
+            raise VahrError(f"--port {self.port}: expected a TCP port (1-65535)")
         if self.broker and self.endpoint:
             raise VahrError(
                 "give either --broker (plaintext loopback) or --endpoint (mTLS), not both"

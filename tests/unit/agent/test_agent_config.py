@@ -120,6 +120,10 @@ def test_a_bad_environment_value_is_named(
             "--thing robot9: not a robot of the fleet; robots are placebot1, placebot2",
         ),
         (
+            ("--thing", "placebot1", "--endpoint", "example.com", "--port", "70000"),
+            "--port 70000: expected a TCP port (1-65535)",
+        ),
+        (
             ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--sim-speed-factor", "0"),
             "--sim-speed-factor must be greater than 0",
         ),
