@@ -1,0 +1,208 @@
+"""The paho-mqtt adapter the local services share: connect (plaintext or mTLS), publish,
+subscribe with callbacks, and stop; every wait bounded. Nothing else imports paho.
+"""
+
+from __future__ import annotations
+
+import logging
+import socket
+import ssl
+import threading
+import uuid
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import paho.mqtt.client as paho
+from paho.mqtt.enums import CallbackAPIVersion, MQTTProtocolVersion
+
+from vahr.errors import VahrError
+from vahr.local.ports import LOOPBACK
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from paho.mqtt.reasoncodes import ReasonCode
+
+    from vahr.local.pki import ClientCredentials
+
+log = logging.getLogger(__name__)
+
+CONNECT_TIMEOUT_S = 10.0
+PUBLISH_TIMEOUT_S = 5.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class MqttEndpoint:
+    """Where and as whom to connect: a plaintext port, or an mTLS port with credentials."""
+
+    port: int
+    host: str = LOOPBACK
+    credentials: ClientCredentials | None = None
+
+
+class PublishDenied(VahrError):
+    """The broker refused a publish (MQTT 5 PUBACK reason code >= 0x80)."""
+
+
+class MqttClient:
+    """One MQTT 5 connection. Handlers run on paho's network thread: keep them short."""
+
+    def __init__(self, endpoint: MqttEndpoint, *, client_id: str | None = None) -> None:
+        self.endpoint = endpoint
+        self._client = paho.Client(
+            CallbackAPIVersion.VERSION2,
+            client_id=client_id or f"vahr-{uuid.uuid4().hex[:12]}",
+            protocol=MQTTProtocolVersion.MQTTv5,
+        )
+        if endpoint.credentials is not None:
+            creds = endpoint.credentials
+            context = ssl.create_default_context(cafile=str(creds.ca_file))
+            context.load_cert_chain(str(creds.cert_file), str(creds.key_file))
+            self._client.tls_set_context(context)
+        self._handlers: list[tuple[str, Callable[[str, bytes], None]]] = []
+        self._connected = threading.Event()
+        self._connect_error: str | None = None
+        self._acks: dict[int, tuple[threading.Event, list[ReasonCode]]] = {}
+        self._subacks: dict[int, tuple[threading.Event, list[ReasonCode]]] = {}
+        self._early: dict[int, list[ReasonCode]] = {}
+        self._ignored: set[int] = set()
+        self._acks_lock = threading.Lock()
+        self._client.on_connect = self._on_connect
+        self._client.on_message = self._on_message
+        self._client.on_publish = self._on_publish
+        self._client.on_socket_open = self._on_socket_open
+        self._client.on_subscribe = self._on_subscribe
+
+    # -- lifecycle --------------------------------------------------------------------
+
+    def connect(self) -> MqttClient:
+        try:
+            self._client.connect(self.endpoint.host, self.endpoint.port, keepalive=30)
+        except (OSError, ssl.SSLError) as err:
+            raise VahrError(
+                f"cannot connect to the MQTT broker at {self.endpoint.host}:"
+                f"{self.endpoint.port}: {err}"
+            ) from err
+        self._client.loop_start()
+        if not self._connected.wait(CONNECT_TIMEOUT_S) or self._connect_error:
+            self.stop()
+            raise VahrError(
+                f"the MQTT broker at {self.endpoint.host}:{self.endpoint.port} refused the "
+                f"connection: {self._connect_error or 'timed out'}"
+            )
+        return self
+
+    def stop(self) -> None:
+        try:
+            self._client.disconnect()
+        finally:
+            self._client.loop_stop()
+
+    def __enter__(self) -> MqttClient:
+        return self.connect()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    # -- messaging --------------------------------------------------------------------
+
+    def subscribe(self, topic_filter: str, handler: Callable[[str, bytes], None]) -> None:
+        """Route messages matching `topic_filter` to `handler`; returns once SUBACKed."""
+        self._handlers.append((topic_filter, handler))
+        result, mid = self._client.subscribe(topic_filter, qos=1)
+        if result != paho.MQTT_ERR_SUCCESS or mid is None:
+            raise VahrError(f"cannot subscribe to {topic_filter}: {paho.error_string(result)}")
+        waiter, _ = self._expect(self._subacks, mid)
+        if not waiter.wait(CONNECT_TIMEOUT_S):
+            raise VahrError(f"the MQTT broker did not acknowledge the subscription {topic_filter}")
+
+    def publish(
+        self, topic: str, payload: bytes, *, qos: int = 1, retain: bool = False, wait: bool = True
+    ) -> None:
+        """Publish; with `wait` and QoS 1, block until PUBACK and raise if it was refused."""
+        info = self._client.publish(topic, payload, qos=qos, retain=retain)
+        if info.rc != paho.MQTT_ERR_SUCCESS:
+            raise VahrError(f"cannot publish to {topic}: {paho.error_string(info.rc)}")
+        if qos == 0 or not wait:
+            self._ignore(info.mid)
+            return
+        waiter, codes = self._expect(self._acks, info.mid)
+        if not waiter.wait(PUBLISH_TIMEOUT_S):
+            raise VahrError(f"the MQTT broker did not acknowledge a publish to {topic}")
+        if codes and codes[0].is_failure:
+            raise PublishDenied(f"the MQTT broker refused a publish to {topic}: {codes[0]}")
+
+    # Acknowledgments may arrive before the caller registers interest in them, and paho
+    # calls back on its own thread while holding its own locks; so no lock of ours is ever
+    # held across a call into paho, and early acknowledgments wait in `_early`.
+
+    def _expect(
+        self, table: dict[int, tuple[threading.Event, list[ReasonCode]]], mid: int
+    ) -> tuple[threading.Event, list[ReasonCode]]:
+        entry: tuple[threading.Event, list[ReasonCode]] = (threading.Event(), [])
+        with self._acks_lock:
+            early = self._early.pop(mid, None)
+            if early is None:
+                table[mid] = entry
+        if early is not None:
+            entry[1].extend(early)
+            entry[0].set()
+        return entry
+
+    def _ignore(self, mid: int) -> None:
+        with self._acks_lock:
+            if self._early.pop(mid, None) is None:
+                self._ignored.add(mid)
+
+    def _acknowledged(
+        self,
+        table: dict[int, tuple[threading.Event, list[ReasonCode]]],
+        mid: int,
+        codes: list[ReasonCode],
+    ) -> None:
+        with self._acks_lock:
+            if mid in self._ignored:
+                self._ignored.discard(mid)
+                return
+            entry = table.pop(mid, None)
+            if entry is None:
+                self._early[mid] = codes
+                return
+        entry[1].extend(codes)
+        entry[0].set()
+
+    # -- paho callbacks ---------------------------------------------------------------
+
+    def _on_socket_open(self, client, userdata, sock):  # type: ignore[no-untyped-def]
+        # paho does not set TCP_NODELAY; without it back-to-back publishes stall ~40 ms.
+        raw = getattr(sock, "_sock", sock)
+        try:
+            raw.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        except (OSError, AttributeError):
+            log.debug("could not set TCP_NODELAY")
+
+    def _on_connect(self, client, userdata, flags, reason_code, properties):  # type: ignore[no-untyped-def]
+        if reason_code.is_failure:
+            self._connect_error = str(reason_code)
+        else:
+            # Resubscribe after an automatic reconnect.
+            for topic_filter, _ in self._handlers:
+                client.subscribe(topic_filter, qos=1)
+        self._connected.set()
+
+    def _on_publish(self, client, userdata, mid, reason_code, properties):  # type: ignore[no-untyped-def]
+        self._acknowledged(self._acks, mid, [reason_code])
+
+    def _on_subscribe(self, client, userdata, mid, reason_codes, properties):  # type: ignore[no-untyped-def]
+        self._acknowledged(self._subacks, mid, list(reason_codes))
+
+    def _on_message(self, client, userdata, message):  # type: ignore[no-untyped-def]
+        for topic_filter, handler in self._handlers:
+            if paho.topic_matches_sub(topic_filter, message.topic):
+                try:
+                    handler(message.topic, bytes(message.payload))
+                except Exception:  # a bad handler must not kill the network thread
+                    log.exception("handler for %s failed", topic_filter)
+
+
+__all__ = ["MqttClient", "MqttEndpoint", "PublishDenied"]

@@ -1,0 +1,137 @@
+"""The local stack without robots: broker, shadow service and data plane, started in order.
+
+`LocalStack` is what `vahr up`, `vahr demo`, the tests and the benchmarks share: it makes
+(or reuses) the local CA, writes the ACL, starts mosquitto with an mTLS listener (and an
+optional plaintext one), connects the shadow service and the data plane to it with the
+service identity, and serves the data-plane HTTP API. `stop()` undoes all of it.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from vahr.local.acl import write_acl
+from vahr.local.broker import BrokerConfig, Mosquitto, TlsListener
+from vahr.local.dataplane import DataPlane, DataPlaneServer
+from vahr.local.meter import Meter
+from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.local.pki import LocalCA
+from vahr.local.ports import LOOPBACK, ensure_free
+from vahr.local.shadow_service import ShadowService
+from vahr.local.shadow_store import ShadowStore
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, kw_only=True)
+class StackConfig:
+    state_dir: Path
+    mqtts_port: int
+    mqtt_port: int | None
+    api_port: int
+
+
+class LocalStack:
+    """AWS IoT Core's part of the system on 127.0.0.1. Use as a context manager."""
+
+    def __init__(self, config: StackConfig) -> None:
+        self.config = config
+        self.meter = Meter()
+        self.ca: LocalCA | None = None
+        self.broker: Mosquitto | None = None
+        self.store: ShadowStore | None = None
+        self.shadows: ShadowService | None = None
+        self.dataplane: DataPlane | None = None
+        self._service_client: MqttClient | None = None
+        self._server: DataPlaneServer | None = None
+
+    @property
+    def api_url(self) -> str:
+        return f"http://{LOOPBACK}:{self.config.api_port}"
+
+    @property
+    def mqtts_url(self) -> str:
+        return f"mqtts://{LOOPBACK}:{self.config.mqtts_port}"
+
+    @property
+    def mqtt_url(self) -> str | None:
+        port = self.config.mqtt_port
+        return f"mqtt://{LOOPBACK}:{port}" if port is not None else None
+
+    def service_endpoint(self) -> MqttEndpoint:
+        """How a local service connects: the mTLS listener with the service identity."""
+        assert self.ca is not None, "start() first"
+        return MqttEndpoint(port=self.config.mqtts_port, credentials=self.ca.service_credentials())
+
+    def start(self) -> LocalStack:
+        cfg = self.config
+        # Check every port first so a conflict is one clear line before anything starts.
+        ensure_free(cfg.api_port, "data-plane API")
+        try:
+            self.ca = LocalCA.load_or_create(cfg.state_dir)
+            acl = write_acl(
+                cfg.state_dir / "broker" / "acl", open_anonymous=cfg.mqtt_port is not None
+            )
+            self.broker = Mosquitto(
+                BrokerConfig(
+                    state_dir=cfg.state_dir / "broker",
+                    plain_port=cfg.mqtt_port,
+                    tls=TlsListener(
+                        port=cfg.mqtts_port,
+                        ca_file=self.ca.ca_file,
+                        cert_file=self.ca.server_cert_file,
+                        key_file=self.ca.server_key_file,
+                        acl_file=acl,
+                    ),
+                )
+            )
+            self.broker.start()
+            self._service_client = MqttClient(
+                self.service_endpoint(), client_id="vahr-shadow-service"
+            ).connect()
+            client = self._service_client
+            self.store = ShadowStore(cfg.state_dir / "shadows.sqlite3")
+
+            def publish_answer(topic: str, payload: bytes) -> None:
+                # Answers go out without waiting for PUBACK: the paho network thread that
+                # delivers requests must not block on its own acknowledgments.
+                client.publish(topic, payload, qos=1, wait=False)
+
+            self.shadows = ShadowService(self.store, publish_answer, self.meter)
+            self.shadows.attach(client)
+
+            def publish(topic: str, payload: bytes, qos: int, retain: bool) -> None:
+                client.publish(topic, payload, qos=qos, retain=retain, wait=qos > 0)
+
+            self.dataplane = DataPlane(self.shadows, publish, self.meter)
+            self._server = DataPlaneServer(self.dataplane, cfg.api_port).start()
+        except BaseException:
+            self.stop()
+            raise
+        return self
+
+    def stop(self) -> None:
+        """Stop what started, in reverse order; safe to call twice."""
+        if self._server is not None:
+            self._server.stop()
+            self._server = None
+        if self._service_client is not None:
+            self._service_client.stop()
+            self._service_client = None
+        if self.store is not None:
+            self.store.close()
+            self.store = None
+        if self.broker is not None:
+            self.broker.stop()
+            self.broker = None
+
+    def __enter__(self) -> LocalStack:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
