@@ -7,6 +7,7 @@ plaintext link never reads certificates.
 from __future__ import annotations
 
 import importlib
+import inspect
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -14,6 +15,7 @@ from robot_agent.agent import RobotAgent
 from robot_agent.backends.sim import SimBackend, SimSettings
 from robot_agent.core.executor import ExecutorSettings
 from robot_agent.core.recent_ids import RecentIds
+from robot_agent.voice.port import VoiceError
 from vahr.errors import VahrError
 from vahr.protocol import Presence, encode, load_fleet, topics
 
@@ -63,7 +65,11 @@ def build_backend(config: AgentConfig, fleet: Fleet, clock: ScaledClock) -> Navi
 
 
 def build_voice(config: AgentConfig) -> Voice | None:
-    """`none`, or `package.module:factory` called with the thing name, returning a Voice."""
+    """`none`, or `package.module:factory` returning a Voice.
+
+    The factory is called with `thing=` and, when it has such a parameter, `config=` (the
+    `AgentConfig`), e.g. `robot_agent.voice.factories:room`.
+    """
     if config.voice == "none":
         return None
     module_name, _, factory_name = config.voice.partition(":")
@@ -73,7 +79,14 @@ def build_voice(config: AgentConfig) -> Voice | None:
         factory = getattr(importlib.import_module(module_name), factory_name)
     except (ImportError, AttributeError) as err:
         raise VahrError(f"--voice {config.voice!r}: {err}") from err
-    voice: Voice = factory(thing=config.thing)
+    arguments: dict[str, object] = {"thing": config.thing}
+    # Factories that can reuse the agent's connection settings take them as `config`.
+    if "config" in inspect.signature(factory).parameters:
+        arguments["config"] = config
+    try:
+        voice: Voice = factory(**arguments)
+    except VoiceError as err:
+        raise VahrError(f"--voice {config.voice}: {err}") from err
     return voice
 
 

@@ -11,6 +11,7 @@ matching event because the skill waits on the shadow, not on events.
 from __future__ import annotations
 
 import asyncio
+import inspect
 import logging
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -185,6 +186,12 @@ class Executor:
                 )
             self._update(**changes)
         await self.backend.close()
+        # A voice adapter may hold a connection or a sound device of its own.
+        closer = getattr(self.voice, "close", None)
+        if callable(closer):
+            result = closer()
+            if inspect.isawaitable(result):
+                await result
 
     # -- tasks --------------------------------------------------------------------------
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import pytest
+
 from robot_agent.core.executor import WEATHER_QUESTION
 from robot_agent.voice.port import Heard, VoiceError
 from tests.unit.agent.conftest import make_executor
@@ -25,9 +27,14 @@ class ScriptedAssistant:
         self.answers = list(answers)
         self.said: list[str] = []
         self.listens: list[float] = []
+        self.closed = False
+        self.config: object = None
 
     async def say(self, text: str) -> None:
         self.said.append(text)
+
+    def close(self) -> None:
+        self.closed = True
 
     async def listen(self, timeout_s: float) -> Heard:
         self.listens.append(timeout_s)
@@ -131,3 +138,38 @@ def test_the_voice_factory_named_in_the_config_is_built_with_the_thing() -> None
     assert voice is not None and type(voice).__name__ == "ScriptedAssistant"
     assert voice.answers[0].text == "The weather is rainy, placebot1."  # type: ignore[attr-defined]
     assert build_voice(AgentConfig(thing="placebot1")) is None
+
+
+def scripted_with_config(thing: str, config: object) -> ScriptedAssistant:
+    """A factory that, like the room voice, reuses the agent's configuration."""
+    assistant = ScriptedAssistant(SUNNY)
+    assistant.config = config
+    return assistant
+
+
+def failing_voice(thing: str) -> ScriptedAssistant:
+    raise VoiceError("no sound card")
+
+
+def test_a_factory_that_takes_the_config_gets_it_and_a_failing_one_is_one_line() -> None:
+    from robot_agent.assembly import build_voice
+    from robot_agent.config import AgentConfig
+    from vahr.errors import VahrError
+
+    config = AgentConfig(
+        thing="placebot1", voice="tests.unit.agent.test_agent_weather_delivery:scripted_with_config"
+    )
+    voice = build_voice(config)
+    assert voice is not None and voice.config is config  # type: ignore[attr-defined]
+    failing = AgentConfig(
+        thing="placebot1", voice="tests.unit.agent.test_agent_weather_delivery:failing_voice"
+    )
+    with pytest.raises(VahrError, match="no sound card"):
+        build_voice(failing)
+
+
+async def test_the_voice_is_closed_when_the_executor_closes(fleet: Fleet) -> None:
+    assistant = ScriptedAssistant()
+    executor, _, _ = make_executor(fleet, voice=assistant)
+    await executor.close()
+    assert assistant.closed
