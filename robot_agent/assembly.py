@@ -33,7 +33,13 @@ if TYPE_CHECKING:
 def build_backend(config: AgentConfig, fleet: Fleet, clock: ScaledClock) -> NavigationBackend:
     thing = str(config.thing)
     if config.backend == "ros1":
-        from robot_agent.backends.ros1 import Ros1Backend, Ros1Settings
+        try:
+            from robot_agent.backends.ros1 import Ros1Backend, Ros1Settings
+        except ImportError as err:
+            raise VahrError(
+                f"--backend ros1 needs ROS 1's rospy, actionlib and move_base_msgs ({err}); "
+                "install ros-core and python3-move-base-msgs, then run make setup"
+            ) from err
 
         ros = config.ros
         return Ros1Backend(
