@@ -28,6 +28,9 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
+# Events an operator should notice at the default log level and above.
+_TROUBLE = frozenset({"rejected", "failed", "stuck"})
+
 
 class RobotAgent:
     """A robot's presence on the broker. Call `attach()` once before the link connects."""
@@ -85,7 +88,6 @@ class RobotAgent:
             command = decode_command(payload, self.fleet)
         except ProtocolError as err:
             command_id, action = _best_effort_identity(payload)
-            log.warning("%s: rejected %s: %s", self.thing, command_id or "a command", err)
             self.executor.reject(command_id, action, str(err))
             return
         if not self.recent_ids.add(command.id):
@@ -130,7 +132,8 @@ class RobotAgent:
         self.link.publish(
             topics.robot_events(self.thing), encode(event), retain=event.event == "delivered"
         )
-        log.info("%s: %s", self.thing, _describe(event))
+        level = logging.WARNING if event.event in _TROUBLE else logging.INFO
+        log.log(level, "%s: %s", self.thing, _describe(event))
 
     async def shut_down(self) -> None:
         """Cancel the running task, report the final state and presence offline."""
