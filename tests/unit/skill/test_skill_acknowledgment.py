@@ -200,3 +200,15 @@ def test_a_silent_robot_is_read_a_handful_of_times_not_continuously(
     # when reads are slow on a busy machine)
     assert answers["placebot1"].outcome == "unconfirmed"
     assert 3 <= Counting.reads <= 5
+
+
+def test_a_robot_reporting_an_unknown_status_is_still_heard_acknowledging(
+    make_skill: Any, robots: RobotDoubles
+) -> None:
+    # Given a newer robot that reports a status this skill does not know ("charging")
+    charging = Reported(status="charging", connected=True)  # type: ignore[arg-type]
+    robots.behave("placebot1", RobotBehaviour(reported=lambda _: charging))
+    # When it is sent somewhere
+    response = make_skill()(load_event("alexa_navigate"), None)
+    # Then its acknowledgment counts all the same
+    assert speech(response) == "Placebot one is on its way to zone A."
