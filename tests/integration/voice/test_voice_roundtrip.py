@@ -25,7 +25,11 @@ SUNNY = (
 )
 RAINY = ("The weather is rainy.", "It is raining.", "It will rain today.",
          "Today will be rainy.", "Bring an umbrella.")  # fmt: skip
-UNRELATED = "Please deliver the package to the loading zone."
+UNRELATED = (
+    "Please deliver the package to the loading zone.",
+    "Thank you. It is sunny, so I am delivering to zone A.",
+    "Robot two is stuck.",
+)
 ANSWERS = [(text, "sunny") for text in SUNNY] + [(text, "rainy") for text in RAINY]
 
 
@@ -57,13 +61,13 @@ def test_silence_and_an_unrelated_sentence_are_unknown(
 ) -> None:
     tts = EspeakSynthesizer(voice)
     rng = np.random.default_rng(3)
-    unrelated = tts.synthesize(UNRELATED)
     cases = {
         "silence": Audio.silence(2.0),
         "quiet room noise": add_white_noise(Audio.from_samples(np.full(SAMPLE_RATE, 20.0)), 0, rng),
-        "unrelated": unrelated,
-        "unrelated, 20 dB SNR": add_white_noise(unrelated, 20.0, rng),
     }
+    for text in UNRELATED:
+        cases[text] = tts.synthesize(text)
+        cases[f"{text} (20 dB SNR)"] = add_white_noise(cases[text], 20.0, rng)
     heard = {name: understanding.hear(audio) for name, audio in cases.items()}
     assert {name: (h.intent, h.text) for name, h in heard.items()} == {
         name: ("unknown", "") for name in cases
