@@ -129,21 +129,27 @@ class Mosquitto:
 
     def kill(self) -> None:
         """Stop abruptly (SIGKILL), as a crash would; for failure tests."""
-        if self._process is not None and self._process.poll() is None:
-            self._process.kill()
-            self._process.wait(timeout=STOP_TIMEOUT_S)
+        process, self._process = self._process, None
+        if process is None:
+            return
+        if process.poll() is None:
+            process.kill()
+            process.wait(timeout=STOP_TIMEOUT_S)
+        if process.stderr is not None:
+            process.stderr.close()
 
     def stop(self) -> None:
         """Stop gracefully (SIGTERM, then SIGKILL after a timeout)."""
         process, self._process = self._process, None
-        if process is None or process.poll() is not None:
+        if process is None:
             return
-        process.send_signal(signal.SIGTERM)
-        try:
-            process.wait(timeout=STOP_TIMEOUT_S)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=STOP_TIMEOUT_S)
+        if process.poll() is None:
+            process.send_signal(signal.SIGTERM)
+            try:
+                process.wait(timeout=STOP_TIMEOUT_S)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait(timeout=STOP_TIMEOUT_S)
         if process.stderr is not None:
             process.stderr.close()
 

@@ -21,6 +21,9 @@ def free_port() -> int:
 def ensure_free(port: int, what: str) -> None:
     """Raise a one-line VahrError if `port` on 127.0.0.1 is already taken."""
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        # mosquitto binds with SO_REUSEADDR, so a port left in TIME_WAIT by a killed broker
+        # is free for it; the check must agree or a restart would be refused for a minute.
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             sock.bind((LOOPBACK, port))
         except OSError as err:
