@@ -153,9 +153,10 @@ def _run_session(args: argparse.Namespace, fleet: Any, session: Any) -> Any:
 
     performer_for: Any
     if args.simulate:
-        from vahr.experiment.assistant import SayCommandAssistant
+        from vahr.experiment.assistant import HttpAssistant, SayCommandAssistant
 
-        performer_for = simulated_performer(session, fleet, SayCommandAssistant(args.api))
+        assistant = HttpAssistant(args.api) if args.api else SayCommandAssistant(None)
+        performer_for = simulated_performer(session, fleet, assistant)
     else:
         from vahr.experiment.observer import ObserverConsole
 

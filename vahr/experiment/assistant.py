@@ -1,8 +1,10 @@
-"""The port through which a simulated participant speaks to the assistant, and its adapter.
+"""The port through which a simulated participant speaks to the assistant, and its adapters.
 
-The adapter runs `vahr say UTTERANCE --api URL --json`, the command-line contract of the
-local stack (DESIGN.md), so the participant talks to the running system exactly as a
-person at the terminal would, through the Alexa simulator and the real skill.
+- `HttpAssistant` posts the utterance to the local stack's `POST /vahr/say` (the Alexa
+  simulator in front of the real skill), as `vahr say` does, without starting a process,
+  so the assistant's own latency is all that is measured.
+- `SayCommandAssistant` runs `vahr say UTTERANCE --json`, the command-line contract
+  (DESIGN.md), for a system reachable only that way.
 """
 
 from __future__ import annotations
@@ -10,6 +12,8 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import urllib.error
+import urllib.request
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -27,6 +31,42 @@ class AssistantReply:
 class Assistant(Protocol):
     def ask(self, utterance: str) -> AssistantReply:
         """Say `utterance` to the assistant; return what it answered and the commands sent."""
+
+
+def _reply(body: dict[str, object]) -> AssistantReply:
+    commands = body.get("commands") or []
+    return AssistantReply(
+        speech=str(body.get("speech") or ""),
+        intent=str(body["intent"]) if body.get("intent") else None,
+        commands=[str(c) for c in commands] if isinstance(commands, list) else [],
+    )
+
+
+class HttpAssistant:
+    """Speaks through the local stack's `POST /vahr/say` (`vahr up`'s `api` URL)."""
+
+    def __init__(self, api_url: str, timeout_s: float = SAY_TIMEOUT_S) -> None:
+        self.url = api_url.rstrip("/") + "/vahr/say"
+        self.timeout_s = timeout_s
+
+    def ask(self, utterance: str) -> AssistantReply:
+        request = urllib.request.Request(
+            self.url,
+            data=json.dumps({"utterance": utterance}).encode(),
+            headers={"Content-Type": "application/json"},
+            method="POST",
+        )
+        try:
+            with urllib.request.urlopen(request, timeout=self.timeout_s) as response:
+                body = json.loads(response.read() or b"{}")
+        except urllib.error.HTTPError as err:
+            detail = err.read().decode("utf-8", "replace")[:200]
+            return AssistantReply("", error=f"the assistant answered HTTP {err.code}: {detail}")
+        except (urllib.error.URLError, TimeoutError, OSError) as err:
+            return AssistantReply("", error=f"the assistant at {self.url} is unreachable: {err}")
+        except json.JSONDecodeError:
+            return AssistantReply("", error="the assistant's answer is not JSON")
+        return _reply(body if isinstance(body, dict) else {})
 
 
 class SayCommandAssistant:
@@ -54,8 +94,4 @@ class SayCommandAssistant:
             body = json.loads(done.stdout.strip().splitlines()[-1])
         except (json.JSONDecodeError, IndexError):
             return AssistantReply("", error="vahr say printed no JSON")
-        return AssistantReply(
-            speech=str(body.get("speech") or ""),
-            intent=body.get("intent"),
-            commands=[str(c) for c in body.get("commands") or []],
-        )
+        return _reply(body if isinstance(body, dict) else {})

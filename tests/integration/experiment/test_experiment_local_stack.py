@@ -102,3 +102,17 @@ def test_a_keyboard_session_through_the_local_stack(
         main(["report", "--from-log", str(tmp_path / "logs"), "--out", str(tmp_path / "out")]) == 0
     )
     assert (tmp_path / "out" / "objective.png").stat().st_size > 1000
+
+
+def test_the_assistant_adapter_reports_a_missing_or_unreachable_assistant(
+    stack: LocalStack,
+) -> None:
+    from vahr.experiment.assistant import HttpAssistant
+
+    # Given a data plane without the Alexa simulator attached, and a port nothing listens on
+    missing = HttpAssistant(stack.api_url).ask("tell placebot one to deliver a package to zone B")
+    unreachable = HttpAssistant(f"http://127.0.0.1:{free_port()}", timeout_s=2).ask("hello")
+    # Then each utterance comes back as a failed exchange naming the reason
+    assert missing.commands == [] and missing.error is not None
+    assert missing.error.startswith("the assistant answered HTTP 404")
+    assert unreachable.error is not None and "is unreachable" in unreachable.error
