@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import signal
-import socket
 import time
 from typing import TYPE_CHECKING
 
@@ -56,25 +55,12 @@ def test_recent_ids_survive_a_restart(
     assert [e["event"] for e in tap.events("placebot1", "once")] == ["accepted", "done"]
 
 
-def _free_for_mosquitto(port: int, what: str) -> None:
-    """`ensure_free` as mosquitto itself binds: with SO_REUSEADDR.
-
-    A broker killed with open connections leaves them in TIME_WAIT on its port for a
-    minute; mosquitto restarts on it regardless, but a plain bind() check would refuse.
-    """
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        sock.bind(("127.0.0.1", port))
-
-
 @pytest.mark.slow
 def test_a_command_sent_while_the_robot_was_away_arrives_when_it_returns(
     mosquitto: Mosquitto,
     tap: WireTap,
     start_agent: Callable[..., AgentProcess],
-    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    monkeypatch.setattr("vahr.local.broker.ensure_free", _free_for_mosquitto)
     # Given a robot with a persistent session, killed mid-task (a power cut: no clean goodbye)
     shadows = ShadowResponder(mosquitto.config.plain_port or 0)
     agent = start_agent("placebot1", "--sim-speed-factor", "5")
@@ -119,11 +105,9 @@ def test_the_broker_killed_mid_task_the_agent_reconnects_and_keeps_serving(
     mosquitto: Mosquitto,
     tmp_path: Path,
     start_agent: Callable[..., AgentProcess],
-    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     from tests.integration.agent.harness import WireTap as Tap
 
-    monkeypatch.setattr("vahr.local.broker.ensure_free", _free_for_mosquitto)
     port = mosquitto.config.plain_port or 0
     tap, shadows = Tap(port), ShadowResponder(port)
     agent = start_agent("placebot1", "--sim-speed-factor", "10")
