@@ -49,6 +49,9 @@ def render_acl(*, service_user: str = SERVICE_COMMON_NAME, open_anonymous: bool 
         f"pattern read {topics.ALL_EVENTS}",
         f"pattern read {topics.ALL_PRESENCE}",
         f"pattern readwrite {_pattern(topics.shadow_filter(_PLACEHOLDER))}",
+        # The room: a robot speaks to the assistant and hears only answers meant for it.
+        f"pattern write {_pattern(topics.room_robot_speech(_PLACEHOLDER))}",
+        f"pattern read {_pattern(topics.room_assistant_speech(_PLACEHOLDER))}",
     ]
     return "\n".join(lines) + "\n"
 

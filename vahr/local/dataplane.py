@@ -70,6 +70,8 @@ class DataPlane:
         self.shadows = shadows
         self._publish = publish
         self.meter = meter
+        # Called with (topic, payload) after each publish (the simulator's command log).
+        self.publish_observers: list[Callable[[str, bytes], None]] = []
         self.local_routes: dict[tuple[str, str], Callable[[Json], tuple[int, Json]]] = {}
 
     def handle(self, method: str, raw_path: str, body: bytes) -> tuple[int, bytes]:
@@ -117,6 +119,8 @@ class DataPlane:
         except VahrError as err:
             raise ApiError(503, str(err)) from err
         self.meter.message("http.publish", len(body))
+        for observer in self.publish_observers:
+            observer(topic, body)
         return 200, b""
 
     # -- shadows ----------------------------------------------------------------------

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from vahr.local.acl import write_acl
 from vahr.local.broker import BrokerConfig, Mosquitto, TlsListener
@@ -24,6 +24,8 @@ from vahr.local.shadow_store import ShadowStore
 
 if TYPE_CHECKING:
     from pathlib import Path
+
+    from vahr.local.alexa.simulator import AlexaSimulator
 
 log = logging.getLogger(__name__)
 
@@ -49,6 +51,7 @@ class LocalStack:
         self.dataplane: DataPlane | None = None
         self._service_client: MqttClient | None = None
         self._server: DataPlaneServer | None = None
+        self.alexa: AlexaSimulator | None = None
 
     @property
     def api_url(self) -> str:
@@ -114,6 +117,45 @@ class LocalStack:
             self.stop()
             raise
         return self
+
+    def attach_alexa(
+        self,
+        *,
+        ack_timeout_s: float | None = None,
+        model_file: Path | None = None,
+        fleet_file: Path | None = None,
+        log_level: str = "WARNING",
+    ) -> AlexaSimulator:
+        """Serve the Alexa simulator (and the skill, in-process) at `POST /vahr/say`."""
+        from vahr.local.alexa.commands_seen import CommandLog
+        from vahr.local.alexa.nlu import InteractionModel
+        from vahr.local.alexa.simulator import AlexaSimulator
+        from vahr.local.alexa.skill import load_skill_handler
+
+        assert self.dataplane is not None, "start() first"
+        log = CommandLog()
+        self.dataplane.publish_observers.append(log.observe)
+        model = InteractionModel.load(model_file)
+        handler = load_skill_handler(
+            self.api_url,
+            ack_timeout_s=ack_timeout_s,
+            fleet_file=str(fleet_file) if fleet_file else None,
+            log_level=log_level,
+        )
+        simulator = AlexaSimulator(model, handler, command_log=log.take)
+        self.alexa = simulator
+
+        def say(request: dict[str, Any]) -> tuple[int, dict[str, Any]]:
+            utterance = request.get("utterance")
+            if request.get("end_session"):
+                ended = simulator.end_session()
+                return 200, ended.to_json() if ended else {"session_open": False}
+            if not isinstance(utterance, str) or not utterance.strip():
+                return 400, {"code": 400, "message": "utterance: a non-empty string is required"}
+            return 200, simulator.say(utterance).to_json()
+
+        self.dataplane.local_routes[("POST", "/vahr/say")] = say
+        return simulator
 
     def stop(self) -> None:
         """Stop what started, in reverse order; safe to call twice."""

@@ -14,6 +14,8 @@ def test_robots_get_only_their_own_topics_by_certificate_name() -> None:
     assert "pattern write vahr/robots/%u/presence" in lines
     assert "pattern read vahr/robots/+/events" in lines
     assert "pattern readwrite $aws/things/%u/shadow/#" in lines
+    assert "pattern write vahr/room/%u/robot" in lines
+    assert "pattern read vahr/room/%u/assistant" in lines
     # No robot line grants writing to any command topic.
     assert not [
         line for line in lines if line.startswith("pattern") and "cmd" in line and "write" in line

@@ -1,0 +1,141 @@
+"""`vahr up`: run the whole system on this machine until Ctrl-C or SIGTERM."""
+
+from __future__ import annotations
+
+import json
+import signal
+import sys
+import threading
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from vahr.cli_dispatch import add_logging_flag, setup_logging
+
+if TYPE_CHECKING:
+    import argparse
+
+    from vahr.protocol import Event
+
+DEFAULT_API_PORT = 8180
+DEFAULT_STATE_DIR = Path(".state")
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--robots", type=int, help="how many robots (default: fleet.yaml's)")
+    parser.add_argument(
+        "--state-dir", type=Path, default=DEFAULT_STATE_DIR, help="local state (default .state)"
+    )
+    parser.add_argument(
+        "--api-port", type=int, default=DEFAULT_API_PORT, help="data-plane API port (default 8180)"
+    )
+    parser.add_argument(
+        "--mqtt-port", type=int, default=1883, help="plaintext loopback MQTT port, 0 for none"
+    )
+    parser.add_argument("--mqtts-port", type=int, default=8883, help="mTLS MQTT port (8883)")
+    parser.add_argument(
+        "--sim-speed-factor", type=float, default=1.0, help="simulated time runs this much faster"
+    )
+    parser.add_argument(
+        "--ack-timeout", type=float, help="seconds the skill waits for acknowledgments"
+    )
+    parser.add_argument(
+        "--no-voice", action="store_true", help="no room assistant (robots cannot ask by voice)"
+    )
+    parser.add_argument("--json", action="store_true", help="print JSON lines")
+    add_logging_flag(parser)
+    parser.set_defaults(log_level="WARNING")
+
+
+def run(args: argparse.Namespace) -> int:
+    from vahr.errors import VahrError
+    from vahr.local.system import LocalSystem, SystemConfig
+
+    setup_logging(args.log_level)
+    for flag in ("api_port", "mqtts_port", "mqtt_port"):
+        value = getattr(args, flag)
+        if not 0 <= value <= 65535 or (value == 0 and flag != "mqtt_port"):
+            raise VahrError(f"--{flag.replace('_', '-')} {value}: not a usable port")
+    if args.sim_speed_factor <= 0:
+        raise VahrError("--sim-speed-factor must be more than 0")
+    config = SystemConfig(
+        state_dir=args.state_dir.resolve(),
+        mqtts_port=args.mqtts_port,
+        mqtt_port=args.mqtt_port or None,
+        api_port=args.api_port,
+        robots=args.robots,
+        sim_speed_factor=args.sim_speed_factor,
+        ack_timeout_s=args.ack_timeout,
+        voice=not args.no_voice,
+        log_level=args.log_level,
+    )
+    stopping = threading.Event()
+    # SIGTERM ends the run like Ctrl-C does; both just set the event the main thread waits on.
+    previous = {
+        signum: signal.signal(signum, lambda *_: stopping.set())
+        for signum in (signal.SIGINT, signal.SIGTERM)
+    }
+    system = LocalSystem(config, on_event=lambda event: _print_event(event, args.json))
+    try:
+        system.start()
+        system.wait_online()
+        endpoints = system.endpoints()
+        if args.json:
+            _emit(json.dumps(endpoints))
+        else:
+            _emit(_banner(endpoints, list(system.fleet.robot_things), system.voice_enabled))
+        while not stopping.wait(0.5):
+            exited = system.robots.exited() if system.robots else {}
+            if exited:
+                thing, code = next(iter(exited.items()))
+                raise VahrError(f"robot {thing} stopped unexpectedly (exit code {code})")
+    finally:
+        system.stop()
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+    if not args.json:
+        print("vahr up: stopped", file=sys.stderr)
+    return 0
+
+
+def _emit(line: str) -> None:
+    print(line, flush=True)
+
+
+def _banner(endpoints: dict[str, str | None], things: list[str], voice: bool) -> str:
+    lines = [
+        "VAHR is up on this machine.",
+        f"  data plane  {endpoints['api']}   (AWS_ENDPOINT_URL_IOT_DATA_PLANE)",
+        f"  mqtts       {endpoints['mqtts']}   (CA {endpoints['ca']})",
+    ]
+    if endpoints["mqtt"]:
+        lines.append(f"  mqtt        {endpoints['mqtt']}   (plaintext, loopback only)")
+    lines += [
+        f"  status      {endpoints['dashboard']}",
+        f"  robots      {', '.join(things)} (sim backend{', room voice' if voice else ''})",
+        '  talk to it: vahr say "send robot one to zone b"   (Ctrl-C stops everything)',
+    ]
+    return "\n".join(lines)
+
+
+def _print_event(event: Event, as_json: bool) -> None:
+    if as_json:
+        from vahr.protocol import encode
+
+        _emit(encode(event).decode())
+        return
+    details = [
+        f"{name}={value}"
+        for name, value in (
+            ("zone", event.zone),
+            ("action", event.action),
+            ("reason", event.reason),
+            ("text", event.text),
+            ("intent", event.intent),
+        )
+        if value is not None
+    ]
+    if event.progress is not None:
+        details.append(f"progress={event.progress:.0%}")
+    command = f" [{event.command_id[:8]}]" if event.command_id else ""
+    stamp = event.at.strftime("%H:%M:%S")
+    _emit(f"{stamp} {event.thing:<10} {event.event:<10} {' '.join(details)}{command}")

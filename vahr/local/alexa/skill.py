@@ -1,0 +1,51 @@
+"""Load the skill's Lambda handler in-process, configured for the local data plane.
+
+`lambda/` is the skill's code root (a Python keyword, so not importable as a package);
+this is the one place that puts it on `sys.path`.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+from vahr.errors import VahrError
+
+LAMBDA_ROOT = Path(__file__).resolve().parents[3] / "lambda"
+
+SkillHandler = Any
+
+
+def load_skill_handler(
+    api_url: str,
+    *,
+    ack_timeout_s: float | None = None,
+    skill_id: str | None = None,
+    fleet_file: str | None = None,
+    log_level: str = "WARNING",
+) -> SkillHandler:
+    """`skill.app`'s handler built around the local data plane (the same handler function
+    Lambda runs, given another configuration)."""
+    # The local data plane accepts any SigV4 signature, but boto3 will not sign without
+    # credentials: give it dummy ones when the environment has none.
+    if not (os.environ.get("AWS_ACCESS_KEY_ID") or os.environ.get("AWS_PROFILE")):
+        os.environ["AWS_ACCESS_KEY_ID"] = "vahr-local"
+        os.environ["AWS_SECRET_ACCESS_KEY"] = "vahr-local"
+    if str(LAMBDA_ROOT) not in sys.path:
+        sys.path.insert(0, str(LAMBDA_ROOT))
+    try:
+        from skill.app import make_lambda_handler
+        from skill.config import SkillConfig
+    except ImportError as err:
+        raise VahrError(f"the skill handler cannot be imported from {LAMBDA_ROOT}: {err}") from err
+    settings: dict[str, Any] = {
+        "data_endpoint": api_url,
+        "skill_id": skill_id,
+        "fleet_file": fleet_file,
+        "log_level": log_level,
+    }
+    if ack_timeout_s is not None:
+        settings["ack_timeout_s"] = ack_timeout_s
+    return make_lambda_handler(SkillConfig(**settings))

@@ -1,0 +1,164 @@
+"""Robot-agent processes for the local stack: one `robot-agent run` per robot, each with
+its own certificate from the local CA, the simulator backend and its own log file."""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import subprocess
+import sys
+import threading
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import msgspec
+
+from vahr.errors import VahrError
+from vahr.protocol import Fleet, Group, Pose, Robot, load_fleet
+
+if TYPE_CHECKING:
+    from vahr.local.pki import LocalCA
+
+log = logging.getLogger(__name__)
+
+STOP_TIMEOUT_S = 8.0
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
+    """The fleet's first `count` robots or, past its size, more `placebotN` robots."""
+    base = base or load_fleet()
+    if count is None:
+        return base
+    if count < 1:
+        raise VahrError(f"--robots {count}: at least one robot is needed")
+    robots = list(base.robots[:count])
+    for index in range(len(robots) + 1, count + 1):
+        robots.append(
+            Robot(
+                thing=f"placebot{index}",
+                spoken=[f"placebot {index}", f"robot {index}"],
+                # A grid west of the loading zone, 1 m apart, so no robot starts in a zone.
+                start=Pose(x=-1.0 - (index - 1) // 20, y=float((index - 1) % 20)),
+            )
+        )
+    things = [robot.thing for robot in robots]
+    groups = [
+        Group(id=group.id, spoken=group.spoken, robots=[t for t in group.robots if t in things])
+        for group in base.groups
+    ]
+    if not any(group.id == "all" for group in groups):
+        groups.append(Group(id="all", spoken=["all robots"], robots=things))
+    groups = [
+        Group(id=g.id, spoken=g.spoken, robots=things if g.id == "all" else g.robots)
+        for g in groups
+        if g.robots or g.id == "all"
+    ]
+    return Fleet(
+        robots=robots, zones=base.zones, groups=groups, experiment_thing=base.experiment_thing
+    ).validate()
+
+
+def write_fleet(fleet: Fleet, path: Path) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(msgspec.yaml.encode(fleet))
+    return path
+
+
+class RobotProcesses:
+    """Start, watch and stop one `robot-agent run` process per robot."""
+
+    def __init__(
+        self,
+        *,
+        fleet_file: Path,
+        things: list[str],
+        ca: LocalCA,
+        mqtts_port: int,
+        state_dir: Path,
+        sim_speed_factor: float = 1.0,
+        voice: str | None = None,
+        log_level: str = "INFO",
+    ) -> None:
+        self.fleet_file = fleet_file
+        self.things = things
+        self.ca = ca
+        self.mqtts_port = mqtts_port
+        self.state_dir = state_dir
+        self.sim_speed_factor = sim_speed_factor
+        self.voice = voice
+        self.log_level = log_level
+        self.processes: dict[str, subprocess.Popen[bytes]] = {}
+        self._lock = threading.Lock()
+
+    def log_file(self, thing: str) -> Path:
+        return self.state_dir / thing / "agent.log"
+
+    def command(self, thing: str) -> list[str]:
+        credentials = self.ca.issue_client(thing, self.state_dir / thing / "certs")
+        command = [
+            sys.executable, "-m", "robot_agent.cli", "run",
+            "--thing", thing,
+            "--endpoint", "127.0.0.1", "--port", str(self.mqtts_port),
+            "--cert", str(credentials.cert_file),
+            "--key", str(credentials.key_file),
+            "--ca", str(credentials.ca_file),
+            "--backend", "sim",
+            "--sim-speed-factor", f"{self.sim_speed_factor:g}",
+            "--fleet", str(self.fleet_file),
+            "--state-dir", str(self.state_dir / thing / "state"),
+            "--log-level", self.log_level,
+        ]  # fmt: skip
+        if self.voice:
+            command += ["--voice", self.voice]
+        return command
+
+    def start(self) -> RobotProcesses:
+        env = {
+            **os.environ,
+            "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
+        }
+        for thing in self.things:
+            log_path = self.log_file(thing)
+            log_path.parent.mkdir(parents=True, exist_ok=True)
+            with log_path.open("ab") as log_stream:
+                process = subprocess.Popen(
+                    self.command(thing),
+                    cwd=ROOT,
+                    env=env,
+                    stdin=subprocess.DEVNULL,
+                    stdout=log_stream,
+                    stderr=subprocess.STDOUT,
+                    # Their own process group: Ctrl-C reaches `vahr up`, which stops them
+                    # in order, rather than every process at once.
+                    start_new_session=True,
+                )
+            with self._lock:
+                self.processes[thing] = process
+        return self
+
+    def exited(self) -> dict[str, int]:
+        """Robots whose process has ended, with the exit code."""
+        with self._lock:
+            return {t: p.returncode for t, p in self.processes.items() if p.poll() is not None}
+
+    def last_log_line(self, thing: str) -> str:
+        path = self.log_file(thing)
+        lines = path.read_text(errors="replace").strip().splitlines() if path.exists() else []
+        return lines[-1] if lines else "no output"
+
+    def stop(self) -> None:
+        """SIGTERM to every robot, then wait; SIGKILL whatever outlives the timeout."""
+        with self._lock:
+            processes, self.processes = self.processes, {}
+        for process in processes.values():
+            if process.poll() is None:
+                process.send_signal(signal.SIGTERM)
+        for thing, process in processes.items():
+            try:
+                process.wait(timeout=STOP_TIMEOUT_S)
+            except subprocess.TimeoutExpired:
+                log.warning("%s did not stop within %s s; killing it", thing, STOP_TIMEOUT_S)
+                process.kill()
+                process.wait(timeout=STOP_TIMEOUT_S)

@@ -1,0 +1,207 @@
+"""The whole system on one machine: the local stack, the Alexa simulator with the skill,
+the room assistant robots talk to, and one robot-agent process per robot.
+
+`LocalSystem` is what `vahr up` and `vahr demo` run. It reports each robot event to a
+callback (the live lines of `vahr up`) and can wait until every robot is online.
+"""
+
+from __future__ import annotations
+
+import logging
+import shutil
+import threading
+import time
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from vahr.errors import VahrError
+from vahr.local.mqtt import MqttClient
+from vahr.local.robots import RobotProcesses, fleet_of, write_fleet
+from vahr.local.shadow_store import ShadowError
+from vahr.local.stack import LocalStack, StackConfig
+from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from pathlib import Path
+
+    from vahr.local.alexa.simulator import AlexaSimulator
+    from vahr.protocol import Fleet
+
+log = logging.getLogger(__name__)
+
+ROOM_VOICE = "robot_agent.voice.factories:room"
+
+
+@dataclass(frozen=True, kw_only=True)
+class SystemConfig:
+    state_dir: Path
+    mqtts_port: int
+    mqtt_port: int | None
+    api_port: int
+    robots: int | None = None
+    sim_speed_factor: float = 1.0
+    ack_timeout_s: float | None = None
+    voice: bool = True
+    log_level: str = "WARNING"
+
+
+class LocalSystem:
+    """Start everything in order; `stop()` stops it in reverse. A context manager."""
+
+    def __init__(
+        self, config: SystemConfig, *, on_event: Callable[[Event], None] | None = None
+    ) -> None:
+        self.config = config
+        self.on_event = on_event
+        self.fleet: Fleet = fleet_of(config.robots)
+        self.stack = LocalStack(
+            StackConfig(
+                state_dir=config.state_dir,
+                mqtts_port=config.mqtts_port,
+                mqtt_port=config.mqtt_port,
+                api_port=config.api_port,
+            )
+        )
+        self.robots: RobotProcesses | None = None
+        self.alexa: AlexaSimulator | None = None
+        self._watcher: MqttClient | None = None
+        self._room: Any = None
+        self._room_client: MqttClient | None = None
+        self._online: dict[str, bool] = {}
+        self._changed = threading.Condition()
+
+    @property
+    def voice_enabled(self) -> bool:
+        return self.config.voice and shutil.which("espeak-ng") is not None
+
+    def endpoints(self) -> dict[str, str | None]:
+        """What `vahr up --json` prints first (DESIGN.md, Command-line surface)."""
+        assert self.stack.ca is not None
+        return {
+            "api": self.stack.api_url,
+            "mqtt": self.stack.mqtt_url,
+            "mqtts": self.stack.mqtts_url,
+            "ca": str(self.stack.ca.ca_file),
+            "dashboard": f"{self.stack.api_url}/vahr/status",
+        }
+
+    def start(self) -> LocalSystem:
+        cfg = self.config
+        try:
+            fleet_file = write_fleet(self.fleet, cfg.state_dir / "fleet.yaml")
+            self.stack.start()
+            self.alexa = self.stack.attach_alexa(
+                ack_timeout_s=cfg.ack_timeout_s, fleet_file=fleet_file, log_level=cfg.log_level
+            )
+            assert self.stack.dataplane is not None and self.stack.ca is not None
+            self.stack.dataplane.local_routes[("GET", "/vahr/status")] = self._status
+            self._watcher = MqttClient(self.stack.service_endpoint()).connect()
+            self._watcher.subscribe(topics.ALL_EVENTS, self._on_event)
+            self._watcher.subscribe(topics.ALL_PRESENCE, self._on_presence)
+            if self.voice_enabled:
+                self._start_room()
+            self.robots = RobotProcesses(
+                fleet_file=fleet_file,
+                things=list(self.fleet.robot_things),
+                ca=self.stack.ca,
+                mqtts_port=cfg.mqtts_port,
+                state_dir=cfg.state_dir / "robots",
+                sim_speed_factor=cfg.sim_speed_factor,
+                voice=ROOM_VOICE if self.voice_enabled else None,
+                log_level="INFO" if cfg.log_level == "DEBUG" else "WARNING",
+            ).start()
+        except BaseException:
+            self.stop()
+            raise
+        return self
+
+    def _start_room(self) -> None:
+        """The assistant robots talk to: a second simulated Echo on the same skill."""
+        from vahr.local.alexa.simulator import AlexaSimulator
+        from vahr.local.room import offline_room_assistant
+
+        assert self.alexa is not None
+        room_echo = AlexaSimulator(self.alexa.model, self.alexa.handler)
+
+        def ask(request: str) -> str | None:
+            turn = room_echo.say(f"alexa {request}")
+            # Each question is one-shot: the robot does not hold a conversation.
+            room_echo.end_session()
+            return turn.speech or None
+
+        self._room_client = MqttClient(self.stack.service_endpoint()).connect()
+        self._room = offline_room_assistant(self._room_client, ask).start()
+
+    def wait_online(self, timeout_s: float = 30.0) -> None:
+        """Block until every robot said it is online, or raise naming those that did not."""
+        deadline = time.monotonic() + timeout_s
+        with self._changed:
+            while True:
+                missing = [t for t in self.fleet.robot_things if not self._online.get(t)]
+                if not missing:
+                    return
+                exited = self.robots.exited() if self.robots else {}
+                for thing in missing:
+                    if thing in exited and self.robots is not None:
+                        raise VahrError(
+                            f"robot {thing} exited with code {exited[thing]}: "
+                            f"{self.robots.last_log_line(thing)}"
+                        )
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    raise VahrError(
+                        f"robots not online within {timeout_s:.0f} s: {', '.join(missing)} "
+                        f"(logs in {self.config.state_dir / 'robots'})"
+                    )
+                self._changed.wait(min(remaining, 0.5))
+
+    def _on_event(self, topic: str, payload: bytes) -> None:
+        try:
+            event = decode_event(payload)
+        except ProtocolError as err:
+            log.warning("malformed event on %s: %s", topic, err)
+            return
+        if self.on_event is not None:
+            self.on_event(event)
+
+    def _on_presence(self, topic: str, payload: bytes) -> None:
+        parsed = topics.parse_robot_topic(topic)
+        if parsed is None:
+            return
+        try:
+            online = decode_presence(payload).online
+        except ProtocolError:
+            return
+        with self._changed:
+            self._online[parsed[0]] = online
+            self._changed.notify_all()
+
+    def _status(self, request: dict[str, Any]) -> tuple[int, dict[str, Any]]:
+        store = self.stack.store
+        robots: dict[str, Any] = {}
+        for thing in self.fleet.robot_things:
+            try:
+                robots[thing] = store.get(thing)["state"].get("reported") if store else None
+            except ShadowError:  # not reported yet
+                robots[thing] = None
+        return 200, {"robots": robots, "online": dict(self._online)}
+
+    def stop(self) -> None:
+        if self.robots is not None:
+            self.robots.stop()
+            self.robots = None
+        if self._room is not None:
+            self._room.stop()
+            self._room = None
+        for client in (self._room_client, self._watcher):
+            if client is not None:
+                client.stop()
+        self._room_client = self._watcher = None
+        self.stack.stop()
+
+    def __enter__(self) -> LocalSystem:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
