@@ -10,6 +10,11 @@ variables are read here, once, for what the configuration does not carry:
   `--broker`); with the agent's mTLS settings instead, its endpoint and certificate.
 - VAHR_VOICE: the espeak-ng voice (default en-us+f2), or `polly:VOICE`.
 - VAHR_PLAY_COMMAND / VAHR_RECORD_COMMAND: the device's player and recorder commands.
+- VAHR_INTERPRETER: `local` (default) or `lex`; for Lex, VAHR_LEX_BOT_ID,
+  VAHR_LEX_BOT_ALIAS_ID, VAHR_LEX_LOCALE (en_US), VAHR_LEX_REGION (else AWS_REGION), and
+  the IoT credentials provider: VAHR_IOT_CREDENTIALS_ENDPOINT, VAHR_IOT_ROLE_ALIAS
+  (vahr-robot-lex), with the robot's certificate from the agent's config (--cert, --key,
+  --ca) or VAHR_ROBOT_CERT, VAHR_ROBOT_KEY, VAHR_ROBOT_CA.
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ if TYPE_CHECKING:
 
     from robot_agent.voice.devices import DeviceVoice
     from robot_agent.voice.room import RoomVoice
+    from robot_agent.voice.understanding import Understanding
 
 
 def _synthesizer(environ: Mapping[str, str]) -> Any:
@@ -36,10 +42,59 @@ def _synthesizer(environ: Mapping[str, str]) -> Any:
     return make_synthesizer(spec if ":" in spec else f"espeak:{spec}")
 
 
+def understanding_for(thing: str, config: Any, environ: Mapping[str, str]) -> Understanding:
+    """pocketsphinx, then the local interpreter or Lex as VAHR_INTERPRETER says."""
+    from robot_agent.voice.answers import WeatherAnswers
+    from robot_agent.voice.stt import GrammarRecognizer
+    from robot_agent.voice.understanding import Understanding, offline_understanding
+
+    choice = environ.get("VAHR_INTERPRETER", "local")
+    if choice == "local":
+        return offline_understanding()
+    if choice != "lex":
+        raise VoiceError(f"VAHR_INTERPRETER={choice!r}: expected local or lex")
+    from robot_agent.voice.iot_credentials import IotCredentialsProvider
+    from robot_agent.voice.lex import LexInterpreter
+
+    def need(name: str) -> str:
+        value = environ.get(name)
+        if not value:
+            raise VoiceError(f"VAHR_INTERPRETER=lex needs {name}")
+        return value
+
+    def robot_file(env_name: str, attribute: str) -> Path | None:
+        value = environ.get(env_name) or getattr(config, attribute, None)
+        return Path(value) if value else None
+
+    cert, key = robot_file("VAHR_ROBOT_CERT", "cert"), robot_file("VAHR_ROBOT_KEY", "key")
+    if cert is None or key is None:
+        raise VoiceError("VAHR_INTERPRETER=lex needs the robot's certificate and key")
+    provider = IotCredentialsProvider(
+        endpoint=need("VAHR_IOT_CREDENTIALS_ENDPOINT"),
+        role_alias=environ.get("VAHR_IOT_ROLE_ALIAS", "vahr-robot-lex"),
+        thing=thing,
+        cert=cert,
+        key=key,
+        ca=robot_file("VAHR_ROBOT_CA", "ca"),
+    )
+    region = environ.get("VAHR_LEX_REGION") or environ.get("AWS_REGION")
+    if not region:
+        raise VoiceError("VAHR_INTERPRETER=lex needs VAHR_LEX_REGION (or AWS_REGION)")
+    lex = LexInterpreter(
+        bot_id=need("VAHR_LEX_BOT_ID"),
+        bot_alias_id=need("VAHR_LEX_BOT_ALIAS_ID"),
+        locale_id=environ.get("VAHR_LEX_LOCALE", "en_US"),
+        session_id=thing,
+        region=region,
+        credentials=provider.get,
+        endpoint_url=environ.get("VAHR_LEX_ENDPOINT_URL"),
+    )
+    return Understanding(GrammarRecognizer(WeatherAnswers.load().all_phrases()), lex)
+
+
 def room(*, thing: str, config: Any = None, environ: Mapping[str, str] | None = None) -> RoomVoice:
     """A `RoomVoice` on its own MQTT connection to the local broker."""
     from robot_agent.voice.room import RoomVoice
-    from robot_agent.voice.understanding import offline_understanding
     from vahr.local.mqtt import MqttClient, MqttEndpoint
     from vahr.local.pki import ClientCredentials
 
@@ -62,9 +117,17 @@ def room(*, thing: str, config: Any = None, environ: Mapping[str, str] | None = 
         raise VoiceError("the room voice needs VAHR_ROOM_BROKER=mqtt://HOST:PORT or --broker")
     # Its own client id: the agent's link holds the thing name as client id.
     client = MqttClient(endpoint, client_id=f"{thing}-voice").connect()
-    return RoomVoice(
-        thing, client, _synthesizer(env), offline_understanding(), on_close=client.stop
-    )
+    try:
+        return RoomVoice(
+            thing,
+            client,
+            _synthesizer(env),
+            understanding_for(thing, config, env),
+            on_close=client.stop,
+        )
+    except BaseException:
+        client.stop()
+        raise
 
 
 def device(
@@ -72,14 +135,13 @@ def device(
 ) -> DeviceVoice:
     """A `DeviceVoice` on the default sound card (aplay/arecord unless overridden)."""
     from robot_agent.voice.devices import DeviceVoice, default_player, default_recorder
-    from robot_agent.voice.understanding import offline_understanding
 
     env = os.environ if environ is None else environ
     play = env.get("VAHR_PLAY_COMMAND")
     record = env.get("VAHR_RECORD_COMMAND")
     return DeviceVoice(
         _synthesizer(env),
-        offline_understanding(),
+        understanding_for(thing, config, env),
         player=shlex.split(play) if play else default_player(),
         recorder=shlex.split(record) if record else default_recorder(),
     )
