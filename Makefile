@@ -57,6 +57,8 @@ node_modules/.installed: package.json package-lock.json
 
 lint: setup
 	$(BIN)/ruff check .
+	$(BIN)/ruff format --check --quiet .
+	$(BIN)/python -m vahr.skill_model --check
 
 typecheck: setup
 	$(BIN)/mypy
