@@ -72,6 +72,21 @@ def speech_text(output: dict[str, Any] | None) -> str:
     return str(output.get("text", ""))
 
 
+def strip_invocation(invocation_name: str, utterance: str) -> str:
+    """What is said to the skill once the wake word and invocation are removed:
+    "Alexa, ask robot fleet to send robot one to zone b" -> "send robot one to zone b"."""
+    text = normalize(utterance)
+    invocation = re.escape(normalize(invocation_name))
+    found = re.match(
+        rf"^(?:alexa\s+)?(?:ask|tell)\s+{invocation}(?:\s+(?:to|for|about|if|whether))?"
+        rf"(?:\s+(?P<rest>.*))?$",
+        text,
+    )
+    if found:
+        return found["rest"] or ""
+    return text.removeprefix("alexa ")
+
+
 class AlexaSimulator:
     """Drive `handler` (a Lambda handler) with requests built from spoken utterances.
 

@@ -1,0 +1,180 @@
+"""`vahr demo`: the paper's scenario end to end on this machine, with its latencies.
+
+Starts the whole system on free ports in a temporary state directory (simulated time runs
+faster so the scenario takes well under a minute), speaks a scripted conversation, waits
+for the robots to finish what each line asked, prints every exchange with its latency,
+then the billable operations the data plane counted, and stops everything.
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from vahr.cli_dispatch import add_logging_flag, setup_logging
+
+if TYPE_CHECKING:
+    import argparse
+
+WAIT_TIMEOUT_S = 30.0
+
+
+@dataclass(frozen=True)
+class Step:
+    """One line of the script, and what must happen for it to count as done."""
+
+    utterance: str
+    # Each (thing, event) must be seen for the step's command before the next line.
+    until: tuple[tuple[str, str], ...] = ()
+    voice: bool = False  # needs the room assistant
+
+
+SCRIPT = (
+    Step("Alexa, open robot fleet"),
+    Step("send robot one to zone b", until=(("placebot1", "arrived"),)),
+    Step("send all robots to the loading zone", until=(("placebot1", "arrived"),
+                                                       ("placebot2", "arrived"))),
+    Step("where is robot two"),
+    Step("have robot two deliver a package to zone d", until=(("placebot2", "delivered"),)),
+    Step(
+        "robot one deliver to zone a then robot two deliver to zone c",
+        until=(("placebot1", "delivered"), ("placebot2", "delivered")),
+    ),
+    Step("send everyone to zone b"),
+    Step("emergency stop", until=(("placebot1", "stopped"), ("placebot2", "stopped"))),
+    Step(
+        "have robot one deliver based on the weather",
+        until=(("placebot1", "delivered"),),
+        voice=True,
+    ),
+    Step("where are the robots"),
+    Step("exit"),
+)  # fmt: skip
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--sim-speed-factor", type=float, default=20.0, help="simulated time speed-up (20)"
+    )
+    parser.add_argument("--no-voice", action="store_true", help="skip the spoken weather task")
+    parser.add_argument("--json", action="store_true", help="print one JSON object per exchange")
+    add_logging_flag(parser)
+    parser.set_defaults(log_level="WARNING")
+
+
+class _Events:
+    """Robot events seen on the broker, to wait for what a command should cause."""
+
+    def __init__(self) -> None:
+        import threading
+
+        self.seen: list[tuple[str, str, str | None]] = []
+        self._changed = threading.Condition()
+
+    def record(self, event: Any) -> None:
+        with self._changed:
+            self.seen.append((event.thing, event.event, event.command_id))
+            self._changed.notify_all()
+
+    def wait(self, commands: list[str], wanted: tuple[tuple[str, str], ...]) -> list[str]:
+        """Wait for each (thing, event) of one of `commands`; return what was missing."""
+        deadline = time.monotonic() + WAIT_TIMEOUT_S
+        with self._changed:
+            while True:
+                missing = [
+                    f"{thing} {kind}"
+                    for thing, kind in wanted
+                    if not any(t == thing and k == kind and c in commands for t, k, c in self.seen)
+                ]
+                remaining = deadline - time.monotonic()
+                if not missing or remaining <= 0:
+                    return missing
+                self._changed.wait(remaining)
+
+
+def run(args: argparse.Namespace) -> int:
+    from vahr.errors import VahrError
+    from vahr.local.ports import free_port
+    from vahr.local.system import LocalSystem, SystemConfig
+
+    setup_logging(args.log_level)
+    events = _Events()
+    with tempfile.TemporaryDirectory(prefix="vahr-demo-") as state:
+        config = SystemConfig(
+            state_dir=Path(state),
+            mqtts_port=free_port(),
+            mqtt_port=None,
+            api_port=free_port(),
+            sim_speed_factor=args.sim_speed_factor,
+            voice=not args.no_voice,
+            log_level=args.log_level,
+        )
+        started = time.perf_counter()
+        with LocalSystem(config, on_event=events.record) as system:
+            system.wait_online()
+            boot_s = time.perf_counter() - started
+            if not args.json:
+                print(
+                    f"vahr demo: {', '.join(system.fleet.robot_things)} online "
+                    f"after {boot_s:.1f} s; simulated time x{args.sim_speed_factor:g}\n"
+                )
+            assert system.alexa is not None and system.stack.dataplane is not None
+            latencies: list[float] = []
+            failures: list[str] = []
+            for step in SCRIPT:
+                if step.voice and not system.voice_enabled:
+                    continue
+                turn = system.alexa.say(step.utterance)
+                latencies.append(turn.latency_ms)
+                missing = events.wait(turn.commands, step.until) if step.until else []
+                _print_turn(step, turn.to_json(), missing, args.json)
+                if missing:
+                    failures.append(f"{step.utterance!r}: no {', '.join(missing)}")
+            meter = system.stack.meter.snapshot()
+        total_s = time.perf_counter() - started
+    _print_summary(latencies, meter, total_s, args.json)
+    if failures:
+        raise VahrError(f"the demo did not complete: {'; '.join(failures)}")
+    return 0
+
+
+def _print_turn(step: Step, turn: dict[str, Any], missing: list[str], as_json: bool) -> None:
+    if as_json:
+        print(json.dumps({"utterance": step.utterance, **turn, "missing": missing}))
+        return
+    print(f"  you    {step.utterance}")
+    print(f"  alexa  {turn['speech'] or '(session closed)'}")
+    outcome = (
+        ""
+        if not step.until
+        else ("  (robots: done)" if not missing else f"  (missing: {', '.join(missing)})")
+    )
+    intent = turn["intent"] or turn["request_type"]
+    print(f"         [{intent}, {turn['latency_ms']:.0f} ms]{outcome}\n")
+
+
+def _print_summary(
+    latencies: list[float], meter: dict[str, dict[str, int]], total_s: float, as_json: bool
+) -> None:
+    ordered = sorted(latencies)
+    p50 = ordered[len(ordered) // 2] if ordered else 0.0
+    summary = {
+        "exchanges": len(latencies),
+        "latency_ms_p50": round(p50, 1),
+        "latency_ms_max": round(max(latencies, default=0.0), 1),
+        "billable_operations": meter["operations"],
+        "seconds": round(total_s, 1),
+    }
+    if as_json:
+        print(json.dumps({"summary": summary}))
+        return
+    operations = ", ".join(f"{k} {v}" for k, v in sorted(meter["operations"].items()))
+    print(
+        f"{summary['exchanges']} exchanges; reply latency p50 {summary['latency_ms_p50']} ms, "
+        f"max {summary['latency_ms_max']} ms; {summary['seconds']} s in all"
+    )
+    print(f"AWS operations counted by the local data plane: {operations}")

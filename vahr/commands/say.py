@@ -1,0 +1,34 @@
+"""`vahr say "UTTERANCE"`: speak to the running system as a person speaks to Alexa."""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import argparse
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("utterance", help='e.g. "Alexa, ask robot fleet to send robot one to A"')
+    parser.add_argument("--api", help="the running system's API (default $VAHR_API or :8180)")
+    parser.add_argument("--json", action="store_true", help="print the whole turn as JSON")
+    parser.add_argument("--speak", action="store_true", help="also speak the reply (espeak-ng)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from vahr.errors import VahrError
+    from vahr.local.client import default_api, say
+
+    if not args.utterance.strip():
+        raise VahrError("the utterance is empty")
+    turn = say(args.api or default_api(), args.utterance)
+    if args.json:
+        print(json.dumps(turn))
+    else:
+        print(turn["speech"] or "(no answer)")
+    if args.speak and turn.get("speech"):
+        from vahr.local.speaker import speak
+
+        speak(turn["speech"])
+    return 0
