@@ -1,0 +1,60 @@
+"""The Alexa simulator driving the real skill on the local data plane: sessions,
+attributes across turns, slot elicitation answered with a bare value, and the commands a
+turn published."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import pytest
+
+if TYPE_CHECKING:
+    from vahr.local.alexa.simulator import AlexaSimulator
+    from vahr.local.stack import LocalStack
+
+
+@pytest.fixture(scope="module")
+def alexa(local_stack: LocalStack) -> AlexaSimulator:
+    # No robots run here, so a short acknowledgment wait keeps the tests quick.
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("AWS_ACCESS_KEY_ID", "testing")
+        patch.setenv("AWS_SECRET_ACCESS_KEY", "testing")
+        patch.setenv("AWS_DEFAULT_REGION", "us-east-1")
+        return local_stack.attach_alexa(ack_timeout_s=0.2)
+
+
+def test_an_unknown_robot_is_asked_for_and_a_bare_answer_completes_it(
+    alexa: AlexaSimulator,
+) -> None:
+    first = alexa.say("Alexa, ask robot fleet to send robot nine to zone b")
+    assert first.intent == "NavigateIntent"
+    assert first.slots["robot"] == {"value": "robot nine", "id": None}
+    assert "Which robot" in first.speech
+    assert first.session_open and first.commands == []
+    # When the person answers with the robot's name alone
+    second = alexa.say("robot two")
+    # Then the skill gets the same intent with both slots and publishes the command
+    assert second.intent == "NavigateIntent"
+    assert second.slots["robot"] == {"value": "robot two", "id": "placebot2"}
+    assert second.slots["zone"]["id"] == "B"
+    assert len(second.commands) == 1
+    alexa.end_session()
+
+
+def test_launch_then_help_then_stop(alexa: AlexaSimulator) -> None:
+    launch = alexa.say("Alexa, open robot fleet")
+    assert launch.request_type == "LaunchRequest"
+    assert launch.session_open
+    helped = alexa.say("help")
+    assert helped.intent == "AMAZON.HelpIntent"
+    assert helped.session_open
+    stopped = alexa.say("stop")
+    assert stopped.intent == "AMAZON.StopIntent"
+    assert not stopped.session_open
+
+
+def test_an_unmatched_utterance_goes_to_the_fallback_intent(alexa: AlexaSimulator) -> None:
+    turn = alexa.say("Alexa, ask robot fleet to bake a cake")
+    assert turn.intent == "AMAZON.FallbackIntent"
+    assert turn.speech
+    alexa.end_session()
