@@ -95,11 +95,15 @@ class EventLog:
             self.events.append(json.loads(payload))
             self._changed.notify_all()
 
-    def wait_for(self, kind: str, timeout_s: float) -> dict[str, Any]:
+    def wait_for(
+        self, kind: str, timeout_s: float, command_id: str | None = None
+    ) -> dict[str, Any]:
         deadline = time.monotonic() + timeout_s
         with self._changed:
             while True:
                 for event in self.events:
+                    if command_id is not None and event.get("command_id") != command_id:
+                        continue
                     if event["event"] in (kind, "failed"):
                         return event
                 remaining = deadline - time.monotonic()
@@ -140,7 +144,7 @@ def test_the_robot_asks_the_weather_by_voice_and_delivers(
             command = new_command("weather_delivery", {}, source="console")
             watcher.publish(topics.robot_cmd("placebot1"), encode(command))
         # Then the robot delivers to the weather's zone
-        delivered = log.wait_for("delivered", TASK_TIMEOUT_S)
+        delivered = log.wait_for("delivered", TASK_TIMEOUT_S, command.id)
         assert delivered["event"] == "delivered", (tmp_path / "agent.log").read_text()
         assert delivered["zone"] == zone
         # And its events show what it said, heard and understood
