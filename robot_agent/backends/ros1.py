@@ -15,15 +15,18 @@ import asyncio
 import math
 import os
 import threading
+import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import actionlib
+import rosgraph
 import rospy
 from actionlib_msgs.msg import GoalStatus
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 
 from robot_agent.backends.port import NavigationFailed, Progress
+from vahr.errors import VahrError
 from vahr.protocol import Pose
 
 if TYPE_CHECKING:
@@ -68,7 +71,22 @@ def ensure_node(settings: Ros1Settings) -> None:
             return
         if settings.master_uri:
             os.environ["ROS_MASTER_URI"] = settings.master_uri
+        _wait_for_master(settings.server_timeout_s)
         rospy.init_node(settings.node_name, anonymous=True, disable_signals=True)
+
+
+def _wait_for_master(timeout_s: float) -> None:
+    # rospy.init_node retries an unreachable master forever, so the agent would hang at
+    # start-up without a word; give up after the server timeout with a one-line reason.
+    master = rosgraph.Master("/vahr_robot_agent")
+    deadline = time.monotonic() + timeout_s
+    while not master.is_online():
+        if time.monotonic() >= deadline:
+            raise VahrError(
+                f"--backend ros1: no ROS master at {master.master_uri} within {timeout_s:g} s "
+                "(start roscore, or set ros.master_uri or ROS_MASTER_URI)"
+            )
+        time.sleep(0.2)
 
 
 class Ros1Backend:

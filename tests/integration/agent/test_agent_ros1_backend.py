@@ -234,3 +234,40 @@ def test_robot_agent_run_with_the_ros1_backend_drives_move_base_from_mqtt(
             agent.kill()
         tap.close()
         shadows.close()
+
+
+def test_robot_agent_run_without_a_ros_master_exits_with_a_one_line_error(
+    tmp_path: Path,
+) -> None:
+    from tests.integration.agent.harness import AgentProcess
+
+    # Given no ROS master on the configured port
+    config = tmp_path / "ros.yaml"
+    config.write_text(
+        f"ros:\n  master_uri: http://127.0.0.1:{free_port()}\n  server_timeout_s: 1\n"
+    )
+    # When the agent starts with the ros1 backend
+    agent = AgentProcess(
+        "--thing",
+        "placebot1",
+        "--broker",
+        f"mqtt://127.0.0.1:{free_port()}",
+        "--backend",
+        "ros1",
+        "--config",
+        str(config),
+        state_dir=tmp_path / "state",
+        log_file=tmp_path / "agent.log",
+    )
+    try:
+        code = agent.process.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        agent.kill()
+        pytest.fail("robot-agent run waited for the ROS master without a timeout")
+    agent.stop()
+    # Then it exits non-zero with one line naming the master it could not reach
+    assert code != 0
+    # (rospy logs its own start-up lines too; the agent's reason is one line of its own)
+    errors = [line for line in agent.log().splitlines() if "error:" in line]
+    assert len(errors) == 1, agent.log()
+    assert "no ROS master at http://127.0.0.1:" in errors[0]
