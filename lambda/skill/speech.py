@@ -49,7 +49,7 @@ def command_report(
                 robot=robot, zone=zone_name, after=vocabulary.robot(after) if after else ""
             )
             return capitalise(sentence)
-        return capitalise(_single_problem(robot, answer))
+        return capitalise(_problem(robot, answer, _SINGLE_PROBLEMS))
     confirmed = [answer for answer in mine if answer.confirmed]
     if len(confirmed) == len(mine):
         robots = (
@@ -57,7 +57,7 @@ def command_report(
         )
         return prompts.FLEET_ACKNOWLEDGED[action].format(robots=robots, zone=zone_name)
     problems = "; ".join(
-        _fleet_problem(vocabulary.robot(answer.thing), answer)
+        _problem(vocabulary.robot(answer.thing), answer, _FLEET_PROBLEMS)
         for answer in mine
         if not answer.confirmed
     )
@@ -83,28 +83,30 @@ def sequential_report(
     return prompts.SEQUENTIAL_PARTIAL + " ".join(parts)
 
 
-def _single_problem(robot: str, answer: RobotAnswer) -> str:
-    if answer.outcome == "rejected":
-        return prompts.REJECTED.format(robot=robot, reason=_reason(answer))
-    if answer.outcome == "failed":
-        return prompts.FAILED.format(robot=robot, reason=_reason(answer))
-    if answer.outcome == "cancelled":
-        return prompts.CANCELLED.format(robot=robot)
-    if answer.offline:
-        return prompts.OFFLINE.format(robot=robot)
-    return prompts.NOT_CONFIRMED.format(robot=robot)
+# A single robot's problem is a sentence of its own; in a fleet answer it is one clause of
+# a list, so the same outcomes are worded shorter.
+_SINGLE_PROBLEMS = {
+    "rejected": prompts.REJECTED,
+    "failed": prompts.FAILED,
+    "cancelled": prompts.CANCELLED,
+    "offline": prompts.OFFLINE,
+    "silent": prompts.NOT_CONFIRMED,
+}
+_FLEET_PROBLEMS = {
+    "rejected": prompts.PROBLEM_REJECTED,
+    "failed": prompts.PROBLEM_FAILED,
+    "cancelled": prompts.PROBLEM_CANCELLED,
+    "offline": prompts.PROBLEM_OFFLINE,
+    "silent": prompts.PROBLEM_SILENT,
+}
 
 
-def _fleet_problem(robot: str, answer: RobotAnswer) -> str:
-    if answer.outcome == "rejected":
-        return prompts.PROBLEM_REJECTED.format(robot=robot, reason=_reason(answer))
-    if answer.outcome == "failed":
-        return prompts.PROBLEM_FAILED.format(robot=robot, reason=_reason(answer))
-    if answer.outcome == "cancelled":
-        return prompts.PROBLEM_CANCELLED.format(robot=robot)
-    if answer.offline:
-        return prompts.PROBLEM_OFFLINE.format(robot=robot)
-    return prompts.PROBLEM_SILENT.format(robot=robot)
+def _problem(robot: str, answer: RobotAnswer, wording: Mapping[str, str]) -> str:
+    """Why `answer` is not a confirmation, in `wording`'s sentence for that case."""
+    case: str = answer.outcome
+    if case not in ("rejected", "failed", "cancelled"):
+        case = "offline" if answer.offline else "silent"
+    return wording[case].format(robot=robot, reason=_reason(answer))
 
 
 def status_report(vocabulary: Vocabulary, reads: Sequence[ShadowRead]) -> str:
