@@ -186,6 +186,10 @@ class ShadowStore:
         # One connection guarded by a lock: the MQTT and HTTP threads share it.
         self._db = sqlite3.connect(target, check_same_thread=False, isolation_level=None)
         self._db.execute("PRAGMA journal_mode=WAL")
+        # With WAL, NORMAL survives a crash of this process (only an OS crash or power loss
+        # can lose the last commits) and skips an fsync per update, which at 1,000 robots
+        # is the difference between seconds and milliseconds.
+        self._db.execute("PRAGMA synchronous=NORMAL")
         self._db.execute(
             "CREATE TABLE IF NOT EXISTS shadows (thing TEXT NOT NULL, name TEXT NOT NULL,"
             " state TEXT NOT NULL, metadata TEXT NOT NULL, version INTEGER NOT NULL,"
