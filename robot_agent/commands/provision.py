@@ -59,12 +59,14 @@ def run(args: argparse.Namespace) -> int:
 def _provision_aws(args: argparse.Namespace, out_dir: Path) -> Bundle:
     from robot_agent.provisioning.aws import AMAZON_ROOT_CA_URL, amazon_root_ca, provision_thing
 
+    # Read before registering: a bad path must not leave an active certificate behind.
+    ca_pem = _read_ca_file(args.ca_file) if args.ca_file else None
     credentials = provision_thing(args.thing, policy=args.policy, region=args.region)
     cert = write_private(out_dir / "cert.pem", credentials.certificate_pem)
     key = write_private(out_dir / "private.key", credentials.private_key)
     note = None
-    if args.ca_file:
-        ca: Path | None = write_private(out_dir / "ca.pem", Path(args.ca_file).read_bytes())
+    if ca_pem is not None:
+        ca: Path | None = write_private(out_dir / "ca.pem", ca_pem)
     else:
         ca = amazon_root_ca(out_dir / "AmazonRootCA1.pem")
         if ca is None:
@@ -80,6 +82,13 @@ def _provision_aws(args: argparse.Namespace, out_dir: Path) -> Bundle:
         ca=ca,
     )
     return Bundle(args.thing, cert, key, ca, config, credentials.endpoint, port, note)
+
+
+def _read_ca_file(path: str) -> bytes:
+    try:
+        return Path(path).read_bytes()
+    except OSError as err:
+        raise VahrError(f"--ca-file {path}: {err.strerror or err}") from err
 
 
 def _provision_local(args: argparse.Namespace, out_dir: Path) -> Bundle:

@@ -152,3 +152,31 @@ def test_the_plain_output_names_every_file_and_a_given_ca_is_used(
     assert lines[2] == f"ca:     {out / 'ca.pem'}"
     assert (out / "ca.pem").read_text() == ca.read_text()
     assert yaml.safe_load((out / "agent.yaml").read_text())["ca"] == str((out / "ca.pem").resolve())
+
+
+def test_an_unreadable_ca_file_is_one_line_and_registers_nothing(
+    iot: object, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Given a --ca-file that does not exist
+    missing = tmp_path / "no-such-ca.pem"
+    # When the robot is provisioned with it
+    code = main(
+        [
+            "provision",
+            "--thing",
+            "placebot1",
+            "--aws",
+            "--ca-file",
+            str(missing),
+            "--out",
+            str(tmp_path / "x"),
+        ]
+    )
+    # Then it is a one-line error, and no certificate was registered or written
+    assert code == 2
+    assert capsys.readouterr().err.strip() == (
+        f"robot-agent provision: error: --ca-file {missing}: No such file or directory"
+    )
+    client = boto3.client("iot", region_name=REGION)
+    assert client.list_certificates()["certificates"] == []
+    assert not (tmp_path / "x" / "cert.pem").exists()
