@@ -82,6 +82,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="experiment seconds after which a task ends undecided (default 600)",
     )
     parser.add_argument(
+        "--pause",
+        type=float,
+        default=0.0,
+        help="experiment seconds between tasks, as the floor is reset (default 0)",
+    )
+    parser.add_argument(
         "--plan-only", action="store_true", help="draw and publish the plan, print it, and stop"
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -96,6 +102,8 @@ def run(args: argparse.Namespace) -> int:
         raise VahrError("--speed-factor must be > 0 and is only for --simulate")
     if args.task_timeout <= 0:
         raise VahrError("--task-timeout must be > 0")
+    if args.pause < 0:
+        raise VahrError("--pause must be >= 0")
     fleet = load_fleet(args.fleet)
     seed = (
         args.seed
@@ -111,6 +119,7 @@ def run(args: argparse.Namespace) -> int:
         simulated=args.simulate,
         speed_factor=args.speed_factor,
         task_timeout_s=args.task_timeout,
+        pause_s=args.pause,
     )
     session = open_session(spec, fleet)
     try:

@@ -93,6 +93,7 @@ def rehearse(
     seed: int | None = None,
     speed_factor: float = 1.0,
     task_timeout_s: float = 600.0,
+    pause_s: float = 0.0,
     data_plane_url: str | None = None,
     write_shadow: bool = True,
     announce: Callable[[str], None] = lambda line: None,
@@ -108,6 +109,7 @@ def rehearse(
         simulated=True,
         speed_factor=speed_factor,
         task_timeout_s=task_timeout_s,
+        pause_s=pause_s,
     )
     session = open_session(spec, fleet)
     try:

@@ -13,6 +13,7 @@ or when `task_timeout_s` passes.
 from __future__ import annotations
 
 import logging
+import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
@@ -55,6 +56,9 @@ class SessionSpec:
     simulated: bool = False
     speed_factor: float = 1.0
     task_timeout_s: float = 600.0
+    # Experiment seconds between one task's end and the next one's start, as when the
+    # experimenter resets the floor and hands over the next task card.
+    pause_s: float = 0.0
 
     @property
     def name(self) -> str:
@@ -145,10 +149,14 @@ def run_tasks(
 ) -> SessionVerdict:
     """Run every task not yet finished and return the judge's verdict (see `end_session`)."""
     plan, event_log = session.plan, session.log
+    ran_one = False
     for task in TASKS:
         window = task_windows(event_log.entries()).get(task)
         if window is not None and window.end is not None:
             continue
+        if ran_one and session.spec.pause_s > 0:
+            time.sleep(session.spec.pause_s / session.spec.speed_factor)
+        ran_one = True
         goal = plan.goal(task)
         recorder.set_task(task)
         if window is None:

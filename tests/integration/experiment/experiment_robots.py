@@ -25,11 +25,12 @@ if TYPE_CHECKING:
     from vahr.protocol import Fleet
 
 SPEED = 50.0
-# The agent's default peer-delivery window (120 simulated s) lets a peer's delivery from the
-# previous task satisfy task III's `sequential_delivery`: placebot2 then sets off at once and
-# may reach zone D first, which the judge rightly scores as the wrong order. Until the agent
-# ties the wait to the command's own zone, these robots look back only 5 s.
-AGENT_CONFIG = "executor:\n  peer_delivery_window_s: 5\n"
+# The agent lets a `sequential_delivery` start at once when the robot it waits for delivered
+# up to `peer_delivery_window_s` (default 120 wall-clock s) before the command was issued.
+# Task II ends with placebot1's delivery, so under the default task III's placebot2 would
+# not wait for placebot1's task III delivery, and the order would be a race the judge
+# scores. These robots count only deliveries made after the command.
+AGENT_CONFIG = "executor:\n  peer_delivery_window_s: 0\n"
 
 
 class RobotAgents:

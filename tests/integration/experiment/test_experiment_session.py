@@ -74,6 +74,13 @@ def test_keyboard_session_runs_all_three_tasks_and_reports(
         "sequential_delivery",
     ]
     assert {c["source"] for c in commands} == {"console"}
+    # and in task III placebot2 waited for placebot1, as robots coordinating among themselves
+    waiting = [
+        e.data["thing"]
+        for e in entries
+        if e.kind == Kind.ROBOT_EVENT and e.task == "III" and e.data["event"] == "waiting"
+    ]
+    assert waiting == ["placebot2"]
     assert entries[-1].kind == Kind.SESSION_ENDED
 
     # When the participant's questionnaire is entered and the report is made from the logs
