@@ -142,13 +142,14 @@ class GrammarRecognizer:
             return best
 
     def _decode(self, audio: Audio) -> Recognition:
-        phone_score = self._score_per_frame("phones", audio)
         grammar_score = self._score_per_frame("grammar", audio)
         hypothesis = self._decoder.hyp()
         text = hypothesis.hypstr if hypothesis is not None else ""
-        if grammar_score is None or phone_score is None or not text:
+        if grammar_score is None or text not in self.phrases or self._too_slow(text, audio):
             return Recognition(text, 0.0, False)
-        if text not in self.phrases or self._too_slow(text, audio):
+        # Only a candidate answer is worth the second pass.
+        phone_score = self._score_per_frame("phones", audio)
+        if phone_score is None:
             return Recognition(text, 0.0, False)
         ratio = grammar_score - phone_score
         confidence = 1.0 / (1.0 + math.exp(-(ratio - RATIO_MIDPOINT) / RATIO_SCALE))
