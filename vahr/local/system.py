@@ -157,6 +157,8 @@ class LocalSystem:
                 self._changed.wait(min(remaining, 0.5))
 
     def _on_event(self, topic: str, payload: bytes) -> None:
+        # A robot's event is a message AWS IoT would bill for, like any other publish.
+        self.stack.meter.message("mqtt.robot.event", len(payload))
         try:
             event = decode_event(payload)
         except ProtocolError as err:
