@@ -87,14 +87,14 @@ def main() -> int:
                     finished.wait(turn.commands, kinds)
                 time.sleep(SETTLE_S)
                 per_command.append((utterance, system.stack.meter.snapshot()["operations"]))
-    kinds = ["http.publish", "http.shadow.get", "http.shadow.update", "mqtt.shadow.update",
+    columns = ["http.publish", "http.shadow.get", "http.shadow.update", "mqtt.shadow.update",
              "mqtt.shadow.get", "mqtt.robot.event"]  # fmt: skip
-    header = "| voice command | " + " | ".join(f"`{k}`" for k in kinds) + " | total |"
-    lines = [header, "|" + " --- |" * (len(kinds) + 2)]
+    header = "| voice command | " + " | ".join(f"`{k}`" for k in columns) + " | total |"
+    lines = [header, "|" + " --- |" * (len(columns) + 2)]
     session: Counter[str] = Counter()
     for utterance, operations in per_command:
         session.update(operations)
-        cells = " | ".join(str(operations.get(k, 0)) for k in kinds)
+        cells = " | ".join(str(operations.get(k, 0)) for k in columns)
         lines.append(f"| {utterance} | {cells} | {sum(operations.values())} |")
     event_total = sum(session.values())
     polls = int(SESSION_S / POLL_PERIOD_S) * ROBOTS
