@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import msgspec
 
@@ -23,23 +23,30 @@ if TYPE_CHECKING:
 
 ENV_PREFIX = "VAHR_AGENT_"
 
+# A zero speed or tick would never arrive (or divide by zero) and a negative delay is
+# meaningless, so such values are refused at start-up with the key's name.
+Positive = Annotated[float, msgspec.Meta(gt=0)]
+NonNegative = Annotated[float, msgspec.Meta(ge=0)]
+NonNegativeInt = Annotated[int, msgspec.Meta(ge=0)]
+PositiveInt = Annotated[int, msgspec.Meta(gt=0)]
+
 
 class SimConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
-    speed_mps: float = 0.5
-    turn_rate_rps: float = 1.0
-    loader_delay_s: float = 3.0
-    unloader_delay_s: float = 3.0
-    tick_s: float = 0.25
+    speed_mps: Positive = 0.5
+    turn_rate_rps: Positive = 1.0
+    loader_delay_s: NonNegative = 3.0
+    unloader_delay_s: NonNegative = 3.0
+    tick_s: Positive = 0.25
     stuck_zones: list[str] = []
     fail_zones: list[str] = []
 
 
 class ExecutorConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
-    stuck_after_s: float = 10.0
-    sequential_timeout_s: float = 300.0
-    peer_delivery_window_s: float = 120.0
-    listen_timeout_s: float = 8.0
-    progress_interval_s: float = 1.0
+    stuck_after_s: Positive = 10.0
+    sequential_timeout_s: Positive = 300.0
+    peer_delivery_window_s: NonNegative = 120.0
+    listen_timeout_s: Positive = 8.0
+    progress_interval_s: NonNegative = 1.0
 
 
 class RosConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
@@ -48,17 +55,17 @@ class RosConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen
     action: str = "move_base"
     frame: str = "map"
     node_name: str = "vahr_robot_agent"
-    server_timeout_s: float = 10.0
+    server_timeout_s: Positive = 10.0
     # ROS has no arm: the loading and unloading arms are timed like the simulator's.
-    loader_delay_s: float = 3.0
-    unloader_delay_s: float = 3.0
+    loader_delay_s: NonNegative = 3.0
+    unloader_delay_s: NonNegative = 3.0
 
 
 class MqttConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
-    keep_alive_s: int = 60
-    session_expiry_s: int = 7 * 24 * 3600
-    min_reconnect_delay_ms: int = 250
-    max_reconnect_delay_ms: int = 30_000
+    keep_alive_s: NonNegativeInt = 60
+    session_expiry_s: NonNegativeInt = 7 * 24 * 3600
+    min_reconnect_delay_ms: PositiveInt = 250
+    max_reconnect_delay_ms: PositiveInt = 30_000
 
 
 class AgentConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):

@@ -69,6 +69,27 @@ def test_an_unknown_key_in_the_file_is_named(
     )
 
 
+@pytest.mark.parametrize(
+    ("section", "message"),
+    [
+        ("sim:\n  turn_rate_rps: 0\n", "sim.turn_rate_rps: expected `float` > 0.0"),
+        ("sim:\n  speed_mps: -1\n", "sim.speed_mps: expected `float` > 0.0"),
+        ("executor:\n  stuck_after_s: 0\n", "executor.stuck_after_s: expected `float` > 0.0"),
+        ("ros:\n  loader_delay_s: -3\n", "ros.loader_delay_s: expected `float` >= 0.0"),
+    ],
+)
+def test_a_number_out_of_range_in_the_file_is_named(
+    section: str, message: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Given a setting no robot could run with (a zero turn rate divides by zero)
+    config = tmp_path / "agent.yaml"
+    config.write_text("thing: placebot1\n" + section)
+    # Then the agent refuses to start and names the key
+    assert error_of(capsys, "--config", str(config)) == (
+        f"robot-agent run: error: configuration: {message}"
+    )
+
+
 def test_a_bad_environment_value_is_named(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
