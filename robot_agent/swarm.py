@@ -201,8 +201,8 @@ class SwarmThread:
 
     def start(self, timeout_s: float = CONNECT_TIMEOUT_S) -> SwarmThread:
         self._thread.start()
-        self.swarm = self._call(self._build(), timeout_s + 5)
         try:
+            self.swarm = self._call(self._build(), timeout_s + 5)
             self._call(self.swarm.start(timeout_s), timeout_s + 5)
         except BaseException:
             self.stop()

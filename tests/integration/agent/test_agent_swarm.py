@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import threading
 from typing import TYPE_CHECKING
+
+import pytest
 
 from robot_agent.swarm import SwarmThread, swarm_fleet
 from tests.integration.agent.harness import command
+from vahr.errors import VahrError
 
 if TYPE_CHECKING:
     from tests.integration.agent.harness import ShadowResponder, WireTap
@@ -19,6 +23,14 @@ def test_swarm_fleet_names_robots_in_order_and_keeps_the_zones() -> None:
     assert fleet.robot_things == ("swarm0001", "swarm0002", "swarm0003")
     assert fleet.zone_ids == ("LOADING", "A", "B", "C", "D")
     assert all(fleet.zone_at(robot.start) is None for robot in fleet.robots)
+
+
+def test_a_swarm_that_cannot_be_built_leaves_no_thread_behind() -> None:
+    # When a swarm of no robots is started from synchronous code
+    with pytest.raises(VahrError, match="at least one robot"):
+        SwarmThread(broker="mqtt://127.0.0.1:1", count=0).start()
+    # Then its event-loop thread was stopped with it
+    assert [t.name for t in threading.enumerate() if t.name == "vahr-swarm"] == []
 
 
 def test_one_fleet_command_reaches_every_robot_of_the_swarm(
