@@ -50,7 +50,12 @@ class RecentIds:
         if self.path is None:
             return
         # Write then rename, so a crash mid-write leaves the previous file intact.
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         temporary = self.path.with_suffix(".tmp")
-        temporary.write_text(json.dumps(list(self._ids)))
-        temporary.replace(self.path)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            temporary.write_text(json.dumps(list(self._ids)))
+            temporary.replace(self.path)
+        except OSError as err:
+            # The command is remembered in memory and must still run; a full or read-only
+            # disk only weakens de-duplication across a restart.
+            log.warning("cannot save recent command ids to %s: %s", self.path, err)

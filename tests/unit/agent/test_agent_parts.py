@@ -43,6 +43,17 @@ def test_a_torn_recent_id_file_does_not_stop_the_robot(tmp_path: Path) -> None:
     assert len(ids) == 0 and ids.add("a")
 
 
+def test_a_recent_id_file_that_cannot_be_written_does_not_lose_the_command(
+    tmp_path: Path,
+) -> None:
+    # Given a state directory that cannot be created (a file stands in its place)
+    (tmp_path / "robots").write_text("not a directory")
+    ids = RecentIds(tmp_path / "robots" / "recent-ids.json")
+    # When a command id arrives, then it is new (it runs), and a redelivery is a duplicate
+    assert ids.add("a") is True
+    assert ids.add("a") is False
+
+
 def test_a_peer_delivery_counts_within_the_window_before_the_command() -> None:
     peers = PeerDeliveries()
     issued = utc_now()
