@@ -220,22 +220,25 @@ def deployed_endpoint(root: Path) -> dict[str, Any] | None:
     return endpoint if isinstance(endpoint, dict) else None
 
 
-def write(root: Path, fleet: Fleet, source: bytes) -> list[Path]:
-    """Write the generated files under `root` and return those that changed."""
-    changed = []
+def _stale(root: Path, fleet: Fleet, source: bytes) -> dict[Path, str]:
+    """The generated files under `root` that differ from the generator's, with its text."""
+    stale = {}
     for relative, text in build_files(fleet, source, deployed_endpoint(root)).items():
         target = root / relative
         if not target.exists() or target.read_text(encoding="utf-8") != text:
-            target.parent.mkdir(parents=True, exist_ok=True)
-            target.write_text(text, encoding="utf-8")
-            changed.append(target)
-    return changed
+            stale[target] = text
+    return stale
+
+
+def write(root: Path, fleet: Fleet, source: bytes) -> list[Path]:
+    """Write the generated files under `root` and return those that changed."""
+    stale = _stale(root, fleet, source)
+    for target, text in stale.items():
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(text, encoding="utf-8")
+    return list(stale)
 
 
 def drift(root: Path, fleet: Fleet, source: bytes) -> list[Path]:
     """The generated files under `root` that differ from what the generator would write."""
-    return [
-        root / relative
-        for relative, text in build_files(fleet, source, deployed_endpoint(root)).items()
-        if not (root / relative).exists() or (root / relative).read_text(encoding="utf-8") != text
-    ]
+    return list(_stale(root, fleet, source))
