@@ -135,6 +135,19 @@ def test_a_session_keeps_going_until_the_person_leaves(up: Up) -> None:
     assert closed["session_open"] is False
 
 
+def test_the_console_reads_turns_from_standard_input(up: Up) -> None:
+    result = subprocess.run(
+        [*VAHR, "console", "--api", up.endpoints["api"]],
+        input="Alexa, open robot fleet\nwhere is robot two\nexit\n",
+        cwd=ROOT, env=_env(), capture_output=True, text=True, timeout=30, check=True,
+    )  # fmt: skip
+    replies = [line for line in result.stdout.splitlines() if line.startswith("alexa> ")]
+    assert len(replies) == 3
+    assert replies[0].startswith("alexa> Welcome to robot fleet")
+    assert "[StatusIntent," in replies[1]
+    assert "[SessionEndedRequest," in replies[2]
+
+
 def test_a_taken_port_is_one_clear_line(tmp_path: Path) -> None:
     with socket.socket() as taken:
         taken.bind((LOOPBACK, 0))
