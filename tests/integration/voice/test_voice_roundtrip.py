@@ -85,3 +85,25 @@ def test_a_sentence_after_the_answer_does_not_hide_it(understanding: Understandi
     # Then the answer is still understood
     heard = understanding.hear(audio)
     assert (heard.intent, heard.text) == ("rainy", "the weather is rainy")
+
+
+@pytest.mark.parametrize("voice", VOICES)
+def test_the_room_assistant_hears_questions_and_ignores_other_robot_talk(voice: str) -> None:
+    from robot_agent.voice.stt import GrammarRecognizer
+    from vahr.local.room import QUESTIONS
+
+    # Given the assistant's fast question recognizer (grammar, decoys, no phone loop)
+    recognizer = GrammarRecognizer(QUESTIONS, verify=False)
+    tts = EspeakSynthesizer(voice)
+    rng = np.random.default_rng(11)
+    asked = {
+        "Alexa, ask robot fleet what the weather is": "alexa ask robot fleet what the weather is",
+        "Alexa, ask robot fleet what is the weather": "alexa ask robot fleet what is the weather",
+    }
+    for spoken, text in asked.items():
+        for audio in (tts.synthesize(spoken), add_white_noise(tts.synthesize(spoken), 20, rng)):
+            heard = recognizer.recognize(audio)
+            assert (heard.accepted, heard.text) == (True, text)
+    for talk in ("Thank you. It is rainy, so I am delivering to zone C.",
+                 "The weather is sunny.", "Robot two is stuck."):  # fmt: skip
+        assert not recognizer.recognize(tts.synthesize(talk)).accepted, talk
