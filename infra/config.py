@@ -21,8 +21,13 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 
 Architecture = Literal["x86_64", "arm64"]
 
-# Log retention periods CloudWatch Logs accepts (days).
-_RETENTION_DAYS = (1, 3, 5, 7, 14, 30, 60, 90, 120, 150, 180, 365, 400, 545, 731, 1096, 1827)
+# Log retention periods CloudWatch Logs accepts (days), with their `logs.RetentionDays` names.
+LOG_RETENTION_NAMES = {
+    1: "ONE_DAY", 3: "THREE_DAYS", 5: "FIVE_DAYS", 7: "ONE_WEEK", 14: "TWO_WEEKS",
+    30: "ONE_MONTH", 60: "TWO_MONTHS", 90: "THREE_MONTHS", 120: "FOUR_MONTHS",
+    150: "FIVE_MONTHS", 180: "SIX_MONTHS", 365: "ONE_YEAR", 400: "THIRTEEN_MONTHS",
+    545: "EIGHTEEN_MONTHS", 731: "TWO_YEARS", 1096: "THREE_YEARS", 1827: "FIVE_YEARS",
+}  # fmt: skip
 _SKILL_ID = re.compile(r"^amzn1\.ask\.skill\.[0-9a-f-]{36}$")
 _NAME = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 
@@ -73,10 +78,10 @@ class InfraConfig:
         if architecture not in ("x86_64", "arm64"):
             raise VahrError(f"architecture: {architecture!r} must be x86_64 or arm64")
         retention = _number(get, "logRetentionDays", defaults.log_retention_days)
-        if retention not in _RETENTION_DAYS:
+        if retention not in LOG_RETENTION_NAMES:
             raise VahrError(
                 f"logRetentionDays: {retention:g} is not a CloudWatch Logs retention "
-                f"({', '.join(str(d) for d in _RETENTION_DAYS)})"
+                f"({', '.join(str(d) for d in LOG_RETENTION_NAMES)})"
             )
         ack_timeout = _number(get, "ackTimeoutS", defaults.ack_timeout_s)
         if not 0 < ack_timeout <= 6:

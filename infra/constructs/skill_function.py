@@ -19,6 +19,7 @@ from aws_cdk import aws_logs as logs
 from constructs import Construct
 
 from infra import lambda_asset
+from infra.config import LOG_RETENTION_NAMES
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
@@ -93,7 +94,7 @@ class SkillFunction(Construct):
         self.log_group = logs.LogGroup(
             self,
             "Logs",
-            retention=logs.RetentionDays[_retention_name(config.log_retention_days)],
+            retention=logs.RetentionDays[LOG_RETENTION_NAMES[config.log_retention_days]],
             removal_policy=cdk.RemovalPolicy.DESTROY,
         )
         self.role = iam.Role(
@@ -173,13 +174,3 @@ def skill_statements(stack: cdk.Stack, fleet: Fleet) -> list[iam.PolicyStatement
             resources=[arn("thing", fleet.experiment_thing)],
         ),
     ]
-
-
-def _retention_name(days: int) -> str:
-    names = {
-        1: "ONE_DAY", 3: "THREE_DAYS", 5: "FIVE_DAYS", 7: "ONE_WEEK", 14: "TWO_WEEKS",
-        30: "ONE_MONTH", 60: "TWO_MONTHS", 90: "THREE_MONTHS", 120: "FOUR_MONTHS",
-        150: "FIVE_MONTHS", 180: "SIX_MONTHS", 365: "ONE_YEAR", 400: "THIRTEEN_MONTHS",
-        545: "EIGHTEEN_MONTHS", 731: "TWO_YEARS", 1096: "THREE_YEARS", 1827: "FIVE_YEARS",
-    }  # fmt: skip
-    return names[days]
