@@ -12,9 +12,10 @@ sets `reported.connected` in its classic shadow.
 
 from __future__ import annotations
 
-import json
 import logging
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from vahr.local.shadow_store import ShadowError, ShadowStore, UpdateResult
 from vahr.protocol import ProtocolError, decode_presence, topics
@@ -39,7 +40,7 @@ REQUEST_FILTERS = (
 
 
 def _encode(body: object) -> bytes:
-    return json.dumps(body, separators=(",", ":")).encode()
+    return msgspec.json.encode(body)
 
 
 class ShadowService:
