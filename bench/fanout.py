@@ -4,7 +4,7 @@ The robots run in swarm mode (many agent cores on one event loop and one MQTT co
 `robot_agent.swarm`) against the local stack. The command goes out as the skill sends it,
 one iot-data Publish to `vahr/fleet/cmd` through the local data plane; the clock stops when
 the shadow service has accepted, for every robot, a reported `last_command.id` equal to the
-command's id (seen on `update/documents`, which the shadow service publishes after storing).
+command's id (seen on `update/accepted`, which the shadow service publishes after storing).
 Run: `.venv/bin/python bench/fanout.py [--sizes 10 100 1000] [--runs 3]`.
 """
 
@@ -43,6 +43,7 @@ class Acknowledgments:
         self.command_id = ""
         self.acked: set[str] = set()
         self.done = threading.Event()
+        self.first_at = 0.0
         self.last_at = 0.0
         self._lock = threading.Lock()
 
@@ -51,15 +52,17 @@ class Acknowledgments:
             self.command_id, self.acked = command_id, set()
             self.done.clear()
 
-    def on_documents(self, topic: str, payload: bytes) -> None:
+    def on_accepted(self, topic: str, payload: bytes) -> None:
         if self.command_id.encode() not in payload:
             return  # cheap filter: 1,000 robots publish a lot
-        reported = json.loads(payload)["current"]["state"].get("reported", {})
+        reported = json.loads(payload)["state"].get("reported") or {}
         if (reported.get("last_command") or {}).get("id") != self.command_id:
             return
         parsed = topics.parse_shadow_topic(topic)
         with self._lock:
             if parsed is not None:
+                if not self.acked:
+                    self.first_at = time.perf_counter()
                 self.acked.add(parsed[0])
             if len(self.acked) >= self.expected:
                 self.last_at = time.perf_counter()
@@ -83,7 +86,7 @@ def run_size(stack: LocalStack, size: int, runs: int) -> list[float]:
     data = boto3.client("iot-data", endpoint_url=stack.api_url, region_name="us-east-1")
     timings: list[float] = []
     with MqttClient(stack.service_endpoint()) as watcher:
-        watcher.subscribe("$aws/things/+/shadow/update/documents", acks.on_documents)
+        watcher.subscribe("$aws/things/+/shadow/update/accepted", acks.on_accepted)
         context = multiprocessing.get_context("spawn")
         ready, stop = context.Event(), context.Event()
         robots = context.Process(target=swarm_process, args=(stack.mqtt_url, size, ready, stop))
@@ -100,6 +103,10 @@ def run_size(stack: LocalStack, size: int, runs: int) -> list[float]:
                 if not acks.done.wait(ACK_TIMEOUT_S):
                     raise RuntimeError(f"{size} robots: only {len(acks.acked)} acknowledged")
                 timings.append((acks.last_at - started) * 1000)
+                print(
+                    f"{size}: first acknowledgment after {(acks.first_at - started) * 1000:.0f} ms",
+                    file=sys.stderr,
+                )
                 time.sleep(0.5)
         finally:
             stop.set()
