@@ -85,10 +85,17 @@ def build_voice(config: AgentConfig) -> Voice | None:
         factory = getattr(importlib.import_module(module_name), factory_name)
     except (ImportError, AttributeError) as err:
         raise VahrError(f"--voice {config.voice!r}: {err}") from err
+    if not callable(factory):
+        raise VahrError(f"--voice {config.voice!r}: {factory_name} is not a factory")
     arguments: dict[str, object] = {"thing": config.thing}
-    # Factories that can reuse the agent's connection settings take them as `config`.
-    if "config" in inspect.signature(factory).parameters:
-        arguments["config"] = config
+    try:
+        signature = inspect.signature(factory)
+        # Factories that can reuse the agent's connection settings take them as `config`.
+        if "config" in signature.parameters:
+            arguments["config"] = config
+        signature.bind(**arguments)
+    except (TypeError, ValueError) as err:
+        raise VahrError(f"--voice {config.voice!r}: not a factory taking thing= ({err})") from err
     try:
         voice: Voice = factory(**arguments)
     except VoiceError as err:

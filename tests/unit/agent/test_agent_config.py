@@ -165,6 +165,15 @@ def test_a_bad_environment_value_is_named(
             ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--voice", "nonsense"),
             "--voice 'nonsense': expected none or package.module:factory",
         ),
+        (
+            ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--voice", "json:decoder"),
+            "--voice 'json:decoder': decoder is not a factory",
+        ),
+        (
+            ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--voice", "json:dumps"),
+            "--voice 'json:dumps': not a factory taking thing= "
+            "(missing a required argument: 'obj')",
+        ),
     ],
 )
 def test_bad_settings_are_one_line_errors(
