@@ -152,8 +152,15 @@ class Mqtt5Link:
         """Wait until every publish so far is acknowledged (or `timeout_s` passes)."""
         with self._lock:
             pending = [asyncio.wrap_future(f, loop=self._loop) for f in self._pending]
-        if pending:
-            await asyncio.wait(pending, timeout=timeout_s)
+        if not pending:
+            return
+        done, unacknowledged = await asyncio.wait(pending, timeout=timeout_s)
+        # `_published` has logged every failure; the copies made here are only let go, so
+        # that a stop interrupting them does not log "exception was never retrieved".
+        for future in done:
+            future.exception()
+        for future in unacknowledged:
+            future.cancel()
 
     async def stop(self, timeout_s: float = 5.0) -> None:
         """Disconnect normally (the broker discards the will) and wait until stopped."""

@@ -143,3 +143,28 @@ def test_the_broker_killed_mid_task_the_agent_reconnects_and_keeps_serving(
     finally:
         shadows.close()
         tap.close()
+
+
+def test_an_agent_that_never_reached_its_broker_stops_cleanly(tmp_path: Path) -> None:
+    from tests.integration.agent.harness import AgentProcess
+    from vahr.local.ports import free_port
+
+    # Given an agent whose broker is not there, so its first reports are never sent
+    agent = AgentProcess(
+        "--thing",
+        "placebot1",
+        "--broker",
+        f"mqtt://127.0.0.1:{free_port()}",
+        state_dir=tmp_path / "state",
+        log_file=tmp_path / "agent.log",
+    )
+    deadline = time.monotonic() + 15
+    while "connection to 127.0.0.1" not in agent.log() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    # When it is told to stop
+    code = agent.stop(signal.SIGTERM, timeout_s=20)
+    # Then it exits 0 and the unsent reports are warnings, not asyncio tracebacks
+    log = agent.log()
+    assert code == 0, log
+    assert "publish failed" in log
+    assert "Traceback" not in log
