@@ -360,9 +360,10 @@ def _tls_context(tls: MutualTls, port: int) -> io.ClientTlsContext:
         )
         if tls.ca is not None:
             options.override_default_trust_store_from_path(None, str(tls.ca))
+        if port == 443 and io.is_alpn_available():
+            # AWS IoT Core serves MQTT on 443 only with this ALPN protocol name.
+            options.alpn_list = ["x-amzn-mqtt-ca"]
+        # awscrt parses the PEM files only here; a file that is not one fails here too.
+        return io.ClientTlsContext(options)
     except Exception as err:
         raise VahrError(f"cannot load the certificate, key or CA: {err}") from err
-    if port == 443 and io.is_alpn_available():
-        # AWS IoT Core serves MQTT on 443 only with this ALPN protocol name.
-        options.alpn_list = ["x-amzn-mqtt-ca"]
-    return io.ClientTlsContext(options)

@@ -180,3 +180,18 @@ def test_bad_settings_are_one_line_errors(
     argv: tuple[str, ...], message: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
     assert error_of(capsys, *argv) == f"robot-agent run: error: {message}"
+
+
+def test_a_certificate_that_is_not_pem_is_a_one_line_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Given certificate and key files that exist but hold no PEM
+    cert, key = tmp_path / "cert.pem", tmp_path / "private.key"
+    cert.write_text("not a certificate\n")
+    key.write_text("not a key\n")
+    # Then the agent stops before connecting, with one line naming what failed
+    error = error_of(
+        capsys, "--thing", "placebot1", "--endpoint", "localhost", "--cert", str(cert),
+        "--key", str(key),
+    )  # fmt: skip
+    assert error.startswith("robot-agent run: error: cannot load the certificate, key or CA: ")
