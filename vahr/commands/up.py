@@ -110,7 +110,7 @@ def _banner(endpoints: dict[str, str | None], things: list[str], voice: bool) ->
     if endpoints["mqtt"]:
         lines.append(f"  mqtt        {endpoints['mqtt']}   (plaintext, loopback only)")
     lines += [
-        f"  status      {endpoints['dashboard']}",
+        f"  dashboard   {endpoints['dashboard']}   (robot states as JSON: /vahr/status)",
         f"  robots      {', '.join(things)} (sim backend{', room voice' if voice else ''})",
         '  talk to it: vahr say "send robot one to zone b"   (Ctrl-C stops everything)',
     ]

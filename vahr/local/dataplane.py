@@ -16,6 +16,7 @@ import json
 import logging
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
@@ -45,6 +46,7 @@ ERROR_TYPES = {
     500: "InternalFailureException",
     503: "ServiceUnavailableException",
 }
+DASHBOARD = Path(__file__).with_name("dashboard.html")
 MAX_PUBLISH_BYTES = 128 * 1024  # AWS IoT's message size limit
 LIST_PAGE_MAX = 100
 
@@ -173,6 +175,8 @@ class DataPlane:
     def _local(self, method: str, path: str, body: bytes) -> tuple[int, bytes]:
         if (method, path) == ("GET", "/vahr/health"):
             return 200, _encode({"ok": True})
+        if (method, path) == ("GET", "/vahr/dashboard"):
+            return 200, DASHBOARD.read_bytes()
         if (method, path) == ("GET", "/vahr/meter"):
             return 200, _encode(self.meter.snapshot())
         if (method, path) == ("POST", "/vahr/meter/reset"):
@@ -221,7 +225,8 @@ class _Handler(BaseHTTPRequestHandler):
             log.exception("data plane request %s %s failed", self.command, self.path)
             status, payload = _error(500, "Internal service failure")
         self.send_response(status)
-        self.send_header("Content-Type", "application/json")
+        html = self.path.split("?", 1)[0] == "/vahr/dashboard" and status == 200
+        self.send_header("Content-Type", "text/html; charset=utf-8" if html else "application/json")
         self.send_header("Content-Length", str(len(payload)))
         if status >= 400:
             self.send_header("x-amzn-ErrorType", ERROR_TYPES.get(status, "InvalidRequestException"))

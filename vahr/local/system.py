@@ -83,7 +83,7 @@ class LocalSystem:
             "mqtt": self.stack.mqtt_url,
             "mqtts": self.stack.mqtts_url,
             "ca": str(self.stack.ca.ca_file),
-            "dashboard": f"{self.stack.api_url}/vahr/status",
+            "dashboard": f"{self.stack.api_url}/vahr/dashboard",
         }
 
     def start(self) -> LocalSystem:

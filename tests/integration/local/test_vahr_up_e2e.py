@@ -12,6 +12,7 @@ import subprocess
 import sys
 import threading
 import time
+import urllib.request
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
@@ -121,6 +122,16 @@ def test_a_spoken_command_moves_the_robot_and_the_reply_reflects_it(up: Up) -> N
     status = say(up, "Alexa, ask robot fleet where is robot one")
     assert "zone B" in status["speech"]
     assert status["commands"] == []
+
+
+def test_the_dashboard_and_status_show_the_robots(up: Up) -> None:
+    with urllib.request.urlopen(up.endpoints["dashboard"], timeout=10) as page:
+        assert page.headers["Content-Type"].startswith("text/html")
+        assert b"VAHR on this machine" in page.read()
+    with urllib.request.urlopen(up.endpoints["api"] + "/vahr/status", timeout=10) as answer:
+        status = json.loads(answer.read())
+    assert status["online"] == {"placebot1": True, "placebot2": True}
+    assert status["robots"]["placebot2"]["connected"] is True
 
 
 def test_a_session_keeps_going_until_the_person_leaves(up: Up) -> None:
