@@ -96,7 +96,10 @@ def _provision_local(args: argparse.Namespace, out_dir: Path) -> Bundle:
         from vahr.local.pki import LocalCA
     except ImportError as err:
         raise VahrError(f"--local needs the local stack (vahr.local.pki): {err}") from err
-    issued = LocalCA.load_or_create(Path(args.state_dir)).issue_client(args.thing, out_dir)
+    try:
+        issued = LocalCA.load_or_create(Path(args.state_dir)).issue_client(args.thing, out_dir)
+    except OSError as err:
+        raise VahrError(f"--state-dir {args.state_dir}: {err.strerror or err}") from err
     port = args.port or 8883
     config = write_config(
         out_dir,

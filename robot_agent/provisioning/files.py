@@ -48,8 +48,11 @@ def prepare_out_dir(out_dir: Path, names: tuple[str, ...], *, force: bool) -> No
             f"{out_dir} already holds {', '.join(existing)}; pass --force to replace them "
             "(the old certificate stays registered until you revoke it)"
         )
-    out_dir.mkdir(parents=True, exist_ok=True)
-    out_dir.chmod(0o700)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        out_dir.chmod(0o700)
+    except OSError as err:
+        raise VahrError(f"cannot make the directory {out_dir}: {err.strerror or err}") from err
 
 
 def write_private(path: Path, content: str | bytes) -> Path:

@@ -180,3 +180,20 @@ def test_an_unreadable_ca_file_is_one_line_and_registers_nothing(
     client = boto3.client("iot", region_name=REGION)
     assert client.list_certificates()["certificates"] == []
     assert not (tmp_path / "x" / "cert.pem").exists()
+
+
+def test_an_out_dir_that_cannot_be_made_is_one_line_and_registers_nothing(
+    iot: object, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Given --out naming a file, not a directory
+    taken = tmp_path / "taken"
+    taken.write_text("")
+    # When the robot is provisioned there
+    code = main(["provision", "--thing", "placebot1", "--aws", "--out", str(taken)])
+    # Then it is a one-line error before anything is registered
+    assert code == 2
+    assert capsys.readouterr().err.strip() == (
+        f"robot-agent provision: error: cannot make the directory {taken}: File exists"
+    )
+    client = boto3.client("iot", region_name=REGION)
+    assert client.list_certificates()["certificates"] == []
