@@ -8,6 +8,7 @@ Parsed and validated once, at start-up, into `AgentConfig`. Environment variable
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal
@@ -110,7 +111,7 @@ class AgentConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, froz
                 value = getattr(self, name)
                 if value and not Path(value).is_file():
                     raise VahrError(f"--{name} {value}: no such file")
-        if self.sim_speed_factor <= 0:
+        if not 0 < self.sim_speed_factor < math.inf:
             raise VahrError("--sim-speed-factor must be greater than 0")
         if self.backend == "ros1" and self.sim_speed_factor != 1.0:
             raise VahrError(

@@ -65,7 +65,10 @@ class LinkSettings:
 
 def plaintext_broker(url: str) -> tuple[str, int]:
     """`mqtt://127.0.0.1:PORT` -> (host, port); any host but loopback is refused."""
-    parts = urlsplit(url)
+    try:
+        parts = urlsplit(url)
+    except ValueError as err:
+        raise VahrError(f"--broker {url!r}: {err}") from err
     if parts.scheme != "mqtt" or not parts.hostname:
         raise VahrError(f"--broker {url!r}: expected mqtt://127.0.0.1:PORT")
     if parts.hostname not in LOOPBACK_HOSTS:

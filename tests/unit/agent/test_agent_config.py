@@ -149,6 +149,18 @@ def test_a_bad_environment_value_is_named(
             "--sim-speed-factor must be greater than 0",
         ),
         (
+            ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--sim-speed-factor", "nan"),
+            "--sim-speed-factor must be greater than 0",
+        ),
+        (
+            ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--sim-speed-factor", "inf"),
+            "--sim-speed-factor must be greater than 0",
+        ),
+        (
+            ("--thing", "placebot1", "--broker", "mqtt://[::1"),
+            "--broker 'mqtt://[::1': Invalid IPv6 URL",
+        ),
+        (
             (
                 "--thing",
                 "placebot1",
