@@ -59,7 +59,9 @@ def function_arn(outputs: dict[str, Any], stack: str | None = None) -> str:
 
 def set_endpoint(manifest_document: dict[str, Any], arn: str) -> bool:
     """Point the custom skill's endpoint at `arn`; True when the document changed."""
-    custom = manifest_document.get("manifest", {}).get("apis", {}).get("custom")
+    custom: Any = manifest_document
+    for key in ("manifest", "apis", "custom"):
+        custom = custom.get(key) if isinstance(custom, dict) else None
     if not isinstance(custom, dict):
         raise VahrError("skill.json has no manifest.apis.custom: it is not a custom skill")
     endpoint = custom.setdefault("endpoint", {})

@@ -137,6 +137,12 @@ def test_missing_or_broken_files_are_named(tmp_path: Path, skill_json: Path) -> 
     assert (
         result.stderr == "error: skill.json has no manifest.apis.custom: it is not a custom skill\n"
     )
+    # A manifest of the wrong shape is named the same way, not a traceback.
+    not_custom.write_text(json.dumps({"manifest": []}))
+    result = run("--outputs", str(outputs), "--skill-json", str(not_custom))
+    assert (
+        result.stderr == "error: skill.json has no manifest.apis.custom: it is not a custom skill\n"
+    )
 
 
 def test_a_deployed_endpoint_does_not_count_as_drift_of_the_generated_package(
