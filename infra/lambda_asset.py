@@ -262,7 +262,10 @@ def build(
     fleet_file = fleet_file or REPO_ROOT / "fleet.yaml"
     if not fleet_file.is_file():
         raise VahrError(f"fleet file {fleet_file} does not exist")
-    out_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise VahrError(f"cannot make the directory {out_dir}: {err.strerror or err}") from err
     if any(out_dir.iterdir()):
         raise VahrError(f"{out_dir} is not empty: give the build an empty directory")
     deps, from_cache = _install_dependencies(architecture, cache_root or REPO_ROOT / ".cache")

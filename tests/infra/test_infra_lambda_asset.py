@@ -214,6 +214,12 @@ def test_a_build_into_a_non_empty_directory_is_refused(tmp_path: Path) -> None:
         lambda_asset.build(tmp_path)
 
 
+def test_a_build_into_a_file_is_refused(tmp_path: Path) -> None:
+    (tmp_path / "taken").write_text("x")
+    with pytest.raises(VahrError, match="cannot make the directory .*taken: File exists"):
+        lambda_asset.build(tmp_path / "taken")
+
+
 def test_the_command_line_prints_one_summary_line(tmp_path: Path) -> None:
     result = subprocess.run(
         [sys.executable, "-m", "infra.lambda_asset", str(tmp_path / "out"), "--zip", str(tmp_path / "skill.zip")],
