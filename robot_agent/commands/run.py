@@ -56,8 +56,6 @@ def run(args: argparse.Namespace) -> int:
         return 0
     config.check()
     setup_logging(config.log_level)
-    # awscrt logs nothing unless asked; its INFO lines would drown the agent's own.
-    logging.getLogger("robot_agent.link").setLevel(config.log_level)
     return asyncio.run(serve(config))
 
 
