@@ -43,7 +43,8 @@ def python312() -> str | None:
     candidates = [found] if found else []
     candidates += [str(p) for p in sorted(Path.home().glob(".pyenv/versions/3.12*/bin/python3.12"))]
     for candidate in candidates:
-        if subprocess.run([candidate, "-c", "pass"], capture_output=True).returncode == 0:
+        probe = subprocess.run([candidate, "-c", "pass"], capture_output=True, timeout=30)
+        if probe.returncode == 0:
             return candidate
     return None
 
@@ -73,7 +74,7 @@ def main() -> None:
         return
     runtime = lambda_asset.runtime_site()
     # The runtime's boto3 ships byte code; compile it once so only the bundle differs.
-    subprocess.run([python, "-m", "compileall", "-q", str(runtime)], check=False)
+    subprocess.run([python, "-m", "compileall", "-q", str(runtime)], check=False, timeout=300)
     with tempfile.TemporaryDirectory() as scratch:
         lambda_asset.build(Path(scratch) / "warm")  # fills the dependency cache
         started = time.perf_counter()
