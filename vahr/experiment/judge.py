@@ -6,9 +6,10 @@
 - Task III: both robots deliver to zone D, placebot1 first; the other order fails.
 
 A robot's first delivery inside the task decides for that robot (a package delivered to the
-wrong zone cannot be taken back). A task still waiting for a delivery when it ends fails.
-The same rule (`score_goal`) lights the world's LED, so the LED and the judge cannot
-disagree.
+wrong zone cannot be taken back); only deliveries that complete a command issued during the
+task count, so a robot still finishing an earlier task's command does not. A task still
+waiting for a delivery when it ends fails. The same rule (`score_goal`) lights the world's
+LED, so the LED and the judge cannot disagree.
 
 Also scored: commands (each command on the wire is acknowledged by the robots it addressed
 and none of them rejects it or fails it), and communication (each person-to-assistant
@@ -48,11 +49,13 @@ _COMMAND_ACKS = {
 
 @dataclass(frozen=True)
 class Delivery:
-    """A robot's `delivered` event: which robot, which zone, when (log order)."""
+    """A robot's `delivered` event: which robot, which zone, when (log order), for which
+    command."""
 
     thing: str
     zone: str | None
     seq: int
+    command_id: str | None = None
 
 
 @dataclass(frozen=True)
@@ -203,11 +206,47 @@ def task_windows(entries: list[LogEntry]) -> dict[str, TaskWindow]:
 
 
 def deliveries_in(entries: list[LogEntry]) -> list[Delivery]:
+    """Every `delivered` event among `entries`."""
     return [
-        Delivery(thing=str(e.data.get("thing")), zone=e.data.get("zone"), seq=e.seq)
+        Delivery(
+            thing=str(e.data.get("thing")),
+            zone=e.data.get("zone"),
+            seq=e.seq,
+            command_id=e.data.get("command_id"),
+        )
         for e in entries
         if e.kind == Kind.ROBOT_EVENT and e.data.get("event") == "delivered"
     ]
+
+
+class TaskDeliveries:
+    """The deliveries that belong to one task, followed as the log grows.
+
+    A delivery belongs to the task when it completes a command seen on the wire during the
+    task. A robot still finishing an earlier task's command (after a task was decided early
+    by a wrong delivery, or a session ended with robots under way) delivers for that older
+    command, which must not count here. A delivery that names no command counts.
+    """
+
+    def __init__(self) -> None:
+        self.commands: set[str] = set()
+        self.deliveries: list[Delivery] = []
+
+    def add(self, entries: list[LogEntry]) -> None:
+        for entry in entries:
+            if entry.kind == Kind.COMMAND and entry.data.get("id"):
+                self.commands.add(str(entry.data["id"]))
+            elif entry.kind == Kind.ROBOT_EVENT and entry.data.get("event") == "delivered":
+                (delivery,) = deliveries_in([entry])
+                if delivery.command_id is None or delivery.command_id in self.commands:
+                    self.deliveries.append(delivery)
+
+
+def task_deliveries(entries: list[LogEntry]) -> list[Delivery]:
+    """The deliveries among a task's entries that complete the task's own commands."""
+    followed = TaskDeliveries()
+    followed.add(entries)
+    return followed.deliveries
 
 
 def _failure_context(window: TaskWindow, waiting: list[str]) -> str:
@@ -228,7 +267,7 @@ def judge_task(window: TaskWindow, goal: TaskGoal, plan: Plan) -> TaskOutcome:
     hint = ""
     if goal.task == "II":
         hint = f"the weather was {plan.weather}: a failure to interpret the assistant"
-    deliveries = deliveries_in(window.entries)
+    deliveries = task_deliveries(window.entries)
     verdict = score_goal(goal, deliveries, wrong_zone_hint=hint)
     success, reason = verdict.success, verdict.reason
     if success is None:

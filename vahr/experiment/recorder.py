@@ -30,6 +30,7 @@ class Recorder:
         self.task: str | None = None
         self.changed = threading.Condition()
         self._lock = threading.Lock()
+        self._task_commands: set[str] = set()
 
     def on_message(self, topic: str, payload: bytes) -> None:
         parsed = topics.parse_robot_topic(topic)
@@ -55,7 +56,9 @@ class Recorder:
             return
         body: dict[str, Any] = json.loads(encode(command))
         body.update(topic=topic, target=target)
-        self.log.append(Kind.COMMAND, body, task=self.task)
+        with self._lock:
+            self.log.append(Kind.COMMAND, body, task=self.task)
+            self._task_commands.add(command.id)
 
     def _event(self, topic: str, payload: bytes) -> None:
         try:
@@ -68,14 +71,18 @@ class Recorder:
         body: dict[str, Any] = json.loads(encode(event))
         with self._lock:  # world changes must follow their event in the log
             self.log.append(Kind.ROBOT_EVENT, body, task=self.task)
-            for change in self.world.apply(body):
+            command_id = body.get("command_id")
+            for_task = command_id is None or command_id in self._task_commands
+            for change in self.world.apply(body, for_task=for_task):
                 self.log.append(Kind.WORLD, change, task=self.task)
         with self.changed:
             self.changed.notify_all()
 
-    def set_task(self, task: str | None) -> None:
+    def set_task(self, task: str | None, commands: set[str] | None = None) -> None:
+        """Tag what follows with `task`; `commands` are its commands already logged (resume)."""
         with self._lock:
             self.task = task
+            self._task_commands = set(commands or ())
 
     def end_task(self, task: str, reason: str) -> None:
         """Log the end of `task` after any robot event being logged, with its world changes.
@@ -87,6 +94,7 @@ class Recorder:
             self.world.disarm_led()
             self.log.append(Kind.TASK_ENDED, {"task": task, "reason": reason}, task=task)
             self.task = None
+            self._task_commands = set()
 
     def log_world(self, changes: list[dict[str, Any]]) -> None:
         with self._lock:

@@ -19,7 +19,13 @@ from typing import TYPE_CHECKING, Protocol
 
 from vahr.errors import VahrError
 from vahr.experiment.eventlog import EventLog, Kind, session_file, session_name
-from vahr.experiment.judge import deliveries_in, judge_session, score_goal, task_windows
+from vahr.experiment.judge import (
+    TaskDeliveries,
+    judge_session,
+    score_goal,
+    task_deliveries,
+    task_windows,
+)
 from vahr.experiment.tasks import TASK_TITLES, TASKS, Plan, draw_plan
 from vahr.experiment.world import World
 
@@ -27,7 +33,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-    from vahr.experiment.judge import Delivery, SessionVerdict
+    from vahr.experiment.judge import SessionVerdict
     from vahr.experiment.recorder import Recorder
     from vahr.experiment.tasks import TaskGoal
     from vahr.protocol import Fleet
@@ -126,16 +132,16 @@ def _decision_watch(event_log: EventLog, goal: TaskGoal, start_seq: int) -> Call
 
     It reads only the events logged since its last look, so polling it often costs little.
     """
-    deliveries: list[Delivery] = []
+    followed = TaskDeliveries()
     seen = start_seq
 
     def decided() -> bool:
         nonlocal seen
-        fresh = event_log.entries(Kind.ROBOT_EVENT, after=seen)
+        fresh = event_log.entries(after=seen)
         if fresh:
             seen = fresh[-1].seq
-            deliveries.extend(deliveries_in(fresh))
-        return score_goal(goal, deliveries).success is not None
+            followed.add(fresh)
+        return score_goal(goal, followed.deliveries).success is not None
 
     return decided
 
@@ -158,7 +164,12 @@ def run_tasks(
             time.sleep(session.spec.pause_s / session.spec.speed_factor)
         ran_one = True
         goal = plan.goal(task)
-        recorder.set_task(task)
+        logged_commands = {
+            str(e.data["id"])
+            for e in (window.entries if window is not None else [])
+            if e.kind == Kind.COMMAND and e.data.get("id")
+        }
+        recorder.set_task(task, logged_commands)
         if window is None:
             event_log.append(Kind.TASK_STARTED, {"task": task}, task=task)
             announce(f"task {task}: {TASK_TITLES[task]}")
@@ -169,7 +180,7 @@ def run_tasks(
             recorder.log_world(recorder.world.arm_led(goal))
         elif goal.order and window is not None:
             # Resumed mid-task: watch on from the deliveries already made in this task.
-            recorder.world.arm_led(goal, deliveries_in(window.entries))
+            recorder.world.arm_led(goal, task_deliveries(window.entries))
         # On resume, what was already said or clicked in this task is not done again.
         done = [
             str(e.data.get("text"))

@@ -65,8 +65,12 @@ class World:
     def disarm_led(self) -> None:
         self._led_goal = None
 
-    def apply(self, event: dict[str, Any]) -> list[dict[str, Any]]:
-        """Apply one robot event (as on the wire); return the world changes it caused."""
+    def apply(self, event: dict[str, Any], *, for_task: bool = True) -> list[dict[str, Any]]:
+        """Apply one robot event (as on the wire); return the world changes it caused.
+
+        `for_task` is False for a delivery completing an earlier task's command: the arm
+        still unloads it, but it does not count towards the LED.
+        """
         self._seq += 1
         kind, thing, zone = event.get("event"), str(event.get("thing")), event.get("zone")
         changes: list[dict[str, Any]] = []
@@ -83,7 +87,7 @@ class World:
                 arm.handled += 1
             self.packages.setdefault(str(zone), []).append(thing)
             changes.append({"what": "unloaded", "thing": thing, "zone": zone, "arm": "unloader"})
-            if self._led_goal is not None:
+            if self._led_goal is not None and for_task:
                 self._led_deliveries.append(Delivery(thing, zone, self._seq))
                 verdict = score_goal(self._led_goal, self._led_deliveries)
                 if verdict.success and not self.led_on:

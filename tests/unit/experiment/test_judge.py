@@ -215,3 +215,22 @@ def test_task_rates_count_every_planned_task(script: SessionScript) -> None:
     tally = verdict(script).task_tally
     assert (tally.successes, tally.total) == (1, 3)
     assert verdict(script).to_json()["task_success"]["success_rate"] == 1 / 3
+
+
+def test_a_robot_finishing_an_earlier_tasks_command_does_not_count(script: SessionScript) -> None:
+    # Given task I, where placebot2 is still driving to C for a command of the previous session
+    script.robot(0, "placebot2", "accepted", command_id="old")
+    script.start("I", 1)
+    script.command(2, "c1", zone="B")
+    script.command(3, "c2", target="placebot2", zone="D")
+    script.robot(20, "placebot2", "delivered", "C", command_id="old")
+    script.robot(50, "placebot1", "delivered", "B", command_id="c1")
+    script.robot(60, "placebot2", "delivered", "D", command_id="c2")
+    script.end(61)
+    # Then only the deliveries of task I's own commands are judged
+    outcome = verdict(script).tasks["I"]
+    assert outcome.success is True, outcome.reason
+    assert [(d.thing, d.zone) for d in outcome.deliveries] == [
+        ("placebot1", "B"),
+        ("placebot2", "D"),
+    ]

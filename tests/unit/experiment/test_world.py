@@ -88,3 +88,13 @@ def test_a_resumed_session_rebuilds_the_world_from_its_log(fleet: Fleet, tmp_pat
         world = rebuild_world(fleet, OpenSession(spec, log, draw_plan(fleet, 1), resumed=True))
     assert world.led_on is True
     assert world.snapshot()["packages"]["D"] == ["placebot1", "placebot2"]
+
+
+def test_an_earlier_tasks_delivery_is_unloaded_but_does_not_light_the_led(fleet: Fleet) -> None:
+    world = World.from_fleet(fleet)
+    world.arm_led(TASK_III)
+    world.apply(delivered("placebot1", "D"))
+    changes = world.apply(delivered("placebot2", "D"), for_task=False)
+    assert [c["what"] for c in changes] == ["unloaded"]
+    assert world.led_on is False
+    assert world.snapshot()["packages"]["D"] == ["placebot1", "placebot2"]
