@@ -30,7 +30,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--region", help="AWS region (default: the AWS configuration's)")
     parser.add_argument("--ca-file", help="CA certificate to use instead of Amazon Root CA 1")
-    parser.add_argument("--port", type=int, help="MQTT port to write in the config (default 8883)")
+    parser.add_argument(
+        "--port", type=int, default=8883, help="MQTT port to write in the config (default 8883)"
+    )
     parser.add_argument("--force", action="store_true", help="replace credentials already in --out")
     parser.add_argument("--json", action="store_true", help="print what was written as JSON")
 
@@ -40,6 +42,8 @@ def run(args: argparse.Namespace) -> int:
         topics.check_thing(args.thing)
     except ValueError as err:
         raise VahrError(str(err)) from err
+    if not 0 < args.port < 65536:
+        raise VahrError(f"--port {args.port}: expected a TCP port (1-65535)")
     out_dir = Path(args.out) if args.out else Path(args.state_dir) / "robots" / args.thing
     names = ("cert.pem", "private.key") if args.aws else (f"{args.thing}.cert.pem",)
     prepare_out_dir(out_dir, names, force=args.force)
@@ -71,17 +75,16 @@ def _provision_aws(args: argparse.Namespace, out_dir: Path) -> Bundle:
         ca = amazon_root_ca(out_dir / "AmazonRootCA1.pem")
         if ca is None:
             note = f"download Amazon Root CA 1 from {AMAZON_ROOT_CA_URL} and pass it as --ca"
-    port = args.port or 8883
     config = write_config(
         out_dir,
         thing=args.thing,
         endpoint=credentials.endpoint,
-        port=port,
+        port=args.port,
         cert=cert,
         key=key,
         ca=ca,
     )
-    return Bundle(args.thing, cert, key, ca, config, credentials.endpoint, port, note)
+    return Bundle(args.thing, cert, key, ca, config, credentials.endpoint, args.port, note)
 
 
 def _read_ca_file(path: str) -> bytes:
@@ -100,12 +103,11 @@ def _provision_local(args: argparse.Namespace, out_dir: Path) -> Bundle:
         issued = LocalCA.load_or_create(Path(args.state_dir)).issue_client(args.thing, out_dir)
     except OSError as err:
         raise VahrError(f"--state-dir {args.state_dir}: {err.strerror or err}") from err
-    port = args.port or 8883
     config = write_config(
         out_dir,
         thing=args.thing,
         endpoint="localhost",
-        port=port,
+        port=args.port,
         cert=issued.cert_file,
         key=issued.key_file,
         ca=issued.ca_file,
@@ -113,5 +115,11 @@ def _provision_local(args: argparse.Namespace, out_dir: Path) -> Bundle:
     for path in (issued.cert_file, issued.key_file):
         path.chmod(0o600)
     return Bundle(
-        args.thing, issued.cert_file, issued.key_file, issued.ca_file, config, "localhost", port
+        args.thing,
+        issued.cert_file,
+        issued.key_file,
+        issued.ca_file,
+        config,
+        "localhost",
+        args.port,
     )

@@ -197,3 +197,17 @@ def test_an_out_dir_that_cannot_be_made_is_one_line_and_registers_nothing(
     )
     client = boto3.client("iot", region_name=REGION)
     assert client.list_certificates()["certificates"] == []
+
+
+def test_a_port_out_of_range_is_one_line_and_registers_nothing(
+    iot: object, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main(
+        ["provision", "--thing", "placebot1", "--aws", "--port", "0", "--out", str(tmp_path / "x")]
+    )
+    assert code == 2
+    assert capsys.readouterr().err.strip() == (
+        "robot-agent provision: error: --port 0: expected a TCP port (1-65535)"
+    )
+    client = boto3.client("iot", region_name=REGION)
+    assert client.list_certificates()["certificates"] == []
