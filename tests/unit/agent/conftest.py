@@ -18,13 +18,18 @@ if TYPE_CHECKING:
     from vahr.protocol import Event, Fleet, Reported
 
 
+# The longest any `async def` test may run, so that a task which never ends fails the test.
+ASYNC_TEST_TIMEOUT_S = 60.0
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_pyfunc_call(pyfuncitem: pytest.Function) -> bool | None:
     """Run `async def` tests in a fresh event loop (no asyncio plugin is pinned)."""
     if not inspect.iscoroutinefunction(pyfuncitem.obj):
         return None
     names = pyfuncitem._fixtureinfo.argnames
-    asyncio.run(pyfuncitem.obj(**{name: pyfuncitem.funcargs[name] for name in names}))
+    test = pyfuncitem.obj(**{name: pyfuncitem.funcargs[name] for name in names})
+    asyncio.run(asyncio.wait_for(test, ASYNC_TEST_TIMEOUT_S))
     return True
 
 
