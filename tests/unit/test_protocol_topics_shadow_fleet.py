@@ -129,6 +129,7 @@ def test_the_default_fleet_is_the_papers(fleet: Fleet) -> None:
             "robots.0.start.x",
         ),
         ("robots: {", "fleet"),
+        ("just a string", "fleet"),
     ],
 )
 def test_a_broken_fleet_file_names_the_field(text: str, field: str) -> None:

@@ -94,7 +94,10 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
         try:
             fleet = msgspec.yaml.decode(text, type=cls)
         except msgspec.ValidationError as err:
-            raise from_validation_error(err) from err
+            error = from_validation_error(err)
+            # A document that is not a mapping fails at its root, which is the fleet itself.
+            field = "fleet" if error.field == "payload" else error.field
+            raise ProtocolError(field, error.reason) from err
         except msgspec.DecodeError as err:
             raise ProtocolError("fleet", f"is not valid YAML ({err})") from err
         return fleet.validate()
