@@ -110,6 +110,7 @@ def executor_settings(config: AgentConfig) -> ExecutorSettings:
         sequential_timeout_s=e.sequential_timeout_s,
         peer_delivery_window_s=e.peer_delivery_window_s,
         listen_timeout_s=e.listen_timeout_s,
+        speak_timeout_s=e.speak_timeout_s,
         progress_interval_s=e.progress_interval_s,
     )
 

@@ -47,6 +47,7 @@ class ExecutorConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, f
     sequential_timeout_s: Positive = 300.0
     peer_delivery_window_s: NonNegative = 120.0
     listen_timeout_s: Positive = 8.0
+    speak_timeout_s: Positive = 30.0
     progress_interval_s: NonNegative = 1.0
 
 

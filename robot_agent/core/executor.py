@@ -14,7 +14,7 @@ import asyncio
 import inspect
 import logging
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import msgspec
 
@@ -36,7 +36,7 @@ from vahr.protocol import (
 )
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Awaitable, Callable
 
     from robot_agent.backends.port import NavigationBackend, Progress
     from robot_agent.core.clock import Clock
@@ -60,8 +60,24 @@ class ExecutorSettings:
     # A peer delivery up to this long before the command was issued still counts.
     peer_delivery_window_s: float = 120.0
     listen_timeout_s: float = 8.0
+    # Wall-clock bound on speaking one sentence, so a hung audio device fails the task.
+    speak_timeout_s: float = 30.0
     progress_interval_s: float = 1.0
     weather_question: str = WEATHER_QUESTION
+
+
+T = TypeVar("T")
+
+# Extra wall-clock time a voice adapter gets beyond its own listening timeout.
+VOICE_GRACE_S = 5.0
+
+
+async def _bounded(step: Awaitable[T], timeout_s: float, what: str) -> T:
+    """Await a voice step in wall-clock time; a hung adapter becomes a VoiceError."""
+    try:
+        return await asyncio.wait_for(step, timeout_s)
+    except TimeoutError:
+        raise VoiceError(f"{what} took longer than {timeout_s:g} s") from None
 
 
 class TaskFailed(Exception):
@@ -350,9 +366,13 @@ class Executor:
         heard_text = ""
         try:
             for _attempt in range(2):
-                await self.voice.say(self.settings.weather_question)
+                await self._say(self.settings.weather_question)
                 self._emit("said", command, text=self.settings.weather_question)
-                heard = await self.voice.listen(self.settings.listen_timeout_s)
+                heard = await _bounded(
+                    self.voice.listen(self.settings.listen_timeout_s),
+                    self.settings.listen_timeout_s + VOICE_GRACE_S,
+                    "listening",
+                )
                 heard_text = heard.text
                 self._emit("heard", command, text=heard.text)
                 self._emit("interpreted", command, intent=heard.intent, confidence=heard.confidence)
@@ -365,11 +385,15 @@ class Executor:
                 )
             zone_id = WEATHER_ZONES[intent]
             acknowledgment = f"Thank you. It is {intent}, so I am delivering to zone {zone_id}."
-            await self.voice.say(acknowledgment)
+            await self._say(acknowledgment)
             self._emit("said", command, text=acknowledgment)
         except VoiceError as err:
             raise TaskFailed(f"voice failed: {err}") from err
         await self._deliver(command, self.fleet.zone(zone_id))
+
+    async def _say(self, text: str) -> None:
+        assert self.voice is not None
+        await _bounded(self.voice.say(text), self.settings.speak_timeout_s, "speaking")
 
     # -- reporting ----------------------------------------------------------------------
 

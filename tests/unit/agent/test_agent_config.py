@@ -54,6 +54,7 @@ def test_flags_beat_environment_beat_file_beat_defaults(
         "sequential_timeout_s": 300.0,
         "peer_delivery_window_s": 120.0,
         "listen_timeout_s": 8.0,
+        "speak_timeout_s": 30.0,
         "progress_interval_s": 1.0,
     }
     assert shown["backend"] == "sim" and shown["port"] == 8883  # defaults

@@ -7,11 +7,12 @@ the robot said and answers with what a person would hear from the assistant.
 
 from __future__ import annotations
 
+import asyncio
 from typing import TYPE_CHECKING
 
 import pytest
 
-from robot_agent.core.executor import WEATHER_QUESTION
+from robot_agent.core.executor import WEATHER_QUESTION, ExecutorSettings
 from robot_agent.voice.port import Heard, VoiceError
 from tests.unit.agent.conftest import make_executor
 from vahr.protocol import new_command
@@ -173,3 +174,22 @@ async def test_the_voice_is_closed_when_the_executor_closes(fleet: Fleet) -> Non
     executor, _, _ = make_executor(fleet, voice=assistant)
     await executor.close()
     assert assistant.closed
+
+
+class SilentDevice(ScriptedAssistant):
+    """A voice whose audio device hangs: speaking never returns."""
+
+    async def say(self, text: str) -> None:
+        await asyncio.Event().wait()
+
+
+async def test_a_hung_voice_fails_the_task_instead_of_stalling_it(fleet: Fleet) -> None:
+    # Given a robot whose speaker hangs, with a short bound on speaking
+    settings = ExecutorSettings(stuck_after_s=120, speak_timeout_s=0.2)
+    executor, rec, _ = make_executor(fleet, voice=SilentDevice(SUNNY), settings=settings)
+    # When it is asked to deliver based on the weather
+    executor.execute(weather())  # type: ignore[arg-type]
+    await asyncio.wait_for(executor.wait_idle(), 10)
+    # Then the task fails with the reason, and nothing is delivered
+    assert rec.first("failed").reason == "voice failed: speaking took longer than 0.2 s"
+    assert not [e for e in rec.events if e.event == "delivered"]
