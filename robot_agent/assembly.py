@@ -108,7 +108,7 @@ def executor_settings(config: AgentConfig) -> ExecutorSettings:
     return ExecutorSettings(
         stuck_after_s=e.stuck_after_s,
         sequential_timeout_s=e.sequential_timeout_s,
-        peer_delivery_window_s=e.peer_delivery_window_s,
+        peer_clock_skew_s=e.peer_clock_skew_s,
         listen_timeout_s=e.listen_timeout_s,
         speak_timeout_s=e.speak_timeout_s,
         progress_interval_s=e.progress_interval_s,

@@ -45,7 +45,7 @@ class SimConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen
 class ExecutorConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
     stuck_after_s: Positive = 10.0
     sequential_timeout_s: Positive = 300.0
-    peer_delivery_window_s: NonNegative = 120.0
+    peer_clock_skew_s: NonNegative = 2.0
     listen_timeout_s: Positive = 8.0
     speak_timeout_s: Positive = 30.0
     progress_interval_s: NonNegative = 1.0

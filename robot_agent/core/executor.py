@@ -57,8 +57,9 @@ class ExecutorSettings:
 
     stuck_after_s: float = 10.0
     sequential_timeout_s: float = 300.0
-    # A peer delivery up to this long before the command was issued still counts.
-    peer_delivery_window_s: float = 120.0
+    # How far the peers' clocks may disagree with the sender's: a peer delivery counts for a
+    # sequential delivery only if it happened after the command was issued, less this.
+    peer_clock_skew_s: float = 2.0
     listen_timeout_s: float = 8.0
     # Wall-clock bound on speaking one sentence, so a hung audio device fails the task.
     speak_timeout_s: float = 30.0
@@ -347,8 +348,8 @@ class Executor:
         after = command.params.after
         zone = self.fleet.zone(command.params.zone)
         if after is not None and after != self.thing:
-            window = self.settings.peer_delivery_window_s
-            if self.peers.delivered_since(after, command.issued_at, window) is None:
+            skew = self.settings.peer_clock_skew_s
+            if self.peers.delivered_since(after, command.issued_at, skew) is None:
                 timeout = self.settings.sequential_timeout_s
                 self._update(status="waiting")
                 self._emit("waiting", command, reason=f"waiting for {after} to deliver")

@@ -1,8 +1,10 @@
 """What the robot knows of its peers' deliveries, for `sequential_delivery`.
 
-A peer's `delivered` event may arrive before the wait begins (the peer was faster, or the
-event is the retained one on its events topic), so deliveries are remembered and a wait
-first looks back `window_s` seconds before the command was issued.
+A peer's `delivered` event may arrive before the wait begins (the peer was faster, this
+robot received its command late, or the event is the retained one on its events topic), so
+deliveries are remembered. Only a delivery made after the command was issued counts: an
+older one belongs to an earlier task and must not release a new sequence. `skew_s`
+tolerates clocks (the peer's and the sender's) that disagree by that much.
 """
 
 from __future__ import annotations
@@ -33,10 +35,10 @@ class PeerDeliveries:
     def latest(self, thing: str) -> datetime | None:
         return self._latest.get(thing)
 
-    def delivered_since(self, thing: str, since: datetime, window_s: float) -> datetime | None:
-        """The peer's delivery time if it is at or after `since - window_s`, else None."""
+    def delivered_since(self, thing: str, since: datetime, skew_s: float) -> datetime | None:
+        """The peer's delivery time if it is at or after `since - skew_s`, else None."""
         at = self._latest.get(thing)
-        if at is not None and at >= since - timedelta(seconds=window_s):
+        if at is not None and at >= since - timedelta(seconds=skew_s):
             return at
         return None
 

@@ -97,8 +97,13 @@ class RobotProcesses:
 
     def command(self, thing: str) -> list[str]:
         credentials = self.ca.issue_client(thing, self.state_dir / thing / "certs")
+        config = self.state_dir / thing / "agent.yaml"
+        # Every robot here runs on this machine's clock, so a sequential delivery needs no
+        # tolerance for clocks that disagree (see robot-agent's `peer_clock_skew_s`).
+        config.write_text("executor:\n  peer_clock_skew_s: 0\n")
         command = [
             sys.executable, "-m", "robot_agent.cli", "run",
+            "--config", str(config),
             "--thing", thing,
             "--endpoint", "127.0.0.1", "--port", str(self.mqtts_port),
             "--cert", str(credentials.cert_file),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from typing import TYPE_CHECKING
 
 from tests.integration.agent.harness import command
@@ -40,21 +41,46 @@ def test_the_second_robot_delivers_only_after_the_first(
 def test_a_delivery_retained_before_the_robot_started_counts(
     tap: WireTap, shadows: ShadowResponder, start_agent: Callable[..., AgentProcess]
 ) -> None:
-    # Given placebot1 delivered before placebot2 even started
+    # Given a sequence issued to both robots at once, while placebot2 is still off
+    late = command("late", "sequential_delivery", {"zone": "C", "after": "placebot1"})
     start_agent("placebot1")
     tap.reported("placebot1", lambda r: r["connected"] is True)
     tap.publish("vahr/robots/placebot1/cmd", command("early", "deliver", {"zone": "A"}))
     tap.event("placebot1", "delivered", "early", timeout_s=30)
-    # When placebot2 starts and is told to deliver after placebot1
+    # When placebot2 starts after placebot1 delivered and only then gets its command
     start_agent("placebot2")
     tap.reported("placebot2", lambda r: r["connected"] is True)
-    tap.publish(
-        "vahr/robots/placebot2/cmd",
-        command("late", "sequential_delivery", {"zone": "C", "after": "placebot1"}),
-    )
+    tap.publish("vahr/robots/placebot2/cmd", late)
     # Then it does not wait (the retained delivered event counts)
     tap.event("placebot2", "delivered", "late", timeout_s=30)
     assert "waiting" not in [e["event"] for e in tap.events("placebot2", "late")]
+
+
+def test_a_delivery_from_an_earlier_task_does_not_release_a_new_sequence(
+    tap: WireTap, shadows: ShadowResponder, start_agent: Callable[..., AgentProcess]
+) -> None:
+    # Given placebot1 delivered for an earlier task
+    start_agent("placebot1")
+    start_agent("placebot2")
+    for thing in ("placebot1", "placebot2"):
+        tap.reported(thing, lambda r: r["connected"] is True)
+    tap.publish("vahr/robots/placebot1/cmd", command("task2", "deliver", {"zone": "A"}))
+    tap.event("placebot1", "delivered", "task2", timeout_s=30)
+    time.sleep(2.5)  # past the clock-skew tolerance, as a next task would be
+    # When a new sequence is issued: placebot1 to D, then placebot2 to D
+    tap.publish(
+        "vahr/robots/placebot2/cmd",
+        command("task3b", "sequential_delivery", {"zone": "D", "after": "placebot1"}),
+    )
+    # Then placebot2 waits for placebot1's new delivery, not the old one
+    tap.event("placebot2", "waiting", "task3b")
+    tap.publish(
+        "vahr/robots/placebot1/cmd",
+        command("task3a", "sequential_delivery", {"zone": "D", "after": None}),
+    )
+    first = tap.event("placebot1", "delivered", "task3a", timeout_s=30)
+    second = tap.event("placebot2", "delivered", "task3b", timeout_s=30)
+    assert first["at"] < second["at"]
 
 
 def test_waiting_for_a_peer_that_never_delivers_times_out_cleanly(

@@ -25,12 +25,9 @@ if TYPE_CHECKING:
     from vahr.protocol import Fleet
 
 SPEED = 50.0
-# The agent lets a `sequential_delivery` start at once when the robot it waits for delivered
-# up to `peer_delivery_window_s` (default 120 wall-clock s) before the command was issued.
-# Task II ends with placebot1's delivery, so under the default task III's placebot2 would
-# not wait for placebot1's task III delivery, and the order would be a race the judge
-# scores. These robots count only deliveries made after the command.
-AGENT_CONFIG = "executor:\n  peer_delivery_window_s: 0\n"
+# These robots run on this machine's clock: no tolerance for clocks that disagree, so task
+# II's delivery (moments earlier at this speed) never counts for task III's sequence.
+AGENT_CONFIG = "executor:\n  peer_clock_skew_s: 0\n"
 
 
 class RobotAgents:

@@ -52,7 +52,7 @@ def test_flags_beat_environment_beat_file_beat_defaults(
     assert shown["executor"] == {
         "stuck_after_s": 42.0,
         "sequential_timeout_s": 300.0,
-        "peer_delivery_window_s": 120.0,
+        "peer_clock_skew_s": 2.0,
         "listen_timeout_s": 8.0,
         "speak_timeout_s": 30.0,
         "progress_interval_s": 1.0,

@@ -54,13 +54,18 @@ def test_a_recent_id_file_that_cannot_be_written_does_not_lose_the_command(
     assert ids.add("a") is False
 
 
-def test_a_peer_delivery_counts_within_the_window_before_the_command() -> None:
+def test_only_a_peer_delivery_after_the_command_was_issued_counts() -> None:
+    # Given a command issued now
     peers = PeerDeliveries()
     issued = utc_now()
+    # When the peer's last delivery was for an earlier task, then it does not count
     peers.record("placebot1", issued - timedelta(seconds=30))
-    assert peers.delivered_since("placebot1", issued, window_s=60) is not None
-    assert peers.delivered_since("placebot1", issued, window_s=10) is None
-    assert peers.delivered_since("placebot2", issued, window_s=60) is None
+    assert peers.delivered_since("placebot1", issued, skew_s=2) is None
+    # When its clock runs a second behind the sender's, then a fresh delivery still counts
+    peers.record("placebot1", issued - timedelta(seconds=1))
+    assert peers.delivered_since("placebot1", issued, skew_s=2) is not None
+    # And another peer's delivery never counts for this one
+    assert peers.delivered_since("placebot2", issued, skew_s=2) is None
 
 
 async def test_a_waiter_is_woken_by_the_next_delivery() -> None:
