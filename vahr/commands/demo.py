@@ -3,7 +3,9 @@
 Starts the whole system on free ports in a temporary state directory (simulated time runs
 faster so the scenario takes well under a minute), speaks a scripted conversation, waits
 for the robots to finish what each line asked, prints every exchange with its latency,
-then the billable operations the data plane counted, and stops everything.
+then has a simulated participant perform the paper's tasks I-III with both methods and
+prints the judge's verdicts and the HRI metrics, then the billable operations the data
+plane counted, and stops everything.
 """
 
 from __future__ import annotations
@@ -61,6 +63,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--sim-speed-factor", type=float, default=20.0, help="simulated time speed-up (20)"
     )
     parser.add_argument("--no-voice", action="store_true", help="skip the spoken weather task")
+    parser.add_argument(
+        "--no-experiment", action="store_true", help="skip the paper's tasks I-III (simulated)"
+    )
     parser.add_argument("--json", action="store_true", help="print one JSON object per exchange")
     add_logging_flag(parser)
     parser.set_defaults(log_level="WARNING")
@@ -107,7 +112,8 @@ def run(args: argparse.Namespace) -> int:
         config = SystemConfig(
             state_dir=Path(state),
             mqtts_port=free_port(),
-            mqtt_port=None,
+            # The simulated participant's console publishes on the loopback dev listener.
+            mqtt_port=free_port(),
             api_port=free_port(),
             sim_speed_factor=args.sim_speed_factor,
             voice=not args.no_voice,
@@ -134,12 +140,68 @@ def run(args: argparse.Namespace) -> int:
                 _print_turn(step, turn.to_json(), missing, args.json)
                 if missing:
                     failures.append(f"{step.utterance!r}: no {', '.join(missing)}")
+            if not args.no_experiment:
+                failures += _experiment(system, Path(state) / "experiment", args)
             meter = system.stack.meter.snapshot()
         total_s = time.perf_counter() - started
     _print_summary(latencies, meter, total_s, args.json)
     if failures:
         raise VahrError(f"the demo did not complete: {'; '.join(failures)}")
     return 0
+
+
+def _experiment(system: Any, log_dir: Path, args: argparse.Namespace) -> list[str]:
+    """The paper's tasks I-III, performed by the simulated participant with both methods."""
+    from vahr.experiment.assistant import HttpAssistant
+    from vahr.experiment.eventlog import read_log
+    from vahr.experiment.metrics import fan_out, rad
+    from vahr.experiment.rehearsal import rehearse
+    from vahr.experiment.results import row_from_log
+
+    if not args.json:
+        print("The paper's experiment, tasks I-III (simulated participant):\n")
+    failures: list[str] = []
+    methods = ("vahr", "keyboard") if system.voice_enabled else ("keyboard",)
+    for method in methods:
+        verdict, log_path = rehearse(
+            fleet=system.fleet,
+            method=method,
+            log_dir=log_dir,
+            broker_url=system.stack.mqtt_url,
+            assistant=HttpAssistant(system.stack.api_url),
+            participant="DEMO",
+            seed=3,
+            speed_factor=args.sim_speed_factor,
+            data_plane_url=system.stack.api_url,
+        )
+        row = row_from_log(read_log(log_path))
+        demand = rad(row.interaction_time_s, row.neglect_time_s)
+        passed = {task: outcome.success for task, outcome in verdict.tasks.items()}
+        result = {
+            "method": method,
+            "simulated": True,
+            "tasks": passed,
+            "interaction_time_s": round(row.interaction_time_s, 1),
+            "neglect_time_s": round(row.neglect_time_s, 1),
+            "time_taken_s": round(row.task_time_s, 1),
+            "rad": round(demand, 3),
+            "fan_out_s": round(fan_out(row.task_time_s, demand), 1),
+        }
+        failures += [
+            f"{method} task {task}: {outcome.reason}"
+            for task, outcome in verdict.tasks.items()
+            if not outcome.success
+        ]
+        if args.json:
+            print(json.dumps({"experiment": result}))
+            continue
+        tasks = ", ".join(f"{task} {'passed' if ok else 'FAILED'}" for task, ok in passed.items())
+        print(
+            f"  {method:8}  {tasks}\n            IE {result['interaction_time_s']} s, "
+            f"NT {result['neglect_time_s']} s, time taken {result['time_taken_s']} s, "
+            f"RAD {result['rad']}, fan-out {result['fan_out_s']} s\n"
+        )
+    return failures
 
 
 def _print_turn(step: Step, turn: dict[str, Any], missing: list[str], as_json: bool) -> None:

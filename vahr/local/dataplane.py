@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import logging
+import sys
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
@@ -214,6 +215,9 @@ class _Handler(BaseHTTPRequestHandler):
     # HTTP/1.1 keeps boto3's connection alive between requests (a new TCP connection per
     # call would add a round trip to every shadow read).
     protocol_version = "HTTP/1.1"
+    # A response written in two sends (headers, then body) would otherwise wait on Nagle's
+    # algorithm for the client's delayed ACK: about 40 ms per shadow read on loopback.
+    disable_nagle_algorithm = True
     server: _Server
 
     def _serve(self) -> None:
@@ -242,6 +246,12 @@ class _Handler(BaseHTTPRequestHandler):
 class _Server(ThreadingHTTPServer):
     daemon_threads = True
     dataplane: DataPlane
+
+    def handle_error(self, request: object, client_address: object) -> None:
+        # A client closing its kept-alive connection is routine, not a server error.
+        if isinstance(sys.exc_info()[1], ConnectionError):
+            return
+        log.exception("data plane connection from %s failed", client_address)
 
 
 class DataPlaneServer:
