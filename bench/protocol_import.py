@@ -1,8 +1,9 @@
 """Benchmark: the cold-start cost of `import vahr.protocol` and its decode throughput.
 
-The import is timed inside fresh interpreters (the way a Lambda cold start pays it), both
-alone and after boto3 and ask-sdk-core are already imported (what the skill actually adds),
-beside the cost of importing msgspec alone. Throughput decodes and validates a typical
+The import is timed inside fresh interpreters (the way a Lambda cold start pays it): in the
+development venv, alone and after boto3 and ask-sdk-core (what the skill actually adds),
+beside msgspec alone; and from the precompiled Lambda bundle in CPython 3.12, the
+function's own environment. Throughput decodes and validates a typical
 command against the fleet, in one process.
 """
 
@@ -11,7 +12,9 @@ from __future__ import annotations
 import argparse
 import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 from _results import median, percentile, write_section
 
@@ -27,6 +30,28 @@ def import_ms(module: str, preload: str = "", runs: int = 25) -> list[float]:
         float(subprocess.run(command, check=True, capture_output=True, text=True).stdout)
         for _ in range(runs)
     ]
+
+
+def import_ms_in_bundle(runs: int) -> list[float] | None:
+    """`import vahr.protocol` from the precompiled Lambda bundle, isolated, in CPython 3.12."""
+    from lambda_bundle import python312
+
+    python = python312()
+    if python is None:
+        return None
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from infra import lambda_asset
+
+    with tempfile.TemporaryDirectory() as scratch:
+        bundle = lambda_asset.build(Path(scratch) / "bundle", compile_with=Path(python)).out_dir
+        code = f"import sys; sys.path[:0] = [{str(bundle)!r}]; " + TIMER.format(
+            module="vahr.protocol"
+        )
+        command = [python, "-I", "-c", code]
+        return [
+            float(subprocess.run(command, check=True, capture_output=True, text=True).stdout)
+            for _ in range(runs)
+        ]
 
 
 def decode_rate(seconds: float = 2.0) -> tuple[float, float]:
@@ -59,6 +84,7 @@ def main() -> None:
     after_skill_deps = import_ms(
         "vahr.protocol", preload="boto3, ask_sdk_core.skill_builder", runs=args.runs
     )
+    in_bundle = import_ms_in_bundle(args.runs)
     good, bad = decode_rate()
     rows = [
         ("`vahr.protocol` alone", alone),
@@ -68,6 +94,8 @@ def main() -> None:
             after_skill_deps,
         ),
     ]
+    if in_bundle is not None:
+        rows.append(("`vahr.protocol` from the Lambda bundle in CPython 3.12", in_bundle))
     table = "\n".join(
         f"| {what} | {median(ms):.1f} | {percentile(ms, 90):.1f} |" for what, ms in rows
     )
