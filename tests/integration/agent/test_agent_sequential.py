@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from datetime import UTC, datetime
 from typing import TYPE_CHECKING
 
 from tests.integration.agent.harness import command
@@ -66,11 +67,17 @@ def test_a_delivery_from_an_earlier_task_does_not_release_a_new_sequence(
         tap.reported(thing, lambda r: r["connected"] is True)
     tap.publish("vahr/robots/placebot1/cmd", command("task2", "deliver", {"zone": "A"}))
     tap.event("placebot1", "delivered", "task2", timeout_s=30)
-    time.sleep(2.5)  # past the clock-skew tolerance, as a next task would be
+    time.sleep(3.0)  # past the 2 s clock-skew tolerance, as a next task would be
     # When a new sequence is issued: placebot1 to D, then placebot2 to D
+    issued_at = datetime.now(UTC).isoformat().replace("+00:00", "Z")
     tap.publish(
         "vahr/robots/placebot2/cmd",
-        command("task3b", "sequential_delivery", {"zone": "D", "after": "placebot1"}),
+        command(
+            "task3b",
+            "sequential_delivery",
+            {"zone": "D", "after": "placebot1"},
+            issued_at=issued_at,
+        ),
     )
     # Then placebot2 waits for placebot1's new delivery, not the old one
     tap.event("placebot2", "waiting", "task3b")
