@@ -99,7 +99,8 @@ class MqttClient:
             self._client.loop_stop()
 
     def __enter__(self) -> MqttClient:
-        return self.connect()
+        # Connecting twice would make paho reconnect under a caller's pending subscribe.
+        return self if self._connected.is_set() else self.connect()
 
     def __exit__(self, *exc: object) -> None:
         self.stop()

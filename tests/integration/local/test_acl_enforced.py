@@ -22,7 +22,7 @@ def _robot(stack: LocalStack, thing: str, tmp_path: Path) -> MqttClient:
     assert stack.ca is not None
     credentials = stack.ca.issue_client(thing, tmp_path / thing)
     endpoint = MqttEndpoint(port=stack.config.mqtts_port, credentials=credentials)
-    return MqttClient(endpoint, client_id=thing).connect()
+    return MqttClient(endpoint, client_id=thing)
 
 
 def test_a_robot_cannot_command_another_robot(local_stack: LocalStack, tmp_path: Path) -> None:
