@@ -10,6 +10,7 @@ import pytest
 
 from vahr.local.broker import BrokerConfig, Mosquitto
 from vahr.local.ports import free_port
+from vahr.local.stack import LocalStack, StackConfig
 from vahr.protocol import Fleet, load_fleet
 
 if TYPE_CHECKING:
@@ -38,3 +39,17 @@ def mosquitto(tmp_path: Path) -> Iterator[Mosquitto]:
         yield broker
     finally:
         broker.stop()
+
+
+@pytest.fixture
+def stack(tmp_path: Path) -> Iterator[LocalStack]:
+    """A fresh local stack of its own: broker (mTLS and plaintext), shadow service and
+    data plane, on free loopback ports."""
+    config = StackConfig(
+        state_dir=tmp_path / "stack",
+        mqtts_port=free_port(),
+        mqtt_port=free_port(),
+        api_port=free_port(),
+    )
+    with LocalStack(config) as running:
+        yield running

@@ -8,31 +8,19 @@ import json
 from typing import TYPE_CHECKING
 
 import boto3
-import pytest
 
 from tests.integration.experiment.experiment_robots import SPEED, RobotAgents
 from vahr.cli import main
 from vahr.local.ports import free_port
-from vahr.local.stack import LocalStack, StackConfig
 from vahr.protocol import experiment_state_from_payload, robot_shadow_from_payload
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator
     from pathlib import Path
 
+    import pytest
+
+    from vahr.local.stack import LocalStack
     from vahr.protocol import Fleet
-
-
-@pytest.fixture
-def stack(tmp_path: Path) -> Iterator[LocalStack]:
-    config = StackConfig(
-        state_dir=tmp_path / "stack",
-        mqtts_port=free_port(),
-        mqtt_port=free_port(),
-        api_port=free_port(),
-    )
-    with LocalStack(config) as running:
-        yield running
 
 
 def test_a_keyboard_session_through_the_local_stack(

@@ -22,30 +22,16 @@ import pytest
 
 from tests.conftest import load_event
 from vahr.local.mqtt import MqttClient, MqttEndpoint
-from vahr.local.ports import free_port
 from vahr.local.room import offline_room_assistant
-from vahr.local.stack import LocalStack, StackConfig
 from vahr.protocol import encode, new_command, topics
 from vahr.protocol.shadow import ExperimentState
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator
+    from vahr.local.stack import LocalStack
 
 ROOT = Path(__file__).resolve().parents[3]
 AGENT = [sys.executable, "-m", "robot_agent.cli"]
 TASK_TIMEOUT_S = 60.0
-
-
-@pytest.fixture
-def stack(tmp_path: Path) -> Iterator[LocalStack]:
-    config = StackConfig(
-        state_dir=tmp_path / "stack",
-        mqtts_port=free_port(),
-        mqtt_port=free_port(),
-        api_port=free_port(),
-    )
-    with LocalStack(config) as running:
-        yield running
 
 
 @pytest.fixture
