@@ -141,3 +141,15 @@ def test_a_broken_fleet_file_names_the_field(text: str, field: str) -> None:
 def test_a_missing_fleet_file_is_one_clear_error(tmp_path: object) -> None:
     with pytest.raises(ProtocolError, match=r"^fleet: cannot read .*nope\.yaml"):
         load_fleet("/nonexistent/nope.yaml")
+
+
+def test_a_whole_shadow_document_over_8_kb_still_reads() -> None:
+    # Given a GetThingShadow document whose metadata takes it past 8 KB (its state is small)
+    document = {
+        "state": {"reported": {"status": "waiting"}},
+        "metadata": {"reported": {"note": {"timestamp": 1, "pad": "x" * 9000}}},
+        "version": 4,
+    }
+    # When it is read, then the state comes through
+    shadow = robot_shadow_from_payload(json.dumps(document).encode())
+    assert (shadow.reported.status, shadow.version) == ("waiting", 4)

@@ -12,7 +12,6 @@ from typing import Any, Literal
 import msgspec
 
 from vahr.protocol.errors import ProtocolError, from_validation_error
-from vahr.protocol.messages import check_payload
 
 Status = Literal[
     "idle", "navigating", "loading", "unloading", "waiting", "stopped", "stuck", "error"
@@ -80,9 +79,10 @@ _document_decoder = msgspec.json.Decoder(_Document)
 
 def robot_shadow_from_payload(payload: bytes | bytearray | memoryview) -> RobotShadow:
     """Read a shadow document (get/accepted, update/accepted, GetThingShadow's payload)."""
-    data = check_payload(payload) if len(payload) <= 8192 else bytes(payload)
+    # No 8 KB rule here: the state is limited, but a whole document with its metadata may be
+    # larger. msgspec rejects bytes that are not UTF-8 JSON itself.
     try:
-        document = _document_decoder.decode(data)
+        document = _document_decoder.decode(payload)
     except (msgspec.ValidationError, msgspec.DecodeError) as err:
         raise from_validation_error(err) from err
     return RobotShadow(
