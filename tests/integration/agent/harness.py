@@ -200,6 +200,7 @@ class ShadowResponder:
         self.versions: dict[str, int] = {}
         self.conflicts_to_inject = 0
         self._lock = threading.Lock()
+        self._written = threading.Condition(self._lock)
         self._client = _client(port, f"shadow-responder-{os.getpid()}-{time.monotonic_ns()}")
         self._client.on_message = self._on_message
         subscribed = threading.Event()
@@ -258,6 +259,22 @@ class ShadowResponder:
                 else:
                     document.setdefault(section, {}).update(state[section])
         self.versions[thing] = self.versions.get(thing, 0) + 1
+        self._written.notify_all()
+
+    def document(
+        self, thing: str, predicate: Callable[[dict[str, Any]], bool], timeout_s: float = 5.0
+    ) -> dict[str, Any]:
+        """The thing's stored document once it satisfies `predicate`.
+
+        The test's wire tap and this responder are separate clients, so the tap may see an
+        update before the responder has stored it.
+        """
+        with self._written:
+            if not self._written.wait_for(
+                lambda: predicate(self.documents.get(thing, {})), timeout_s
+            ):
+                raise TimeoutError(f"{thing}'s shadow: {self.documents.get(thing)}")
+            return self.documents[thing]
 
     def set_desired(self, thing: str, desired: dict[str, Any]) -> None:
         """Write desired state as the skill would over the data plane (no MQTT request)."""
