@@ -14,6 +14,7 @@ import logging
 import os
 import socket
 import threading
+from concurrent import futures
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -154,16 +155,14 @@ class Mqtt5Link:
     async def flush(self, timeout_s: float = 5.0) -> None:
         """Wait until every publish so far is acknowledged (or `timeout_s` passes)."""
         with self._lock:
-            pending = [asyncio.wrap_future(f, loop=self._loop) for f in self._pending]
+            pending = list(self._pending)
         if not pending:
             return
-        done, unacknowledged = await asyncio.wait(pending, timeout=timeout_s)
-        # `_published` has logged every failure; the copies made here are only let go, so
-        # that a stop interrupting them does not log "exception was never retrieved".
-        for future in done:
-            future.exception()
-        for future in unacknowledged:
-            future.cancel()
+        # Wait on awscrt's own futures from a worker thread rather than through asyncio
+        # wrappers: cancelling a wrapper cancels the future it wraps, and awscrt completing
+        # that future later raises InvalidStateError on its thread. Nothing here is ever
+        # cancelled; `_published` logs each publish that fails, whenever it completes.
+        await asyncio.to_thread(futures.wait, pending, timeout_s)
 
     async def stop(self, timeout_s: float = 5.0) -> None:
         """Disconnect normally (the broker discards the will) and wait until stopped."""
