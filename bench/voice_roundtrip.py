@@ -23,11 +23,11 @@ from _results import median, percentile, write_section
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from robot_agent.voice.answers import WeatherAnswers  # noqa: E402
-from robot_agent.voice.audio import add_white_noise  # noqa: E402
 from robot_agent.voice.interpreter import LocalInterpreter  # noqa: E402
-from robot_agent.voice.stt import GrammarRecognizer  # noqa: E402
-from robot_agent.voice.tts import EspeakSynthesizer  # noqa: E402
 from vahr.local.room import QUESTIONS  # noqa: E402
+from vahr.speech.audio import add_white_noise  # noqa: E402
+from vahr.speech.stt import GrammarRecognizer  # noqa: E402
+from vahr.speech.tts import EspeakSynthesizer  # noqa: E402
 
 QUESTION = "Alexa, ask robot fleet what the weather is"
 ANSWER = "The weather is sunny."
@@ -76,6 +76,7 @@ def stages(runs: int) -> dict[str, list[float]]:
 
 
 def room_round_trip(runs: int) -> list[float]:
+    from robot_agent.config import AgentConfig
     from robot_agent.voice.factories import room
     from vahr.local.broker import BrokerConfig, Mosquitto
     from vahr.local.mqtt import MqttClient, MqttEndpoint
@@ -88,7 +89,8 @@ def room_round_trip(runs: int) -> list[float]:
         broker.start()
         client = MqttClient(MqttEndpoint(port=port)).connect()
         assistant = offline_room_assistant(client, lambda _utterance: ANSWER).start()
-        voice = room(thing="placebot1", environ={"VAHR_ROOM_BROKER": f"mqtt://127.0.0.1:{port}"})
+        robot_link = MqttClient(MqttEndpoint(port=port)).connect()
+        voice = room(thing="placebot1", config=AgentConfig(thing="placebot1"), link=robot_link)
         try:
 
             async def exchanges() -> list[float]:
@@ -103,7 +105,7 @@ def room_round_trip(runs: int) -> list[float]:
 
             return asyncio.run(exchanges())
         finally:
-            voice.close()
+            robot_link.stop()
             assistant.stop()
             client.stop()
             broker.stop()

@@ -22,9 +22,9 @@ if TYPE_CHECKING:
     from robot_agent.core.clock import Clock
     from robot_agent.core.executor import ExecutorSettings
     from robot_agent.core.recent_ids import RecentIds
-    from robot_agent.link.port import Link
     from robot_agent.voice.port import Voice
     from vahr.protocol import Event, Fleet, Reported
+    from vahr.protocol.link import Link
 
 log = logging.getLogger(__name__)
 

@@ -1,15 +1,22 @@
-"""`robot-agent run` configuration: defaults < config file (YAML) < environment < flags.
+"""`robot-agent run` settings, declared once: defaults < config file (YAML) < environment <
+flags, parsed and validated at start-up into `AgentConfig`.
 
-Parsed and validated once, at start-up, into `AgentConfig`. Environment variables are
+Each adapter's settings struct is its section of the config, with its limits: `sim`
+(`SimBackend`), `ros` (`Ros1Backend`), `executor` (the core), `mqtt` (the awscrt link) and
+`voice` (which voice, its synthesizer, devices and interpreter). The adapters take these
+very structs; nothing copies them field by field.
+
+Environment variables map onto the config in one place, `ENVIRONMENT` below:
 `VAHR_AGENT_<FIELD>` for the top-level fields (e.g. `VAHR_AGENT_THING`,
-`VAHR_AGENT_BROKER`, `VAHR_AGENT_SIM_SPEED_FACTOR`); the nested sections (`sim`,
-`executor`, `ros`, `mqtt`) come from the file. See docs/robot-agent.md for every key.
+`VAHR_AGENT_BROKER`, `VAHR_AGENT_SIM_SPEED_FACTOR`) and the voice's own `VAHR_*` names.
+See docs/robot-agent.md and docs/voice.md for every key.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import shlex
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
@@ -32,26 +39,37 @@ NonNegativeInt = Annotated[int, msgspec.Meta(ge=0)]
 PositiveInt = Annotated[int, msgspec.Meta(gt=0)]
 
 
-class SimConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+class SimSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+    """The simulator backend (`robot_agent.backends.sim`)."""
+
     speed_mps: Positive = 0.5
     turn_rate_rps: Positive = 1.0
     loader_delay_s: NonNegative = 3.0
     unloader_delay_s: NonNegative = 3.0
+    # Simulated seconds between two kinematic steps (and two progress reports).
     tick_s: Positive = 0.25
-    stuck_zones: list[str] = []
-    fail_zones: list[str] = []
+    # Fault injection: goals to these zones stop moving half way / abort half way.
+    stuck_zones: tuple[str, ...] = ()
+    fail_zones: tuple[str, ...] = ()
 
 
-class ExecutorConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+class ExecutorSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+    """Timing rules of the executor, in simulated seconds (see `ScaledClock`)."""
+
     stuck_after_s: Positive = 10.0
     sequential_timeout_s: Positive = 300.0
+    # How far the peers' clocks may disagree with the sender's: a peer delivery counts for a
+    # sequential delivery only if it happened after the command was issued, less this.
     peer_clock_skew_s: NonNegative = 2.0
     listen_timeout_s: Positive = 8.0
+    # Wall-clock bound on speaking one sentence, so a hung audio device fails the task.
     speak_timeout_s: Positive = 30.0
     progress_interval_s: NonNegative = 1.0
 
 
-class RosConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+class Ros1Settings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+    """The ROS 1 backend (`robot_agent.backends.ros1`)."""
+
     # None: use ROS_MASTER_URI from the environment, as every ROS node does.
     master_uri: str | None = None
     action: str = "move_base"
@@ -61,13 +79,51 @@ class RosConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen
     # ROS has no arm: the loading and unloading arms are timed like the simulator's.
     loader_delay_s: NonNegative = 3.0
     unloader_delay_s: NonNegative = 3.0
+    # rospy's threads keep a process alive until the node shuts down; the agent's one
+    # backend owns the node. Tests that build several backends in one process keep it.
+    shutdown_node_on_close: bool = True
 
 
-class MqttConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+class MqttSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+    """The awscrt link's session (`robot_agent.link.mqtt5`)."""
+
     keep_alive_s: NonNegativeInt = 60
+    # How long the broker keeps the session (subscriptions, queued QoS 1) while away.
     session_expiry_s: NonNegativeInt = 7 * 24 * 3600
     min_reconnect_delay_ms: PositiveInt = 250
     max_reconnect_delay_ms: PositiveInt = 30_000
+    connect_timeout_ms: PositiveInt = 5_000
+
+
+class LexSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+    """Amazon Lex V2 as the interpreter, reached with the robot's certificate through the
+    AWS IoT credentials provider (`robot_agent.voice.lex`, `iot_credentials`)."""
+
+    bot_id: str | None = None
+    bot_alias_id: str | None = None
+    locale_id: str = "en_US"
+    region: str | None = None
+    endpoint_url: str | None = None
+    credentials_endpoint: str | None = None
+    role_alias: str = "vahr-robot-lex"
+    # The robot's certificate for the credentials provider (default: --cert, --key, --ca).
+    cert: str | None = None
+    key: str | None = None
+    ca: str | None = None
+
+
+class VoiceSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+    """The robot's voice (`robot_agent.voice.factories`)."""
+
+    # `none`, or `package.module:factory` returning a Voice (e.g. ...factories:room).
+    factory: str = "none"
+    # An espeak-ng voice, or `polly:VOICE`, `gtts[:LANG]`.
+    synthesizer: str = "en-us+f2"
+    # The sound device's player and recorder commands (default aplay / arecord).
+    play_command: tuple[str, ...] | None = None
+    record_command: tuple[str, ...] | None = None
+    interpreter: Literal["local", "lex"] = "local"
+    lex: LexSettings = LexSettings()
 
 
 class AgentConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
@@ -84,11 +140,11 @@ class AgentConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, froz
     state_dir: str = ".state"
     log_level: Literal["DEBUG", "INFO", "WARNING", "ERROR"] = "INFO"
     sim_speed_factor: float = 1.0
-    voice: str = "none"
-    sim: SimConfig = SimConfig()
-    executor: ExecutorConfig = ExecutorConfig()
-    ros: RosConfig = RosConfig()
-    mqtt: MqttConfig = MqttConfig()
+    sim: SimSettings = SimSettings()
+    executor: ExecutorSettings = ExecutorSettings()
+    ros: Ros1Settings = Ros1Settings()
+    mqtt: MqttSettings = MqttSettings()
+    voice: VoiceSettings = VoiceSettings()
 
     def check(self) -> AgentConfig:
         """The rules that span fields; raises VahrError naming the flag to fix."""
@@ -121,27 +177,38 @@ class AgentConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, froz
         return self
 
 
-# Flags whose argparse destination differs from the config key, or that are not config.
-_FLAG_KEYS = {
-    "thing": "thing",
-    "endpoint": "endpoint",
-    "port": "port",
-    "cert": "cert",
-    "key": "key",
-    "ca": "ca",
-    "broker": "broker",
-    "client_id": "client_id",
-    "backend": "backend",
-    "fleet": "fleet_file",
-    "state_dir": "state_dir",
-    "log_level": "log_level",
-    "sim_speed_factor": "sim_speed_factor",
-    "voice": "voice",
-}
 _SCALARS = (
     "thing endpoint port cert key ca broker client_id backend fleet_file state_dir log_level "
-    "sim_speed_factor voice"
+    "sim_speed_factor"
 ).split()
+# Every environment variable the agent reads, and the key it sets (later rows win).
+ENVIRONMENT: dict[str, tuple[str, ...]] = {
+    **{ENV_PREFIX + name.upper(): (name,) for name in _SCALARS},
+    "VAHR_AGENT_VOICE": ("voice", "factory"),
+    "VAHR_VOICE": ("voice", "synthesizer"),
+    "VAHR_PLAY_COMMAND": ("voice", "play_command"),
+    "VAHR_RECORD_COMMAND": ("voice", "record_command"),
+    "VAHR_INTERPRETER": ("voice", "interpreter"),
+    "AWS_REGION": ("voice", "lex", "region"),
+    "VAHR_LEX_REGION": ("voice", "lex", "region"),
+    "VAHR_LEX_BOT_ID": ("voice", "lex", "bot_id"),
+    "VAHR_LEX_BOT_ALIAS_ID": ("voice", "lex", "bot_alias_id"),
+    "VAHR_LEX_LOCALE": ("voice", "lex", "locale_id"),
+    "VAHR_LEX_ENDPOINT_URL": ("voice", "lex", "endpoint_url"),
+    "VAHR_IOT_CREDENTIALS_ENDPOINT": ("voice", "lex", "credentials_endpoint"),
+    "VAHR_IOT_ROLE_ALIAS": ("voice", "lex", "role_alias"),
+    "VAHR_ROBOT_CERT": ("voice", "lex", "cert"),
+    "VAHR_ROBOT_KEY": ("voice", "lex", "key"),
+    "VAHR_ROBOT_CA": ("voice", "lex", "ca"),
+}
+# Commands are written as a shell would split them.
+_COMMANDS = {("voice", "play_command"), ("voice", "record_command")}
+# Flags whose argparse destination differs from the config key, or that are not config.
+_FLAG_KEYS: dict[str, tuple[str, ...]] = {
+    **{name: (name,) for name in _SCALARS if name != "fleet_file"},
+    "fleet": ("fleet_file",),
+    "voice": ("voice", "factory"),
+}
 
 
 def load_config(args: argparse.Namespace, environ: Mapping[str, str] | None = None) -> AgentConfig:
@@ -150,20 +217,37 @@ def load_config(args: argparse.Namespace, environ: Mapping[str, str] | None = No
     config_file = getattr(args, "config", None)
     if config_file:
         merged.update(_read_file(Path(config_file)))
+        if isinstance(merged.get("voice"), str):
+            # `voice: package.module:factory`, as written before the voice had a section.
+            merged["voice"] = {"factory": merged["voice"]}
     env = os.environ if environ is None else environ
-    for name in _SCALARS:
-        value = env.get(ENV_PREFIX + name.upper())
+    for name, key in ENVIRONMENT.items():
+        value = env.get(name)
         if value is not None and value != "":
-            merged[name] = value
+            _set(merged, key, shlex.split(value) if key in _COMMANDS else value)
     for flag, key in _FLAG_KEYS.items():
         value = getattr(args, flag, None)
         if value is not None:
-            merged[key] = value
+            _set(merged, key, value)
+    return config_from(merged)
+
+
+def config_from(settings: Mapping[str, Any]) -> AgentConfig:
+    """Validate merged settings into an `AgentConfig`; errors name the key."""
     try:
-        config = msgspec.convert(merged, AgentConfig, strict=False)
+        return msgspec.convert(settings, AgentConfig, strict=False)
     except msgspec.ValidationError as err:
         raise VahrError(f"configuration: {from_validation_error(err)}") from err
-    return config
+
+
+def _set(merged: dict[str, Any], key: tuple[str, ...], value: object) -> None:
+    section = merged
+    for part in key[:-1]:
+        inner = section.get(part)
+        if not isinstance(inner, dict):
+            inner = section[part] = {}
+        section = inner
+    section[key[-1]] = value
 
 
 def _read_file(path: Path) -> dict[str, Any]:

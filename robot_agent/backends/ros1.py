@@ -16,7 +16,6 @@ import math
 import os
 import threading
 import time
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import actionlib
@@ -32,6 +31,7 @@ from vahr.protocol import Pose
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from robot_agent.config import Ros1Settings
     from vahr.protocol import Zone
 
 _STATUS_NAMES = {
@@ -42,20 +42,6 @@ _STATUS_NAMES = {
     GoalStatus.LOST: "lost",
 }
 _node_lock = threading.Lock()
-
-
-@dataclass(frozen=True, kw_only=True)
-class Ros1Settings:
-    master_uri: str | None = None
-    action: str = "move_base"
-    frame: str = "map"
-    node_name: str = "vahr_robot_agent"
-    server_timeout_s: float = 10.0
-    loader_delay_s: float = 3.0
-    unloader_delay_s: float = 3.0
-    # rospy's threads keep a process alive until the node shuts down; the agent's one
-    # backend owns the node. Tests that build several backends in one process keep it.
-    shutdown_node_on_close: bool = True
 
 
 def shutdown_node(reason: str = "robot-agent stopping") -> None:

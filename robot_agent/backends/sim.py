@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from robot_agent.backends.port import NavigationFailed, Progress
+from robot_agent.config import SimSettings
 from vahr.protocol import Pose
 
 if TYPE_CHECKING:
@@ -21,19 +22,6 @@ if TYPE_CHECKING:
 
     from robot_agent.core.clock import Clock
     from vahr.protocol import Zone
-
-
-@dataclass(frozen=True, kw_only=True)
-class SimSettings:
-    speed_mps: float = 0.5
-    turn_rate_rps: float = 1.0
-    loader_delay_s: float = 3.0
-    unloader_delay_s: float = 3.0
-    # Simulated seconds between two kinematic steps (and two progress reports).
-    tick_s: float = 0.25
-    # Fault injection: goals to these zones stop moving half way / abort half way.
-    stuck_zones: tuple[str, ...] = ()
-    fail_zones: tuple[str, ...] = ()
 
 
 @dataclass

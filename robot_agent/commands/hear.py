@@ -6,8 +6,8 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from robot_agent.voice.port import VoiceError
 from vahr.errors import VahrError
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     import argparse
@@ -29,8 +29,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import sys
 
-    from robot_agent.voice.audio import Audio
     from robot_agent.voice.understanding import offline_understanding
+    from vahr.speech.audio import Audio
 
     path: Path = args.file
     try:
@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
         raise VahrError(f"{path}: {err.strerror}") from err
     try:
         heard = offline_understanding(args.answers).hear(Audio.from_wav(data))
-    except VoiceError as err:
+    except SpeechError as err:
         raise VahrError(f"{path}: {err}") from err
     if args.json:
         print(

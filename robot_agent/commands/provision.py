@@ -96,9 +96,9 @@ def _read_ca_file(path: str) -> bytes:
 
 def _provision_local(args: argparse.Namespace, out_dir: Path) -> Bundle:
     try:
-        from vahr.local.pki import LocalCA
+        from vahr.pki import LocalCA
     except ImportError as err:
-        raise VahrError(f"--local needs the local stack (vahr.local.pki): {err}") from err
+        raise VahrError(f"--local needs the local stack (vahr.pki): {err}") from err
     try:
         issued = LocalCA.load_or_create(Path(args.state_dir)).issue_client(args.thing, out_dir)
     except OSError as err:

@@ -65,10 +65,10 @@ async def serve(config: AgentConfig) -> int:
 
     # Everything that can be wrong in the settings fails before anything connects.
     fleet = load_robot_fleet(config)
-    voice = build_voice(config)
     loop = asyncio.get_running_loop()
     clock = ScaledClock(config.sim_speed_factor)
     link = build_link(config, loop, clock)
+    voice = build_voice(config, link)
     agent = build_agent(config, fleet, link, clock, voice)
     agent.attach()
     stopping = asyncio.Event()

@@ -6,9 +6,9 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from robot_agent.voice.port import VoiceError
-from robot_agent.voice.tts import DEFAULT_VOICE
 from vahr.errors import VahrError
+from vahr.speech.errors import SpeechError
+from vahr.speech.tts import DEFAULT_VOICE
 
 if TYPE_CHECKING:
     import argparse
@@ -26,13 +26,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from robot_agent.voice.tts import make_synthesizer
+    from vahr.speech.tts import make_synthesizer
 
     spec = args.voice if ":" in args.voice or args.voice in ("polly", "gtts") else None
     try:
         synthesizer = make_synthesizer(spec or f"espeak:{args.voice}")
         audio = synthesizer.synthesize(args.text)
-    except VoiceError as err:
+    except SpeechError as err:
         raise VahrError(str(err)) from err
     out: Path = args.out
     try:

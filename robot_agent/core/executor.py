@@ -13,14 +13,13 @@ from __future__ import annotations
 import asyncio
 import inspect
 import logging
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import msgspec
 
 from robot_agent.backends.port import NavigationFailed
+from robot_agent.config import ExecutorSettings
 from robot_agent.core.peers import PeerDeliveries
-from robot_agent.voice.port import VoiceError
 from vahr.protocol import (
     Deliver,
     Event,
@@ -34,6 +33,9 @@ from vahr.protocol import (
     Stop,
     WeatherDelivery,
 )
+from vahr.protocol.assistant import WEATHER_QUESTION
+from vahr.protocol.weather import WEATHER_ZONES
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from collections.abc import Awaitable, Callable
@@ -45,26 +47,8 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-WEATHER_QUESTION = "Alexa, ask robot fleet what the weather is"
-WEATHER_ZONES = {"sunny": "A", "rainy": "C"}
 # How long shutting down waits for the running task to unwind (halt the backend).
 CLOSE_TIMEOUT_S = 5.0
-
-
-@dataclass(frozen=True, kw_only=True)
-class ExecutorSettings:
-    """Timing rules of the executor, in simulated seconds (see `ScaledClock`)."""
-
-    stuck_after_s: float = 10.0
-    sequential_timeout_s: float = 300.0
-    # How far the peers' clocks may disagree with the sender's: a peer delivery counts for a
-    # sequential delivery only if it happened after the command was issued, less this.
-    peer_clock_skew_s: float = 2.0
-    listen_timeout_s: float = 8.0
-    # Wall-clock bound on speaking one sentence, so a hung audio device fails the task.
-    speak_timeout_s: float = 30.0
-    progress_interval_s: float = 1.0
-    weather_question: str = WEATHER_QUESTION
 
 
 T = TypeVar("T")
@@ -74,11 +58,11 @@ VOICE_GRACE_S = 5.0
 
 
 async def _bounded(step: Awaitable[T], timeout_s: float, what: str) -> T:
-    """Await a voice step in wall-clock time; a hung adapter becomes a VoiceError."""
+    """Await a voice step in wall-clock time; a hung adapter becomes a SpeechError."""
     try:
         return await asyncio.wait_for(step, timeout_s)
     except TimeoutError:
-        raise VoiceError(f"{what} took longer than {timeout_s:g} s") from None
+        raise SpeechError(f"{what} took longer than {timeout_s:g} s") from None
 
 
 class TaskFailed(Exception):
@@ -367,8 +351,8 @@ class Executor:
         heard_text = ""
         try:
             for _attempt in range(2):
-                await self._say(self.settings.weather_question)
-                self._emit("said", command, text=self.settings.weather_question)
+                await self._say(WEATHER_QUESTION)
+                self._emit("said", command, text=WEATHER_QUESTION)
                 heard = await _bounded(
                     self.voice.listen(self.settings.listen_timeout_s),
                     self.settings.listen_timeout_s + VOICE_GRACE_S,
@@ -388,7 +372,7 @@ class Executor:
             acknowledgment = f"Thank you. It is {intent}, so I am delivering to zone {zone_id}."
             await self._say(acknowledgment)
             self._emit("said", command, text=acknowledgment)
-        except VoiceError as err:
+        except SpeechError as err:
             raise TaskFailed(f"voice failed: {err}") from err
         await self._deliver(command, self.fleet.zone(zone_id))
 

@@ -18,28 +18,22 @@ from concurrent import futures
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
-from urllib.parse import urlsplit
 
 from awscrt import io, mqtt5
 
-from robot_agent.link.port import topic_matches
+from robot_agent.config import MqttSettings
 from vahr.errors import VahrError
+from vahr.protocol.link import topic_matches
 
 if TYPE_CHECKING:
     from collections.abc import Callable
     from concurrent.futures import Future
 
+    from vahr.protocol.broker import ClientCredentials
+
 log = logging.getLogger(__name__)
 
-LOOPBACK_HOSTS = frozenset({"127.0.0.1", "localhost", "::1"})
 SUBSCRIBE_CHUNK = 100
-
-
-@dataclass(frozen=True, kw_only=True)
-class MutualTls:
-    cert: Path
-    key: Path
-    ca: Path | None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -54,34 +48,10 @@ class LinkSettings:
     client_id: str
     host: str
     port: int
-    tls: MutualTls | None = None
+    tls: ClientCredentials | None = None
     will: Will | None = None
-    keep_alive_s: int = 60
-    # How long the broker keeps the session (subscriptions, queued QoS 1) while away.
-    session_expiry_s: int = 7 * 24 * 3600
-    min_reconnect_delay_ms: int = 250
-    max_reconnect_delay_ms: int = 30_000
-    connect_timeout_ms: int = 5_000
-
-
-def plaintext_broker(url: str) -> tuple[str, int]:
-    """`mqtt://127.0.0.1:PORT` -> (host, port); any host but loopback is refused."""
-    try:
-        parts = urlsplit(url)
-    except ValueError as err:
-        raise VahrError(f"--broker {url!r}: {err}") from err
-    if parts.scheme != "mqtt" or not parts.hostname:
-        raise VahrError(f"--broker {url!r}: expected mqtt://127.0.0.1:PORT")
-    if parts.hostname not in LOOPBACK_HOSTS:
-        raise VahrError(
-            f"--broker {url!r}: plaintext MQTT is allowed only to a loopback broker; "
-            "use --endpoint with --cert, --key and --ca for any other host"
-        )
-    try:
-        port = parts.port or 1883
-    except ValueError as err:
-        raise VahrError(f"--broker {url!r}: {err}") from err
-    return parts.hostname, port
+    # The `mqtt` section of the agent's config: keep-alive, session expiry, reconnect delays.
+    session: MqttSettings = MqttSettings()
 
 
 class Mqtt5Link:
@@ -185,7 +155,7 @@ class Mqtt5Link:
                 retain=s.will.retain,
             )
         socket_options = io.SocketOptions()
-        socket_options.connect_timeout_ms = s.connect_timeout_ms
+        socket_options.connect_timeout_ms = s.session.connect_timeout_ms
         socket_options.domain = io.SocketDomain.IPv6 if ":" in s.host else io.SocketDomain.IPv4
         options = mqtt5.ClientOptions(
             host_name=s.host,
@@ -195,16 +165,16 @@ class Mqtt5Link:
             tls_ctx=_tls_context(s.tls, s.port) if s.tls is not None else None,
             connect_options=mqtt5.ConnectPacket(
                 client_id=s.client_id,
-                keep_alive_interval_sec=s.keep_alive_s,
-                session_expiry_interval_sec=s.session_expiry_s,
+                keep_alive_interval_sec=s.session.keep_alive_s,
+                session_expiry_interval_sec=s.session.session_expiry_s,
                 will=will,
             ),
             # Rejoin even on the first connection of a new process, so commands queued by
             # the broker while the agent was down are delivered after a restart too.
             session_behavior=mqtt5.ClientSessionBehaviorType.REJOIN_ALWAYS,
             retry_jitter_mode=mqtt5.ExponentialBackoffJitterMode.FULL,
-            min_reconnect_delay_ms=s.min_reconnect_delay_ms,
-            max_reconnect_delay_ms=s.max_reconnect_delay_ms,
+            min_reconnect_delay_ms=s.session.min_reconnect_delay_ms,
+            max_reconnect_delay_ms=s.session.max_reconnect_delay_ms,
             ack_timeout_sec=30,
             on_publish_callback_fn=self._on_publish_received,
             on_lifecycle_event_connection_success_fn=self._on_lifecycle_connection_success,
@@ -355,13 +325,13 @@ def _dispatch(handlers: list[Callable[[str, bytes], None]], topic: str, payload:
             log.exception("handler for %s failed", topic)
 
 
-def _tls_context(tls: MutualTls, port: int) -> io.ClientTlsContext:
+def _tls_context(tls: ClientCredentials, port: int) -> io.ClientTlsContext:
     try:
         options = io.TlsContextOptions.create_client_with_mtls_from_path(
-            str(tls.cert), str(tls.key)
+            str(tls.cert_file), str(tls.key_file)
         )
-        if tls.ca is not None:
-            options.override_default_trust_store_from_path(None, str(tls.ca))
+        if tls.ca_file is not None:
+            options.override_default_trust_store_from_path(None, str(tls.ca_file))
         if port == 443 and io.is_alpn_available():
             # AWS IoT Core serves MQTT on 443 only with this ALPN protocol name.
             options.alpn_list = ["x-amzn-mqtt-ca"]

@@ -21,8 +21,8 @@ from vahr.protocol import topics
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from robot_agent.link.port import Link
     from vahr.protocol import Reported
+    from vahr.protocol.link import Link
 
 log = logging.getLogger(__name__)
 

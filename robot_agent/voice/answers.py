@@ -6,27 +6,21 @@ Lex bot, so what the robot can hear and what it understands never drift apart.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
 import yaml
 
-from robot_agent.voice.port import VoiceError
+from vahr.protocol.weather import WEATHERS
+from vahr.speech.errors import SpeechError
+from vahr.speech.text import normalize
 
 if TYPE_CHECKING:
     from robot_agent.voice.port import WeatherIntent
 
 ANSWERS_FILE = Path(__file__).with_name("weather_answers.yaml")
-INTENTS: tuple[WeatherIntent, ...] = ("sunny", "rainy")
-_NOT_WORD = re.compile(r"[^a-z0-9' ]+")
-
-
-def normalize(text: str) -> str:
-    """Lower case, punctuation removed, single spaces: how phrases are compared."""
-    cleaned = _NOT_WORD.sub(" ", text.lower().replace("\u2019", "'"))
-    return " ".join(word.strip("'") for word in cleaned.split() if word.strip("'"))
+INTENTS: tuple[WeatherIntent, ...] = WEATHERS
 
 
 @dataclass(frozen=True)
@@ -49,24 +43,24 @@ class WeatherAnswers:
     @classmethod
     def parse(cls, document: object, source: str = "weather answers") -> WeatherAnswers:
         if not isinstance(document, dict) or not isinstance(document.get("intents"), dict):
-            raise VoiceError(f"{source}: expected a mapping `intents: {{sunny: [...], ...}}`")
+            raise SpeechError(f"{source}: expected a mapping `intents: {{sunny: [...], ...}}`")
         intents = document["intents"]
         unexpected = sorted(set(intents) - set(INTENTS))
         if unexpected:
-            raise VoiceError(f"{source}: unknown intents {unexpected}; expected sunny and rainy")
+            raise SpeechError(f"{source}: unknown intents {unexpected}; expected sunny and rainy")
         phrases: dict[WeatherIntent, tuple[str, ...]] = {}
         seen: dict[str, str] = {}
         for intent in INTENTS:
             samples = intents.get(intent)
             if not isinstance(samples, list) or not samples:
-                raise VoiceError(f"{source}: intents.{intent} must be a non-empty list")
+                raise SpeechError(f"{source}: intents.{intent} must be a non-empty list")
             kept: list[str] = []
             for sample in samples:
                 phrase = normalize(str(sample))
                 if not phrase:
-                    raise VoiceError(f"{source}: intents.{intent} has an empty phrase")
+                    raise SpeechError(f"{source}: intents.{intent} has an empty phrase")
                 if seen.get(phrase, intent) != intent:
-                    raise VoiceError(
+                    raise SpeechError(
                         f"{source}: {sample!r} is listed under both {seen[phrase]} and {intent}"
                     )
                 if phrase not in kept:
@@ -80,9 +74,9 @@ class WeatherAnswers:
         try:
             document = yaml.safe_load(path.read_text(encoding="utf-8"))
         except OSError as err:
-            raise VoiceError(f"{path}: cannot read the weather answers: {err.strerror}") from err
+            raise SpeechError(f"{path}: cannot read the weather answers: {err.strerror}") from err
         except yaml.YAMLError as err:
-            raise VoiceError(f"{path}: not valid YAML: {err}") from err
+            raise SpeechError(f"{path}: not valid YAML: {err}") from err
         return cls.parse(document, str(path))
 
 

@@ -18,7 +18,8 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from robot_agent.voice.audio import (
+from robot_agent.voice.port import Heard
+from vahr.speech.audio import (
     FRAME_MS,
     FRAME_SAMPLES,
     SAMPLE_RATE,
@@ -27,13 +28,13 @@ from robot_agent.voice.audio import (
     SpeechDetector,
     frame_levels_dbfs,
 )
-from robot_agent.voice.port import Heard, VoiceError
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from robot_agent.voice.tts import Synthesizer
     from robot_agent.voice.understanding import Understanding
+    from vahr.speech.tts import Synthesizer
 
 PLAY_GRACE_S = 5.0
 STOP_TIMEOUT_S = 2.0
@@ -43,13 +44,13 @@ _FRAME_BYTES = FRAME_SAMPLES * SAMPLE_WIDTH
 def default_player() -> list[str]:
     if shutil.which("aplay"):
         return ["aplay", "-q", "-"]
-    raise VoiceError("no audio player: install alsa-utils (aplay) or set VAHR_PLAY_COMMAND")
+    raise SpeechError("no audio player: install alsa-utils (aplay) or set VAHR_PLAY_COMMAND")
 
 
 def default_recorder() -> list[str]:
     if shutil.which("arecord"):
         return ["arecord", "-q", "-t", "raw", "-f", "S16_LE", "-r", str(SAMPLE_RATE), "-c", "1"]
-    raise VoiceError("no audio recorder: install alsa-utils (arecord) or set VAHR_RECORD_COMMAND")
+    raise SpeechError("no audio recorder: install alsa-utils (arecord) or set VAHR_RECORD_COMMAND")
 
 
 @dataclass(frozen=True)
@@ -102,12 +103,12 @@ class DeviceVoice:
                 check=False,
             )
         except FileNotFoundError as err:
-            raise VoiceError(f"audio player {self.player[0]!r} not found") from err
+            raise SpeechError(f"audio player {self.player[0]!r} not found") from err
         except subprocess.TimeoutExpired as err:
-            raise VoiceError(f"the audio player did not finish within {err.timeout:g} s") from err
+            raise SpeechError(f"the audio player did not finish within {err.timeout:g} s") from err
         if done.returncode != 0:
             reason = done.stderr.decode(errors="replace").strip()
-            raise VoiceError(f"the audio player failed: {reason or done.returncode}")
+            raise SpeechError(f"the audio player failed: {reason or done.returncode}")
 
     def record(self, timeout_s: float) -> Audio | None:
         """One utterance from the recorder, or None if no speech started within `timeout_s`."""
@@ -116,7 +117,7 @@ class DeviceVoice:
                 self.recorder, stdout=subprocess.PIPE, stderr=subprocess.PIPE
             )
         except FileNotFoundError as err:
-            raise VoiceError(f"audio recorder {self.recorder[0]!r} not found") from err
+            raise SpeechError(f"audio recorder {self.recorder[0]!r} not found") from err
         try:
             return self._capture(process, timeout_s)
         finally:
@@ -174,6 +175,6 @@ class DeviceVoice:
             if code != 0:
                 stderr = process.stderr.read() if process.stderr is not None else b""
                 reason = stderr.decode(errors="replace").strip()
-                raise VoiceError(f"the audio recorder failed: {reason or code}")
+                raise SpeechError(f"the audio recorder failed: {reason or code}")
             return None
         return Audio(b"".join(frames[started_at:]))

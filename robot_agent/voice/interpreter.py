@@ -13,9 +13,10 @@ from dataclasses import dataclass
 from difflib import SequenceMatcher
 from typing import TYPE_CHECKING, Protocol
 
-from robot_agent.voice.answers import WeatherAnswers, normalize
+from vahr.speech.text import normalize
 
 if TYPE_CHECKING:
+    from robot_agent.voice.answers import WeatherAnswers
     from robot_agent.voice.port import WeatherIntent
 
 

@@ -18,7 +18,7 @@ from datetime import UTC, datetime, timedelta
 from typing import TYPE_CHECKING
 from urllib.parse import quote
 
-from robot_agent.voice.port import VoiceError
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -57,7 +57,7 @@ class IotCredentialsProvider:
         try:
             self._context.load_cert_chain(str(cert), str(key))
         except (OSError, ssl.SSLError) as err:
-            raise VoiceError(f"cannot load the robot certificate {cert}: {err}") from err
+            raise SpeechError(f"cannot load the robot certificate {cert}: {err}") from err
         self._now = now
         self._cached: TemporaryCredentials | None = None
         self._lock = threading.Lock()
@@ -78,12 +78,12 @@ class IotCredentialsProvider:
                 body = json.loads(response.read())
         except urllib.error.HTTPError as err:
             detail = err.read().decode(errors="replace")[:200]
-            raise VoiceError(
+            raise SpeechError(
                 f"the IoT credentials provider refused ({err.code}): {detail or err.reason}"
             ) from err
         except (urllib.error.URLError, OSError, ValueError) as err:
             reason = getattr(err, "reason", err)
-            raise VoiceError(f"cannot reach the IoT credentials provider: {reason}") from err
+            raise SpeechError(f"cannot reach the IoT credentials provider: {reason}") from err
         try:
             found = body["credentials"]
             expiration = datetime.fromisoformat(found["expiration"].replace("Z", "+00:00"))
@@ -94,4 +94,4 @@ class IotCredentialsProvider:
                 expiration=expiration,
             )
         except (KeyError, TypeError, AttributeError, ValueError) as err:
-            raise VoiceError(f"the IoT credentials provider's answer lacks {err}") from err
+            raise SpeechError(f"the IoT credentials provider's answer lacks {err}") from err

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 from robot_agent.voice.answers import as_intent
 from robot_agent.voice.interpreter import UNKNOWN, Interpretation
-from robot_agent.voice.port import VoiceError
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -95,7 +95,7 @@ class LexInterpreter:
                 text=text,
             )
         except (BotoCoreError, ClientError) as err:
-            raise VoiceError(f"Amazon Lex could not interpret the answer: {err}") from err
+            raise SpeechError(f"Amazon Lex could not interpret the answer: {err}") from err
         intent = response.get("sessionState", {}).get("intent", {}).get("name", "")
         meaning = as_intent(str(intent).lower().removesuffix("intent"))
         if meaning == "unknown":

@@ -1,6 +1,7 @@
 """The port through which the executor talks to the assistant by voice.
 
-The executor owns the conversation (what to say, retry once on `unknown`, the events it
+Adapters raise `vahr.speech.errors.SpeechError` when the voice path fails. The executor
+owns the conversation (what to say, retry once on `unknown`, the events it
 publishes); an adapter owns the audio: where speech goes and where the answer comes from
 (a speaker and microphone next to an Echo, or the local stack's room channel).
 """
@@ -10,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
+# A weather word (`vahr.protocol.weather`), or `unknown` when the answer was not understood.
 WeatherIntent = Literal["sunny", "rainy", "unknown"]
 
 
@@ -20,10 +22,6 @@ class Heard:
     text: str
     intent: WeatherIntent
     confidence: float
-
-
-class VoiceError(Exception):
-    """The voice path failed (no audio device, TTS missing, channel down); says why."""
 
 
 class Voice(Protocol):

@@ -13,9 +13,9 @@ from typing import TYPE_CHECKING
 from robot_agent.voice.port import Heard
 
 if TYPE_CHECKING:
-    from robot_agent.voice.audio import Audio
     from robot_agent.voice.interpreter import Interpreter
-    from robot_agent.voice.stt import Recognizer
+    from vahr.speech.audio import Audio
+    from vahr.speech.stt import Recognizer
 
 log = logging.getLogger(__name__)
 
@@ -46,7 +46,7 @@ def offline_understanding(answers_file: str | None = None) -> Understanding:
 
     from robot_agent.voice.answers import ANSWERS_FILE, WeatherAnswers
     from robot_agent.voice.interpreter import LocalInterpreter
-    from robot_agent.voice.stt import GrammarRecognizer
+    from vahr.speech.stt import GrammarRecognizer
 
     answers = WeatherAnswers.load(Path(answers_file) if answers_file else ANSWERS_FILE)
     return Understanding(GrammarRecognizer(answers.all_phrases()), LocalInterpreter(answers))

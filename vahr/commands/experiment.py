@@ -180,11 +180,11 @@ def _run_session(args: argparse.Namespace, fleet: Any, session: Any) -> Any:
 
     tls = None
     if args.cert or args.key or args.ca:
-        from vahr.experiment.bus import TlsFiles
+        from vahr.protocol.broker import ClientCredentials
 
         if not (args.cert and args.key and args.ca):
             raise VahrError("--cert, --key and --ca go together")
-        tls = TlsFiles(cert_file=args.cert, key_file=args.key, ca_file=args.ca)
+        tls = ClientCredentials(cert_file=args.cert, key_file=args.key, ca_file=args.ca)
     verdict = run_live(
         session,
         fleet,

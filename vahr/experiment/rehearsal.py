@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from vahr.experiment.bus import Bus, TlsFiles
+from vahr.experiment.bus import Bus
 from vahr.experiment.participant import Console, SimulatedParticipant
 from vahr.experiment.recorder import Recorder
 from vahr.experiment.session import (
@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from vahr.experiment.judge import SessionVerdict
     from vahr.experiment.session import OpenSession, Performer
     from vahr.protocol import Fleet
+    from vahr.protocol.broker import ClientCredentials
 
 
 def run_live(
@@ -40,7 +41,7 @@ def run_live(
     broker_url: str,
     performer_for: Callable[[Console], Performer],
     announce: Callable[[str], None] = lambda line: None,
-    tls: TlsFiles | None = None,
+    tls: ClientCredentials | None = None,
 ) -> SessionVerdict:
     """Record the wire into the session's log while `performer_for(console)` runs the tasks,
     then end the session; return the judge's verdict."""
@@ -97,7 +98,7 @@ def rehearse(
     data_plane_url: str | None = None,
     write_shadow: bool = True,
     announce: Callable[[str], None] = lambda line: None,
-    tls: TlsFiles | None = None,
+    tls: ClientCredentials | None = None,
 ) -> tuple[SessionVerdict, Path]:
     """Run (or resume) one simulated session end to end; return the verdict and the log."""
     spec = SessionSpec(

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from vahr.local.pki import SERVICE_COMMON_NAME
+from vahr.pki import SERVICE_COMMON_NAME
 from vahr.protocol import topics
 
 if TYPE_CHECKING:

@@ -1,5 +1,11 @@
-"""The paho-mqtt adapter the local services share: connect (plaintext or mTLS), publish,
-subscribe with callbacks, and stop; every wait bounded. Nothing else imports paho.
+"""The lab side's one paho-mqtt adapter: the local services, the room assistant and the
+experiment's recorder all connect through it (plaintext or mTLS), publish, subscribe with
+callbacks and stop; every wait bounded. It implements the `Link` port. Nothing else
+imports paho.
+
+A session may be persistent (`session_expiry_s` > 0 with a fixed client id): while the
+client is down the broker queues the QoS 1 messages it misses and delivers them when the
+session resumes, which is what the experiment's recorder needs after a crash.
 """
 
 from __future__ import annotations
@@ -14,6 +20,8 @@ from typing import TYPE_CHECKING
 
 import paho.mqtt.client as paho
 from paho.mqtt.enums import CallbackAPIVersion, MQTTProtocolVersion
+from paho.mqtt.packettypes import PacketTypes
+from paho.mqtt.properties import Properties
 
 from vahr.errors import VahrError
 from vahr.local.ports import LOOPBACK
@@ -23,7 +31,7 @@ if TYPE_CHECKING:
 
     from paho.mqtt.reasoncodes import ReasonCode
 
-    from vahr.local.pki import ClientCredentials
+    from vahr.protocol.broker import ClientCredentials
 
 log = logging.getLogger(__name__)
 
@@ -47,20 +55,32 @@ class PublishDenied(VahrError):
 class MqttClient:
     """One MQTT 5 connection. Handlers run on paho's network thread: keep them short."""
 
-    def __init__(self, endpoint: MqttEndpoint, *, client_id: str | None = None) -> None:
+    def __init__(
+        self, endpoint: MqttEndpoint, *, client_id: str | None = None, session_expiry_s: int = 0
+    ) -> None:
         self.endpoint = endpoint
+        self.session_expiry_s = session_expiry_s
         self._client = paho.Client(
             CallbackAPIVersion.VERSION2,
             client_id=client_id or f"vahr-{uuid.uuid4().hex[:12]}",
             protocol=MQTTProtocolVersion.MQTTv5,
         )
         if endpoint.credentials is not None:
-            creds = endpoint.credentials
-            context = ssl.create_default_context(cafile=str(creds.ca_file))
-            context.load_cert_chain(str(creds.cert_file), str(creds.key_file))
+            creds = endpoint.credentials.check_files()
+            try:
+                context = ssl.create_default_context(
+                    cafile=str(creds.ca_file) if creds.ca_file is not None else None
+                )
+                context.load_cert_chain(str(creds.cert_file), str(creds.key_file))
+            except (OSError, ssl.SSLError) as err:
+                raise VahrError(f"cannot load the certificate, key or CA: {err}") from err
             self._client.tls_set_context(context)
-        self._handlers: list[tuple[str, Callable[[str, bytes], None]]] = []
+        # (filter, handler, whether retained messages reach it)
+        self._handlers: list[tuple[str, Callable[[str, bytes], None], bool]] = []
+        self._connected_callbacks: list[Callable[[bool], None]] = []
+        self._disconnected_callbacks: list[Callable[[str], None]] = []
         self._connected = threading.Event()
+        self.connections = 0
         self._connect_error: str | None = None
         self._acks: dict[int, tuple[threading.Event, list[ReasonCode]]] = {}
         self._subacks: dict[int, tuple[threading.Event, list[ReasonCode]]] = {}
@@ -72,13 +92,29 @@ class MqttClient:
         self._client.on_publish = self._on_publish
         self._client.on_socket_open = self._on_socket_open
         self._client.on_subscribe = self._on_subscribe
+        self._client.on_disconnect = self._on_disconnect
 
     # -- lifecycle --------------------------------------------------------------------
 
     def connect(self) -> MqttClient:
+        properties = None
+        if self.session_expiry_s:
+            properties = Properties(PacketTypes.CONNECT)
+            properties.SessionExpiryInterval = self.session_expiry_s
         try:
-            self._client.connect(self.endpoint.host, self.endpoint.port, keepalive=30)
-        except (OSError, ssl.SSLError) as err:
+            self._client.connect(
+                self.endpoint.host,
+                self.endpoint.port,
+                keepalive=30,
+                clean_start=not self.session_expiry_s,
+                properties=properties,
+            )
+        except ssl.SSLError as err:
+            raise VahrError(
+                f"TLS handshake with {self.endpoint.host}:{self.endpoint.port} failed: "
+                f"{err.reason or err}"
+            ) from err
+        except OSError as err:
             raise VahrError(
                 f"cannot connect to the MQTT broker at {self.endpoint.host}:"
                 f"{self.endpoint.port}: {err}"
@@ -90,6 +126,14 @@ class MqttClient:
                 f"the MQTT broker at {self.endpoint.host}:{self.endpoint.port} refused the "
                 f"connection: {self._connect_error or 'timed out'}"
             )
+        try:
+            # Routes added before connecting: their handlers are already in place for what a
+            # resumed session delivers at once; wait until every subscription holds.
+            for topic_filter in dict.fromkeys(f for f, _, _ in self._handlers):
+                self._subscribe_and_wait(topic_filter)
+        except VahrError:
+            self.stop()
+            raise
         return self
 
     def stop(self) -> None:
@@ -107,15 +151,41 @@ class MqttClient:
 
     # -- messaging --------------------------------------------------------------------
 
-    def subscribe(self, topic_filter: str, handler: Callable[[str, bytes], None]) -> None:
-        """Route messages matching `topic_filter` to `handler`; returns once SUBACKed."""
-        self._handlers.append((topic_filter, handler))
+    def subscribe(
+        self,
+        topic_filter: str,
+        handler: Callable[[str, bytes], None],
+        *,
+        retained: bool = True,
+    ) -> None:
+        """Route messages matching `topic_filter` to `handler`; returns once SUBACKed.
+
+        With `retained=False` the broker's retained messages (the past: a robot's last
+        `delivered`, replayed on every subscription) do not reach `handler`.
+        """
+        self._handlers.append((topic_filter, handler, retained))
+        if self._connected.is_set():
+            self._subscribe_and_wait(topic_filter)
+        # Else `connect` subscribes it, before anything is published to this client.
+
+    def _subscribe_and_wait(self, topic_filter: str) -> None:
         result, mid = self._client.subscribe(topic_filter, qos=1)
         if result != paho.MQTT_ERR_SUCCESS or mid is None:
             raise VahrError(f"cannot subscribe to {topic_filter}: {paho.error_string(result)}")
         waiter, _ = self._expect(self._subacks, mid)
         if not waiter.wait(CONNECT_TIMEOUT_S):
             raise VahrError(f"the MQTT broker did not acknowledge the subscription {topic_filter}")
+
+    # -- the Link port (vahr.protocol.link) ---------------------------------------------
+
+    def add_route(self, topic_filter: str, handler: Callable[[str, bytes], None]) -> None:
+        self.subscribe(topic_filter, handler)
+
+    def on_connected(self, callback: Callable[[bool], None]) -> None:
+        self._connected_callbacks.append(callback)
+
+    def on_disconnected(self, callback: Callable[[str], None]) -> None:
+        self._disconnected_callbacks.append(callback)
 
     def publish(
         self, topic: str, payload: bytes, *, qos: int = 1, retain: bool = False, wait: bool = True
@@ -186,10 +256,18 @@ class MqttClient:
         if reason_code.is_failure:
             self._connect_error = str(reason_code)
         else:
-            # Resubscribe after an automatic reconnect.
-            for topic_filter, _ in self._handlers:
-                client.subscribe(topic_filter, qos=1)
+            self.connections += 1
+            if self.connections > 1:
+                # Resubscribe after an automatic reconnect (`connect` does the first time).
+                for topic_filter in dict.fromkeys(f for f, _, _ in self._handlers):
+                    client.subscribe(topic_filter, qos=1)
+            for callback in self._connected_callbacks:
+                callback(bool(getattr(flags, "session_present", False)))
         self._connected.set()
+
+    def _on_disconnect(self, client, userdata, flags, reason_code, properties):  # type: ignore[no-untyped-def]
+        for callback in self._disconnected_callbacks:
+            callback(str(reason_code))
 
     def _on_publish(self, client, userdata, mid, reason_code, properties):  # type: ignore[no-untyped-def]
         self._acknowledged(self._acks, mid, [reason_code])
@@ -198,7 +276,9 @@ class MqttClient:
         self._acknowledged(self._subacks, mid, list(reason_codes))
 
     def _on_message(self, client, userdata, message):  # type: ignore[no-untyped-def]
-        for topic_filter, handler in self._handlers:
+        for topic_filter, handler, retained in self._handlers:
+            if message.retain and not retained:
+                continue
             if paho.topic_matches_sub(topic_filter, message.topic):
                 try:
                     handler(message.topic, bytes(message.payload))

@@ -18,7 +18,7 @@ from vahr.errors import VahrError
 from vahr.protocol import Fleet, Group, Pose, Robot, load_fleet
 
 if TYPE_CHECKING:
-    from vahr.local.pki import LocalCA
+    from vahr.pki import LocalCA
 
 log = logging.getLogger(__name__)
 

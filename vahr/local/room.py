@@ -19,16 +19,14 @@ import threading
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from robot_agent.voice.port import VoiceError
-from robot_agent.voice.room_message import Utterance
-from vahr.protocol import topics
+from vahr.speech.room import RoomChannel, Utterance
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from robot_agent.voice.room import RoomChannel
-    from robot_agent.voice.stt import Recognizer
-    from robot_agent.voice.tts import Synthesizer
+    from vahr.protocol.link import Link
+    from vahr.speech.stt import Recognizer
+    from vahr.speech.tts import Synthesizer
 
 log = logging.getLogger(__name__)
 
@@ -63,14 +61,14 @@ class RoomAssistant:
 
     def __init__(
         self,
-        channel: RoomChannel,
+        link: Link,
         ask: Callable[[str], str | None],
         synthesizer: Synthesizer,
         recognizer: Recognizer,
         *,
         on_exchange: Callable[[Exchange], None] | None = None,
     ) -> None:
-        self.channel = channel
+        self.room = RoomChannel(link)
         self.ask = ask
         self.synthesizer = synthesizer
         self.recognizer = recognizer
@@ -81,7 +79,7 @@ class RoomAssistant:
     def start(self) -> RoomAssistant:
         self._worker = threading.Thread(target=self._serve, name="vahr-room", daemon=True)
         self._worker.start()
-        self.channel.subscribe(topics.ROOM_ROBOT_SPEECH, self._on_message)
+        self.room.hear_robots(self._on_speech)
         return self
 
     def stop(self) -> None:
@@ -99,16 +97,8 @@ class RoomAssistant:
     def __exit__(self, *exc: object) -> None:
         self.stop()
 
-    def _on_message(self, topic: str, payload: bytes) -> None:
-        parsed = topics.parse_room_topic(topic)
-        try:
-            utterance = Utterance.decode(payload)
-        except VoiceError as err:
-            log.warning("ignoring a room message on %s: %s", topic, err)
-            return
-        if parsed is None or parsed[0] != utterance.thing or utterance.speaker != "robot":
-            log.warning("ignoring a room message on %s from %s", topic, utterance.thing)
-            return
+    def _on_speech(self, utterance: Utterance) -> None:
+        # Runs on the link's thread: queue the work for the worker.
         try:
             self._inbox.put_nowait(utterance)
         except queue.Full:
@@ -136,8 +126,9 @@ class RoomAssistant:
         if not speech:
             return
         audio = self.synthesizer.synthesize(speech)
-        reply = Utterance.new(utterance.thing, "assistant", audio, in_reply_to=utterance.id)
-        self.channel.publish(topics.room_assistant_speech(utterance.thing), reply.encode())
+        self.room.speak(
+            Utterance.new(utterance.thing, "assistant", audio, in_reply_to=utterance.id)
+        )
 
     def _report(self, exchange: Exchange) -> None:
         log.info("room: %s asked %r, answered %r", exchange.thing, exchange.heard, exchange.answer)
@@ -146,16 +137,16 @@ class RoomAssistant:
 
 
 def offline_room_assistant(
-    channel: RoomChannel, ask: Callable[[str], str | None], *, voice: str = "en-us+f4"
+    link: Link, ask: Callable[[str], str | None], *, voice: str = "en-us+f4"
 ) -> RoomAssistant:
     """The room assistant with espeak-ng (a voice unlike the robots') and pocketsphinx.
 
     Questions are recognized without the phone-loop check (the grammar's decoys reject the
     robots' other talk), which keeps the assistant's part of an exchange near 60 ms.
     """
-    from robot_agent.voice.stt import GrammarRecognizer
-    from robot_agent.voice.tts import EspeakSynthesizer
+    from vahr.speech.stt import GrammarRecognizer
+    from vahr.speech.tts import EspeakSynthesizer
 
     return RoomAssistant(
-        channel, ask, EspeakSynthesizer(voice), GrammarRecognizer(QUESTIONS, verify=False)
+        link, ask, EspeakSynthesizer(voice), GrammarRecognizer(QUESTIONS, verify=False)
     )

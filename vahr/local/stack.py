@@ -17,10 +17,10 @@ from vahr.local.broker import BrokerConfig, Mosquitto, TlsListener
 from vahr.local.dataplane import DataPlane, DataPlaneServer
 from vahr.local.meter import Meter
 from vahr.local.mqtt import MqttClient, MqttEndpoint
-from vahr.local.pki import LocalCA
 from vahr.local.ports import LOOPBACK, ensure_free
 from vahr.local.shadow_service import ShadowService
 from vahr.local.shadow_store import ShadowStore
+from vahr.pki import LocalCA
 
 if TYPE_CHECKING:
     from pathlib import Path

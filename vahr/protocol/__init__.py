@@ -1,8 +1,10 @@
 """The wire contract shared by the skill, the robots, the local stack and the experiment.
 
 Import from here: topic builders (`topics`), messages (`Command`, `Event`, `Presence`),
-the reported shadow state (`Reported`), the fleet model (`Fleet`, `load_fleet`), and the one
-error type decoding raises (`ProtocolError`). This package ships in the Lambda, so it
+the reported shadow state (`Reported`), the fleet model (`Fleet`, `load_fleet`), the domain
+facts (`WEATHER_ZONES`; `assistant` for the invocation name), and the one error type
+decoding raises (`ProtocolError`). `link` is the port MQTT adapters implement and `broker`
+how they reach the broker. This package ships in the Lambda, so it
 imports only msgspec (and PyYAML lazily, when a fleet file is read).
 """
 
@@ -50,6 +52,7 @@ from vahr.protocol.shadow import (
     experiment_state_from_payload,
     robot_shadow_from_payload,
 )
+from vahr.protocol.weather import WEATHER_ZONES, WEATHERS
 
 __all__ = [
     "ACTIONS",
@@ -96,4 +99,6 @@ __all__ = [
     "robot_shadow_from_payload",
     "topics",
     "utc_now",
+    "WEATHERS",
+    "WEATHER_ZONES",
 ]

@@ -12,12 +12,12 @@ from typing import Any, Literal
 import msgspec
 
 from vahr.protocol.errors import ProtocolError, from_validation_error
+from vahr.protocol.weather import Weather
 
 Status = Literal[
     "idle", "navigating", "loading", "unloading", "waiting", "stopped", "stuck", "error"
 ]
 Result = Literal["accepted", "rejected", "done", "failed", "cancelled"]
-Weather = Literal["sunny", "rainy"]
 
 
 class ShadowPose(msgspec.Struct, frozen=True):

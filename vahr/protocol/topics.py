@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 
 FLEET_CMD = "vahr/fleet/cmd"
+ALL_ROBOT_CMDS = "vahr/robots/+/cmd"
 ALL_EVENTS = "vahr/robots/+/events"
 ALL_PRESENCE = "vahr/robots/+/presence"
 ALL_SHADOW_UPDATES = "$aws/things/+/shadow/update"

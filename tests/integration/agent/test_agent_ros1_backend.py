@@ -17,8 +17,9 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
+from robot_agent.config import ExecutorSettings
 from robot_agent.core.clock import ScaledClock
-from robot_agent.core.executor import Executor, ExecutorSettings
+from robot_agent.core.executor import Executor
 from tests.unit.agent.conftest import Recorder
 from vahr.local.ports import free_port, wait_for_listener
 from vahr.protocol import new_command
@@ -75,7 +76,8 @@ def ros_master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
 @pytest.fixture(scope="session")
 def move_base(ros_master: str) -> Iterator[dict[str, Any]]:
     """A fake move_base in this process; records the goals it received."""
-    from robot_agent.backends.ros1 import Ros1Settings, ensure_node
+    from robot_agent.backends.ros1 import ensure_node
+    from robot_agent.config import Ros1Settings
 
     ensure_node(Ros1Settings(master_uri=ros_master, node_name="vahr_agent_test"))
     import actionlib
@@ -119,7 +121,8 @@ def move_base(ros_master: str) -> Iterator[dict[str, Any]]:
 
 
 def ros_executor(fleet: Fleet, ros_master: str) -> tuple[Executor, Recorder]:
-    from robot_agent.backends.ros1 import Ros1Backend, Ros1Settings
+    from robot_agent.backends.ros1 import Ros1Backend
+    from robot_agent.config import Ros1Settings
 
     backend = Ros1Backend(
         Ros1Settings(

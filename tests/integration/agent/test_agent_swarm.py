@@ -7,8 +7,8 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from robot_agent.swarm import SwarmThread, swarm_fleet
 from tests.integration.agent.harness import command
+from tests.support.swarm import SwarmThread, swarm_fleet
 from vahr.errors import VahrError
 
 if TYPE_CHECKING:

@@ -14,10 +14,11 @@ from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 
 from vahr.errors import VahrError
-from vahr.experiment.bus import Bus, TlsFiles
+from vahr.experiment.bus import Bus
 from vahr.local.broker import BrokerConfig, Mosquitto, TlsListener
 from vahr.local.ports import free_port
 from vahr.protocol import encode, new_command, topics
+from vahr.protocol.broker import ClientCredentials
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -134,7 +135,7 @@ def test_the_recorder_works_over_mtls(tls_broker: tuple[Mosquitto, tuple, Path])
         f"mqtts://127.0.0.1:{broker.config.tls.port}",
         on_message,
         "vahr-experiment-t",
-        tls=TlsFiles(cert_file=cert, key_file=key, ca_file=ca[2]),
+        tls=ClientCredentials(cert_file=cert, key_file=key, ca_file=ca[2]),
     )
     bus.start()
     try:
@@ -158,7 +159,7 @@ def test_a_broker_signed_by_another_ca_is_refused_in_one_line(
         f"mqtts://127.0.0.1:{broker.config.tls.port}",
         lambda t, p: None,
         "x",
-        tls=TlsFiles(cert_file=cert, key_file=key, ca_file=other_ca),
+        tls=ClientCredentials(cert_file=cert, key_file=key, ca_file=other_ca),
     )
     with pytest.raises(VahrError, match="TLS handshake with 127.0.0.1:.* failed"):
         bus.start()

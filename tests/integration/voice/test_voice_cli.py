@@ -6,7 +6,7 @@ import json
 from typing import TYPE_CHECKING
 
 from robot_agent.cli import main
-from robot_agent.voice.audio import Audio
+from vahr.speech.audio import Audio
 
 if TYPE_CHECKING:
     from pathlib import Path

@@ -9,10 +9,10 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from robot_agent.voice.audio import Audio, concatenate
 from robot_agent.voice.devices import DeviceVoice, ListenSettings
-from robot_agent.voice.port import VoiceError
-from robot_agent.voice.tts import EspeakSynthesizer
+from vahr.speech.audio import Audio, concatenate
+from vahr.speech.errors import SpeechError
+from vahr.speech.tts import EspeakSynthesizer
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -99,9 +99,9 @@ def test_a_missing_device_command_is_a_voice_error(
     voice = DeviceVoice(
         tts, understanding, player=["no-such-player"], recorder=["no-such-recorder"]
     )
-    with pytest.raises(VoiceError, match="audio player 'no-such-player' not found"):
+    with pytest.raises(SpeechError, match="audio player 'no-such-player' not found"):
         asyncio.run(voice.say("hello"))
-    with pytest.raises(VoiceError, match="audio recorder 'no-such-recorder' not found"):
+    with pytest.raises(SpeechError, match="audio recorder 'no-such-recorder' not found"):
         asyncio.run(voice.listen(1.0))
 
 
@@ -112,5 +112,5 @@ def test_a_failing_recorder_says_why(understanding: Understanding, tts: EspeakSy
         player=["true"],
         recorder=["sh", "-c", "echo 'no such device' >&2; exit 1"],
     )
-    with pytest.raises(VoiceError, match="no such device"):
+    with pytest.raises(SpeechError, match="no such device"):
         asyncio.run(voice.listen(1.0))

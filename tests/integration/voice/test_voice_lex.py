@@ -23,14 +23,14 @@ from robot_agent.voice.answers import WeatherAnswers
 from robot_agent.voice.interpreter import LocalInterpreter
 from robot_agent.voice.iot_credentials import IotCredentialsProvider
 from robot_agent.voice.lex import LexInterpreter
-from robot_agent.voice.port import VoiceError
-from vahr.local.pki import LocalCA
+from vahr.pki import LocalCA
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
 
-    from vahr.local.pki import ClientCredentials
+    from vahr.pki import ClientCredentials
 
 
 class Recorder:
@@ -200,7 +200,7 @@ def test_a_refused_role_alias_is_a_voice_error(
     endpoint, _ = credentials_server
     lex_url, lex = lex_server
     interpreter = make_lex(pki, endpoint, lex_url, "someone-elses-alias")
-    with pytest.raises(VoiceError, match=r"refused \(403\).*Access Denied"):
+    with pytest.raises(SpeechError, match=r"refused \(403\).*Access Denied"):
         interpreter.interpret("the weather is sunny")
     assert lex.requests == []
 
@@ -212,7 +212,7 @@ def test_an_unreachable_lex_is_a_voice_error(
     from vahr.local.ports import free_port
 
     interpreter = make_lex(pki, endpoint, f"http://127.0.0.1:{free_port()}", "vahr-robot-lex")
-    with pytest.raises(VoiceError, match="Amazon Lex could not interpret"):
+    with pytest.raises(SpeechError, match="Amazon Lex could not interpret"):
         interpreter.interpret("the weather is rainy")
 
 

@@ -10,8 +10,8 @@ import boto3
 import pytest
 from moto import mock_aws
 
-from robot_agent.voice.port import VoiceError
-from robot_agent.voice.tts import PollySynthesizer
+from vahr.speech.errors import SpeechError
+from vahr.speech.tts import PollySynthesizer
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -40,10 +40,10 @@ def test_polly_is_asked_for_16k_pcm_in_the_chosen_voice(polly: object) -> None:
 
 
 def test_a_polly_error_is_a_voice_error(polly: object) -> None:
-    with pytest.raises(VoiceError, match="Amazon Polly could not speak"):
+    with pytest.raises(SpeechError, match="Amazon Polly could not speak"):
         PollySynthesizer("NoSuchVoice", client=polly).synthesize("hello")
 
 
 def test_empty_text_is_refused_before_any_request(polly: object) -> None:
-    with pytest.raises(VoiceError, match="the text is empty"):
+    with pytest.raises(SpeechError, match="the text is empty"):
         PollySynthesizer(client=polly).synthesize("   ")

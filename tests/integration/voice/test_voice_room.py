@@ -1,7 +1,10 @@
 """The room channel on a real mosquitto: a robot's `RoomVoice` asks, the local assistant
 recognizes the question from audio, answers through `ask`, and the robot understands the
 spoken answer. `ask` here is the weather intent's contract (the skill's own answers); the
-end-to-end test with the skill and a robot agent is test_voice_weather_task.py."""
+end-to-end test with the skill and a robot agent is test_voice_weather_task.py.
+
+Both ends speak over the `Link` port; here the robot's link is the lab's paho client (the
+agent's own awscrt link carries it in test_voice_weather_task.py)."""
 
 from __future__ import annotations
 
@@ -11,16 +14,18 @@ from typing import TYPE_CHECKING
 
 import pytest
 
+from robot_agent.config import AgentConfig, VoiceSettings
 from robot_agent.voice.factories import room
-from robot_agent.voice.room_message import Utterance
-from robot_agent.voice.tts import EspeakSynthesizer
 from vahr.local.mqtt import MqttClient, MqttEndpoint
 from vahr.local.room import Exchange, offline_room_assistant
 from vahr.protocol import topics
+from vahr.speech.room import Utterance
+from vahr.speech.tts import EspeakSynthesizer
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
+    from robot_agent.voice.room import RoomVoice
     from vahr.local.broker import Mosquitto
 
 QUESTION = "Alexa, ask robot fleet what the weather is"
@@ -37,6 +42,18 @@ class Skill:
     def ask(self, utterance: str) -> str:
         self.requests.append(utterance)
         return WEATHER_ANSWERS[self.weather]
+
+
+class RobotInTheRoom:
+    """A robot's room voice on its own connection to the broker."""
+
+    def __init__(self, url: str, thing: str, synthesizer: str = "en-us+f2") -> None:
+        self.link = MqttClient(MqttEndpoint(port=int(url.rsplit(":", 1)[1]))).connect()
+        config = AgentConfig(thing=thing, voice=VoiceSettings(synthesizer=synthesizer))
+        self.voice: RoomVoice = room(thing=thing, config=config, link=self.link)
+
+    def close(self) -> None:
+        self.link.stop()
 
 
 @pytest.fixture
@@ -62,7 +79,8 @@ def test_the_robot_asks_and_understands_the_spoken_answer(
     skill, exchanges, url = room_setup
     skill.weather = weather
     # Given a robot's room voice on the broker
-    voice = room(thing="placebot1", environ={"VAHR_ROOM_BROKER": url, "VAHR_VOICE": "en-us+m3"})
+    robot = RobotInTheRoom(url, "placebot1", synthesizer="en-us+m3")
+    voice = robot.voice
     try:
         # When it asks the weather question aloud and listens
         async def converse() -> tuple[str, str, float]:
@@ -72,7 +90,7 @@ def test_the_robot_asks_and_understands_the_spoken_answer(
 
         text, intent, confidence = asyncio.run(converse())
     finally:
-        voice.close()
+        robot.close()
     # Then the assistant recognized the question from audio and asked the skill
     assert skill.requests == ["ask robot fleet what the weather is"]
     assert exchanges[0].heard == "alexa ask robot fleet what the weather is"
@@ -85,7 +103,8 @@ def test_speech_not_for_the_assistant_gets_no_answer(
     room_setup: tuple[Skill, list[Exchange], str],
 ) -> None:
     skill, exchanges, url = room_setup
-    voice = room(thing="placebot2", environ={"VAHR_ROOM_BROKER": url})
+    robot = RobotInTheRoom(url, "placebot2")
+    voice = robot.voice
     try:
 
         async def acknowledge() -> tuple[str, str]:
@@ -95,7 +114,7 @@ def test_speech_not_for_the_assistant_gets_no_answer(
 
         assert asyncio.run(acknowledge()) == ("", "unknown")
     finally:
-        voice.close()
+        robot.close()
     assert skill.requests == []
     assert [(e.thing, e.heard, e.answer) for e in exchanges] == [("placebot2", "", None)]
 
@@ -105,7 +124,8 @@ def test_an_answer_to_an_older_question_is_ignored(
 ) -> None:
     _, _, url = room_setup
     port = int(url.rsplit(":", 1)[1])
-    voice = room(thing="placebot1", environ={"VAHR_ROOM_BROKER": url})
+    robot = RobotInTheRoom(url, "placebot1")
+    voice = robot.voice
     stale_sent = threading.Event()
     try:
 
@@ -126,7 +146,7 @@ def test_an_answer_to_an_older_question_is_ignored(
 
         assert asyncio.run(converse()) == ("", "unknown")
     finally:
-        voice.close()
+        robot.close()
     assert stale_sent.is_set()
 
 
@@ -138,7 +158,8 @@ def test_a_broken_room_message_is_ignored_and_the_room_keeps_answering(
     with MqttClient(MqttEndpoint(port=port)) as intruder:
         intruder.publish(topics.room_robot_speech("placebot1"), b"not json")
         intruder.publish(topics.room_robot_speech("placebot1"), b'{"id": "x"}')
-    voice = room(thing="placebot1", environ={"VAHR_ROOM_BROKER": url})
+    robot = RobotInTheRoom(url, "placebot1")
+    voice = robot.voice
     try:
 
         async def converse() -> str:
@@ -147,13 +168,4 @@ def test_a_broken_room_message_is_ignored_and_the_room_keeps_answering(
 
         assert asyncio.run(converse()) == "sunny"
     finally:
-        voice.close()
-
-
-def test_the_room_voice_needs_a_broker() -> None:
-    from robot_agent.voice.port import VoiceError
-
-    with pytest.raises(VoiceError, match="VAHR_ROOM_BROKER"):
-        room(thing="placebot1", environ={})
-    with pytest.raises(VoiceError, match="expected mqtt://HOST:PORT"):
-        room(thing="placebot1", environ={"VAHR_ROOM_BROKER": "http://127.0.0.1"})
+        robot.close()

@@ -9,8 +9,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pytest
 
-from robot_agent.voice.audio import SAMPLE_RATE, Audio, add_white_noise, concatenate
-from robot_agent.voice.tts import EspeakSynthesizer
+from vahr.speech.audio import SAMPLE_RATE, Audio, add_white_noise, concatenate
+from vahr.speech.tts import EspeakSynthesizer
 
 if TYPE_CHECKING:
     from robot_agent.voice.understanding import Understanding
@@ -89,8 +89,8 @@ def test_a_sentence_after_the_answer_does_not_hide_it(understanding: Understandi
 
 @pytest.mark.parametrize("voice", VOICES)
 def test_the_room_assistant_hears_questions_and_ignores_other_robot_talk(voice: str) -> None:
-    from robot_agent.voice.stt import GrammarRecognizer
     from vahr.local.room import QUESTIONS
+    from vahr.speech.stt import GrammarRecognizer
 
     # Given the assistant's fast question recognizer (grammar, decoys, no phone loop)
     recognizer = GrammarRecognizer(QUESTIONS, verify=False)

@@ -9,9 +9,10 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from robot_agent.backends.sim import SimBackend, SimSettings
+from robot_agent.backends.sim import SimBackend
+from robot_agent.config import ExecutorSettings, SimSettings
 from robot_agent.core.clock import ScaledClock
-from robot_agent.core.executor import Executor, ExecutorSettings
+from robot_agent.core.executor import Executor
 
 if TYPE_CHECKING:
     from robot_agent.voice.port import Voice

@@ -6,8 +6,7 @@ import asyncio
 from typing import TYPE_CHECKING
 
 from robot_agent.backends.port import Progress
-from robot_agent.backends.sim import SimSettings
-from robot_agent.core.executor import ExecutorSettings
+from robot_agent.config import ExecutorSettings, SimSettings
 from tests.unit.agent.conftest import make_executor
 from vahr.protocol import Event, Pose, new_command, utc_now
 

@@ -11,12 +11,13 @@ from typing import TYPE_CHECKING
 import pytest
 
 from robot_agent.backends.port import NavigationFailed, Progress
-from robot_agent.backends.sim import SimBackend, SimSettings
+from robot_agent.backends.sim import SimBackend
+from robot_agent.config import SimSettings
 from robot_agent.core.clock import ScaledClock
 from robot_agent.core.peers import PeerDeliveries
 from robot_agent.core.recent_ids import RecentIds
-from robot_agent.link.port import topic_matches
 from vahr.protocol import Pose, utc_now
+from vahr.protocol.link import topic_matches
 
 if TYPE_CHECKING:
     from pathlib import Path

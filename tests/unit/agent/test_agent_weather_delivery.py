@@ -8,23 +8,25 @@ the robot said and answers with what a person would hear from the assistant.
 from __future__ import annotations
 
 import asyncio
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from robot_agent.core.executor import WEATHER_QUESTION, ExecutorSettings
-from robot_agent.voice.port import Heard, VoiceError
+from robot_agent.config import ExecutorSettings
+from robot_agent.voice.port import Heard
 from tests.unit.agent.conftest import make_executor
 from vahr.protocol import new_command
+from vahr.protocol.assistant import WEATHER_QUESTION
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from vahr.protocol import Fleet
 
 
 class ScriptedAssistant:
-    """Answers each question with the next scripted `Heard` (or raises a VoiceError)."""
+    """Answers each question with the next scripted `Heard` (or raises a SpeechError)."""
 
-    def __init__(self, *answers: Heard | VoiceError) -> None:
+    def __init__(self, *answers: Heard | SpeechError) -> None:
         self.answers = list(answers)
         self.said: list[str] = []
         self.listens: list[float] = []
@@ -40,7 +42,7 @@ class ScriptedAssistant:
     async def listen(self, timeout_s: float) -> Heard:
         self.listens.append(timeout_s)
         answer = self.answers.pop(0)
-        if isinstance(answer, VoiceError):
+        if isinstance(answer, SpeechError):
             raise answer
         return answer
 
@@ -115,10 +117,14 @@ async def test_without_a_voice_it_fails_with_voice_not_configured(fleet: Fleet) 
 
 
 async def test_a_broken_voice_path_fails_with_its_reason(fleet: Fleet) -> None:
-    executor, rec, _ = make_executor(fleet, voice=ScriptedAssistant(VoiceError("no audio device")))
+    executor, rec, _ = make_executor(fleet, voice=ScriptedAssistant(SpeechError("no audio device")))
     executor.execute(weather())  # type: ignore[arg-type]
     await executor.wait_idle()
     assert rec.first("failed").reason == "voice failed: no audio device"
+
+
+# The agent's link, which these factories never use.
+NO_LINK: Any = object()
 
 
 def scripted_rainy_assistant(thing: str) -> ScriptedAssistant:
@@ -128,45 +134,48 @@ def scripted_rainy_assistant(thing: str) -> ScriptedAssistant:
 
 def test_the_voice_factory_named_in_the_config_is_built_with_the_thing() -> None:
     from robot_agent.assembly import build_voice
-    from robot_agent.config import AgentConfig
+    from robot_agent.config import AgentConfig, VoiceSettings
 
     config = AgentConfig(
         thing="placebot1",
-        voice="tests.unit.agent.test_agent_weather_delivery:scripted_rainy_assistant",
+        voice=VoiceSettings(
+            factory="tests.unit.agent.test_agent_weather_delivery:scripted_rainy_assistant"
+        ),
     )
-    voice = build_voice(config)
+    voice = build_voice(config, NO_LINK)
     # pytest imports this file under another module name, so compare by behaviour.
     assert voice is not None and type(voice).__name__ == "ScriptedAssistant"
     assert voice.answers[0].text == "The weather is rainy, placebot1."  # type: ignore[attr-defined]
-    assert build_voice(AgentConfig(thing="placebot1")) is None
+    assert build_voice(AgentConfig(thing="placebot1"), NO_LINK) is None
 
 
-def scripted_with_config(thing: str, config: object) -> ScriptedAssistant:
-    """A factory that, like the room voice, reuses the agent's configuration."""
+def scripted_with_config(thing: str, config: object, link: object) -> ScriptedAssistant:
+    """A factory that, like the room voice, takes the agent's configuration and link."""
     assistant = ScriptedAssistant(SUNNY)
     assistant.config = config
+    assistant.link = link
     return assistant
 
 
 def failing_voice(thing: str) -> ScriptedAssistant:
-    raise VoiceError("no sound card")
+    raise SpeechError("no sound card")
 
 
 def test_a_factory_that_takes_the_config_gets_it_and_a_failing_one_is_one_line() -> None:
     from robot_agent.assembly import build_voice
-    from robot_agent.config import AgentConfig
+    from robot_agent.config import AgentConfig, VoiceSettings
     from vahr.errors import VahrError
 
+    module = "tests.unit.agent.test_agent_weather_delivery"
     config = AgentConfig(
-        thing="placebot1", voice="tests.unit.agent.test_agent_weather_delivery:scripted_with_config"
+        thing="placebot1", voice=VoiceSettings(factory=f"{module}:scripted_with_config")
     )
-    voice = build_voice(config)
+    voice = build_voice(config, NO_LINK)
     assert voice is not None and voice.config is config  # type: ignore[attr-defined]
-    failing = AgentConfig(
-        thing="placebot1", voice="tests.unit.agent.test_agent_weather_delivery:failing_voice"
-    )
+    assert voice.link is NO_LINK  # type: ignore[attr-defined]
+    failing = AgentConfig(thing="placebot1", voice=VoiceSettings(factory=f"{module}:failing_voice"))
     with pytest.raises(VahrError, match="no sound card"):
-        build_voice(failing)
+        build_voice(failing, NO_LINK)
 
 
 async def test_the_voice_is_closed_when_the_executor_closes(fleet: Fleet) -> None:

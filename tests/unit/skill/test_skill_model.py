@@ -344,7 +344,7 @@ def test_example_phrases_are_sample_utterances(model: dict[str, Any]) -> None:
 
 def test_the_robots_weather_question_is_a_weather_intent_sample(model: dict[str, Any]) -> None:
     # The robots ask the assistant themselves (task II); the skill must understand them.
-    from robot_agent.core.executor import WEATHER_QUESTION
+    from vahr.protocol.assistant import WEATHER_QUESTION
 
     invocation = language_model(model)["invocationName"]
     asked = re.sub(rf"^Alexa, ask {invocation} (to )?", "", WEATHER_QUESTION).rstrip("?.").lower()

@@ -8,7 +8,7 @@ import pytest
 
 from robot_agent.voice.answers import WeatherAnswers, normalize
 from robot_agent.voice.interpreter import LocalInterpreter
-from robot_agent.voice.port import VoiceError
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -85,5 +85,5 @@ def test_a_broken_answers_file_is_one_clear_error(
 ) -> None:
     path = tmp_path / "answers.yaml"
     path.write_text(document)
-    with pytest.raises(VoiceError, match=reason.replace("[", r"\[").replace("]", r"\]")):
+    with pytest.raises(SpeechError, match=reason.replace("[", r"\[").replace("]", r"\]")):
         WeatherAnswers.load(path)

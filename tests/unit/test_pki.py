@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from cryptography import x509
 from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 
-from vahr.local.pki import LocalCA
+from vahr.pki import LocalCA
 
 if TYPE_CHECKING:
     from pathlib import Path

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robot_agent.voice.port import VoiceError
+from vahr.speech.errors import SpeechError
 
 SAMPLE_RATE = 16_000
 SAMPLE_WIDTH = 2  # bytes: signed 16-bit little-endian
@@ -78,7 +78,7 @@ def convert_to_pcm16k(data: bytes, file_type: str) -> bytes:
     """Convert audio of `file_type` (wav, mp3...) to raw 16 kHz mono 16-bit PCM with sox."""
     sox = shutil.which("sox")
     if sox is None:
-        raise VoiceError("sox is not installed (Debian: apt-get install sox)")
+        raise SpeechError("sox is not installed (Debian: apt-get install sox)")
     try:
         done = subprocess.run(
             [sox, "-t", file_type, "-", "-t", "raw", "-r", str(SAMPLE_RATE), "-c", "1",
@@ -89,10 +89,10 @@ def convert_to_pcm16k(data: bytes, file_type: str) -> bytes:
             check=False,
         )  # fmt: skip
     except subprocess.TimeoutExpired as err:
-        raise VoiceError(f"sox did not convert the audio within {SOX_TIMEOUT_S:g} s") from err
+        raise SpeechError(f"sox did not convert the audio within {SOX_TIMEOUT_S:g} s") from err
     if done.returncode != 0:
         reason = done.stderr.decode(errors="replace").strip().splitlines()
-        raise VoiceError(f"not readable audio: {reason[-1] if reason else 'sox failed'}")
+        raise SpeechError(f"not readable audio: {reason[-1] if reason else 'sox failed'}")
     return done.stdout
 
 

@@ -7,10 +7,10 @@ import json
 
 import pytest
 
-from robot_agent.voice.audio import Audio
-from robot_agent.voice.port import VoiceError
-from robot_agent.voice.room_message import MAX_MESSAGE_BYTES, Utterance
 from vahr.protocol import topics
+from vahr.speech.audio import Audio
+from vahr.speech.errors import SpeechError
+from vahr.speech.room import MAX_MESSAGE_BYTES, Utterance
 
 
 def test_room_topics_are_built_and_parsed_in_one_place() -> None:
@@ -44,10 +44,10 @@ def test_an_utterance_round_trips_with_its_audio() -> None:
     ],
 )
 def test_a_bad_room_message_is_a_voice_error(payload: bytes, reason: str) -> None:
-    with pytest.raises(VoiceError, match=reason):
+    with pytest.raises(SpeechError, match=reason):
         Utterance.decode(payload)
 
 
 def test_an_utterance_too_long_for_the_channel_is_refused() -> None:
-    with pytest.raises(VoiceError, match="too long for the room channel"):
+    with pytest.raises(SpeechError, match="too long for the room channel"):
         Utterance.new("placebot1", "robot", Audio.silence(40.0)).encode()

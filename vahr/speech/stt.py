@@ -27,8 +27,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
-from robot_agent.voice.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio, SpeechDetector
-from robot_agent.voice.port import VoiceError
+from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio, SpeechDetector
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -79,7 +79,7 @@ def jsgf_grammar(phrases: Iterable[str], name: str = "answers") -> str:
     """A JSGF grammar whose one public rule is any of `phrases` (already normalized)."""
     alternatives = " | ".join(dict.fromkeys(phrases))
     if not alternatives:
-        raise VoiceError("the recognizer needs at least one phrase")
+        raise SpeechError("the recognizer needs at least one phrase")
     return f"#JSGF V1.0;\ngrammar {name};\npublic <utterance> = {alternatives};\n"
 
 
@@ -114,7 +114,7 @@ class GrammarRecognizer:
             {w for p in self.phrases for w in p.split() if self._decoder.lookup_word(w) is None}
         )
         if missing:
-            raise VoiceError(f"words missing from the pronunciation dictionary: {missing}")
+            raise SpeechError(f"words missing from the pronunciation dictionary: {missing}")
         self.decoys = tuple(
             d
             for d in decoys
@@ -189,7 +189,9 @@ class GoogleRecognizer:
         try:
             import speech_recognition
         except ImportError as err:
-            raise VoiceError("the google recognizer needs `pip install SpeechRecognition`") from err
+            raise SpeechError(
+                "the google recognizer needs `pip install SpeechRecognition`"
+            ) from err
         self._sr = speech_recognition
         self._recognizer = speech_recognition.Recognizer()
         self.language = language
@@ -201,7 +203,7 @@ class GoogleRecognizer:
         try:
             result = self._recognizer.recognize_google(data, language=self.language, show_all=True)
         except self._sr.RequestError as err:
-            raise VoiceError(f"Google speech recognition is unreachable: {err}") from err
+            raise SpeechError(f"Google speech recognition is unreachable: {err}") from err
         alternatives = result.get("alternative", []) if isinstance(result, dict) else []
         if not alternatives:
             return NOTHING_HEARD

@@ -8,14 +8,14 @@ import wave
 import numpy as np
 import pytest
 
-from robot_agent.voice.audio import (
+from vahr.speech.audio import (
     SAMPLE_RATE,
     Audio,
     SpeechDetector,
     add_white_noise,
     concatenate,
 )
-from robot_agent.voice.port import VoiceError
+from vahr.speech.errors import SpeechError
 
 
 def tone(seconds: float, amplitude: float = 8000.0, hz: float = 440.0) -> Audio:
@@ -43,7 +43,7 @@ def test_a_44k_stereo_wav_is_converted_to_16k_mono() -> None:
 
 
 def test_not_audio_is_a_voice_error() -> None:
-    with pytest.raises(VoiceError, match="not readable audio"):
+    with pytest.raises(SpeechError, match="not readable audio"):
         Audio.from_wav(b"this is not a wav file")
 
 

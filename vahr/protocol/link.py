@@ -1,7 +1,10 @@
-"""The `Link` port: publish and route messages, without saying which MQTT library does it.
+"""The `Link` port: publish and route MQTT messages, without saying which library does it.
 
-Handlers run on the asyncio event loop that owns the agent, never on a library thread.
-Every publish is QoS 1. One link can carry many robots (swarm mode): each adds its routes.
+Robots implement it with awscrt (`robot_agent.link.mqtt5`), the lab side with paho
+(`vahr.local.mqtt`); the agent, the device shadow and the room channel speak through it.
+Every publish is QoS 1. Handlers run on one thread the adapter chooses (the agent's event
+loop for awscrt, paho's network thread for the lab): keep them short. One link can carry
+many robots (swarm mode): each adds its routes.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ if TYPE_CHECKING:
 
 class Link(Protocol):
     def publish(self, topic: str, payload: bytes, *, retain: bool = False) -> None:
-        """Queue a QoS 1 publish; queued while offline and sent once connected."""
+        """Publish with QoS 1 (queued while offline where the adapter can)."""
 
     def add_route(self, topic_filter: str, handler: Callable[[str, bytes], None]) -> None:
         """Subscribe to `topic_filter` (QoS 1) and call `handler(topic, payload)` for each match."""

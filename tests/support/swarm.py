@@ -27,9 +27,9 @@ import uuid
 from typing import TYPE_CHECKING, Any
 
 from robot_agent.agent import RobotAgent
-from robot_agent.backends.sim import SimBackend, SimSettings
+from robot_agent.backends.sim import SimBackend
+from robot_agent.config import ExecutorSettings, SimSettings
 from robot_agent.core.clock import ScaledClock
-from robot_agent.core.executor import ExecutorSettings
 from robot_agent.core.recent_ids import RecentIds
 from vahr.errors import VahrError
 from vahr.protocol import (
@@ -108,11 +108,19 @@ class Swarm:
 
     async def start(self, timeout_s: float = CONNECT_TIMEOUT_S) -> None:
         """Build every robot, connect once, and return when all of them are online."""
-        from robot_agent.link.mqtt5 import LinkSettings, Mqtt5Link, plaintext_broker
+        from robot_agent.config import MqttSettings
+        from robot_agent.link.mqtt5 import LinkSettings, Mqtt5Link
+        from vahr.protocol.broker import plaintext_loopback
 
-        host, port = plaintext_broker(self.broker)
+        address = plaintext_loopback(self.broker)
+        host, port = address.host, address.port
         link = Mqtt5Link(
-            LinkSettings(client_id=self._client_id, host=host, port=port, session_expiry_s=0),
+            LinkSettings(
+                client_id=self._client_id,
+                host=host,
+                port=port,
+                session=MqttSettings(session_expiry_s=0),
+            ),
             asyncio.get_running_loop(),
         )
         self.link = link

@@ -1,5 +1,8 @@
 """The local certificate authority that stands in for AWS IoT's certificate registry.
 
+Shared by the local stack (the broker's and the services' certificates) and by
+`robot-agent provision --local` (a robot's), so it sits below both.
+
 Created once per state directory with the `cryptography` package and reused across runs:
 an EC P-256 CA, a server certificate for the broker (SAN `localhost` and `127.0.0.1`) and
 client certificates whose common name is the thing name, which mosquitto's
@@ -11,7 +14,6 @@ from __future__ import annotations
 import datetime as dt
 import ipaddress
 import os
-from dataclasses import dataclass
 from pathlib import Path
 
 from cryptography import x509
@@ -20,6 +22,7 @@ from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 
 from vahr.errors import VahrError
+from vahr.protocol.broker import ClientCredentials
 
 CA_COMMON_NAME = "VAHR local CA"
 SERVER_COMMON_NAME = "localhost"
@@ -28,15 +31,6 @@ CA_VALIDITY = dt.timedelta(days=3650)
 LEAF_VALIDITY = dt.timedelta(days=825)
 # Certificates are backdated a little so a clock that is slightly behind still accepts them.
 CLOCK_SKEW = dt.timedelta(minutes=5)
-
-
-@dataclass(frozen=True)
-class ClientCredentials:
-    """The three files an MQTT client needs for mTLS."""
-
-    cert_file: Path
-    key_file: Path
-    ca_file: Path
 
 
 def _new_key() -> ec.EllipticCurvePrivateKey:
@@ -203,6 +197,9 @@ class LocalCA:
             out / f"{SERVICE_COMMON_NAME}.private.key",
             out / "ca.crt",
         )
-        if all(p.exists() for p in (existing.cert_file, existing.key_file, existing.ca_file)):
+        if all(
+            p is not None and p.exists()
+            for p in (existing.cert_file, existing.key_file, existing.ca_file)
+        ):
             return existing
         return self.issue_client(SERVICE_COMMON_NAME, out)

@@ -11,8 +11,8 @@ import shutil
 import subprocess
 from typing import TYPE_CHECKING, Any, Protocol
 
-from robot_agent.voice.audio import SAMPLE_RATE, Audio, convert_to_pcm16k
-from robot_agent.voice.port import VoiceError
+from vahr.speech.audio import SAMPLE_RATE, Audio, convert_to_pcm16k
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -25,16 +25,16 @@ MAX_TEXT_CHARS = 1_000
 
 class Synthesizer(Protocol):
     def synthesize(self, text: str) -> Audio:
-        """Render `text` as speech; raises VoiceError when it cannot."""
+        """Render `text` as speech; raises SpeechError when it cannot."""
         ...
 
 
 def _check_text(text: str) -> str:
     text = text.strip()
     if not text:
-        raise VoiceError("nothing to say: the text is empty")
+        raise SpeechError("nothing to say: the text is empty")
     if len(text) > MAX_TEXT_CHARS:
-        raise VoiceError(f"the text is {len(text)} characters long; at most {MAX_TEXT_CHARS}")
+        raise SpeechError(f"the text is {len(text)} characters long; at most {MAX_TEXT_CHARS}")
     return text
 
 
@@ -46,9 +46,9 @@ class EspeakSynthesizer:
     ) -> None:
         executable = shutil.which("espeak-ng")
         if executable is None:
-            raise VoiceError("espeak-ng is not installed (Debian: apt-get install espeak-ng)")
+            raise SpeechError("espeak-ng is not installed (Debian: apt-get install espeak-ng)")
         if not 80 <= words_per_minute <= 450:
-            raise VoiceError(f"speed {words_per_minute} wpm: espeak-ng speaks 80 to 450")
+            raise SpeechError(f"speed {words_per_minute} wpm: espeak-ng speaks 80 to 450")
         self.executable = executable
         self.voice = voice
         self.words_per_minute = words_per_minute
@@ -65,11 +65,11 @@ class EspeakSynthesizer:
                 check=False,
             )
         except subprocess.TimeoutExpired as err:
-            raise VoiceError(f"espeak-ng did not finish within {ESPEAK_TIMEOUT_S:g} s") from err
+            raise SpeechError(f"espeak-ng did not finish within {ESPEAK_TIMEOUT_S:g} s") from err
         message = done.stderr.decode(errors="replace").strip()
         # espeak-ng exits 0 for an unknown voice; it only says so on stderr.
         if done.returncode != 0 or not done.stdout or "voice" in message.lower():
-            raise VoiceError(f"espeak-ng voice {self.voice!r}: {message or 'no audio produced'}")
+            raise SpeechError(f"espeak-ng voice {self.voice!r}: {message or 'no audio produced'}")
         return Audio(convert_to_pcm16k(done.stdout, "wav"))
 
 
@@ -99,7 +99,7 @@ class PollySynthesizer:
             )
             pcm = response["AudioStream"].read()
         except (BotoCoreError, ClientError) as err:
-            raise VoiceError(f"Amazon Polly could not speak: {err}") from err
+            raise SpeechError(f"Amazon Polly could not speak: {err}") from err
         return Audio(pcm)
 
 
@@ -110,7 +110,7 @@ class GttsSynthesizer:
         try:
             from gtts import gTTS
         except ImportError as err:
-            raise VoiceError("the gtts voice needs `pip install gTTS`") from err
+            raise SpeechError("the gtts voice needs `pip install gTTS`") from err
         self._make: Callable[..., Any] = gTTS
         self.language = language
         self.tld = tld
@@ -123,7 +123,7 @@ class GttsSynthesizer:
         try:
             self._make(text=text, lang=self.language, tld=self.tld).write_to_fp(buffer)
         except Exception as err:  # gTTS raises its own and requests' errors
-            raise VoiceError(f"gTTS could not speak: {err}") from err
+            raise SpeechError(f"gTTS could not speak: {err}") from err
         # sox reads MP3 only with libsox-fmt-mp3 installed; the error says so if not.
         return Audio(convert_to_pcm16k(buffer.getvalue(), "mp3"))
 
@@ -137,4 +137,4 @@ def make_synthesizer(spec: str) -> Synthesizer:
         return PollySynthesizer(option or "Joanna")
     if kind == "gtts":
         return GttsSynthesizer(option or "en")
-    raise VoiceError(f"unknown synthesizer {spec!r}: use espeak[:VOICE], polly[:VOICE], gtts")
+    raise SpeechError(f"unknown synthesizer {spec!r}: use espeak[:VOICE], polly[:VOICE], gtts")
