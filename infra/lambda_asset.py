@@ -4,7 +4,7 @@
 
 The bundle holds `skill/` (from `lambda/skill`, handler `skill.app.lambda_handler`), the
 parts of `vahr` the skill imports (`vahr/__init__.py`, `vahr/errors.py`, `vahr/protocol`),
-`fleet.yaml` at its root (where `vahr.protocol.fleet` looks for it), and the skill's
+`fleet.yaml` as `vahr/protocol/fleet.yaml` (where `vahr.protocol.fleet` looks for it), the skill's
 runtime dependencies installed from wheels built for the Lambda runtime (CPython 3.12 on
 Amazon Linux), so no Docker is needed. boto3 comes from the Lambda runtime and awscrt
 must stay out: botocore imports awscrt whenever it is present, which costs cold start.
@@ -50,6 +50,8 @@ FORBIDDEN_TOP_LEVEL = ("awscrt", "awsiot", "boto3", "botocore", "s3transfer")
 VAHR_FILES = ("vahr/__init__.py", "vahr/errors.py")
 VAHR_PACKAGES = ("vahr/protocol",)
 SKILL_DIR = "lambda/skill"
+# Where `vahr.protocol.fleet` looks for the bundled fleet definition.
+FLEET_IN_BUNDLE = "vahr/protocol/fleet.yaml"
 _IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".mypy_cache", ".pytest_cache")
 _REQUIREMENT = re.compile(r"^\s*([A-Za-z0-9][A-Za-z0-9._-]*)\s*==\s*([^\s;#]+)")
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
@@ -110,7 +112,7 @@ def _source_files(fleet_file: Path) -> list[tuple[Path, str]]:
         for path in sorted((REPO_ROOT / package).rglob("*.py")):
             if "__pycache__" not in path.parts:
                 pairs.append((path, path.relative_to(REPO_ROOT).as_posix()))
-    pairs.append((fleet_file, "fleet.yaml"))
+    pairs.append((fleet_file, FLEET_IN_BUNDLE))
     return pairs
 
 

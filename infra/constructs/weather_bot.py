@@ -12,58 +12,34 @@ from __future__ import annotations
 
 import hashlib
 import json
-import re
 from typing import TYPE_CHECKING
 
-import yaml
 from aws_cdk import aws_iam as iam
 from aws_cdk import aws_iot as iot
 from aws_cdk import aws_lex as lex
 from constructs import Construct
 
+from robot_agent.voice.answers import WeatherAnswers
 from vahr.errors import VahrError
+from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
     from pathlib import Path
 
 LOCALE = "en_US"
-INTENTS = ("sunny", "rainy")
 # Below this confidence Lex answers FallbackIntent, and the robot asks again.
 CONFIDENCE_THRESHOLD = 0.4
 ROLE_ALIAS_CREDENTIAL_SECONDS = 3600
-_NOT_SPOKEN = re.compile(r"[^a-z0-9' ]+")
 
 
 def load_weather_answers(path: Path) -> dict[str, list[str]]:
-    """Sample utterances per intent, normalised the way Lex wants them (lower case, no
+    """Sample utterances per intent, read by the robot's own reader (lower case, no
     punctuation, unique across intents). Raises VahrError naming what is wrong."""
     try:
-        document = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as err:
-        raise VahrError(f"{path}: cannot read the weather answers ({err})") from err
-    intents = document.get("intents") if isinstance(document, dict) else None
-    if not isinstance(intents, dict):
-        raise VahrError(f"{path}: expected `intents: {{sunny: [...], rainy: [...]}}`")
-    answers: dict[str, list[str]] = {}
-    owner: dict[str, str] = {}
-    for intent in INTENTS:
-        phrases = intents.get(intent)
-        if not isinstance(phrases, list) or not phrases:
-            raise VahrError(f"{path}: intents.{intent} must be a non-empty list of phrases")
-        answers[intent] = []
-        for phrase in phrases:
-            spoken = " ".join(_NOT_SPOKEN.sub(" ", str(phrase).lower()).split())
-            if not spoken:
-                raise VahrError(f"{path}: intents.{intent} has an empty phrase {phrase!r}")
-            if owner.get(spoken, intent) != intent:
-                raise VahrError(f"{path}: {phrase!r} is both {owner[spoken]} and {intent}")
-            if spoken not in owner:
-                owner[spoken] = intent
-                answers[intent].append(spoken)
-    unknown = sorted(set(intents) - set(INTENTS))
-    if unknown:
-        raise VahrError(f"{path}: unknown intents {', '.join(unknown)} (only sunny, rainy)")
-    return answers
+        answers = WeatherAnswers.load(path)
+    except SpeechError as err:
+        raise VahrError(str(err)) from err
+    return {intent: list(phrases) for intent, phrases in answers.phrases.items()}
 
 
 class WeatherBot(Construct):

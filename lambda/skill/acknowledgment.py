@@ -18,13 +18,7 @@ import msgspec
 
 from skill.errors import GatewayError
 from skill.logs import log_event
-from vahr.protocol import (
-    LastCommand,
-    ProtocolError,
-    Reported,
-    RobotShadow,
-    robot_shadow_from_payload,
-)
+from vahr.protocol import ProtocolError, RobotShadow, robot_shadow_from_payload
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
@@ -68,37 +62,6 @@ def classify(thing: str, command_id: str, shadow: RobotShadow) -> RobotAnswer | 
     if last.result in ("rejected", "failed", "cancelled"):
         outcome = last.result  # type: ignore[assignment]
     return RobotAnswer(thing, command_id, outcome, last.reason, shadow)
-
-
-class _Acknowledging(msgspec.Struct, frozen=True):
-    last_command: LastCommand | None = None
-    connected: bool = False
-
-
-class _AcknowledgingState(msgspec.Struct, frozen=True):
-    reported: _Acknowledging = _Acknowledging()
-
-
-class _AcknowledgingDocument(msgspec.Struct, frozen=True):
-    state: _AcknowledgingState = _AcknowledgingState()
-
-
-def read_shadow(payload: bytes) -> RobotShadow:
-    """The robot's shadow; if some field breaks the contract, at least what acknowledges.
-
-    A robot that reports a status this skill does not know yet must still be heard
-    acknowledging its command, so only `last_command` and `connected` are required.
-    """
-    try:
-        return robot_shadow_from_payload(payload)
-    except ProtocolError:
-        try:
-            reported = msgspec.json.decode(payload, type=_AcknowledgingDocument).state.reported
-        except (msgspec.ValidationError, msgspec.DecodeError):
-            raise ProtocolError("payload", "the shadow holds no readable last_command") from None
-        return RobotShadow(
-            reported=Reported(last_command=reported.last_command, connected=reported.connected)
-        )
 
 
 def await_acknowledgments(
@@ -162,7 +125,11 @@ def _poll(
             return RobotAnswer(thing, command_id, "unconfirmed", shadow=shadow, error=error)
         try:
             payload = gateway.get_shadow(thing)
-            shadow = read_shadow(payload) if payload is not None else None
+            # Tolerant: a robot reporting a status this skill does not know yet must still
+            # be heard acknowledging its command.
+            shadow = (
+                robot_shadow_from_payload(payload, tolerant=True) if payload is not None else None
+            )
             error = None
         except (GatewayError, ProtocolError) as err:
             error = str(err)

@@ -15,7 +15,6 @@ from ask_sdk_core.skill_builder import SkillBuilder
 
 from skill import logs
 from skill.config import SkillConfig
-from skill.exceptions import CatchAllExceptionHandler
 from skill.handlers.built_in import (
     CancelIntentHandler,
     FallbackIntentHandler,
@@ -25,6 +24,7 @@ from skill.handlers.built_in import (
     SessionEndedRequestHandler,
     StopIntentHandler,
 )
+from skill.handlers.catch_all import CatchAllExceptionHandler
 from skill.handlers.deliver import DeliverIntentHandler
 from skill.handlers.emergency_stop import EmergencyStopIntentHandler
 from skill.handlers.navigate import NavigateIntentHandler

@@ -1,4 +1,5 @@
-"""The skill's small exception hierarchy; `skill.exceptions` maps it to speech in one place."""
+"""The skill's small exception hierarchy; `skill.handlers.catch_all` maps it to speech in one
+place."""
 
 from __future__ import annotations
 
@@ -13,6 +14,10 @@ class ConfigError(SkillError):
 
 class GatewayError(SkillError):
     """AWS IoT (or the local data plane) refused or failed a publish or a shadow call."""
+
+
+class MissingCredentials(GatewayError):
+    """boto3 found no AWS credentials to sign a data-plane call with."""
 
 
 class ShadowConflict(GatewayError):

@@ -1,8 +1,10 @@
-"""The boto3 `iot-data` adapter of the RobotGateway port (the only module importing boto3).
+"""The boto3 `iot-data` adapter of the RobotGateway port: the one wrapper of that client in
+VAHR (the skill's, and the experiment's writer of its thing's shadow, use it alike).
 
 The client is created once at cold start. It honours `AWS_ENDPOINT_URL_IOT_DATA_PLANE` like
 any boto3 client, so the same code talks to AWS IoT Core, to moto, and to the local stack's
 data-plane API. Timeouts are short because the whole answer must reach Alexa within 8 s.
+Library errors become the skill's `GatewayError` family here and nowhere else.
 """
 
 from __future__ import annotations
@@ -11,9 +13,9 @@ from typing import TYPE_CHECKING, Any
 
 import boto3
 from botocore.config import Config
-from botocore.exceptions import BotoCoreError, ClientError, NoRegionError
+from botocore.exceptions import BotoCoreError, ClientError, NoCredentialsError, NoRegionError
 
-from skill.errors import ConfigError, GatewayError, ShadowConflict
+from skill.errors import ConfigError, GatewayError, MissingCredentials, ShadowConflict
 
 if TYPE_CHECKING:
     from skill.config import SkillConfig
@@ -46,6 +48,23 @@ def create_client(config: SkillConfig) -> Any:
         )
 
 
+def client_for(endpoint_url: str | None, *, fallback_region: str = "us-east-1") -> Any:
+    """An iot-data client for tools outside Lambda: boto3's region or `fallback_region`,
+    and at a given endpoint without credentials, placeholder keys (a local data plane does
+    not check signatures, but botocore will not send an unsigned request)."""
+    session = boto3.session.Session()
+    credentials: dict[str, str] = {}
+    if endpoint_url is not None and session.get_credentials() is None:
+        credentials = {"aws_access_key_id": "vahr-local", "aws_secret_access_key": "vahr-local"}
+    return session.client(
+        "iot-data",
+        endpoint_url=endpoint_url,
+        region_name=session.region_name or fallback_region,
+        config=CLIENT_CONFIG,
+        **credentials,
+    )
+
+
 class IotDataGateway:
     """RobotGateway over an iot-data client (thread-safe, as boto3 clients are)."""
 
@@ -60,7 +79,7 @@ class IotDataGateway:
         try:
             self._client.publish(topic=topic, qos=1, payload=payload)
         except (ClientError, BotoCoreError) as err:
-            raise GatewayError(f"publish to {topic} failed: {_describe(err)}") from err
+            raise _failure(f"publish to {topic}", err) from err
 
     def get_shadow(self, thing: str) -> bytes | None:
         try:
@@ -68,9 +87,9 @@ class IotDataGateway:
         except ClientError as err:
             if _code(err) == "ResourceNotFoundException":
                 return None
-            raise GatewayError(f"reading the shadow of {thing} failed: {_describe(err)}") from err
+            raise _failure(f"reading the shadow of {thing}", err) from err
         except BotoCoreError as err:
-            raise GatewayError(f"reading the shadow of {thing} failed: {_describe(err)}") from err
+            raise _failure(f"reading the shadow of {thing}", err) from err
         body: bytes = response["payload"].read()
         return body
 
@@ -80,15 +99,21 @@ class IotDataGateway:
         except ClientError as err:
             if _code(err) == "ConflictException":
                 raise ShadowConflict(f"the shadow of {thing} changed meanwhile") from err
-            raise GatewayError(f"updating the shadow of {thing} failed: {_describe(err)}") from err
+            raise _failure(f"updating the shadow of {thing}", err) from err
         except BotoCoreError as err:
-            raise GatewayError(f"updating the shadow of {thing} failed: {_describe(err)}") from err
+            raise _failure(f"updating the shadow of {thing}", err) from err
         body: bytes = response["payload"].read()
         return body
 
 
 def _code(err: ClientError) -> str:
     return str(err.response.get("Error", {}).get("Code", ""))
+
+
+def _failure(what: str, err: ClientError | BotoCoreError) -> GatewayError:
+    if isinstance(err, NoCredentialsError):
+        return MissingCredentials(f"{what} failed: no AWS credentials")
+    return GatewayError(f"{what} failed: {_describe(err)}")
 
 
 def _describe(err: Exception) -> str:

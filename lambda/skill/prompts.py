@@ -6,10 +6,13 @@ Robot names come from fleet.yaml (their first spoken name) and zone names from
 
 from __future__ import annotations
 
-SKILL_NAME = "robot fleet"
+from vahr.protocol.assistant import INVOCATION_NAME
+from vahr.protocol.weather import WEATHERS
+
+SKILL_NAME = INVOCATION_NAME
 
 WELCOME = (
-    "Welcome to robot fleet. You can send a robot to a zone, have it deliver a package, "
+    f"Welcome to {SKILL_NAME}. You can send a robot to a zone, have it deliver a package, "
     "ask where the robots are, or say emergency stop. What would you like to do?"
 )
 WELCOME_REPROMPT = "For example, say: send {robot} to {zone}. What would you like to do?"
@@ -24,8 +27,8 @@ NEXT = "What else would you like the robots to do?"
 GOODBYE = "Goodbye."
 GOODBYE_ROBOTS_KEEP_GOING = "Goodbye. The robots carry on; to halt them, say emergency stop."
 FALLBACK = (
-    "Sorry, robot fleet can't help with that. You can say: send {robot} to {zone}, or: "
-    "where are the robots?"
+    f"Sorry, {SKILL_NAME} can't help with that. "
+    "You can say: send {robot} to {zone}, or: where are the robots?"
 )
 FALLBACK_REPROMPT = "What would you like the robots to do?"
 
@@ -111,7 +114,7 @@ STATUS_ERROR = "{robot} has a problem."
 STATUS_UNREADABLE = "I could not read the state of {robot}."
 
 # The experiment's weather. The robots recognise these exact openings.
-WEATHER = {"sunny": "The weather is sunny.", "rainy": "The weather is rainy."}
+WEATHER = {weather: f"The weather is {weather}." for weather in WEATHERS}
 
 # Errors, spoken by the catch-all exception handler.
 GATEWAY_ERROR = "Sorry, I could not reach the robots just now. Please try again in a moment."

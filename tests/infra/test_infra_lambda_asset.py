@@ -70,7 +70,8 @@ def test_the_bundle_holds_the_skill_the_protocol_and_the_fleet(
     assert (root / "skill" / "app.py").is_file()
     assert (root / "vahr" / "protocol" / "topics.py").is_file()
     assert (root / "vahr" / "errors.py").is_file()
-    assert (root / "fleet.yaml").read_bytes() == (REPO_ROOT / "fleet.yaml").read_bytes()
+    fleet = root / "vahr" / "protocol" / "fleet.yaml"
+    assert fleet.read_bytes() == (REPO_ROOT / "fleet.yaml").read_bytes()
     assert not (root / "vahr" / "local").exists()  # only what the skill needs
 
 
@@ -108,7 +109,7 @@ def test_a_clean_python_3_12_imports_the_handler_from_the_bundle_alone(
     assert seen["handler"] is True
     assert seen["version"] == [3, 12]
     assert all(file.startswith(str(bundle.out_dir)) for file in seen["files"]), seen["files"]
-    assert seen["fleet"] == str(bundle.out_dir / "fleet.yaml")
+    assert seen["fleet"] == str(bundle.out_dir / "vahr" / "protocol" / "fleet.yaml")
     assert seen["awscrt"] is False
 
 

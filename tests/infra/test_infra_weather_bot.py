@@ -81,9 +81,12 @@ def test_robots_credentials_allow_only_recognize_text_on_the_alias(
     ("text", "message"),
     [
         ("intents: {sunny: [It is sunny.]}", "intents.rainy must be a non-empty list"),
-        ("intents: {sunny: [Sunny!], rainy: [sunny]}", "'sunny' is both sunny and rainy"),
-        ("intents: {sunny: [a], rainy: [b], snowy: [c]}", "unknown intents snowy"),
-        ("answers: []", "expected `intents: {sunny: [...], rainy: [...]}`"),
+        (
+            "intents: {sunny: [Sunny!], rainy: [sunny]}",
+            "'sunny' is listed under both sunny and rainy",
+        ),
+        ("intents: {sunny: [a], rainy: [b], snowy: [c]}", "unknown intents ['snowy']"),
+        ("answers: []", "expected a mapping `intents: {sunny: [...], ...}`"),
         ("intents: {sunny: ['...'], rainy: [b]}", "intents.sunny has an empty phrase"),
     ],
 )

@@ -125,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         plan = session.plan
         if not args.no_shadow:
-            from vahr.experiment.shadow_store import ExperimentShadow
+            from vahr.experiment.experiment_shadow import ExperimentShadow
 
             ExperimentShadow(fleet, endpoint_url=args.api).write(plan.experiment_state(spec.name))
         summary: dict[str, Any] = {

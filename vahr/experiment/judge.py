@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 from vahr.experiment.eventlog import Kind
 from vahr.experiment.metrics import rate
+from vahr.protocol import WEATHERS
 
 if TYPE_CHECKING:
     from datetime import datetime
@@ -334,7 +335,7 @@ def judge_communication(entries: list[LogEntry]) -> Tally:
                 failures.append(f"{said!r}: {why}")
         elif entry.kind == Kind.ROBOT_EVENT and entry.data.get("event") == "interpreted":
             total += 1
-            if entry.data.get("intent") in {"sunny", "rainy"}:
+            if entry.data.get("intent") in WEATHERS:
                 successes += 1
             else:
                 failures.append(

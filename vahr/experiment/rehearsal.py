@@ -115,7 +115,7 @@ def rehearse(
     session = open_session(spec, fleet)
     try:
         if write_shadow:
-            from vahr.experiment.shadow_store import ExperimentShadow
+            from vahr.experiment.experiment_shadow import ExperimentShadow
 
             shadow = ExperimentShadow(fleet, endpoint_url=data_plane_url)
             shadow.write(session.plan.experiment_state(spec.name))

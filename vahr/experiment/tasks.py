@@ -17,15 +17,14 @@ import random
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
-from vahr.protocol import ExperimentState
+from vahr.protocol import WEATHER_ZONES, WEATHERS, ExperimentState
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.protocol import Fleet, Weather
 
 TaskId = Literal["I", "II", "III"]
 TASKS: tuple[TaskId, ...] = ("I", "II", "III")
 METHODS = ("vahr", "keyboard")
-WEATHER_ZONES = {"sunny": "A", "rainy": "C"}
 SEQUENCE_ZONE = "D"
 
 TASK_TITLES = {
@@ -58,7 +57,7 @@ class Plan:
 
     seed: int
     assignments: dict[str, str]
-    weather: Literal["sunny", "rainy"]
+    weather: Weather
     weather_robot: str
     goals: dict[str, TaskGoal] = field(default_factory=dict)
 
@@ -115,7 +114,7 @@ def draw_plan(fleet: Fleet, seed: int) -> Plan:
     else:
         assigned = [rng.choice(zones) for _ in robots]
     assignments = dict(zip(robots, assigned, strict=True))
-    weather: Literal["sunny", "rainy"] = rng.choice(("sunny", "rainy"))
+    weather: Weather = rng.choice(WEATHERS)
     first, second = robots[0], robots[1]
     goals = {
         "I": TaskGoal(task="I", zones=dict(assignments)),

@@ -19,6 +19,7 @@ import threading
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from vahr.protocol.assistant import INVOCATION_NAME, WAKE_WORD
 from vahr.speech.room import RoomChannel, Utterance
 
 if TYPE_CHECKING:
@@ -30,11 +31,9 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-WAKE_WORD = "alexa"
-INVOCATION = "robot fleet"
 # What robots say to the assistant (normalized); the executor asks the first one.
 QUESTIONS = tuple(
-    f"{WAKE_WORD} ask {INVOCATION} {question}"
+    f"{WAKE_WORD} ask {INVOCATION_NAME} {question}"
     for question in (
         "what the weather is",
         "what is the weather",

@@ -12,11 +12,10 @@ import msgspec
 from vahr.protocol.errors import ProtocolError, from_validation_error
 from vahr.protocol.topics import check_thing
 
-# The bundled fleet definition: the repository root in a checkout, the asset root in the
-# Lambda bundle (the build script copies fleet.yaml next to the vahr package). os.path
-# rather than pathlib because this module is on the Lambda's cold-start path.
-_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # noqa: PTH100, PTH120
-DEFAULT_FLEET_FILE = os.path.join(_ROOT, "fleet.yaml")  # noqa: PTH118
+# The bundled fleet definition, next to this module: in a checkout a link to the repository's
+# fleet.yaml, in the wheel and the Lambda bundle a copy of it. os.path rather than pathlib
+# because this module is on the Lambda's cold-start path.
+DEFAULT_FLEET_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fleet.yaml")  # noqa: PTH100, PTH118, PTH120
 
 SpokenNames = Annotated[
     list[Annotated[str, msgspec.Meta(min_length=1)]], msgspec.Meta(min_length=1)

@@ -74,17 +74,47 @@ class _Document(msgspec.Struct, frozen=True):
     version: int | None = None
 
 
+class _Acknowledging(msgspec.Struct, frozen=True):
+    last_command: LastCommand | None = None
+    connected: bool = False
+
+
+class _AcknowledgingState(msgspec.Struct, frozen=True):
+    reported: _Acknowledging = _Acknowledging()
+
+
+class _AcknowledgingDocument(msgspec.Struct, frozen=True):
+    state: _AcknowledgingState = _AcknowledgingState()
+
+
 _document_decoder = msgspec.json.Decoder(_Document)
+_acknowledging_decoder = msgspec.json.Decoder(_AcknowledgingDocument)
 
 
-def robot_shadow_from_payload(payload: bytes | bytearray | memoryview) -> RobotShadow:
-    """Read a shadow document (get/accepted, update/accepted, GetThingShadow's payload)."""
+def robot_shadow_from_payload(
+    payload: bytes | bytearray | memoryview, *, tolerant: bool = False
+) -> RobotShadow:
+    """Read a robot's shadow document (get/accepted, update/accepted, GetThingShadow).
+
+    Strict by default: any field that breaks the contract is a ProtocolError naming it.
+    `tolerant` keeps what acknowledges a command when another field breaks the contract
+    (a robot reporting a status this reader does not know yet must still be heard
+    acknowledging), so only `last_command` and `connected` must be readable then.
+    """
     # No 8 KB rule here: the state is limited, but a whole document with its metadata may be
     # larger. msgspec rejects bytes that are not UTF-8 JSON itself.
     try:
         document = _document_decoder.decode(payload)
     except (msgspec.ValidationError, msgspec.DecodeError) as err:
-        raise from_validation_error(err) from err
+        if not tolerant:
+            raise from_validation_error(err) from err
+        try:
+            reported = _acknowledging_decoder.decode(payload).state.reported
+        except (msgspec.ValidationError, msgspec.DecodeError):
+            raise ProtocolError("payload", "the shadow holds no readable last_command") from None
+        return RobotShadow(
+            reported=Reported(last_command=reported.last_command, connected=reported.connected)
+        )
     return RobotShadow(
         reported=document.state.reported, desired=document.state.desired, version=document.version
     )

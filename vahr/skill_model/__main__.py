@@ -10,7 +10,8 @@ from vahr.errors import VahrError
 from vahr.protocol import DEFAULT_FLEET_FILE, Fleet, ProtocolError
 from vahr.skill_model.generator import drift, write
 
-DEFAULT_ROOT = Path(DEFAULT_FLEET_FILE).parent
+# In a checkout the bundled fleet is a link to the repository's fleet.yaml, at its root.
+DEFAULT_ROOT = Path(DEFAULT_FLEET_FILE).resolve().parent
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -24,7 +25,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--fleet",
         type=Path,
-        default=Path(DEFAULT_FLEET_FILE),
+        default=Path(DEFAULT_FLEET_FILE).resolve(),
         help="fleet file (default: %(default)s)",
     )
     parser.add_argument(

@@ -15,10 +15,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from vahr.errors import VahrError
+from vahr.protocol.assistant import INVOCATION_NAME
 from vahr.skill_model.intents import (
     BUILT_IN_INTENTS,
     CUSTOM_INTENTS,
-    INVOCATION_NAME,
     LOCALE,
     ROBOT_TYPE,
     ZONE_TYPE,

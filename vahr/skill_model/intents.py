@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-INVOCATION_NAME = "robot fleet"
 LOCALE = "en-US"
 ROBOT_TYPE = "ROBOT"
 ZONE_TYPE = "ZONE"
@@ -230,7 +229,7 @@ WEATHER = IntentSpec(
         "is it rainy",
         "is it raining",
         "what's the weather for the experiment",
-        # The robots' own question (robot_agent's WEATHER_QUESTION) and its variants.
+        # The robots' own question (vahr.protocol.assistant.WEATHER_QUESTION) and its variants.
         "what the weather is",
         "what the weather is like",
         "tell me what the weather is",

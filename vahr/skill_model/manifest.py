@@ -10,7 +10,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from vahr.skill_model.intents import INVOCATION_NAME, LOCALE
+from vahr.protocol.assistant import INVOCATION_NAME
+from vahr.skill_model.intents import LOCALE
 
 SKILL_NAME = "VAHR Robot Fleet"
 

@@ -8,8 +8,8 @@ from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_intent_name
 
 from skill import prompts
-from skill.experiment import current_weather
 from skill.responses import answer
+from skill.weather import current_weather
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput

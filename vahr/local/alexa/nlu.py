@@ -19,12 +19,9 @@ from typing import Any
 
 from vahr.errors import VahrError
 
+# The interaction model ships with the package (in a checkout, a link to skill-package/).
 DEFAULT_MODEL = (
-    Path(__file__).resolve().parents[3]
-    / "skill-package"
-    / "interactionModels"
-    / "custom"
-    / "en-US.json"
+    Path(__file__).with_name("skill-package") / "interactionModels" / "custom" / "en-US.json"
 )
 FALLBACK = "AMAZON.FallbackIntent"
 # The phrases Alexa's built-in intents answer to (a representative subset).

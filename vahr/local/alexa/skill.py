@@ -1,19 +1,15 @@
 """Load the skill's Lambda handler in-process, configured for the local data plane.
 
-`lambda/` is the skill's code root (a Python keyword, so not importable as a package);
-this is the one place that puts it on `sys.path`.
+The skill (`lambda/skill` in the repository) is installed with the package as `skill`,
+the name Lambda imports it by too.
 """
 
 from __future__ import annotations
 
 import os
-import sys
-from pathlib import Path
 from typing import Any
 
 from vahr.errors import VahrError
-
-LAMBDA_ROOT = Path(__file__).resolve().parents[3] / "lambda"
 
 SkillHandler = Any
 
@@ -33,13 +29,11 @@ def load_skill_handler(
     if not (os.environ.get("AWS_ACCESS_KEY_ID") or os.environ.get("AWS_PROFILE")):
         os.environ["AWS_ACCESS_KEY_ID"] = "vahr-local"
         os.environ["AWS_SECRET_ACCESS_KEY"] = "vahr-local"
-    if str(LAMBDA_ROOT) not in sys.path:
-        sys.path.insert(0, str(LAMBDA_ROOT))
     try:
         from skill.app import make_lambda_handler
         from skill.config import SkillConfig
     except ImportError as err:
-        raise VahrError(f"the skill handler cannot be imported from {LAMBDA_ROOT}: {err}") from err
+        raise VahrError(f"the skill handler cannot be imported ({err}): reinstall vahr") from err
     settings: dict[str, Any] = {
         "data_endpoint": api_url,
         "skill_id": skill_id,

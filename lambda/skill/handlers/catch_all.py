@@ -1,4 +1,6 @@
-"""The one catch-all exception handler: log the failure, speak a safe sentence."""
+"""The one catch-all exception handler: log the failure, speak a safe sentence.
+
+It maps the skill's error hierarchy (`skill.errors`) to speech in one place."""
 
 from __future__ import annotations
 

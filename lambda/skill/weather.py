@@ -15,13 +15,12 @@ import msgspec
 
 from skill.errors import ShadowConflict
 from skill.logs import log_event
-from vahr.protocol import ExperimentState, experiment_state_from_payload
+from vahr.protocol import WEATHERS, ExperimentState, experiment_state_from_payload
 
 if TYPE_CHECKING:
     from skill.gateway import RobotGateway
     from vahr.protocol import Weather
 
-WEATHERS: tuple[Weather, ...] = ("sunny", "rainy")
 ATTEMPTS = 3
 
 
