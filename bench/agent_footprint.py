@@ -33,6 +33,7 @@ sys.path.insert(0, str(ROOT))
 
 from vahr.local.broker import BrokerConfig, Mosquitto  # noqa: E402
 from vahr.local.ports import free_port  # noqa: E402
+from vahr.protocol import topics  # noqa: E402
 
 THING = "placebot1"
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
@@ -67,7 +68,7 @@ class Probe:
         self._client.connect("127.0.0.1", port)
         self._client.loop_start()
         self._client.subscribe(
-            [(f"$aws/things/{THING}/shadow/update", 1), (f"vahr/robots/{THING}/presence", 1)]
+            [(topics.shadow(THING, "update"), 1), (topics.robot_presence(THING), 1)]
         )
 
     @staticmethod
@@ -105,7 +106,7 @@ class Probe:
             }
         )
         sent = time.perf_counter()
-        self._client.publish(f"vahr/robots/{THING}/cmd", payload, qos=1)
+        self._client.publish(topics.robot_cmd(THING), payload, qos=1)
         if not arrived.wait(5):
             raise RuntimeError(f"no acknowledgment for {action} {command_id}")
         return (self._arrived.pop(command_id) - sent) * 1000
@@ -138,7 +139,7 @@ def swarm_fan_out(port: int, count: int, rounds: int) -> list[float]:
     client.on_message = on_message
     client.connect("127.0.0.1", port)
     client.loop_start()
-    client.subscribe("$aws/things/+/shadow/update", qos=1)
+    client.subscribe(topics.ALL_SHADOW_UPDATES, qos=1)
     times: list[float] = []
     try:
         with SwarmThread(broker=f"mqtt://127.0.0.1:{port}", count=count):
@@ -156,7 +157,7 @@ def swarm_fan_out(port: int, count: int, rounds: int) -> list[float]:
                     }
                 )
                 sent = time.perf_counter()
-                client.publish("vahr/fleet/cmd", payload, qos=1)
+                client.publish(topics.FLEET_CMD, payload, qos=1)
                 if not done[command_id].wait(30):
                     raise RuntimeError("the swarm did not acknowledge a fleet ping")
                 times.append((arrived[command_id] - sent) * 1000)

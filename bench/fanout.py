@@ -86,7 +86,7 @@ def run_size(stack: LocalStack, size: int, runs: int) -> list[float]:
     data = boto3.client("iot-data", endpoint_url=stack.api_url, region_name="us-east-1")
     timings: list[float] = []
     with MqttClient(stack.service_endpoint()) as watcher:
-        watcher.subscribe("$aws/things/+/shadow/update/accepted", acks.on_accepted)
+        watcher.subscribe(topics.ALL_SHADOW_UPDATES_ACCEPTED, acks.on_accepted)
         context = multiprocessing.get_context("spawn")
         ready, stop = context.Event(), context.Event()
         robots = context.Process(target=swarm_process, args=(stack.mqtt_url, size, ready, stop))

@@ -27,6 +27,7 @@ from vahr.local.client import say  # noqa: E402
 from vahr.local.mqtt import MqttClient  # noqa: E402
 from vahr.local.ports import free_port  # noqa: E402
 from vahr.local.system import LocalSystem, SystemConfig  # noqa: E402
+from vahr.protocol import topics  # noqa: E402
 
 ZONES = ("zone b", "zone c", "zone d", "zone a")
 
@@ -104,7 +105,7 @@ def main() -> int:
             assert system.stack.dataplane is not None
             system.stack.dataplane.publish_observers.append(clock.on_publish)
             watcher = MqttClient(system.stack.service_endpoint()).connect()
-            watcher.subscribe("$aws/things/placebot1/shadow/update/accepted", clock.on_accepted)
+            watcher.subscribe(topics.shadow("placebot1", "update/accepted"), clock.on_accepted)
             say(api, "Alexa, ask robot fleet where is robot one")  # warm the skill up
             latencies: list[float] = []
             unacknowledged = 0

@@ -32,13 +32,16 @@ def render_acl(*, service_user: str = SERVICE_COMMON_NAME, open_anonymous: bool 
     if open_anonymous:
         # Lines before the first `user` apply to anonymous clients only: the plaintext
         # development listener on loopback. `#` does not match `$aws/...`, hence both.
-        lines += ["topic readwrite #", "topic readwrite $aws/#"]
+        lines += [
+            f"topic readwrite {topics.EVERY_TOPIC}",
+            f"topic readwrite {topics.EVERY_AWS_TOPIC}",
+        ]
     lines += [
         "",
         "# The local services (shadow service, data plane, simulator).",
         f"user {service_user}",
-        "topic readwrite #",
-        "topic readwrite $aws/#",
+        f"topic readwrite {topics.EVERY_TOPIC}",
+        f"topic readwrite {topics.EVERY_AWS_TOPIC}",
         "",
         "# Every robot, by certificate common name (= thing name).",
         f"pattern read {_pattern(topics.robot_cmd(_PLACEHOLDER))}",

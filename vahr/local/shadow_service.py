@@ -28,15 +28,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-# Request topics only: subscribing to `shadow/#` would echo our own answers back to us.
-REQUEST_FILTERS = (
-    "$aws/things/+/shadow/update",
-    "$aws/things/+/shadow/get",
-    "$aws/things/+/shadow/delete",
-    "$aws/things/+/shadow/name/+/update",
-    "$aws/things/+/shadow/name/+/get",
-    "$aws/things/+/shadow/name/+/delete",
-)
+REQUEST_FILTERS = topics.shadow_request_filters()
 
 
 def _encode(body: object) -> bytes:

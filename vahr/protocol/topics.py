@@ -9,6 +9,10 @@ ALL_ROBOT_CMDS = "vahr/robots/+/cmd"
 ALL_EVENTS = "vahr/robots/+/events"
 ALL_PRESENCE = "vahr/robots/+/presence"
 ALL_SHADOW_UPDATES = "$aws/things/+/shadow/update"
+ALL_SHADOW_UPDATES_ACCEPTED = "$aws/things/+/shadow/update/accepted"
+# Every topic: `#` does not match topics that start with `$`, so AWS's need their own filter.
+EVERY_TOPIC = "#"
+EVERY_AWS_TOPIC = "$aws/#"
 
 # AWS IoT thing names: 1-128 of letters, digits, colon, underscore and hyphen. Anything
 # else (notably `/`, `+` and `#`) would change the meaning of a topic.
@@ -68,6 +72,16 @@ def shadow(thing: str, operation: str, name: str | None = None) -> str:
             raise ValueError(f"name: {name!r} is not a valid shadow name")
         base = f"{base}/name/{name}"
     return f"{base}/{operation}"
+
+
+def shadow_request_filters() -> tuple[str, ...]:
+    """The requests a shadow service answers (update, get, delete), classic and named, of
+    every thing; not `shadow/#`, which would echo the service's own answers back to it."""
+    return tuple(
+        f"$aws/things/+/shadow/{named}{operation}"
+        for named in ("", "name/+/")
+        for operation in ("update", "get", "delete")
+    )
 
 
 def shadow_filter(thing: str = "+") -> str:
