@@ -112,6 +112,15 @@ class LexSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, froz
     ca: str | None = None
 
 
+class ListenSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+    """When an answer heard through the sound device starts and ends (`DeviceVoice`)."""
+
+    trailing_silence_ms: PositiveInt = 800
+    max_utterance_s: Positive = 15.0
+    # Audio kept from before the first loud frame: the start of a word is quiet.
+    pre_roll_ms: NonNegativeInt = 300
+
+
 class VoiceSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
     """The robot's voice (`robot_agent.voice.factories`)."""
 
@@ -122,6 +131,7 @@ class VoiceSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, fr
     # The sound device's player and recorder commands (default aplay / arecord).
     play_command: tuple[str, ...] | None = None
     record_command: tuple[str, ...] | None = None
+    listen: ListenSettings = ListenSettings()
     interpreter: Literal["local", "lex"] = "local"
     lex: LexSettings = LexSettings()
 

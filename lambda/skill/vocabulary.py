@@ -9,13 +9,14 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
+
 if TYPE_CHECKING:
     from vahr.protocol import Fleet, Zone
 
 # The ROBOT slot value (and target) that means every robot; it matches the generator's id.
-FLEET = "all"
-FLEET_GROUP = "all"
-DEFAULT_FLEET_NAMES = ("all robots", "every robot", "everyone")
+FLEET = FLEET_GROUP
+DEFAULT_FLEET_NAMES = FLEET_GROUP_NAMES
 # Packages are picked up here, so it is never a delivery destination.
 LOADING = "LOADING"
 

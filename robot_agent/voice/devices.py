@@ -15,9 +15,9 @@ import select
 import shutil
 import subprocess
 import time
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from robot_agent.config import ListenSettings
 from robot_agent.voice.port import Heard
 from vahr.speech.audio import (
     FRAME_MS,
@@ -51,16 +51,6 @@ def default_recorder() -> list[str]:
     if shutil.which("arecord"):
         return ["arecord", "-q", "-t", "raw", "-f", "S16_LE", "-r", str(SAMPLE_RATE), "-c", "1"]
     raise SpeechError("no audio recorder: install alsa-utils (arecord) or set VAHR_RECORD_COMMAND")
-
-
-@dataclass(frozen=True)
-class ListenSettings:
-    """When an answer starts and ends."""
-
-    trailing_silence_ms: int = 800
-    max_utterance_s: float = 15.0
-    # Audio kept from before the first loud frame: the start of a word is quiet.
-    pre_roll_ms: int = 300
 
 
 class DeviceVoice:

@@ -92,4 +92,5 @@ def device(*, thing: str, config: AgentConfig) -> DeviceVoice:
         understanding_for(thing, config),
         player=voice.play_command or default_player(),
         recorder=voice.record_command or default_recorder(),
+        settings=voice.listen,
     )

@@ -33,6 +33,7 @@ from robot_agent.core.clock import ScaledClock
 from robot_agent.core.recent_ids import RecentIds
 from vahr.errors import VahrError
 from vahr.protocol import (
+    FLEET_GROUP,
     Fleet,
     Group,
     Pose,
@@ -75,7 +76,7 @@ def swarm_fleet(count: int, *, prefix: str = "swarm", base: Fleet | None = None)
     return Fleet(
         robots=robots,
         zones=base.zones,
-        groups=[Group(id="all", spoken=["all robots"], robots=things)],
+        groups=[Group(id=FLEET_GROUP, spoken=["all robots"], robots=things)],
         experiment_thing=base.experiment_thing,
     ).validate()
 

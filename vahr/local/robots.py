@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from vahr.errors import VahrError
-from vahr.protocol import Fleet, Group, Pose, Robot, load_fleet
+from vahr.protocol import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
 
 if TYPE_CHECKING:
     from vahr.pki import LocalCA
@@ -48,12 +48,12 @@ def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
         Group(id=group.id, spoken=group.spoken, robots=[t for t in group.robots if t in things])
         for group in base.groups
     ]
-    if not any(group.id == "all" for group in groups):
-        groups.append(Group(id="all", spoken=["all robots"], robots=things))
+    if not any(group.id == FLEET_GROUP for group in groups):
+        groups.append(Group(id=FLEET_GROUP, spoken=["all robots"], robots=things))
     groups = [
-        Group(id=g.id, spoken=g.spoken, robots=things if g.id == "all" else g.robots)
+        Group(id=g.id, spoken=g.spoken, robots=things if g.id == FLEET_GROUP else g.robots)
         for g in groups
-        if g.robots or g.id == "all"
+        if g.robots or g.id == FLEET_GROUP
     ]
     return Fleet(
         robots=robots, zones=base.zones, groups=groups, experiment_thing=base.experiment_thing

@@ -12,7 +12,17 @@ from __future__ import annotations
 
 from vahr.protocol import topics
 from vahr.protocol.errors import ProtocolError
-from vahr.protocol.fleet import DEFAULT_FLEET_FILE, Fleet, Group, Pose, Robot, Zone, load_fleet
+from vahr.protocol.fleet import (
+    DEFAULT_FLEET_FILE,
+    FLEET_GROUP,
+    FLEET_GROUP_NAMES,
+    Fleet,
+    Group,
+    Pose,
+    Robot,
+    Zone,
+    load_fleet,
+)
 from vahr.protocol.messages import (
     ACTIONS,
     MAX_PAYLOAD_BYTES,
@@ -57,6 +67,8 @@ from vahr.protocol.weather import WEATHER_ZONES, WEATHERS
 __all__ = [
     "ACTIONS",
     "DEFAULT_FLEET_FILE",
+    "FLEET_GROUP",
+    "FLEET_GROUP_NAMES",
     "MAX_PAYLOAD_BYTES",
     "MOTION_ACTIONS",
     "Command",

@@ -17,6 +17,12 @@ from vahr.protocol.topics import check_thing
 # because this module is on the Lambda's cold-start path.
 DEFAULT_FLEET_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fleet.yaml")  # noqa: PTH100, PTH118, PTH120
 
+# The group, and the ROBOT slot value, that mean every robot (commands to it go out once, on
+# the fleet topic `topics.FLEET_CMD`).
+FLEET_GROUP = "all"
+# What people call every robot when fleet.yaml names no such group.
+FLEET_GROUP_NAMES = ("all robots", "every robot", "everyone")
+
 SpokenNames = Annotated[
     list[Annotated[str, msgspec.Meta(min_length=1)]], msgspec.Meta(min_length=1)
 ]

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from vahr.errors import VahrError
+from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
 from vahr.protocol.assistant import INVOCATION_NAME
 from vahr.skill_model.intents import (
     BUILT_IN_INTENTS,
@@ -30,9 +31,9 @@ if TYPE_CHECKING:
     from vahr.protocol import Fleet
 
 # The ROBOT value that means every robot; the skill publishes once on the fleet topic for it.
-FLEET_ROBOT_ID = "all"
-FLEET_GROUP_ID = "all"
-DEFAULT_FLEET_NAMES = ("all robots", "every robot", "everyone")
+FLEET_ROBOT_ID = FLEET_GROUP
+FLEET_GROUP_ID = FLEET_GROUP
+DEFAULT_FLEET_NAMES = FLEET_GROUP_NAMES
 
 PACKAGE_DIR = Path("skill-package")
 MODEL_PATH = PACKAGE_DIR / "interactionModels" / "custom" / f"{LOCALE}.json"

@@ -9,7 +9,8 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from robot_agent.voice.devices import DeviceVoice, ListenSettings
+from robot_agent.config import ListenSettings
+from robot_agent.voice.devices import DeviceVoice
 from vahr.speech.audio import Audio, concatenate
 from vahr.speech.errors import SpeechError
 from vahr.speech.tts import EspeakSynthesizer
