@@ -208,7 +208,9 @@ class Executor:
                 await self._stop(command)
                 return
             if isinstance(command, Navigate):
-                await self._drive(command, self.fleet.zone(command.params.zone))
+                zone = self.fleet.zone(command.params.zone)
+                await self._drive(command, zone)
+                await self._arm_on_arrival(command, zone)
                 self._update(status="idle")
             elif isinstance(command, Deliver):
                 await self._deliver(command, self.fleet.zone(command.params.zone))
@@ -317,16 +319,33 @@ class Executor:
         loading = self.fleet.zone("LOADING")
         if not self.state.cargo:
             await self._drive(command, loading)
-            self._update(status="loading")
-            await self.backend.operate_arm(loading)
-            self._update(cargo=True)
-            self._emit("loaded", command, zone=loading.id)
+            await self._load(command, loading)
         self._update(destination=zone.id)
         await self._drive(command, zone)
+        # A delivery ends unloaded wherever it was sent, whatever arm the zone has.
+        await self._unload(command, zone)
+
+    async def _load(self, command: Command, zone: Zone) -> None:
+        self._update(status="loading")
+        await self.backend.operate_arm(zone)
+        self._update(cargo=True)
+        self._emit("loaded", command, zone=zone.id)
+
+    async def _unload(self, command: Command, zone: Zone) -> None:
         self._update(status="unloading")
         await self.backend.operate_arm(zone)
         self._update(status="idle", cargo=False)
         self._emit("delivered", command, zone=zone.id, pose=self.backend.pose)
+
+    async def _arm_on_arrival(self, command: Command, zone: Zone) -> None:
+        """The zone's arm acts on its own when a robot arrives, as on the paper's floor:
+        the loader loads an empty robot, an unloader unloads a loaded one; otherwise the
+        arm leaves the robot alone. A plain `navigate` is therefore enough to load at
+        LOADING and to deliver at a zone (the keyboard-and-mouse procedure relies on it)."""
+        if zone.arm == "loader" and not self.state.cargo:
+            await self._load(command, zone)
+        elif zone.arm == "unloader" and self.state.cargo:
+            await self._unload(command, zone)
 
     async def _sequential(self, command: SequentialDelivery) -> None:
         after = command.params.after

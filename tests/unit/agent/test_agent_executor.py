@@ -319,3 +319,30 @@ async def test_no_progress_is_reported_for_a_task_after_its_cancelled_event(flee
     await asyncio.sleep(0.05)
     kinds = rec.kinds("first")
     assert kinds[-1] == "cancelled", kinds[-5:]
+
+
+async def test_the_zones_arms_act_on_a_robot_that_navigates_there(fleet: Fleet) -> None:
+    # Given an empty robot, as on the paper's floor where arms act on arrival
+    executor, rec, _ = make_executor(fleet)
+    # When it is only navigated: to the loading zone, then to zone B, then to zone C
+    executor.execute(cmd("navigate", {"zone": "LOADING"}, "to-loading"))
+    await executor.wait_idle()
+    executor.execute(cmd("navigate", {"zone": "B"}, "to-b"))
+    await executor.wait_idle()
+    executor.execute(cmd("navigate", {"zone": "C"}, "to-c"))
+    await executor.wait_idle()
+    # Then the loader loaded it on arrival and B's arm unloaded it; C's arm had nothing to take
+    milestones = [
+        (e.event, e.zone, e.command_id)
+        for e in rec.events
+        if e.event in {"arrived", "loaded", "delivered"}
+    ]
+    assert milestones == [
+        ("arrived", "LOADING", "to-loading"),
+        ("loaded", "LOADING", "to-loading"),
+        ("arrived", "B", "to-b"),
+        ("delivered", "B", "to-b"),
+        ("arrived", "C", "to-c"),
+    ]
+    final = rec.states[-1]
+    assert (final.status, final.zone, final.cargo) == ("idle", "C", False)
