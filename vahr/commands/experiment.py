@@ -151,9 +151,9 @@ def _show_plan(name: str, plan: dict[str, Any], resumed: bool, method: str) -> N
     for thing, zone in plan["assignments"].items():
         print(f"  task I: {thing} delivers to zone {zone}")
     if method == "keyboard":
-        print(f"  task II: the weather is {plan['weather']}")
+        print("  task II: ask the assistant for the weather for each robot, then deliver")
     else:
-        print(f"  task II: {plan['weather_robot']} asks the assistant for the weather")
+        print("  task II: each robot asks the assistant for the weather and delivers")
     print("  task III: both robots deliver to zone D, the first robot first")
 
 

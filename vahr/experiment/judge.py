@@ -4,6 +4,11 @@
 - Task II: sunny -> zone A, rainy -> zone C; a wrong zone is a failure to interpret the
   assistant.
 - Task III: both robots deliver to zone D, placebot1 first; the other order fails.
+- In sessions run with the paper's procedures (the header's `procedure`), a task also fails
+  when its orders break the method's procedure (`vahr.experiment.procedures.conformance`):
+  a command the method does not use in the task, or an order given before what it must
+  follow was visible (a robot sent on before it was loaded, placebot2 sent before
+  placebot1 delivered).
 
 A robot's first delivery inside the task decides for that robot (a package delivered to the
 wrong zone cannot be taken back); only deliveries that complete a command issued during the
@@ -23,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 from vahr.experiment.eventlog import Kind
 from vahr.experiment.metrics import rate
+from vahr.experiment.procedures import PROCEDURE, conformance, heard_weather, procedure_for
 from vahr.protocol import WEATHERS
 
 if TYPE_CHECKING:
@@ -264,7 +270,10 @@ def _failure_context(window: TaskWindow, waiting: list[str]) -> str:
     return ""
 
 
-def judge_task(window: TaskWindow, goal: TaskGoal, plan: Plan) -> TaskOutcome:
+def judge_task(
+    window: TaskWindow, goal: TaskGoal, plan: Plan, header: dict[str, Any] | None = None
+) -> TaskOutcome:
+    """Score one task; `header` (the session's) says which procedure its orders follow."""
     hint = ""
     if goal.task == "II":
         hint = f"the weather was {plan.weather}: a failure to interpret the assistant"
@@ -277,6 +286,13 @@ def judge_task(window: TaskWindow, goal: TaskGoal, plan: Plan) -> TaskOutcome:
         reason = f"the task {how} before {', '.join(waiting)} delivered"
         reason += _failure_context(window, waiting)
         success = False
+    if header is not None and header.get("procedure") == PROCEDURE:
+        procedure = procedure_for(str(header.get("method")), goal.task, plan, None)
+        robots = [str(r) for r in header.get("robots") or goal.zones]
+        problems = conformance(procedure, window.entries, robots)
+        if problems:
+            reason = "; ".join(problems) + (f"; {reason}" if not success else "")
+            success = False
     led_on: bool | None = None
     if goal.order:
         led_on = False
@@ -325,9 +341,15 @@ def judge_communication(entries: list[LogEntry]) -> Tally:
     for entry in entries:
         if entry.kind == Kind.INTERACTION_ENDED:
             if not entry.data.get("counts", True):
-                continue  # a click that only selects (a robot, a zone) sends nothing by design
+                continue  # a glance, or a click that only selects, sends nothing by design
             total += 1
-            if entry.data.get("commands") and not entry.data.get("error"):
+            if entry.data.get("asks") and not entry.data.get("error"):
+                # A question to the assistant succeeds when its answer names the weather.
+                if heard_weather(str(entry.data.get("speech", ""))) is not None:
+                    successes += 1
+                else:
+                    failures.append(f"{entry.data.get('text')!r}: the answer named no weather")
+            elif entry.data.get("commands") and not entry.data.get("error"):
                 successes += 1
             else:
                 said = entry.data.get("text") or entry.data.get("id")
@@ -347,11 +369,12 @@ def judge_communication(entries: list[LogEntry]) -> Tally:
 def judge_session(entries: list[LogEntry], plan: Plan) -> SessionVerdict:
     """Score every task of the plan (a task never started fails), commands and communication."""
     windows = task_windows(entries)
+    header = next((e.data for e in entries if e.kind == Kind.SESSION_STARTED), None)
     outcomes: dict[str, TaskOutcome] = {}
     for task, goal in plan.goals.items():
         window = windows.get(task)
         if window is None:
             outcomes[task] = TaskOutcome(task, False, "the task was not run", None, None)
         else:
-            outcomes[task] = judge_task(window, goal, plan)
+            outcomes[task] = judge_task(window, goal, plan, header)
     return SessionVerdict(outcomes, judge_commands(entries), judge_communication(entries))

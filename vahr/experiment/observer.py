@@ -3,17 +3,24 @@
 The observer sits beside the participant and marks what the log cannot see by itself, one
 short line each (read with a timeout, so the session never blocks on the keyboard):
 
-    u              the participant starts speaking to the assistant (voice method)
-    r              the assistant's reply has ended
+    u              the participant starts speaking to the assistant (both methods:
+                   the keyboard-and-mouse method asks it for the weather in task II)
+    w              the participant looks at the robots on the screen (watching counts
+                   as interaction, as in the paper)
+    r              the reply has ended, or the participant is back on the puzzle
     k              the participant starts a click sequence (keyboard method)
+    go THING ZONE  the order the participant clicked: navigate THING to ZONE
+                   (source "console"); ends the click sequence
     send THING ACTION [ZONE] [AFTER]
-                   the console's send button: publishes the command (source "console")
-                   and ends the click sequence
+                   the same with any action the procedure allows in the task; in a
+                   keyboard-and-mouse session that is `navigate` only
     p [N]          N puzzle pieces solved (default 1)
     e              end the task now (the judge scores what happened)
     ?              show this help
 
 Commands sent by the assistant between `u` and `r` are attributed to that utterance.
+Orders are checked against the paper's procedure (`vahr.experiment.procedures`): a keyboard
+session cannot send a compound command, and a voice session sends nothing from here.
 """
 
 from __future__ import annotations
@@ -26,6 +33,7 @@ import time
 from typing import TYPE_CHECKING, Any, TextIO
 
 from vahr.experiment.eventlog import Kind
+from vahr.experiment.procedures import ProcedureViolation, check_action
 from vahr.protocol import ProtocolError
 
 if TYPE_CHECKING:
@@ -35,6 +43,7 @@ if TYPE_CHECKING:
     from vahr.experiment.participant import Console
 
 HELP = (__doc__ or "").split("\n\n", 2)[2].split("\n\nCommands")[0]
+CHANNELS = {"u": "voice", "k": "click", "w": "watch"}
 
 
 class ObserverConsole:
@@ -62,8 +71,8 @@ class ObserverConsole:
     def perform(self, task: str, done: list[str] | None = None) -> None:
         self._task = task
         self.out(
-            "observer: u/r mark an utterance, k + send a click sequence, p a puzzle piece, "
-            "e ends the task, ? help"
+            "observer: u/r mark an utterance, w/r watching, k + go THING ZONE a click "
+            "sequence, p a puzzle piece, e ends the task, ? help"
         )
 
     def _line(self, timeout_s: float) -> str | None:
@@ -117,32 +126,44 @@ class ObserverConsole:
             self.log.append(
                 Kind.OBSERVER, {"what": "puzzle_piece", "count": count}, task=self._task
             )
-        elif word in ("u", "k"):
+        elif word in CHANNELS:
             self._close_open()
-            channel = "voice" if word == "u" else "click"
-            entry = self.log.append(
-                Kind.INTERACTION_STARTED,
-                {"id": f"{self._task}-{next(self._ids)}", "channel": channel},
-                task=self._task,
-            )
+            channel = CHANNELS[word]
+            body: dict[str, Any] = {"id": f"{self._task}-{next(self._ids)}", "channel": channel}
+            if channel == "watch":
+                body["counts"] = False  # looking sends nothing: not a communication attempt
+            entry = self.log.append(Kind.INTERACTION_STARTED, body, task=self._task)
             self._open = {"id": entry.data["id"], "channel": channel, "seq": entry.seq}
         elif word == "r":
             self._close_open()
-        elif word == "send":
-            if len(args) < 2:
+        elif word in ("go", "send"):
+            if word == "go" and len(args) != 2:
+                raise ValueError("go THING ZONE")
+            if word == "send" and len(args) < 2:
                 raise ValueError("send THING ACTION [ZONE] [AFTER]")
-            thing, action, *rest = args
-            params: dict[str, Any] = {}
-            if rest:
-                params["zone"] = rest[0].upper()
-            if action == "sequential_delivery":
-                params["after"] = rest[1] if len(rest) > 1 else None
-            if self._open is None or self._open["channel"] != "click":
-                self.handle("k")
-            command_id = self.console.send(thing, action, params)
-            self._close_open(commands=[command_id])
+            thing, action, rest = (
+                (args[0], "navigate", args[1:]) if word == "go" else (args[0], args[1], args[2:])
+            )
+            self._send(thing, action, rest)
         else:
             raise ValueError(f"{word!r} is not an observer command; ? shows them")
+
+    def _send(self, thing: str, action: str, rest: list[str]) -> None:
+        if self.console.method != "keyboard":
+            raise ProcedureViolation(
+                f"the {self.console.method} method gives its orders by voice; "
+                "go and send are for keyboard-and-mouse sessions"
+            )
+        check_action(self.console.method, self._task, action)  # before opening a sequence
+        params: dict[str, Any] = {}
+        if rest:
+            params["zone"] = rest[0].upper()
+        if action == "sequential_delivery":
+            params["after"] = rest[1] if len(rest) > 1 else None
+        if self._open is None or self._open["channel"] != "click":
+            self.handle("k")
+        command_id = self.console.send(thing, action, params, task=self._task)
+        self._close_open(commands=[command_id])
 
     def _close_open(self, commands: list[str] | None = None) -> None:
         if self._open is None:
@@ -154,8 +175,8 @@ class ObserverConsole:
                 for e in self.log.entries(Kind.COMMAND)
                 if e.seq > opened["seq"] and e.data.get("source") == "alexa"
             ]
-        self.log.append(
-            Kind.INTERACTION_ENDED,
-            {"id": opened["id"], "channel": opened["channel"], "commands": commands},
-            task=self._task,
-        )
+        body: dict[str, Any] = {"id": opened["id"], "channel": opened["channel"]}
+        body["commands"] = commands if opened["channel"] != "watch" else []
+        if opened["channel"] == "watch":
+            body["counts"] = False
+        self.log.append(Kind.INTERACTION_ENDED, body, task=self._task)

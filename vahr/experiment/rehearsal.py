@@ -21,7 +21,7 @@ from vahr.experiment.session import (
     run_tasks,
 )
 from vahr.experiment.tasks import default_seed
-from vahr.experiment.timing import TimingModel
+from vahr.experiment.timing import Person
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -51,7 +51,8 @@ def run_live(
     )
     bus.start()
     try:
-        run_tasks(session, recorder, performer_for(Console(bus.publish)), announce=announce)
+        console = Console(bus.publish, session.spec.method)
+        run_tasks(session, recorder, performer_for(console), announce=announce)
     finally:
         bus.stop()
     return end_session(session)
@@ -61,9 +62,10 @@ def simulated_performer(
     session: OpenSession,
     fleet: Fleet,
     assistant: Assistant | None,
-    timing: TimingModel | None = None,
+    person: Person | None = None,
 ) -> Callable[[Console], Performer]:
-    """A factory of the simulated participant for `run_live`."""
+    """A factory of the simulated participant for `run_live`. Both methods talk to the
+    assistant (the keyboard-and-mouse method asks it for the weather in task II)."""
 
     def build(console: Console) -> Performer:
         method = session.spec.method
@@ -72,10 +74,10 @@ def simulated_performer(
             fleet=fleet,
             plan=session.plan,
             log=session.log,
-            timing=timing or TimingModel(),
+            person=person or Person(),
             seed=session.plan.seed,
             speed_factor=session.spec.speed_factor,
-            assistant=assistant if method == "vahr" else None,
+            assistant=assistant,
             console=console if method == "keyboard" else None,
         )
 
@@ -99,6 +101,7 @@ def rehearse(
     write_shadow: bool = True,
     announce: Callable[[str], None] = lambda line: None,
     tls: ClientCredentials | None = None,
+    person: Person | None = None,
 ) -> tuple[SessionVerdict, Path]:
     """Run (or resume) one simulated session end to end; return the verdict and the log."""
     spec = SessionSpec(
@@ -123,7 +126,7 @@ def rehearse(
             session,
             fleet,
             broker_url=broker_url,
-            performer_for=simulated_performer(session, fleet, assistant),
+            performer_for=simulated_performer(session, fleet, assistant, person),
             announce=announce,
             tls=tls,
         )

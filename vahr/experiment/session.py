@@ -26,6 +26,7 @@ from vahr.experiment.judge import (
     task_deliveries,
     task_windows,
 )
+from vahr.experiment.procedures import PROCEDURE
 from vahr.experiment.tasks import TASK_TITLES, TASKS, Plan, draw_plan
 from vahr.experiment.world import World
 
@@ -101,6 +102,8 @@ def open_session(spec: SessionSpec, fleet: Fleet) -> OpenSession:
                 "speed_factor": spec.speed_factor,
                 "robots": list(fleet.robot_things),
                 "plan": plan.to_json(),
+                # The procedures the session follows: the judge checks the orders against them.
+                "procedure": PROCEDURE,
             },
         )
         return OpenSession(spec, event_log, plan, resumed=False)

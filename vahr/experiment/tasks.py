@@ -1,9 +1,10 @@
 """The paper's three tasks and the seeded plan of one session.
 
 - Task I: each robot delivers its package to the zone it is assigned (drawn at random).
-- Task II: a robot asks the assistant for the weather and delivers to A if it is sunny, C if
-  it is rainy (the weather is drawn at random and stored in the experiment thing's shadow,
-  which the skill answers from).
+- Task II: each robot delivers to A if the weather is sunny, C if it is rainy (the weather
+  is drawn at random and stored in the experiment thing's shadow, which the skill answers
+  from). With the voice method each robot asks the assistant itself; with the keyboard and
+  mouse the participant asks the assistant, once per robot, as the paper describes it.
 - Task III: both robots deliver to zone D, placebot1 first; the LED lights only on success.
 
 The plan is a pure function of the seed and the fleet, so a session can be replayed and a
@@ -29,7 +30,7 @@ SEQUENCE_ZONE = "D"
 
 TASK_TITLES = {
     "I": "deliver each package to its assigned zone",
-    "II": "deliver according to the weather (sunny: A, rainy: C)",
+    "II": "each robot delivers according to the weather (sunny: A, rainy: C)",
     "III": "both robots deliver to zone D, placebot1 first",
 }
 
@@ -58,6 +59,8 @@ class Plan:
     seed: int
     assignments: dict[str, str]
     weather: Weather
+    # The first robot to deliver by the weather (logs from before task II had both robots
+    # deliver name only this one in their task II goal).
     weather_robot: str
     goals: dict[str, TaskGoal] = field(default_factory=dict)
 
@@ -118,7 +121,9 @@ def draw_plan(fleet: Fleet, seed: int) -> Plan:
     first, second = robots[0], robots[1]
     goals = {
         "I": TaskGoal(task="I", zones=dict(assignments)),
-        "II": TaskGoal(task="II", zones={first: WEATHER_ZONES[weather]}),
+        "II": TaskGoal(
+            task="II", zones={first: WEATHER_ZONES[weather], second: WEATHER_ZONES[weather]}
+        ),
         "III": TaskGoal(
             task="III", zones={first: SEQUENCE_ZONE, second: SEQUENCE_ZONE}, order=(first, second)
         ),
