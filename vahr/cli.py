@@ -21,6 +21,10 @@ SUBCOMMANDS: Subcommands = {
         "vahr.commands.report",
         "turn experiment results into the paper's tables and figures",
     ),
+    "rehearse": (
+        "vahr.commands.rehearse",
+        "run a whole simulated study and set it beside the paper's Table II",
+    ),
 }
 
 

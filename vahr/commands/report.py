@@ -2,7 +2,8 @@
 
 `vahr report FILE.csv --out DIR` reads one row per participant, method and trial;
 `vahr report --from-log DIR --out DIR` measures the rows from the session logs under DIR.
-Both write DIR/report.json, DIR/report.md, DIR/results.csv and PNG figures; from logs also
+Both write DIR/report.json, DIR/report.md, DIR/results.csv and the figures (PNG and SVG);
+from logs also
 DIR/sessions.json (each session's plan, measured times and the judge's verdict).
 """
 
@@ -32,7 +33,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from vahr.experiment.report import FIGURES, write_report
+    from vahr.experiment.figures import figure_names
+    from vahr.experiment.report import write_report
     from vahr.experiment.results import read_csv, rows_from_logs
 
     if (args.csv is None) == (args.from_log is None):
@@ -54,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
             if entry.kind == Kind.SESSION_STARTED
         )
     report = write_report(rows, args.out, source=source, simulated=simulated)
-    files = ["report.json", "report.md", "results.csv", *FIGURES]
+    files = ["report.json", "report.md", "results.csv", *figure_names(report)]
     if args.from_log is not None:
         from vahr.experiment.eventlog import find_logs, read_log
         from vahr.experiment.results import session_summary

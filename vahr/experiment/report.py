@@ -1,25 +1,30 @@
-"""The paper's tables and figures from the results rows: means, one-way ANOVA, charts.
+"""The paper's tables from the results rows, with the analysis a within-subjects study needs.
 
-`build_report(rows)` returns the report.json document:
-`{"objective": {METRIC: {"means": {METHOD: value}, "p_value": p}}, "subjective": {ITEM:
-{"means": {METHOD: percent}, "p_value": p}}}` plus `tlx_by_trial`, `tlx_change`, standard
-deviations and counts. RAD and fan-out are computed per row, then averaged; each p-value
-is a one-way ANOVA (`scipy.stats.f_oneway`) with method as the factor over every row (every
-participant's every trial). It is None when it is undefined: fewer than two methods, a
-method with no rows, or no variance at all.
+`build_report(rows)` returns the report.json document. For each metric under `objective`
+and each questionnaire item under `subjective` (the contract of DESIGN.md):
 
-`write_report(rows, out_dir)` writes report.json, report.md, results.csv and the figures.
-matplotlib is imported here only, with the Agg backend, so nothing else pays for it.
+    {"means": {METHOD: value}, "p_value": p, "sd": {...}, "n": {...},
+     "ci95": {METHOD: [low, high]}, "within_subjects": {...}}
+
+`means` and `p_value` are the paper's: means over every run and a one-way ANOVA with method
+as the factor (`vahr.experiment.stats.one_way_p`, scipy's `f_oneway`). `ci95` is the 95 %
+confidence interval of the mean over participants (each participant's mean over trials),
+and `within_subjects` the repeated-measures analysis (`vahr.experiment.stats`). Beside them:
+`trial_change` (each metric's and item's change between consecutive trials, per method),
+`tlx_by_trial`, `tlx_change`, `trust_adjusted_rad`, `success` and counts. RAD and fan-out
+are computed per row, then averaged.
+
+`write_report(rows, out_dir)` writes report.json, report.md, results.csv and the figures
+(`vahr.experiment.figures`).
 """
 
 from __future__ import annotations
 
 import json
-import math
 import statistics
-import warnings
 from typing import TYPE_CHECKING, Any
 
+from vahr.experiment import stats
 from vahr.experiment.metrics import rate
 from vahr.experiment.results import ResultRow, write_csv
 from vahr.experiment.tasks import METHODS
@@ -47,7 +52,7 @@ ITEM_LABELS = {
     "confidence": "Confidence",
     "trust": "Trust",
 }
-FIGURES = ("subjective.png", "tlx_by_trial.png", "objective.png")
+TEST_NAMES = {"paired_t": "paired t", "wilcoxon": "Wilcoxon", "rm_anova": "RM ANOVA"}
 
 
 def method_order(rows: list[ResultRow]) -> list[str]:
@@ -55,29 +60,52 @@ def method_order(rows: list[ResultRow]) -> list[str]:
     return [m for m in METHODS if m in present] + sorted(present - set(METHODS))
 
 
-def anova_p(groups: list[list[float]]) -> float | None:
-    """One-way ANOVA p-value over the groups, or None where it is undefined."""
-    from scipy import stats
-
-    usable = [g for g in groups if g]
-    if len(usable) < 2 or sum(len(g) for g in usable) <= len(usable):
-        return None
-    with warnings.catch_warnings():
-        # Constant input makes F undefined; scipy warns and returns nan, reported as None.
-        warnings.simplefilter("ignore")
-        p = float(stats.f_oneway(*usable).pvalue)
-    return p if math.isfinite(p) else None
-
-
-def _summary(values_by_method: dict[str, list[float]]) -> dict[str, Any]:
+def _summary(
+    rows: list[ResultRow], methods: list[str], value: Callable[[ResultRow], float | None]
+) -> dict[str, Any]:
+    """One metric's object: the paper's means and one-way p, and the within-subjects view."""
+    triples = [(r.participant, r.method, v) for r in rows if (v := value(r)) is not None]
+    by_method = {m: [v for _, method, v in triples if method == m] for m in methods}
+    per_participant = stats.participant_means(triples)
+    ci95: dict[str, list[float] | None] = {}
+    for m in methods:
+        interval = stats.mean_ci(list(per_participant.get(m, {}).values()))
+        ci95[m] = [interval[1], interval[2]] if interval else None
     return {
-        "means": {m: statistics.fmean(v) for m, v in values_by_method.items() if v},
-        "p_value": anova_p(list(values_by_method.values())),
-        "sd": {
-            m: statistics.stdev(v) if len(v) > 1 else 0.0 for m, v in values_by_method.items() if v
-        },
-        "n": {m: len(v) for m, v in values_by_method.items()},
+        "means": {m: statistics.fmean(v) for m, v in by_method.items() if v},
+        "p_value": stats.one_way_p(list(by_method.values())),
+        "sd": {m: statistics.stdev(v) if len(v) > 1 else 0.0 for m, v in by_method.items() if v},
+        "n": {m: len(v) for m, v in by_method.items()},
+        "ci95": ci95,
+        "within_subjects": stats.within_subjects(per_participant, methods),
     }
+
+
+def _trial_change(
+    rows: list[ResultRow], methods: list[str], value: Callable[[ResultRow], float | None]
+) -> dict[str, dict[str, Any]]:
+    """{METHOD: {"1->2": paired change}} over consecutive trials."""
+    trials = sorted({r.trial for r in rows})
+    change: dict[str, dict[str, Any]] = {}
+    for m in methods:
+        per_trial = {
+            t: {
+                r.participant: v
+                for r in rows
+                if r.method == m and r.trial == t and (v := value(r)) is not None
+            }
+            for t in trials
+        }
+        present = [t for t in trials if per_trial[t]]
+        change[m] = {
+            f"{a}->{b}": stats.paired_change(per_trial[a], per_trial[b])
+            for a, b in zip(present, present[1:], strict=False)
+        }
+    return change
+
+
+def _item(item: str) -> Callable[[ResultRow], float | None]:
+    return lambda r: r.tlx.percents()[item] if r.tlx is not None else None
 
 
 def build_report(
@@ -86,18 +114,16 @@ def build_report(
     """The report.json document for `rows`."""
     methods = method_order(rows)
     objective = {
-        metric: _summary({m: [value(r) for r in rows if r.method == m] for m in methods})
-        for metric, (_, _, value) in OBJECTIVE.items()
+        metric: _summary(rows, methods, value) for metric, (_, _, value) in OBJECTIVE.items()
     }
     answered = [r for r in rows if r.tlx is not None]
-    subjective = {
-        item: _summary(
-            {
-                m: [r.tlx.percents()[item] for r in answered if r.method == m and r.tlx]
-                for m in methods
-            }
-        )
-        for item in ITEMS
+    subjective = {item: _summary(answered, methods, _item(item)) for item in ITEMS}
+    trial_change = {
+        "objective": {
+            metric: _trial_change(rows, methods, value)
+            for metric, (_, _, value) in OBJECTIVE.items()
+        },
+        "subjective": {item: _trial_change(answered, methods, _item(item)) for item in ITEMS},
     }
     trials = sorted({r.trial for r in answered})
     by_trial: dict[str, dict[str, dict[str, float]]] = {}
@@ -119,12 +145,6 @@ def build_report(
             change[item][m] = {
                 f"{a}->{b}": means[b] - means[a] for a, b in zip(ordered, ordered[1:], strict=False)
             }
-    trust_adjusted = _summary(
-        {
-            m: [v for r in rows if r.method == m and (v := r.trust_adjusted) is not None]
-            for m in methods
-        }
-    )
     success: dict[str, dict[str, Any]] = {}
     for kind in ("task", "command", "communication"):
         pooled = {}
@@ -142,8 +162,9 @@ def build_report(
     return {
         "objective": objective,
         "subjective": subjective,
-        "trust_adjusted_rad": trust_adjusted,
+        "trust_adjusted_rad": _summary(answered, methods, lambda r: r.trust_adjusted),
         "success": success,
+        "trial_change": trial_change,
         "tlx_by_trial": by_trial,
         "tlx_change": change,
         "methods": methods,
@@ -172,15 +193,52 @@ def _p(value: float | None) -> str:
     return "< 0.001" if value < 0.001 else f"{value:.3f}"
 
 
+def _within_cells(entry: dict[str, Any], unit: str) -> list[str]:
+    """Test, p, effect size and the difference with its CI, for one metric's row."""
+    within = entry["within_subjects"]
+    test = TEST_NAMES.get(str(within.get("test")), "n/a")
+    effect = "n/a"
+    if within.get("cohens_dz") is not None:
+        effect = f"d_z {within['cohens_dz']:.2f}"
+    anova = within.get("rm_anova") or {}
+    if anova.get("partial_eta_squared") is not None:
+        effect += f", ηp² {anova['partial_eta_squared']:.2f}"
+    difference = "n/a"
+    if within.get("mean_difference") is not None:
+        difference = _fmt(within["mean_difference"], unit)
+        if within.get("ci95"):
+            low, high = within["ci95"]
+            difference += f" [{_fmt(low, unit)}, {_fmt(high, unit)}]"
+    return [test, _p(within.get("p_value")), effect, difference]
+
+
+def _table(
+    title_rows: list[tuple[str, str, dict[str, Any]]], methods: list[str], difference: str
+) -> list[str]:
+    head = (
+        "| | "
+        + " | ".join(methods)
+        + f" | p (one-way ANOVA) | within-subjects test | p | effect size | {difference} |"
+    )
+    lines = [head, "|---|" + "---|" * (len(methods) + 5)]
+    for label, unit, entry in title_rows:
+        cells = [_fmt(entry["means"].get(m), unit) for m in methods]
+        cells += [_p(entry["p_value"]), *_within_cells(entry, unit)]
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    return lines
+
+
 def render_markdown(report: dict[str, Any]) -> str:
-    """report.md: the paper's Table II layout, the subjective results and the TLX trend."""
+    """report.md: the paper's Table II with the within-subjects analysis beside it."""
+    from vahr.experiment.figures import figure_names
+
     methods: list[str] = report["methods"]
-    head = "| | " + " | ".join(methods) + " | p (ANOVA) |\n|---|" + "---|" * (len(methods) + 1)
+    difference = " - ".join(methods[:2]) + " [95% CI]" if len(methods) == 2 else "difference"
     lines = ["# Experiment report", ""]
     if report.get("simulated"):
         lines += [
             "**Simulated participants**: these numbers come from the simulated "
-            "participant's timing model, not from people.",
+            "participant's model (docs/experiment.md), not from people.",
             "",
         ]
     lines += [
@@ -191,22 +249,26 @@ def render_markdown(report: dict[str, Any]) -> str:
         "",
         "## Objective results (Table II)",
         "",
-        "Means per method; RAD and fan-out are computed per run, then averaged.",
+        "Means per method over every run and the paper's one-way ANOVA; beside them the "
+        "within-subjects test on each participant's mean over trials (paired t-test, or "
+        "Wilcoxon signed-rank when Shapiro-Wilk rejects normal differences), Cohen's d_z, "
+        "the repeated-measures partial eta squared, and the mean difference with its 95 % "
+        "confidence interval. RAD and fan-out are computed per run, then averaged.",
         "",
-        head,
     ]
-    for metric, (label, unit, _) in OBJECTIVE.items():
-        entry = report["objective"][metric]
-        cells = [_fmt(entry["means"].get(m), unit) for m in methods]
-        lines.append(f"| {label} | " + " | ".join(cells) + f" | {_p(entry['p_value'])} |")
-    trust = report["trust_adjusted_rad"]
-    if trust["means"]:
-        cells = [_fmt(trust["means"].get(m), "s") for m in methods]
-        lines.append(
-            "| Trust-adjusted demand = IE + NT x (1 - trust) | "
-            + " | ".join(cells)
-            + f" | {_p(trust['p_value'])} |"
+    objective = [
+        (label, unit, report["objective"][metric])
+        for metric, (label, unit, _) in OBJECTIVE.items()
+    ]
+    if report["trust_adjusted_rad"]["means"]:
+        objective.append(
+            (
+                "Trust-adjusted demand = IE + NT x (1 - trust)",
+                "s",
+                report["trust_adjusted_rad"],
+            )
         )
+    lines += _table(objective, methods, difference)
     if report["success"]:
         lines += [
             "",
@@ -226,133 +288,51 @@ def render_markdown(report: dict[str, Any]) -> str:
                 for p in [pooled.get(m, {"success_rate": None})]
             ]
             lines.append(f"| {kind.capitalize()} success | " + " | ".join(cells) + " |")
+    lines += ["", "## Subjective results", ""]
+    if report["rows_with_questionnaire"]:
+        lines += ["NASA-TLX and the two extra questions, as percent ((level - 1) x 5).", ""]
+        items = [(ITEM_LABELS[i], "%", report["subjective"][i]) for i in ITEMS]
+        lines += _table(items, methods, difference)
+    else:
+        lines += ["No run has questionnaire answers (simulated participants answer none)."]
     lines += [
         "",
-        "## Subjective results",
+        "## Change between trials",
         "",
-        "NASA-TLX and the two extra questions, as percent ((level - 1) x 5).",
-        "",
-        head,
-    ]
-    for item in ITEMS:
-        entry = report["subjective"][item]
-        cells = [
-            _fmt(entry["means"].get(m), "%") + " %" if m in entry["means"] else "n/a"
-            for m in methods
-        ]
-        lines.append(
-            f"| {ITEM_LABELS[item]} | " + " | ".join(cells) + f" | {_p(entry['p_value'])} |"
-        )
-    lines += [
-        "",
-        "## NASA-TLX per trial",
-        "",
-        "Mean percent per trial, and the change between consecutive trials.",
+        "Per method, the mean of each trial and the change to the next (percent of the "
+        "first), with the 95 % CI of the paired change over participants who did both.",
         "",
     ]
-    for item in SUBSCALES:
-        per_method = report["tlx_by_trial"][item]
-        for m in methods:
-            means = per_method.get(m, {})
-            if not means:
-                continue
-            trend = ", ".join(
-                f"trial {t}: {v:.1f} %" for t, v in sorted(means.items(), key=lambda kv: int(kv[0]))
-            )
-            deltas = ", ".join(f"{k}: {v:+.1f}" for k, v in report["tlx_change"][item][m].items())
-            lines.append(
-                f"- {ITEM_LABELS[item]}, {m}: {trend}" + (f" ({deltas})" if deltas else "")
-            )
+    for group, labels in (
+        ("objective", {m: (label, unit) for m, (label, unit, _) in OBJECTIVE.items()}),
+        ("subjective", {i: (ITEM_LABELS[i], "%") for i in ITEMS}),
+    ):
+        for key, (label, unit) in labels.items():
+            for m in methods:
+                for step, body in report["trial_change"][group][key].get(m, {}).items():
+                    if body["change"] is None:
+                        continue
+                    percent = f" ({body['percent']:+.0f} %)" if body["percent"] is not None else ""
+                    interval = ""
+                    if body["ci95"]:
+                        interval = f", 95% CI [{_fmt(body['ci95'][0], unit)}, "
+                        interval += f"{_fmt(body['ci95'][1], unit)}]"
+                    before, after = body["means"]
+                    lines.append(
+                        f"- {label}, {m}, trial {step}: {_fmt(before, unit)} -> "
+                        f"{_fmt(after, unit)}{percent}{interval}"
+                    )
     lines += ["", "## Figures", ""]
-    lines += [f"![{name}]({name})" for name in FIGURES]
+    lines += [f"![{name}]({name})" for name in figure_names(report) if name.endswith(".png")]
     return "\n".join(lines) + "\n"
-
-
-def _sem(values: list[float]) -> float:
-    return statistics.stdev(values) / math.sqrt(len(values)) if len(values) > 1 else 0.0
-
-
-def draw_figures(rows: list[ResultRow], report: dict[str, Any], out_dir: Path) -> list[Path]:
-    """The subjective-results bar chart, the TLX-per-trial lines and the objective bars."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    methods: list[str] = report["methods"]
-    answered = [r for r in rows if r.tlx is not None]
-    written: list[Path] = []
-    suffix = " (simulated)" if report.get("simulated") else ""
-    width = 0.8 / max(1, len(methods))
-
-    fig, ax = plt.subplots(figsize=(10, 4.5))
-    for index, m in enumerate(methods):
-        values = [
-            [r.tlx.percents()[item] for r in answered if r.method == m and r.tlx] for item in ITEMS
-        ]
-        xs = [i + (index - (len(methods) - 1) / 2) * width for i in range(len(ITEMS))]
-        ax.bar(
-            xs,
-            [statistics.fmean(v) if v else 0 for v in values],
-            width,
-            yerr=[_sem(v) for v in values],
-            capsize=3,
-            label=m,
-        )
-    for i, item in enumerate(ITEMS):
-        p = report["subjective"][item]["p_value"]
-        if p is not None and p < 0.05:
-            ax.annotate("*", (i, 102), ha="center")
-    ax.set_xticks(range(len(ITEMS)), [ITEM_LABELS[i] for i in ITEMS], rotation=20)
-    ax.set_ylim(0, 110)
-    ax.set_ylabel("percent (mean, SEM)")
-    ax.set_title("Subjective results" + suffix)
-    ax.legend()
-    fig.tight_layout()
-    written.append(out_dir / "subjective.png")
-    fig.savefig(written[-1], dpi=120)
-    plt.close(fig)
-
-    fig, axes = plt.subplots(2, 3, figsize=(11, 6), sharey=True)
-    for ax, item in zip(axes.flat, SUBSCALES, strict=True):
-        for m in methods:
-            means = report["tlx_by_trial"][item].get(m, {})
-            trials = sorted(means, key=int)
-            ax.plot([int(t) for t in trials], [means[t] for t in trials], marker="o", label=m)
-        ax.set_title(ITEM_LABELS[item])
-        ax.set_xlabel("trial")
-        ax.set_ylim(0, 100)
-    axes.flat[0].set_ylabel("percent")
-    axes.flat[3].set_ylabel("percent")
-    axes.flat[0].legend()
-    fig.suptitle("NASA-TLX per trial" + suffix)
-    fig.tight_layout()
-    written.append(out_dir / "tlx_by_trial.png")
-    fig.savefig(written[-1], dpi=120)
-    plt.close(fig)
-
-    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
-    ie = [report["objective"]["interaction_time"]["means"].get(m, 0) for m in methods]
-    nt = [report["objective"]["neglect_time"]["means"].get(m, 0) for m in methods]
-    left.bar(methods, ie, label="interaction time (IE)")
-    left.bar(methods, nt, bottom=ie, label="neglect time (NT)")
-    left.set_ylabel("seconds (mean)")
-    left.set_title("Time taken = IE + NT" + suffix)
-    left.legend()
-    right.bar(methods, [report["objective"]["rad"]["means"].get(m, 0) for m in methods])
-    right.set_ylim(0, 1)
-    right.set_title("RAD" + suffix)
-    fig.tight_layout()
-    written.append(out_dir / "objective.png")
-    fig.savefig(written[-1], dpi=120)
-    plt.close(fig)
-    return written
 
 
 def write_report(
     rows: list[ResultRow], out_dir: Path, *, source: str = "", simulated: bool = False
 ) -> dict[str, Any]:
-    """Write report.json, report.md, results.csv and the PNG figures into `out_dir`."""
+    """Write report.json, report.md, results.csv and the figures into `out_dir`."""
+    from vahr.experiment.figures import draw_figures
+
     out_dir.mkdir(parents=True, exist_ok=True)
     report = build_report(rows, source=source, simulated=simulated)
     (out_dir / "report.json").write_text(json.dumps(report, indent=2, sort_keys=False) + "\n")

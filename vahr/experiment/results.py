@@ -2,8 +2,9 @@
 
 Columns: participant, method, trial, interaction_time_s, neglect_time_s, task_time_s,
 puzzle_parts, and the questionnaire's eight items as levels 1-21 (mental, physical,
-temporal, performance, effort, frustration, confidence, trust). Rows come from a CSV file
-or from session logs (`rows_from_logs`).
+temporal, performance, effort, frustration, confidence, trust). A run without a
+questionnaire (a simulated one) leaves all eight empty. Rows come from a CSV file or from
+session logs (`rows_from_logs`).
 """
 
 from __future__ import annotations
@@ -108,10 +109,19 @@ def parse_row(line: int, raw: dict[str, str]) -> ResultRow:
     trial = _number(line, "trial", cell("trial"), whole=True)
     if trial < 1:
         raise VahrError(f"row {line}: trial must be 1 or more")
-    try:
-        tlx = TlxAnswers.from_mapping({item: check_level(item, cell(item)) for item in ITEMS})
-    except ValueError as err:
-        raise VahrError(f"row {line}: {err}") from None
+    answered = [item for item in ITEMS if (raw.get(item) or "").strip()]
+    tlx = None
+    if answered and len(answered) < len(ITEMS):
+        missing = ", ".join(item for item in ITEMS if item not in answered)
+        raise VahrError(
+            f"row {line}: the questionnaire is incomplete ({missing} empty); "
+            "give all eight items, or none for a run without a questionnaire"
+        )
+    if answered:
+        try:
+            tlx = TlxAnswers.from_mapping({item: check_level(item, cell(item)) for item in ITEMS})
+        except ValueError as err:
+            raise VahrError(f"row {line}: {err}") from None
     row = ResultRow(
         participant=cell("participant"),
         method=cell("method"),

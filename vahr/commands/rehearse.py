@@ -1,0 +1,152 @@
+"""`vahr rehearse`: a whole simulated study, reported beside the paper's Table II.
+
+Runs N simulated participants through both methods and T trials each
+(`vahr.experiment.study`) against a running `vahr up` (`--api` and `--broker`), or on a
+stack it starts itself on free ports, faster than real time by `--speed-factor` (the robots'
+simulated time and the participant's clock run at the same factor; every metric is in
+study seconds). Writes DIR/logs/, DIR/results.csv (the CSV `vahr report` reads),
+DIR/report.json, DIR/report.md and the figures; prints the paper's Table II beside the
+rehearsal's. Everything it writes or prints is labelled simulated.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from vahr.cli_dispatch import add_logging_flag, setup_logging
+from vahr.errors import VahrError
+
+if TYPE_CHECKING:
+    import argparse
+
+DEFAULT_OUT = Path("out") / "rehearsal"
+DEFAULT_SPEED = 30.0
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--participants", type=int, default=10, help="how many (default 10)")
+    parser.add_argument("--trials", type=int, default=2, help="trials per method (default 2)")
+    parser.add_argument(
+        "--out", type=Path, default=DEFAULT_OUT, help=f"output directory (default {DEFAULT_OUT})"
+    )
+    parser.add_argument(
+        "--api",
+        default=None,
+        help="a running `vahr up`'s api URL (with --broker); default: start a stack here",
+    )
+    parser.add_argument(
+        "--broker", default=None, help="a running `vahr up`'s mqtt:// URL (with --api)"
+    )
+    parser.add_argument(
+        "--speed-factor",
+        type=float,
+        default=DEFAULT_SPEED,
+        help="study seconds per wall second; with --api it must equal the running "
+        f"`vahr up --sim-speed-factor` (default {DEFAULT_SPEED:g})",
+    )
+    parser.add_argument("--seed", type=int, default=1, help="the study's seed (default 1)")
+    parser.add_argument(
+        "--task-timeout",
+        type=float,
+        default=600.0,
+        help="study seconds after which a task ends undecided (default 600)",
+    )
+    parser.add_argument("--json", action="store_true", help="print report.json to stdout")
+    add_logging_flag(parser)
+    parser.set_defaults(log_level="WARNING")
+
+
+def _check(args: argparse.Namespace) -> None:
+    if args.participants < 1 or args.trials < 1:
+        raise VahrError("--participants and --trials must be 1 or more")
+    if not args.speed_factor > 0:
+        raise VahrError("--speed-factor must be more than 0")
+    if args.task_timeout <= 0:
+        raise VahrError("--task-timeout must be more than 0")
+    if (args.api is None) != (args.broker is None):
+        raise VahrError("--api and --broker go together (a running `vahr up`'s endpoints)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from vahr.experiment.study import StudySpec, run_study
+
+    _check(args)
+    setup_logging(args.log_level)
+    spec = StudySpec(
+        participants=args.participants,
+        trials=args.trials,
+        out_dir=args.out,
+        speed_factor=args.speed_factor,
+        seed=args.seed,
+        task_timeout_s=args.task_timeout,
+    )
+
+    def announce(line: str) -> None:
+        print(f"[simulated] {line}", file=sys.stderr, flush=True)
+
+    started = time.monotonic()
+    if args.api is not None:
+        from vahr.protocol import load_fleet
+
+        report = run_study(
+            spec, load_fleet(), broker_url=args.broker, api_url=args.api, announce=announce
+        )
+    else:
+        report = _on_own_stack(spec, args, announce)
+    _print(report, args, time.monotonic() - started)
+    return 0
+
+
+def _on_own_stack(spec: Any, args: argparse.Namespace, announce: Any) -> dict[str, Any]:
+    from vahr.experiment.study import run_study
+    from vahr.local.ports import free_port
+    from vahr.local.system import LocalSystem, SystemConfig
+
+    with tempfile.TemporaryDirectory(prefix="vahr-rehearse-") as state:
+        config = SystemConfig(
+            state_dir=Path(state),
+            mqtts_port=free_port(),
+            mqtt_port=free_port(),  # the participant's panel publishes on the loopback listener
+            api_port=free_port(),
+            sim_speed_factor=args.speed_factor,
+            voice=True,
+            log_level=args.log_level,
+        )
+        with LocalSystem(config) as system:
+            if not system.voice_enabled:
+                raise VahrError(
+                    "the voice method needs the room assistant (espeak-ng); "
+                    "install it or rehearse against a running `vahr up`"
+                )
+            system.wait_online()
+            announce(
+                f"stack up: {', '.join(system.fleet.robot_things)} at x{args.speed_factor:g}"
+            )
+            assert system.stack.mqtt_url is not None
+            return run_study(
+                spec,
+                system.fleet,
+                broker_url=system.stack.mqtt_url,
+                api_url=system.stack.api_url,
+                announce=announce,
+            )
+
+
+def _print(report: dict[str, Any], args: argparse.Namespace, wall_s: float) -> None:
+    from vahr.experiment.paper import render_comparison
+
+    if args.json:
+        print(json.dumps(report))
+        return
+    print(
+        f"Simulated study: {report['participants']} participants x {len(report['trials'])} "
+        f"trial(s) x {len(report['methods'])} methods, speed x{args.speed_factor:g}, "
+        f"{wall_s:.0f} s of wall time. SIMULATED participants, not people.\n"
+    )
+    print(render_comparison(report["paper_comparison"]))
+    print(f"written to {args.out}: report.md, report.json, results.csv, figures, logs/")
