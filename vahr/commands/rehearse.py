@@ -124,9 +124,7 @@ def _on_own_stack(spec: Any, args: argparse.Namespace, announce: Any) -> dict[st
                     "install it or rehearse against a running `vahr up`"
                 )
             system.wait_online()
-            announce(
-                f"stack up: {', '.join(system.fleet.robot_things)} at x{args.speed_factor:g}"
-            )
+            announce(f"stack up: {', '.join(system.fleet.robot_things)} at x{args.speed_factor:g}")
             assert system.stack.mqtt_url is not None
             return run_study(
                 spec,

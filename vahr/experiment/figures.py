@@ -200,7 +200,9 @@ def _percent_changes(
             before = abs(body["means"][0])
             if body["ci95"] and before:
                 low, high = (100 * c / before for c in body["ci95"])
-                errors[m].append((max(0.0, body["percent"] - low), max(0.0, high - body["percent"])))
+                errors[m].append(
+                    (max(0.0, body["percent"] - low), max(0.0, high - body["percent"]))
+                )
             else:
                 errors[m].append(None)
     return heights, errors

@@ -340,9 +340,7 @@ class SimulatedParticipant:
         body: dict[str, Any] = {"clicks": 2}
         try:
             body["commands"] = [
-                self.console.send(
-                    step.thing, step.action, {"zone": resolved.zone}, task=self._task
-                )
+                self.console.send(step.thing, step.action, {"zone": resolved.zone}, task=self._task)
             ]
         except Exception as err:  # noqa: BLE001 - any publish failure is the order's outcome
             body["commands"], body["error"] = [], str(err)

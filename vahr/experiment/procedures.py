@@ -5,11 +5,16 @@ the observer's console enforces, and that the station's keyboard-and-mouse panel
 (see docs/experiment.md, "Procedures"). The facts are the paper's
 (`PAPER-EXPERIMENT.md`):
 
-| task | voice (`vahr`) | keyboard and mouse (`keyboard`) |
-| --- | --- | --- |
-| I | per robot: navigate to LOADING; once it is loaded, navigate to its zone | the same two navigation orders per robot, with the panel |
-| II | per robot: the weather-navigation intent (the robot asks the assistant itself); the second once the first robot's spoken exchange has ended | ask the assistant for the weather once per robot, then per robot: navigate to LOADING; once loaded, navigate to the zone the weather calls for |
-| III | one sequential-delivery intent (placebot1, then placebot2, to D) | placebot1: LOADING, loaded, D; once placebot1 has delivered, placebot2: LOADING, loaded, D |
+- Task I. Voice: per robot, "navigate to the loading zone"; once it is loaded, "navigate
+  to" its zone. Keyboard and mouse: the same two navigation orders per robot, clicked on the
+  station's map.
+- Task II. Voice: per robot, the weather-navigation intent (the robot asks the assistant
+  itself); the second once the first robot's spoken exchange has ended. Keyboard and mouse:
+  ask the assistant for the weather once per robot, then per robot navigate to LOADING
+  and, once it is loaded, to the zone the weather calls for.
+- Task III. Voice: one sequential-delivery intent (placebot1, then placebot2, to D).
+  Keyboard and mouse: placebot1 to LOADING, once loaded to D; once placebot1 has
+  delivered, placebot2 to LOADING and, once loaded, to D.
 
 The arms load and unload on arrival, so `navigate` is the only command the keyboard-and-mouse
 method ever sends. The compound commands (`deliver`, `weather_delivery`,
@@ -238,9 +243,7 @@ def _task_two(method: str, plan: Plan, fleet: Fleet | None) -> list[Step]:
                 if fleet is not None
                 else None
             )
-            steps.append(
-                Step(0, (thing,), "voice", "weather_delivery", None, requires, utterance)
-            )
+            steps.append(Step(0, (thing,), "voice", "weather_delivery", None, requires, utterance))
         return steps
     question = _say("what is the weather")
     steps = [Step(0, (thing,), "voice", None, None, (), question) for thing in things]
@@ -304,7 +307,9 @@ def _matches(step: Step, action: object, zone: object) -> bool:
     return bool(step.zone == zone)
 
 
-def conformance(procedure: Procedure, entries: list[LogEntry], robots: Collection[str]) -> list[str]:
+def conformance(
+    procedure: Procedure, entries: list[LogEntry], robots: Collection[str]
+) -> list[str]:
     """Why the orders among a task's `entries` break the procedure (empty if they do not).
 
     Each order (a command from the participant, not one robot's to another) must be one the

@@ -257,8 +257,7 @@ def render_markdown(report: dict[str, Any]) -> str:
         "",
     ]
     objective = [
-        (label, unit, report["objective"][metric])
-        for metric, (label, unit, _) in OBJECTIVE.items()
+        (label, unit, report["objective"][metric]) for metric, (label, unit, _) in OBJECTIVE.items()
     ]
     if report["trust_adjusted_rad"]["means"]:
         objective.append(

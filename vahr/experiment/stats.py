@@ -144,9 +144,7 @@ def _paired(differences: list[float]) -> dict[str, Any]:
 def within_subjects(by_method: dict[str, dict[str, float]], methods: list[str]) -> dict[str, Any]:
     """The within-subjects analysis of one metric (see the module docstring)."""
     present = [m for m in methods if by_method.get(m)]
-    complete = (
-        sorted(set.intersection(*(set(by_method[m]) for m in present))) if present else []
-    )
+    complete = sorted(set.intersection(*(set(by_method[m]) for m in present))) if present else []
     result: dict[str, Any] = {"participants": len(complete), "methods": present}
     if len(present) < 2 or len(complete) < 2:
         result["test"] = None

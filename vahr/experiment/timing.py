@@ -161,7 +161,9 @@ class Person:
         """One click: BB."""
         return 2 * BUTTON.value * self.tempo
 
-    def point_s(self, start: tuple[float, float], end: tuple[float, float], width_m: float) -> float:
+    def point_s(
+        self, start: tuple[float, float], end: tuple[float, float], width_m: float
+    ) -> float:
         """Pointing from `start` to a target of `width_m` (metres of floor) at `end`."""
         distance = math.dist(start, end)
         return fitts_s(distance, width_m * MAP_SCALE.value) * self.tempo

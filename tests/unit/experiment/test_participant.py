@@ -1,126 +1,188 @@
-"""The simulated participant's scripts, timing model and the observer's console."""
+"""The simulated participant following the paper's procedures, and the observer's console."""
 
 from __future__ import annotations
 
 import io
-import json
 import os
-import random
-import re
-from pathlib import Path
+import threading
+import time
 from typing import TYPE_CHECKING
 
 import pytest
 
+from vahr.experiment import timing
 from vahr.experiment.assistant import AssistantReply
 from vahr.experiment.eventlog import EventLog, Kind
 from vahr.experiment.observer import ObserverConsole
-from vahr.experiment.participant import (
-    Console,
-    SimulatedParticipant,
-    keyboard_script,
-    voice_script,
-)
+from vahr.experiment.participant import Console, SimulatedParticipant
+from vahr.experiment.procedures import procedure_for
 from vahr.experiment.tasks import draw_plan
-from vahr.experiment.timing import TimingModel
 from vahr.protocol import decode_command
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from vahr.protocol import Fleet
 
-MODEL = Path(__file__).resolve().parents[3] / "skill-package/interactionModels/custom/en-US.json"
+SPEED = 100.0
 
 
-def sample_patterns() -> list[tuple[str, re.Pattern[str]]]:
-    model = json.loads(MODEL.read_text())["interactionModel"]["languageModel"]
-    patterns = []
-    for intent in model["intents"]:
-        for sample in intent.get("samples", []):
-            regex = re.sub(r"\\\{\w+\\\}", "(.+)", re.escape(sample))
-            patterns.append((intent["name"], re.compile(f"^{regex}$")))
-    return patterns
+class ScriptedAssistant:
+    """Stands in for the Alexa simulator in these unit tests only: it answers at once."""
+
+    def __init__(self, weather: str = "sunny") -> None:
+        self.heard: list[str] = []
+        self.weather = weather
+
+    def ask(self, utterance: str) -> AssistantReply:
+        self.heard.append(utterance)
+        if "what is the weather" in utterance:
+            return AssistantReply(f"The weather is {self.weather}.", intent="WeatherIntent")
+        return AssistantReply(
+            "Okay, it is on its way.", intent="NavigateIntent", commands=[f"c{len(self.heard)}"]
+        )
 
 
-@pytest.mark.parametrize("seed", [1, 2, 3])
-def test_every_utterance_is_a_sample_of_the_interaction_model(fleet: Fleet, seed: int) -> None:
-    plan = draw_plan(fleet, seed)
-    patterns = sample_patterns()
-    expected = {
-        "I": "DeliverIntent",
-        "II": "WeatherDeliveryIntent",
-        "III": "SequentialDeliveryIntent",
-    }
-    for task, intent in expected.items():
-        for utterance in voice_script(task, plan, fleet):
-            matched = {name for name, pattern in patterns if pattern.match(utterance)}
-            assert intent in matched, utterance
+def robot_event(log: EventLog, thing: str, event: str, **data: object) -> None:
+    log.append(Kind.ROBOT_EVENT, {"event": event, "thing": thing, **data})
 
 
-def test_keyboard_scripts_send_the_commands_each_task_needs(fleet: Fleet) -> None:
-    plan = draw_plan(fleet, 9)
-    assert keyboard_script("I", plan) == [
-        (thing, "deliver", {"zone": zone}) for thing, zone in plan.assignments.items()
+def test_the_voice_participant_looks_for_the_robot_loaded_before_sending_it_on(
+    fleet: Fleet, tmp_path: Path
+) -> None:
+    # Given a voice participant in task I, and robots that get loaded a moment later
+    the_plan = draw_plan(fleet, 3)
+    assistant = ScriptedAssistant()
+    with EventLog.open(tmp_path / "log.sqlite") as log:
+        log.append(Kind.TASK_STARTED, {"task": "I"}, task="I")
+        participant = SimulatedParticipant(
+            method="vahr",
+            fleet=fleet,
+            plan=the_plan,
+            log=log,
+            person=timing.Person(),
+            seed=3,
+            speed_factor=SPEED,
+            assistant=assistant,
+        )
+
+        def robots() -> None:
+            while len(assistant.heard) < 2:
+                time.sleep(0.01)
+            time.sleep(0.05)
+            for thing in fleet.robot_things:
+                robot_event(log, thing, "loaded", zone="LOADING")
+
+        loader = threading.Thread(target=robots)
+        loader.start()
+        # When it performs the task until it has said all four orders
+        participant.perform("I")
+        decided = participant.wait(lambda: len(assistant.heard) == 4, timeout_s=600)
+        loader.join(5)
+        entries = log.entries()
+    # Then it said the paper's navigation orders: both robots to LOADING, then each to its zone
+    steps = procedure_for("vahr", "I", the_plan, fleet).steps
+    assert decided and assistant.heard == [step.utterance for step in steps]
+    # and it only sent a robot on after a glance at the screen showed it loaded
+    loaded = max(e.seq for e in entries if e.data.get("event") == "loaded")
+    glances = [
+        e for e in entries if e.kind == Kind.INTERACTION_ENDED and e.data["channel"] == "watch"
     ]
-    assert keyboard_script("II", plan) == [
-        ("placebot1", "deliver", {"zone": "A" if plan.weather == "sunny" else "C"})
-    ]
-    assert keyboard_script("III", plan) == [
-        ("placebot1", "deliver", {"zone": "D"}),
-        ("placebot2", "sequential_delivery", {"zone": "D", "after": "placebot1"}),
-    ]
-
-
-def test_the_timing_model_follows_the_keystroke_level_model() -> None:
-    exact = TimingModel(jitter=0.0)
-    rng = random.Random(1)
-    assert exact.first_click_s(rng) == pytest.approx(1.35 + 0.4 + 1.1 + 0.2)
-    assert exact.next_click_s(rng) == pytest.approx(1.3)
-    # "tell placebot one to do the weather delivery": 8 words at 150 per minute
-    assert exact.speaking_s(rng, "tell placebot one to do the weather delivery") == pytest.approx(
-        1.35 + 0.6 + 8 * 60 / 150
+    saw = [g for g in glances if g.data["seen"]]
+    assert saw and saw[0].seq > loaded and all(g.data["counts"] is False for g in glances)
+    third = next(
+        e
+        for e in entries
+        if e.kind == Kind.INTERACTION_STARTED and e.data["text"] == steps[2].utterance
     )
-    assert exact.listening_s(rng, "The weather is sunny.") == pytest.approx(4 * 60 / 175)
-    pieces = [exact.puzzle_piece_s(random.Random(s)) for s in range(2000)]
-    assert sum(pieces) / len(pieces) == pytest.approx(25, rel=0.1)
+    assert third.seq > saw[0].seq
+    # and each exchange lasted at least its mental preparation, words and reply (wall seconds)
+    ended = {e.data["id"]: e for e in entries if e.kind == Kind.INTERACTION_ENDED}
+    first = next(e for e in entries if e.kind == Kind.INTERACTION_STARTED)
+    model_s = (
+        timing.Person().mental_s()
+        + timing.Person().speaking_s(steps[0].utterance or "")
+        + timing.listening_s("Okay, it is on its way.")
+    )
+    lasted = (ended[first.data["id"]].at - first.at).total_seconds()
+    assert lasted >= model_s / SPEED * 0.95
+    assert ended[first.data["id"]].data["commands"] == ["c1"]
+    # and it solved puzzle parts while it waited
+    assert any(e.kind == Kind.OBSERVER and e.data["what"] == "puzzle_piece" for e in entries)
 
 
-def test_the_same_seed_replays_the_same_durations() -> None:
-    model = TimingModel()
-    first = [model.first_click_s(random.Random(4)) for _ in range(3)]
-    assert first[0] == first[1] == first[2]
-    assert model.first_click_s(random.Random(5)) != first[0]
+def test_the_keyboard_participant_asks_the_weather_per_robot_and_clicks_navigations(
+    fleet: Fleet, tmp_path: Path
+) -> None:
+    # Given a keyboard participant in task II, with robots already loaded
+    the_plan = draw_plan(fleet, 4)
+    assistant = ScriptedAssistant(weather="rainy")
+    sent: list[tuple[str, bytes]] = []
+    with EventLog.open(tmp_path / "log.sqlite") as log:
+        log.append(Kind.TASK_STARTED, {"task": "II"}, task="II")
+        participant = SimulatedParticipant(
+            method="keyboard",
+            fleet=fleet,
+            plan=the_plan,
+            log=log,
+            person=timing.Person(),
+            seed=4,
+            speed_factor=SPEED,
+            assistant=assistant,
+            console=Console(lambda topic, payload: sent.append((topic, payload))),
+        )
+        participant.perform("II")
+        for thing in fleet.robot_things:
+            robot_event(log, thing, "loaded", zone="LOADING")
+        decided = participant.wait(lambda: len(sent) == 4, timeout_s=600)
+        entries = log.entries()
+    # Then it asked the assistant twice, once per robot, and navigated by what it heard
+    assert decided and assistant.heard == ["Alexa, ask robot fleet what is the weather"] * 2
+    orders = [(topic.split("/")[2], decode_command(payload)) for topic, payload in sent]
+    assert [(thing, c.action, c.params.zone) for thing, c in orders] == [  # type: ignore[union-attr]
+        ("placebot1", "navigate", "LOADING"),
+        ("placebot2", "navigate", "LOADING"),
+        ("placebot1", "navigate", "C"),
+        ("placebot2", "navigate", "C"),
+    ]
+    # and each click sequence lasted at least its KLM operators (M, H, two BB clicks)
+    clicks = [
+        e for e in entries if e.kind == Kind.INTERACTION_ENDED and e.data["channel"] == "click"
+    ]
+    assert len(clicks) == 4 and all(c.data["clicks"] == 2 for c in clicks)
+    questions = [e for e in entries if e.kind == Kind.INTERACTION_ENDED and e.data.get("asks")]
+    assert [q.data["asks"] for q in questions] == ["placebot1", "placebot2"]
 
 
-def test_the_observer_marks_utterances_clicks_and_puzzle_pieces(tmp_path: Path) -> None:
+def test_the_observer_marks_utterances_watching_clicks_and_puzzle_pieces(tmp_path: Path) -> None:
     sent: list[tuple[str, bytes]] = []
     with EventLog.open(tmp_path / "log.sqlite") as log:
         observer = ObserverConsole(
             log=log,
-            console=Console(lambda t, p: sent.append((t, p))),
+            console=Console(lambda t, p: sent.append((t, p)), "keyboard"),
             stdin=io.StringIO(),
             out=lambda line: None,
         )
-        observer.perform("I")
+        observer.perform("II")
         observer.handle("u")
-        log.append(Kind.COMMAND, {"id": "c-alexa", "source": "alexa", "action": "deliver"})
         observer.handle("r")
         observer.handle("p 2")
+        observer.handle("w")
+        observer.handle("r")
         observer.handle("k")
-        observer.handle("send placebot2 deliver d")
-        observer.handle("send placebot2 sequential_delivery D placebot1")
+        observer.handle("go placebot2 loading")
+        observer.handle("send placebot1 navigate C")
         with pytest.raises(ValueError, match="not an observer command"):
             observer.handle("dance")
         entries = log.entries()
     ended = [e.data for e in entries if e.kind == Kind.INTERACTION_ENDED]
-    assert ended[0]["commands"] == ["c-alexa"] and ended[0]["channel"] == "voice"
-    assert [e["channel"] for e in ended[1:]] == ["click", "click"]
+    assert [e["channel"] for e in ended] == ["voice", "watch", "click", "click"]
+    assert ended[1]["counts"] is False  # watching is interaction effort, not communication
     assert [e.data["count"] for e in entries if e.kind == Kind.OBSERVER] == [2]
-    topics = [topic for topic, _ in sent]
-    assert topics == ["vahr/robots/placebot2/cmd"] * 2
     first, second = (decode_command(payload) for _, payload in sent)
-    assert (first.action, first.params.zone, first.source) == ("deliver", "D", "console")  # type: ignore[union-attr]
-    assert ended[1]["commands"] == [first.id]
-    assert second.params.after == "placebot1"  # type: ignore[union-attr]
+    assert [t for t, _ in sent] == ["vahr/robots/placebot2/cmd", "vahr/robots/placebot1/cmd"]
+    assert (first.action, first.params.zone, first.source) == ("navigate", "LOADING", "console")  # type: ignore[union-attr]
+    assert ended[2]["commands"] == [first.id] and second.params.zone == "C"  # type: ignore[union-attr]
 
 
 def test_the_observer_ends_a_task_on_e(tmp_path: Path) -> None:
@@ -136,59 +198,3 @@ def test_the_observer_ends_a_task_on_e(tmp_path: Path) -> None:
         # When the task is waited for, Then "e" ends it undecided after one puzzle piece
         assert observer.wait(lambda: False, timeout_s=5) is False
         assert [e.kind for e in log.entries()] == [Kind.OBSERVER]
-
-
-class ScriptedAssistant:
-    """Stands in for the Alexa simulator in this unit test only: it answers at once."""
-
-    def __init__(self) -> None:
-        self.heard: list[str] = []
-
-    def ask(self, utterance: str) -> AssistantReply:
-        self.heard.append(utterance)
-        if "weather" in utterance:
-            return AssistantReply("Sorry, I did not get that.", intent="AMAZON.FallbackIntent")
-        return AssistantReply(
-            "Okay, placebot one is on its way.",
-            intent="DeliverIntent",
-            commands=[f"c{len(self.heard)}"],
-        )
-
-
-def test_the_voice_participant_logs_each_exchange_as_speaking_plus_listening(
-    fleet: Fleet, tmp_path: Path
-) -> None:
-    # Given a voice participant running 100 times faster than real time, with no jitter
-    plan = draw_plan(fleet, 3)
-    assistant = ScriptedAssistant()
-    timing = TimingModel(jitter=0.0)
-    with EventLog.open(tmp_path / "log.sqlite") as log:
-        participant = SimulatedParticipant(
-            method="vahr",
-            fleet=fleet,
-            plan=plan,
-            log=log,
-            timing=timing,
-            seed=3,
-            speed_factor=100.0,
-            assistant=assistant,
-        )
-        # When it performs tasks I and II
-        participant.perform("I")
-        participant.perform("II")
-        entries = log.entries()
-    # Then it said the scripted sentences, in order, to the assistant
-    assert assistant.heard == voice_script("I", plan, fleet) + voice_script("II", plan, fleet)
-    started = [e for e in entries if e.kind == Kind.INTERACTION_STARTED]
-    ended = [e for e in entries if e.kind == Kind.INTERACTION_ENDED]
-    assert len(started) == len(ended) == 3
-    # and each exchange lasted at least its speaking and listening time (in wall seconds)
-    rng = random.Random(0)
-    for start, end in zip(started, ended, strict=True):
-        model_s = timing.speaking_s(rng, start.data["text"]) + timing.listening_s(
-            rng, end.data["speech"]
-        )
-        assert (end.at - start.at).total_seconds() >= model_s / 100 * 0.95
-    # and what the assistant did with each utterance is kept for the judge
-    assert ended[0].data["commands"] == ["c1"] and ended[0].data["intent"] == "DeliverIntent"
-    assert ended[2].data["commands"] == [] and ended[2].data["speech"].startswith("Sorry")

@@ -135,10 +135,16 @@ def test_the_report_files_are_written(tmp_path: Path) -> None:
     assert set(report["subjective"]) == set(ITEMS)
     markdown = (out / "report.md").read_text()
     assert "| RAD = IE / (IE + NT) |" in markdown
-    assert "| | vahr | keyboard | p (ANOVA) |" in markdown
-    for name in ("subjective.png", "tlx_by_trial.png", "objective.png"):
-        assert (out / name).read_bytes()[:8] == PNG_MAGIC
+    assert "| | vahr | keyboard | p (one-way ANOVA) | within-subjects test | p |" in markdown
+    for stem in ("subjective", "tlx_by_trial", "objective", "trial_change"):
+        assert (out / f"{stem}.png").read_bytes()[:8] == PNG_MAGIC
+        assert b"<svg" in (out / f"{stem}.svg").read_bytes()[:1000]
+        assert f"![{stem}.png]({stem}.png)" in markdown
     assert len(read_csv(out / "results.csv")) == 12
+    # and each metric keeps the paper's means and p beside the within-subjects analysis
+    rad = report["objective"]["rad"]
+    assert {"means", "p_value", "within_subjects", "ci95"} <= set(rad)
+    assert rad["within_subjects"]["test"] in ("paired_t", "wilcoxon")
 
 
 @pytest.mark.parametrize(
@@ -162,6 +168,26 @@ def test_bad_csv_rows_are_named(tmp_path: Path, edit, message: str) -> None:  # 
     with pytest.raises(VahrError) as caught:
         read_csv(path)
     assert message in str(caught.value)
+
+
+def test_runs_without_a_questionnaire_leave_its_columns_empty(tmp_path: Path) -> None:
+    # Given a results CSV whose runs have no questionnaire (simulated participants)
+    data = generated_csv(tmp_path / "results.csv", participants=3, trials=1)
+    lines = data.read_text().splitlines()
+    blank = [",".join(line.split(",")[:7] + [""] * len(ITEMS)) for line in lines[1:]]
+    data.write_text("\n".join([lines[0], *blank]) + "\n")
+    # When the report is made, Then it has the objective results and no subjective figures
+    out = tmp_path / "out"
+    report = write_report(read_csv(data), out)
+    assert report["rows_with_questionnaire"] == 0
+    assert report["objective"]["rad"]["means"]
+    assert (out / "objective.png").exists() and not (out / "subjective.png").exists()
+    assert "No run has questionnaire answers" in (out / "report.md").read_text()
+    # while a questionnaire half filled in is refused, naming the empty items
+    half = [",".join(line.split(",")[:7] + ["5"] * 4 + [""] * 4) for line in lines[1:2]]
+    data.write_text("\n".join([lines[0], *half]) + "\n")
+    with pytest.raises(VahrError, match="row 2: the questionnaire is incomplete"):
+        read_csv(data)
 
 
 def test_missing_columns_are_named(tmp_path: Path) -> None:
