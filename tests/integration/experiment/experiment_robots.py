@@ -1,7 +1,8 @@
 """Robots on a real mosquitto for the experiment's integration tests (a fixture module).
 
 `robot_agents` runs one `robot-agent run --backend sim` process per robot of the fleet on
-the test's mosquitto, faster than real time, and waits until each is online.
+the test's mosquitto, faster than real time, and waits until each is online; `lab` runs
+them on the local stack with the Alexa simulator attached.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ if TYPE_CHECKING:
     from pathlib import Path
 
     from vahr.local.broker import Mosquitto
+    from vahr.local.stack import LocalStack
     from vahr.protocol import Fleet
 
 SPEED = 50.0
@@ -110,5 +112,30 @@ def robot_agents(fleet: Fleet, mosquitto: Mosquitto, tmp_path: Path) -> Iterator
     agents.start()
     try:
         yield agents
+    finally:
+        agents.stop()
+
+
+class Lab:
+    """The local stack with the Alexa simulator (the skill in-process) and robot agents:
+    what a keyboard-and-mouse session needs, for its participant asks the assistant for the
+    weather in task II."""
+
+    def __init__(self, stack: LocalStack, robots: RobotAgents) -> None:
+        self.stack, self.robots = stack, robots
+        assert stack.mqtt_url is not None
+        self.broker_url: str = stack.mqtt_url
+        self.api_url: str = stack.api_url
+
+
+@pytest.fixture
+def lab(fleet: Fleet, stack: LocalStack, tmp_path: Path) -> Iterator[Lab]:
+    stack.attach_alexa()
+    assert stack.mqtt_url is not None
+    (tmp_path / "robots").mkdir()
+    agents = RobotAgents(fleet, stack.mqtt_url, tmp_path / "robots", SPEED)
+    agents.start()
+    try:
+        yield Lab(stack, agents)
     finally:
         agents.stop()

@@ -6,28 +6,26 @@ from __future__ import annotations
 import json
 from typing import TYPE_CHECKING, Any
 
-from tests.integration.experiment.experiment_robots import SPEED, robot_agents
+from tests.integration.experiment.experiment_robots import SPEED, lab
 from vahr.cli import main
 from vahr.experiment.eventlog import Kind, read_log
 
-__all__ = ["robot_agents"]  # the fixture, used by name
+__all__ = ["lab"]  # the fixture, used by name
 
 if TYPE_CHECKING:
     from pathlib import Path
 
     import pytest
 
-    from tests.integration.experiment.experiment_robots import RobotAgents
-    from vahr.local.broker import Mosquitto
+    from tests.integration.experiment.experiment_robots import Lab
 
 
 def test_keyboard_session_runs_all_three_tasks_and_reports(
     tmp_path: Path,
-    mosquitto: Mosquitto,
-    robot_agents: RobotAgents,
+    lab: Lab,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    # Given robots on a real broker and a simulated participant using the console
+    # Given robots on the local stack and a simulated participant using the panel
     logs = tmp_path / "logs"
     argv = [
         "experiment",
@@ -42,8 +40,9 @@ def test_keyboard_session_runs_all_three_tasks_and_reports(
         "--log-dir",
         str(logs),
         "--broker",
-        mosquitto.plain_url,
-        "--no-shadow",
+        lab.broker_url,
+        "--api",
+        lab.api_url,
         "--simulate",
         "--speed-factor",
         str(SPEED),
@@ -63,24 +62,19 @@ def test_keyboard_session_runs_all_three_tasks_and_reports(
     assert summary["verdict"]["command_success"]["success_rate"] == 1.0
     plan = summary["plan"]
     assert {d["thing"]: d["zone"] for d in tasks["I"]["deliveries"]} == plan["assignments"]
-    # and the log holds the console's commands as seen on the wire, source "console"
+    # and the log holds the panel's orders as seen on the wire: navigation only, source
+    # "console", two per robot and task (to the loading zone, then on)
     entries = read_log(logs / "SIM01-keyboard-trial1.sqlite")
     commands = [e.data for e in entries if e.kind == Kind.COMMAND]
-    assert [c["action"] for c in commands] == [
-        "deliver",
-        "deliver",
-        "deliver",
-        "deliver",
-        "sequential_delivery",
-    ]
+    assert [c["action"] for c in commands] == ["navigate"] * 12
     assert {c["source"] for c in commands} == {"console"}
-    # and in task III placebot2 waited for placebot1, as robots coordinating among themselves
-    waiting = [
-        e.data["thing"]
-        for e in entries
-        if e.kind == Kind.ROBOT_EVENT and e.task == "III" and e.data["event"] == "waiting"
-    ]
-    assert waiting == ["placebot2"]
+    # and in task III placebot2 was sent only after placebot1 had delivered, as seen
+    third = [e for e in entries if e.task == "III"]
+    delivered = next(
+        e.seq for e in third if e.kind == Kind.ROBOT_EVENT and e.data["event"] == "delivered"
+    )
+    second = [e.seq for e in third if e.kind == Kind.COMMAND and e.data["target"] == "placebot2"]
+    assert second and min(second) > delivered
     assert entries[-1].kind == Kind.SESSION_ENDED
 
     # When the participant's questionnaire is entered and the report is made from the logs
@@ -129,8 +123,9 @@ def test_keyboard_session_runs_all_three_tasks_and_reports(
         means["interaction_time"]["means"]["keyboard"],
         means["neglect_time"]["means"]["keyboard"],
     )
-    # Five commands of four clicks each, by the keystroke-level model: about 6.5 s each.
-    assert 20 < ie < 60
+    # Twelve orders of two clicks each (KLM and Fitts: about 3-4 s each), two questions to
+    # the assistant and the glances at the screen
+    assert 40 < ie < 150
     assert nt > 0
     assert means["rad"]["means"]["keyboard"] == ie / (ie + nt)
     assert report["subjective"]["mental"]["means"]["keyboard"] == 25.0
@@ -145,14 +140,13 @@ def test_keyboard_session_runs_all_three_tasks_and_reports(
     assert session["verdict"]["tasks"]["III"]["led_on"] is True
     assert set(session["times"]["tasks"]) == {"I", "II", "III"}
     assert "Simulated participants" in (out / "report.md").read_text()
-    for name in ("subjective.png", "tlx_by_trial.png", "objective.png"):
+    for name in ("subjective.png", "tlx_by_trial.png", "objective.png", "objective.svg"):
         assert (out / name).stat().st_size > 1000
 
 
 def test_a_session_cut_mid_task_resumes_without_repeating_or_losing_anything(
     tmp_path: Path,
-    mosquitto: Mosquitto,
-    robot_agents: RobotAgents,
+    lab: Lab,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
@@ -172,8 +166,9 @@ def test_a_session_cut_mid_task_resumes_without_repeating_or_losing_anything(
         "--log-dir",
         str(logs),
         "--broker",
-        mosquitto.plain_url,
-        "--no-shadow",
+        lab.broker_url,
+        "--api",
+        lab.api_url,
         "--simulate",
         "--speed-factor",
         str(SPEED),
@@ -181,13 +176,13 @@ def test_a_session_cut_mid_task_resumes_without_repeating_or_losing_anything(
     ]
     # Given a session interrupted (Ctrl-C) in task I, after its first click sequence
     original = SimulatedParticipant._click
-    clicks: list[str] = []
+    clicks: list[str | None] = []
 
-    def interrupted(self: SimulatedParticipant, task: str, click: Any) -> None:
-        clicks.append(task)
+    def interrupted(self: SimulatedParticipant, step: Any, *, hand_back: bool) -> None:
+        clicks.append(self._task)
         if clicks.count("I") == 2:
             raise KeyboardInterrupt
-        original(self, task, click)
+        original(self, step, hand_back=hand_back)
 
     monkeypatch.setattr(SimulatedParticipant, "_click", interrupted)
     assert main(argv) == 130
@@ -206,14 +201,13 @@ def test_a_session_cut_mid_task_resumes_without_repeating_or_losing_anything(
     assert summary["resumed"] is True
     assert [e.kind for e in after].count(Kind.SESSION_RESUMED) == 1
     sent = [e.data["action"] for e in after if e.kind == Kind.COMMAND]
-    assert sent == ["deliver", "deliver", "deliver", "deliver", "sequential_delivery"]
+    assert sent == ["navigate"] * 12
     assert all(body["success"] for body in summary["verdict"]["tasks"].values()), summary
 
 
 def test_an_observed_keyboard_session_with_a_person_at_the_console(
     tmp_path: Path,
-    mosquitto: Mosquitto,
-    robot_agents: RobotAgents,
+    lab: Lab,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
@@ -227,28 +221,57 @@ def test_an_observed_keyboard_session_with_a_person_at_the_console(
     logs = tmp_path / "logs"
     plan = draw_plan(load_fleet(), 21)
     path = logs / "P05-keyboard-trial2.sqlite"
-    # What the observer types during each task: the participant's clicks and puzzle pieces
-    typed = {
-        "I": ["p", *[f"send {t} deliver {z}" for t, z in plan.assignments.items()], "p 2"],
-        "II": [f"send placebot1 deliver {'A' if plan.weather == 'sunny' else 'C'}"],
-        "III": ["k", "send placebot1 deliver D", "send placebot2 sequential_delivery D placebot1"],
+    weather_zone = "A" if plan.weather == "sunny" else "C"
+    one, two = plan.assignments["placebot1"], plan.assignments["placebot2"]
+    # What the observer types in each task, each line once what it waits for (a robot
+    # event in the task) is in the log: the participant's clicks, questions and puzzle parts
+    Wait = tuple[str, str] | None
+    typed: dict[str, list[tuple[Wait, str]]] = {
+        "I": [
+            (None, "p"),
+            (None, "go placebot1 LOADING"),
+            (None, "go placebot2 LOADING"),
+            (("placebot1", "loaded"), f"go placebot1 {one}"),
+            (("placebot2", "loaded"), f"go placebot2 {two}"),
+            (None, "p 2"),
+        ],
+        "II": [
+            (None, "u"),
+            (None, "r"),
+            (None, "u"),
+            (None, "r"),
+            (None, "go placebot1 LOADING"),
+            (None, "go placebot2 LOADING"),
+            (("placebot1", "loaded"), f"go placebot1 {weather_zone}"),
+            (("placebot2", "loaded"), f"go placebot2 {weather_zone}"),
+        ],
+        "III": [
+            (None, "k"),
+            (None, "go placebot1 LOADING"),
+            (("placebot1", "loaded"), "go placebot1 D"),
+            (("placebot1", "delivered"), "w"),
+            (None, "go placebot2 LOADING"),
+            (("placebot2", "loaded"), "go placebot2 D"),
+        ],
     }
     read_end, write_end = os.pipe()
     stop = threading.Event()
 
     def observer_types() -> None:
-        done: set[str] = set()
-        while not stop.is_set() and len(done) < 3:
-            started = (
-                [e.data["task"] for e in read_log(path) if e.kind == Kind.TASK_STARTED]
-                if path.exists()
-                else []
-            )
-            for task in started:
-                if task not in done:
-                    done.add(task)
-                    os.write(write_end, "".join(f"{line}\n" for line in typed[task]).encode())
-            time.sleep(0.05)
+        for task in ("I", "II", "III"):
+            for wait, line in typed[task]:
+                while not stop.is_set():
+                    entries = read_log(path) if path.exists() else []
+                    started = [e.seq for e in entries if e.kind == Kind.TASK_STARTED and e.task == task]
+                    happened = {
+                        (e.data.get("thing"), e.data.get("event"))
+                        for e in entries
+                        if started and e.seq > started[0] and e.kind == Kind.ROBOT_EVENT
+                    }
+                    if started and (wait is None or wait in happened):
+                        break
+                    time.sleep(0.05)
+                os.write(write_end, f"{line}\n".encode())
 
     typist = threading.Thread(target=observer_types)
     typist.start()
@@ -270,7 +293,7 @@ def test_an_observed_keyboard_session_with_a_person_at_the_console(
                     "--log-dir",
                     str(logs),
                     "--broker",
-                    str(mosquitto.plain_url),
+                    lab.broker_url,
                     "--no-shadow",
                     "--task-timeout",
                     "30",
@@ -288,5 +311,7 @@ def test_an_observed_keyboard_session_with_a_person_at_the_console(
     assert all(body["success"] for body in summary["verdict"]["tasks"].values()), summary
     entries = read_log(path)
     assert sum(e.data.get("count", 0) for e in entries if e.kind == Kind.OBSERVER) == 3
-    clicks = [e.data for e in entries if e.kind == Kind.INTERACTION_ENDED]
-    assert len(clicks) == 5 and all(c["channel"] == "click" and c["commands"] for c in clicks)
+    ended = [e.data for e in entries if e.kind == Kind.INTERACTION_ENDED]
+    clicks = [e for e in ended if e["channel"] == "click"]
+    assert len(clicks) == 12 and all(c["commands"] for c in clicks)
+    assert [e["channel"] for e in ended].count("watch") == 1

@@ -114,9 +114,15 @@ def test_both_methods_run_all_three_tasks_and_the_report_has_figures(
             ("placebot1", "D"),
             ("placebot2", "D"),
         ], third
-    # and with the voice method the robot asked the assistant for the weather and understood
+    # and with the voice method each robot asked the assistant for the weather and
+    # understood: four navigation orders, two weather navigations, one sequential delivery
+    # said by the participant, and the two robots' own exchanges
     voice = verdicts["vahr"]["communication_success"]
-    assert voice["success_rate"] == 1.0 and voice["total"] == 5, voice
+    assert voice["success_rate"] == 1.0 and voice["total"] == 9, voice
+    # while with the keyboard and mouse the participant asked for the weather twice and
+    # clicked twelve navigation orders, every one answered or acknowledged
+    keyboard = verdicts["keyboard"]["communication_success"]
+    assert keyboard["success_rate"] == 1.0 and keyboard["total"] == 14, keyboard
     # When the report is made from the two sessions' logs
     out = tmp_path / "report"
     assert main(["report", "--from-log", str(logs), "--out", str(out)]) == 0
@@ -125,5 +131,6 @@ def test_both_methods_run_all_three_tasks_and_the_report_has_figures(
     assert report["methods"] == ["vahr", "keyboard"] and report["simulated"] is True
     for metric in ("interaction_time", "neglect_time", "rad", "fan_out", "time_taken"):
         assert set(report["objective"][metric]["means"]) == {"vahr", "keyboard"}
-    for name in ("subjective.png", "tlx_by_trial.png", "objective.png"):
+    for name in ("objective.png", "objective.svg", "trial_change.png"):
         assert (out / name).stat().st_size > 1000
+    assert not (out / "subjective.png").exists()  # simulated runs answer no questionnaire
