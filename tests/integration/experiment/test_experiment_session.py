@@ -262,7 +262,9 @@ def test_an_observed_keyboard_session_with_a_person_at_the_console(
             for wait, line in typed[task]:
                 while not stop.is_set():
                     entries = read_log(path) if path.exists() else []
-                    started = [e.seq for e in entries if e.kind == Kind.TASK_STARTED and e.task == task]
+                    started = [
+                        e.seq for e in entries if e.kind == Kind.TASK_STARTED and e.task == task
+                    ]
                     happened = {
                         (e.data.get("thing"), e.data.get("event"))
                         for e in entries
