@@ -51,6 +51,14 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--seed", type=int, default=1, help="the study's seed (default 1)")
     parser.add_argument(
+        "--monitoring",
+        choices=["glance", "watch"],
+        default="glance",
+        help="how participants monitor a robot they wait for: a glance at each puzzle "
+        "part's end (the model, default) or eyes on the screen until it happens "
+        "(a sensitivity variant)",
+    )
+    parser.add_argument(
         "--task-timeout",
         type=float,
         default=600.0,
@@ -84,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
         speed_factor=args.speed_factor,
         seed=args.seed,
         task_timeout_s=args.task_timeout,
+        monitoring=args.monitoring,
     )
 
     def announce(line: str) -> None:
@@ -144,6 +153,7 @@ def _print(report: dict[str, Any], args: argparse.Namespace, wall_s: float) -> N
     print(
         f"Simulated study: {report['participants']} participants x {len(report['trials'])} "
         f"trial(s) x {len(report['methods'])} methods, speed x{args.speed_factor:g}, "
+        f"monitoring by {args.monitoring}, "
         f"{wall_s:.0f} s of wall time. SIMULATED participants, not people.\n"
     )
     print(render_comparison(report["paper_comparison"]))

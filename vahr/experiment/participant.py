@@ -12,8 +12,10 @@ How it spends a task:
    hand goes to the mouse once, and back to the puzzle after the block's last click);
 2. otherwise it works on the puzzle; each time a part is done, if some step waits for
    something to be seen (a robot loaded, a robot delivered), it glances at the screen and
-   sees what has happened by then. What is heard (a robot's exchange with the assistant
-   ending) is noticed at once. Glances count as interaction, as the paper counts watching;
+   sees what has happened by then (or, with `Person.monitoring == "watch"`, it keeps its
+   eyes on the screen until it sees it). What is heard (a robot's exchange with the
+   assistant ending) is noticed at once. Looking counts as interaction, as the paper
+   counts watching;
 3. once every step is taken it keeps solving the puzzle until the task is decided.
 
 Clock: durations are study seconds, slept for `seconds / speed_factor` of wall time, so a
@@ -51,6 +53,7 @@ POLL_S = 0.25
 # Never poll more often than this in wall time: a fast rehearsal must not spin on 2 cores.
 POLL_WALL_S = 0.02
 GLANCE_TEXT = "glance at the screen"
+WATCH_TEXT = "watch the screen"
 
 
 class Console:
@@ -160,6 +163,9 @@ class SimulatedParticipant:
             if self._take_ready_steps():
                 continue
             self._block = None
+            if self.person.monitoring == "watch" and self._must_watch():
+                self._watch(decided, deadline, poll)
+                continue
             work = min(part_left, poll)
             self._sleep(work)
             part_left -= work
@@ -276,6 +282,15 @@ class SimulatedParticipant:
         self._sleep(self.person.glance_s())
         seen = self._look(sight=True)
         self._end(ident, "watch", GLANCE_TEXT, counts=False, commands=[], seen=seen)
+
+    def _watch(self, decided: Callable[[], bool], deadline: float, poll: float) -> None:
+        """Keep the eyes on the screen until something awaited shows (the `watch` variant)."""
+        ident = self._interaction("watch", WATCH_TEXT, counts=False)
+        seen: list[str] = []
+        while not seen and not decided() and time.monotonic() < deadline:
+            self._sleep(poll)
+            seen = self._look(sight=True)
+        self._end(ident, "watch", WATCH_TEXT, counts=False, commands=[], seen=seen)
 
     def _speak(self, step: Step) -> None:
         assert self.assistant is not None and step.utterance is not None

@@ -49,6 +49,7 @@ class StudySpec:
     speed_factor: float
     seed: int = 1
     task_timeout_s: float = 600.0
+    monitoring: str = "glance"
 
     @property
     def log_dir(self) -> Path:
@@ -65,10 +66,10 @@ def method_order(position: int) -> tuple[str, ...]:
     return METHODS if position % 2 == 0 else tuple(reversed(METHODS))
 
 
-def person_for(study_seed: int, participant: str) -> Person:
+def person_for(study_seed: int, participant: str, monitoring: str = "glance") -> Person:
     """The participant's tempo, the same for every session of theirs and every rerun."""
     digest = hashlib.sha256(f"{study_seed}\x00{participant}".encode()).digest()
-    return Person.draw(random.Random(int.from_bytes(digest[:8], "big")))
+    return Person.draw(random.Random(int.from_bytes(digest[:8], "big")), monitoring)
 
 
 def _finished(path: Path) -> bool:
@@ -86,7 +87,7 @@ def run_study(
     """Run every session not yet finished, then write the report; return report.json."""
     assistant = HttpAssistant(api_url)
     for position, participant in enumerate(participant_ids(spec.participants)):
-        person = person_for(spec.seed, participant)
+        person = person_for(spec.seed, participant, spec.monitoring)
         for method in method_order(position):
             for trial in range(1, spec.trials + 1):
                 path = session_file(spec.log_dir, participant, method, trial)
@@ -129,6 +130,7 @@ def write_study_report(spec: StudySpec) -> dict[str, Any]:
         "trials": spec.trials,
         "speed_factor": spec.speed_factor,
         "seed": spec.seed,
+        "monitoring": spec.monitoring,
         "counterbalancing": "AB/BA: odd-numbered participants start with vahr",
     }
     (spec.out_dir / "report.json").write_text(json.dumps(report, indent=2) + "\n")

@@ -140,16 +140,25 @@ def fitts_s(distance_px: float, width_px: float) -> float:
     return max(0.0, FITTS_INTERCEPT.value + FITTS_SLOPE.value * index)
 
 
+MONITORING = ("glance", "watch")
+
+
 @dataclass(frozen=True)
 class Person:
-    """One simulated participant: how fast they are relative to the KLM's average person."""
+    """One simulated participant: how fast they are relative to the KLM's average person,
+    and how they monitor a robot whose arrival they wait for: `glance` (the model above:
+    a look at each puzzle part's end) or `watch` (eyes on the screen until it happens; a
+    sensitivity variant with no constant of its own, see docs/experiment.md)."""
 
     tempo: float = 1.0
+    monitoring: str = "glance"
 
     @classmethod
-    def draw(cls, rng: random.Random) -> Person:
+    def draw(cls, rng: random.Random, monitoring: str = "glance") -> Person:
         """A participant with a log-normal tempo around 1 (seeded, so a study replays)."""
-        return cls(tempo=math.exp(rng.gauss(0.0, TEMPO_SPREAD.value)))
+        if monitoring not in MONITORING:
+            raise ValueError(f"monitoring is one of {', '.join(MONITORING)}, not {monitoring!r}")
+        return cls(tempo=math.exp(rng.gauss(0.0, TEMPO_SPREAD.value)), monitoring=monitoring)
 
     def mental_s(self) -> float:
         return MENTAL_PREPARATION.value * self.tempo

@@ -33,6 +33,8 @@ def test_a_keyboard_session_through_the_local_stack(
     for name in ("AWS_ACCESS_KEY_ID", "AWS_SECRET_ACCESS_KEY", "AWS_SESSION_TOKEN"):
         monkeypatch.delenv(name, raising=False)
     assert stack.mqtt_url is not None
+    # The assistant answers the participant's weather questions in task II
+    stack.attach_alexa()
     (tmp_path / "robots").mkdir()
     robots = RobotAgents(fleet, stack.mqtt_url, tmp_path / "robots", SPEED)
     robots.start()
