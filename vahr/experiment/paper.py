@@ -68,7 +68,9 @@ def compare(report: dict[str, Any]) -> list[dict[str, Any]]:
 def _number(value: float | None) -> str:
     if value is None:
         return "n/a"
-    return f"{value:.2f}" if abs(value) < 10 else f"{value:.0f}"
+    if abs(value) >= 10 or float(value).is_integer():
+        return f"{value:.0f}"
+    return f"{value:.2f}"
 
 
 def _p(value: float | None) -> str:
