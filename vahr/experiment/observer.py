@@ -5,6 +5,8 @@ short line each (read with a timeout, so the session never blocks on the keyboar
 
     u              the participant starts speaking to the assistant (both methods:
                    the keyboard-and-mouse method asks it for the weather in task II)
+    q              the participant asks the assistant a question (the weather, task II
+                   with keyboard and mouse): interaction time, not a command
     w              the participant looks at the robots on the screen (watching counts
                    as interaction, as in the paper)
     r              the reply has ended, or the participant is back on the puzzle
@@ -43,7 +45,10 @@ if TYPE_CHECKING:
     from vahr.experiment.participant import Console
 
 HELP = (__doc__ or "").split("\n\n", 2)[2].split("\n\nCommands")[0]
-CHANNELS = {"u": "voice", "k": "click", "w": "watch"}
+CHANNELS = {"u": "voice", "q": "voice", "k": "click", "w": "watch"}
+# Marks that send no command by design: counted as interaction, not as communication (the
+# log has no reply text for the judge to check a question's answer against).
+NO_COMMAND = {"q", "w"}
 
 
 class ObserverConsole:
@@ -130,10 +135,15 @@ class ObserverConsole:
             self._close_open()
             channel = CHANNELS[word]
             body: dict[str, Any] = {"id": f"{self._task}-{next(self._ids)}", "channel": channel}
-            if channel == "watch":
-                body["counts"] = False  # looking sends nothing: not a communication attempt
+            if word in NO_COMMAND:
+                body["counts"] = False
             entry = self.log.append(Kind.INTERACTION_STARTED, body, task=self._task)
-            self._open = {"id": entry.data["id"], "channel": channel, "seq": entry.seq}
+            self._open = {
+                "id": entry.data["id"],
+                "channel": channel,
+                "seq": entry.seq,
+                "counts": word not in NO_COMMAND,
+            }
         elif word == "r":
             self._close_open()
         elif word in ("go", "send"):
@@ -176,7 +186,7 @@ class ObserverConsole:
                 if e.seq > opened["seq"] and e.data.get("source") == "alexa"
             ]
         body: dict[str, Any] = {"id": opened["id"], "channel": opened["channel"]}
-        body["commands"] = commands if opened["channel"] != "watch" else []
-        if opened["channel"] == "watch":
+        body["commands"] = commands if opened["counts"] else []
+        if not opened["counts"]:
             body["counts"] = False
         self.log.append(Kind.INTERACTION_ENDED, body, task=self._task)

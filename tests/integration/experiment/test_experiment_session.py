@@ -236,9 +236,9 @@ def test_an_observed_keyboard_session_with_a_person_at_the_console(
             (None, "p 2"),
         ],
         "II": [
-            (None, "u"),
+            (None, "q"),
             (None, "r"),
-            (None, "u"),
+            (None, "q"),
             (None, "r"),
             (None, "go placebot1 LOADING"),
             (None, "go placebot2 LOADING"),

@@ -166,6 +166,8 @@ def test_the_observer_marks_utterances_watching_clicks_and_puzzle_pieces(tmp_pat
         observer.perform("II")
         observer.handle("u")
         observer.handle("r")
+        observer.handle("q")
+        observer.handle("r")
         observer.handle("p 2")
         observer.handle("w")
         observer.handle("r")
@@ -176,13 +178,15 @@ def test_the_observer_marks_utterances_watching_clicks_and_puzzle_pieces(tmp_pat
             observer.handle("dance")
         entries = log.entries()
     ended = [e.data for e in entries if e.kind == Kind.INTERACTION_ENDED]
-    assert [e["channel"] for e in ended] == ["voice", "watch", "click", "click"]
-    assert ended[1]["counts"] is False  # watching is interaction effort, not communication
+    assert [e["channel"] for e in ended] == ["voice", "voice", "watch", "click", "click"]
+    # a question and watching are interaction effort, not attempts to command the robots
+    assert ended[1]["counts"] is False and ended[2]["counts"] is False
+    assert "counts" not in ended[0]
     assert [e.data["count"] for e in entries if e.kind == Kind.OBSERVER] == [2]
     first, second = (decode_command(payload) for _, payload in sent)
     assert [t for t, _ in sent] == ["vahr/robots/placebot2/cmd", "vahr/robots/placebot1/cmd"]
     assert (first.action, first.params.zone, first.source) == ("navigate", "LOADING", "console")  # type: ignore[union-attr]
-    assert ended[2]["commands"] == [first.id] and second.params.zone == "C"  # type: ignore[union-attr]
+    assert ended[3]["commands"] == [first.id] and second.params.zone == "C"  # type: ignore[union-attr]
 
 
 def test_the_observer_ends_a_task_on_e(tmp_path: Path) -> None:
