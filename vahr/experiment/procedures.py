@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING, Literal
 from vahr.experiment.eventlog import Kind
 from vahr.experiment.tasks import SEQUENCE_ZONE
 from vahr.protocol import WEATHER_ZONES
-from vahr.skill_model.intents import INVOCATION_NAME
+from vahr.protocol.assistant import INVOCATION_NAME
 
 if TYPE_CHECKING:
     from collections.abc import Collection, Iterable
