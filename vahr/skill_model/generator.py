@@ -46,6 +46,17 @@ _WORD_OR_SLOT = r"(?:[a-z']+|\{[A-Za-z]+\})"
 _SAMPLE = re.compile(rf"^{_WORD_OR_SLOT}(?: {_WORD_OR_SLOT})*$")
 _SLOT_REF = re.compile(r"\{([A-Za-z]+)\}")
 
+# Limits the model is held to, inside what Alexa accepts: a slot value (or synonym) of at
+# most 140 characters and 50,000 values and synonyms in all (the limits Amazon states for
+# custom slot types), and a model definition of at most 1,000,000 characters (the SMAPI
+# `modelDefinition` length constraint). Sample utterances are kept to 200,000 characters in
+# all, and an utterance to 200, far under the definition limit.
+MAX_SLOT_VALUE_CHARS = 140
+MAX_SLOT_VALUES = 50_000
+MAX_MODEL_CHARS = 1_000_000
+MAX_SAMPLE_CHARS = 200_000
+MAX_UTTERANCE_CHARS = 200
+
 
 class ModelError(VahrError):
     """The intents or the fleet would make an interaction model Alexa rejects or confuses."""
@@ -99,7 +110,7 @@ def build_interaction_model(
         for intent in intents
     ]
     built_in = [{"name": name, "samples": []} for name in BUILT_IN_INTENTS]
-    return {
+    model = {
         "interactionModel": {
             "languageModel": {
                 "invocationName": INVOCATION_NAME,
@@ -135,6 +146,32 @@ def build_interaction_model(
             "prompts": [],
         }
     }
+    check_limits(model)
+    return model
+
+
+def check_limits(model: dict[str, Any]) -> None:
+    """Refuse a model larger than Alexa accepts (see the limits above)."""
+    language = model["interactionModel"]["languageModel"]
+    names = [
+        name
+        for slot_type in language["types"]
+        for value in slot_type["values"]
+        for name in [value["name"]["value"], *value["name"]["synonyms"]]
+    ]
+    if len(names) > MAX_SLOT_VALUES:
+        raise ModelError(f"{len(names)} slot values and synonyms; Alexa takes {MAX_SLOT_VALUES}")
+    for name in names:
+        if len(name) > MAX_SLOT_VALUE_CHARS:
+            raise ModelError(f"the slot value {name!r} is over {MAX_SLOT_VALUE_CHARS} characters")
+    samples = [sample for intent in language["intents"] for sample in intent["samples"]]
+    for sample in samples:
+        if len(sample) > MAX_UTTERANCE_CHARS:
+            raise ModelError(f"the sample {sample!r} is over {MAX_UTTERANCE_CHARS} characters")
+    if sum(len(sample) for sample in samples) > MAX_SAMPLE_CHARS:
+        raise ModelError(f"the sample utterances exceed {MAX_SAMPLE_CHARS} characters in all")
+    if len(render(model)) > MAX_MODEL_CHARS:
+        raise ModelError(f"the interaction model exceeds {MAX_MODEL_CHARS} characters")
 
 
 def robot_type(fleet: Fleet) -> dict[str, Any]:

@@ -1,19 +1,29 @@
-"""The skill's intents as data: slots, sample utterances and elicitation samples.
+"""The skill's intents as data: slots, sample-utterance templates and elicitation samples.
 
-The generator turns these, together with `fleet.yaml`, into the interaction model. Sample
-utterances follow Alexa's rules: lower-case words, numbers spelled out, no punctuation
-other than apostrophes, and `{slot}` references surrounded by spaces. No utterance, and no
-utterance shape once slot names are replaced by their types, may appear in two intents:
-the generator refuses to write a model that breaks this.
+The generator expands each intent's templates (alternatives, optional words and the shared
+phrases of `vahr.skill_model.phrases`) into sample utterances and, together with
+`fleet.yaml`, writes the interaction model. Sample utterances follow Alexa's rules:
+lower-case words, numbers spelled out, no punctuation other than apostrophes, and `{slot}`
+references surrounded by spaces. No utterance, and no utterance shape once slot names are
+replaced by their types, may appear in two intents: the generator refuses to write a model
+that breaks this.
 """
 
 from __future__ import annotations
 
+import random
 from dataclasses import dataclass
+from functools import cached_property
+
+from vahr.skill_model.phrases import RULES
+from vahr.skill_model.templates import draw
 
 LOCALE = "en-US"
 ROBOT_TYPE = "ROBOT"
 ZONE_TYPE = "ZONE"
+# How many expanded samples an intent keeps at most: enough variety for Alexa (and the
+# simulator's classifier) to generalize, far inside the model's size limits (generator.py).
+MAX_SAMPLES_PER_INTENT = 240
 
 # The answers a person (or a robot) gives when the skill elicits one slot.
 ROBOT_ANSWERS = ("{slot}", "use {slot}", "with {slot}", "i mean {slot}", "i want {slot}")
@@ -35,13 +45,36 @@ class SlotSpec:
 
 @dataclass(frozen=True)
 class IntentSpec:
-    """A custom intent: its slots and at least one sample utterance per phrasing."""
+    """A custom intent: its slots and the templates its sample utterances expand from."""
 
     name: str
     slots: tuple[SlotSpec, ...] = ()
-    samples: tuple[str, ...] = ()
-    # Robot-command intents need at least 15 varied samples (a test holds them to it).
+    templates: tuple[str, ...] = ()
+    # Samples kept whatever the draw: the skill's example phrases and the question robots ask.
+    essentials: tuple[str, ...] = ()
+    # Robot-command intents need at least 60 varied samples (a test holds them to it).
     commands_robots: bool = False
+
+    @cached_property
+    def samples(self) -> list[str]:
+        """The expanded samples: every template contributes in turn, up to the cap.
+
+        Each template's sentences are drawn and shuffled with a seed made of the intent's
+        name, so the choice is varied (not the first words of every alternative) and the
+        same on every run.
+        """
+        rng = random.Random(f"{self.name}:samples")
+        pools: list[list[str]] = []
+        for template in self.templates:
+            expansions = draw(template, RULES, rng, MAX_SAMPLES_PER_INTENT)
+            rng.shuffle(expansions)
+            pools.append(expansions)
+        chosen: dict[str, None] = dict.fromkeys(self.essentials)
+        while len(chosen) < MAX_SAMPLES_PER_INTENT and any(pools):
+            for pool in pools:
+                if pool and len(chosen) < MAX_SAMPLES_PER_INTENT:
+                    chosen.setdefault(pool.pop(), None)
+        return list(chosen)
 
 
 ROBOT = SlotSpec("robot", ROBOT_TYPE)
@@ -51,29 +84,28 @@ NAVIGATE = IntentSpec(
     name="NavigateIntent",
     slots=(ROBOT, ZONE),
     commands_robots=True,
-    samples=(
-        "send {robot} to {zone}",
-        "send {robot} over to {zone}",
-        "move {robot} to {zone}",
-        "drive {robot} to {zone}",
-        "navigate {robot} to {zone}",
-        "tell {robot} to go to {zone}",
-        "tell {robot} to drive to {zone}",
-        "have {robot} go to {zone}",
-        "make {robot} go to {zone}",
-        "get {robot} over to {zone}",
-        "bring {robot} to {zone}",
-        "take {robot} to {zone}",
-        "direct {robot} to {zone}",
-        "{robot} go to {zone}",
-        "{robot} move to {zone}",
-        "{robot} drive to {zone}",
-        "{robot} head to {zone}",
-        "i want {robot} in {zone}",
-        "send {robot}",
-        "move {robot}",
-        "send a robot to {zone}",
-        "navigate to {zone}",
+    essentials=("send {robot} to {zone}", "move {robot} to {zone}", "{robot} go to {zone}"),
+    templates=(
+        "<ask> <send> {robot} <way> <to> {zone} <end>",
+        "<ask> (tell|ask|get) {robot} to <go> <way> <to> {zone} <end>",
+        "<ask> (have|let|make) {robot} <go> <way> <to> {zone} <end>",
+        "{robot} <goes> <way> <to> {zone} <end>",
+        "{robot} (please|can you|could you|i need you to|you need to|i want you to) <go> <way> "
+        "<to> {zone}",
+        "{robot} (should|needs to|has to|must|can) <go> <way> <to> {zone} <end>",
+        "(i want|i need|i'd like|put|park|position|station) {robot} (in|at|over at|by) {zone}",
+        "(i want|i need|i'd like) {robot} to <go> <way> <to> {zone} <end>",
+        "{robot} <to> {zone} <end>",
+        "{robot} {zone} <end>",
+        "<ask> (navigate|drive|head) {robot} <way> <to> {zone}",
+        "<ask> (send|move|take|drive|get) {robot} <way> (there|to it|to that zone)",
+        "<ask> (send|move|dispatch) {robot} <end>",
+        "<ask> (send|move|dispatch) (a|one|some) (robot|bot) <way> <to> {zone} <end>",
+        "<ask> (navigate|drive|head) <way> <to> {zone} <end>",
+        "<ask> (start|begin) (navigating|driving|moving|heading) <to> {zone} with {robot}",
+        "<ask> (move|relocate|reposition) {robot} (over|across) <to> {zone}",
+        "<ask> (let's|lets) (get|send|move|take) {robot} <way> <to> {zone}",
+        "<ask> (bring|get|send) {robot} <way> (here|over) to {zone}",
     ),
 )
 
@@ -81,28 +113,34 @@ DELIVER = IntentSpec(
     name="DeliverIntent",
     slots=(ROBOT, ZONE),
     commands_robots=True,
-    samples=(
-        "have {robot} deliver a package to {zone}",
-        "tell {robot} to deliver a package to {zone}",
-        "ask {robot} to deliver a package to {zone}",
-        "use {robot} to deliver a package to {zone}",
-        "{robot} deliver a package to {zone}",
-        "{robot} deliver to {zone}",
-        "let {robot} deliver to {zone}",
-        "deliver a package to {zone} with {robot}",
-        "send a package to {zone} with {robot}",
-        "have {robot} take a package to {zone}",
-        "have {robot} carry a package to {zone}",
-        "tell {robot} to bring a package to {zone}",
-        "{robot} bring a package to {zone}",
-        "{robot} pick up a package and take it to {zone}",
-        "have {robot} pick up a package for {zone}",
-        "have {robot} make a delivery to {zone}",
-        "have {robot} deliver a package",
-        "start a delivery with {robot}",
-        "deliver a package to {zone}",
-        "make a delivery to {zone}",
-        "deliver a package",
+    essentials=("have {robot} deliver a package to {zone}", "deliver a package to {zone}"),
+    templates=(
+        "<ask> (have|let|make) {robot} <carry> <cargo> <way> to {zone} <end>",
+        "<ask> (tell|ask|get) {robot} to <carry> <cargo> <way> to {zone} <end>",
+        "{robot} <carry> <cargo> <way> to {zone} <end>",
+        "{robot} (please|can you|could you|i need you to|you need to) <carry> <cargo> <way> "
+        "to {zone}",
+        "{robot} (should|needs to|has to|will) <carry> <cargo> <way> to {zone} <end>",
+        "(i want|i need|i'd like) {robot} to <carry> <cargo> <way> to {zone} <end>",
+        "<ask> <carry> <cargo> <way> to {zone} (with|using|on|via) {robot} <end>",
+        "<ask> (use|with) {robot} to <carry> <cargo> to {zone}",
+        "{robot} (pick up|grab|fetch|collect|load up|get) <cargo> and (deliver|bring|take|carry) "
+        "it to {zone}",
+        "<ask> (have|let) {robot} (pick up|grab|fetch|collect|get) <cargo> (and|then|and then) "
+        "(deliver|bring|take|carry|drop) it (to|at|off at) {zone}",
+        "<ask> (make|do|run|start) a delivery to {zone} (with|using|on) {robot}",
+        "{robot} (make|do|run) a delivery (to|for) {zone} <end>",
+        "<ask> (have|let) {robot} (make|do|run) a delivery (to|for) {zone}",
+        "{robot} deliver (to|at|for) {zone} <end>",
+        "<ask> (have|let) {robot} deliver (to|at|for) {zone} <end>",
+        "<ask> (tell|ask) {robot} to deliver (to|at|for) {zone} <end>",
+        "<ask> (have|let|tell|ask) {robot} (to deliver|deliver) <cargo> <end>",
+        "<ask> <carry> <cargo> <way> to {zone} <end>",
+        "<ask> (make|do|run) a delivery to {zone} <end>",
+        "<ask> (start|begin|do|make) a delivery (with|using) {robot}",
+        "<ask> (deliver|ship|bring|send) <cargo> <end>",
+        "<ask> (send|get) <cargo> (to|over to) {zone} (with|on|using) {robot}",
+        "{robot} (deliver|drop) (the|a|one|this) (package|parcel|box) (in|at) {zone}",
     ),
 )
 
@@ -110,24 +148,30 @@ WEATHER_DELIVERY = IntentSpec(
     name="WeatherDeliveryIntent",
     slots=(ROBOT,),
     commands_robots=True,
-    samples=(
-        "have {robot} deliver based on the weather",
-        "have {robot} deliver according to the weather",
-        "{robot} deliver depending on the weather",
-        "tell {robot} to do the weather delivery",
-        "start the weather delivery with {robot}",
-        "weather delivery with {robot}",
-        "have {robot} ask about the weather and deliver",
-        "let {robot} check the weather and deliver",
-        "{robot} make a weather delivery",
-        "ask {robot} to make a delivery based on the weather",
-        "send {robot} on a weather delivery",
-        "use {robot} for the weather delivery",
-        "{robot} find out the weather and deliver a package",
-        "tell {robot} to deliver wherever the weather says",
-        "run the weather task with {robot}",
-        "start a weather delivery",
-        "deliver based on the weather",
+    essentials=("have {robot} deliver based on the weather",),
+    templates=(
+        "<ask> (have|let|make) {robot} (deliver|make a delivery|do a delivery|navigate|go) "
+        "<weather_basis> <end>",
+        "<ask> (tell|ask|get) {robot} to (deliver|make a delivery|navigate|go) <weather_basis>",
+        "{robot} (deliver|navigate|go|drive) <weather_basis> <end>",
+        "{robot} (should|needs to|can) (deliver|navigate|go) <weather_basis>",
+        "<ask> (have|let) {robot} (do|run|handle|take care of|start|perform) <weather_job> <end>",
+        "<ask> (tell|ask|get) {robot} to (do|run|handle|start|perform) <weather_job> <end>",
+        "<ask> (start|run|begin|do|kick off|launch) <weather_job> (with|for|using) {robot}",
+        "<ask> (start|run|begin|do|kick off) a weather (delivery|task|navigation|run) (with|for|"
+        "using) {robot}",
+        "{robot} (do|run|start|handle) <weather_job> <end>",
+        "<ask> (have|let) {robot} (check|ask about|find out|ask alexa about|ask for|look up) the "
+        "weather (and|then|and then) (deliver|decide where to deliver|go to the right place)",
+        "{robot} (check|ask about|find out) the weather (and|then|and then) deliver <cargo>",
+        "<ask> send {robot} on (a|the) weather (delivery|run|mission|errand)",
+        "<ask> (use|take) {robot} for <weather_job>",
+        "{robot} deliver wherever the weather (says|tells you)",
+        "<ask> (have|let) {robot} deliver (wherever|where) the weather (says|tells it)",
+        "weather (delivery|navigation|task) (with|for) {robot} <end>",
+        "<ask> (start|run|begin|do) <weather_job> <end>",
+        "<ask> (start|run|begin|do) a weather (delivery|navigation|task|run) <end>",
+        "<ask> (deliver|navigate) <weather_basis> <end>",
     ),
 )
 
@@ -140,48 +184,68 @@ SEQUENTIAL_DELIVERY = IntentSpec(
     name="SequentialDeliveryIntent",
     slots=(FIRST_ROBOT, FIRST_ZONE, SECOND_ROBOT, SECOND_ZONE),
     commands_robots=True,
-    samples=(
-        "{firstRobot} deliver to {firstZone} then {secondRobot} deliver to {secondZone}",
-        "have {firstRobot} deliver to {firstZone} and then {secondRobot} deliver to {secondZone}",
-        "first {firstRobot} delivers to {firstZone} then {secondRobot} delivers to {secondZone}",
-        "deliver to {firstZone} with {firstRobot} and then to {secondZone} with {secondRobot}",
-        "have {firstRobot} deliver to {firstZone} and after that {secondRobot} to {secondZone}",
-        "have {secondRobot} deliver to {secondZone} after {firstRobot} delivers to {firstZone}",
-        "sequential delivery with {firstRobot} to {firstZone} and {secondRobot} to {secondZone}",
-        "make a sequential delivery with {firstRobot} and {secondRobot}",
-        "let {firstRobot} deliver first and {secondRobot} second",
-        "{firstRobot} delivers first then {secondRobot}",
-        "sequential delivery to {firstZone} and {secondZone}",
-        "take turns delivering to {firstZone} and {secondZone}",
-        "deliver to {firstZone} and {secondZone} one after the other",
-        "start a sequential delivery with {firstRobot}",
-        "start a sequential delivery",
-        "do a sequential delivery",
-        "deliver one after the other",
+    essentials=("{firstRobot} deliver to {firstZone} then {secondRobot} deliver to {secondZone}",),
+    templates=(
+        "<ask> (have|let) {firstRobot} deliver [<cargo>] to {firstZone} (and then|then|and after "
+        "that|after that|followed by) {secondRobot} [deliver|delivers] [<cargo>] to {secondZone}",
+        "{firstRobot} (delivers|deliver|goes) [first] to {firstZone} (then|and then|after that) "
+        "{secondRobot} [delivers|goes] to {secondZone}",
+        "first {firstRobot} (delivers|deliver|goes) to {firstZone} (then|and then|next) "
+        "{secondRobot} [delivers|goes] to {secondZone}",
+        "<ask> (have|let) {secondRobot} deliver [<cargo>] to {secondZone} (after|once|when) "
+        "{firstRobot} (delivers|has delivered|is done|finishes|is finished) [to {firstZone}]",
+        "{secondRobot} (delivers|should deliver|goes) to {secondZone} (after|once) {firstRobot} "
+        "(delivers|has delivered|is done) [to {firstZone}]",
+        "<ask> (have|let) {firstRobot} and {secondRobot} deliver [<cargo>] to {firstZone} (one "
+        "after the other|in sequence|in turn|in order|sequentially|back to back)",
+        "{firstRobot} and (then|after that) {secondRobot} (deliver|go) to {firstZone}",
+        "<ask> (do|run|start|make|coordinate) a (sequential|sequenced|coordinated|staggered) "
+        "delivery (with|using|between) {firstRobot} and {secondRobot} [to {firstZone}]",
+        "<ask> (have|tell|ask|get) {firstRobot} to (coordinate|work|sync up) with {secondRobot} "
+        "[to deliver to {firstZone}|on the delivery|on a sequential delivery]",
+        "<ask> (have|let) {firstRobot} (coordinate|work together|team up) with {secondRobot} "
+        "[to deliver to {firstZone}|on the delivery]",
+        "{firstRobot} first then {secondRobot} [to {firstZone}|deliver to {firstZone}]",
+        "<ask> (deliver|bring|take) <cargo> to {firstZone} with {firstRobot} (first and then|and "
+        "then|then|followed by) {secondRobot}",
+        "<ask> (let|have) {firstRobot} deliver first and {secondRobot} (second|next|after|"
+        "afterwards) [to {firstZone}]",
+        "{firstRobot} (delivers|goes) first (then|and then|followed by) {secondRobot}",
+        "<ask> (sequential|sequenced|coordinated) delivery (to|at) {firstZone} [and {secondZone}]",
+        "<ask> take turns delivering to {firstZone} [and {secondZone}]",
+        "<ask> deliver to {firstZone} and {secondZone} one after the other",
+        "<ask> (start|begin|do|run) a (sequential|sequenced|coordinated) delivery (with|using) "
+        "{firstRobot}",
+        "<ask> (start|do|run|begin) a (sequential|sequenced|coordinated) delivery <end>",
+        "<ask> (deliver|do the deliveries) one after the other <end>",
+        "<ask> (have|let) {secondRobot} wait (for|until) {firstRobot} (delivers|has delivered|is "
+        "done) (and then|then|before it) (deliver|delivers) to {secondZone}",
     ),
 )
 
 STATUS = IntentSpec(
     name="StatusIntent",
     slots=(ROBOT,),
-    samples=(
-        "where is {robot}",
-        "where's {robot}",
-        "where are {robot}",
-        "what is {robot} doing",
-        "what's {robot} doing",
-        "what are {robot} doing",
-        "what's {robot} up to",
-        "how is {robot} doing",
-        "status of {robot}",
-        "give me the status of {robot}",
-        "check on {robot}",
-        "is {robot} busy",
-        "where are the robots",
-        "what are the robots doing",
-        "give me a status report",
-        "fleet status",
-        "robot status",
+    essentials=("where is {robot}", "where are the robots", "what are the robots doing"),
+    templates=(
+        "[so|um|okay|hey] (where is|where's) {robot} [right now|now|at the moment|at]",
+        "[so|um|okay|hey] (what is|what's) {robot} (doing|up to) [right now|now|at the moment]",
+        "(how is|how's) {robot} (doing|getting on|coming along|going)",
+        "<ask> (give me|tell me) the (status|state|location|position) of {robot}",
+        "(what's|what is) the (status|state|location|position) of {robot}",
+        "{robot} (status|location|position)",
+        "[<ask>] (check on|update me on|give me an update on|report on) {robot}",
+        "(is|has) {robot} (done|finished|there yet|busy|idle|moving|loaded|arrived|delivered|"
+        "still moving|stuck) [yet]",
+        "(where are {robot}|what are {robot} (doing|up to)) [right now|now]",
+        "(where are the robots|what are the robots (doing|up to)) [right now|now]",
+        "(where are they|what are they (doing|up to)) [right now]",
+        "[<ask>] (give me|tell me|i want|i'd like) a (status|progress) (report|update)",
+        "[what's the|what is the] (fleet|robot) status",
+        "how are the robots (doing|getting on|coming along)",
+        "[<ask>] (status|progress) report [please]",
+        "(what's|what is) (happening|going on) with {robot}",
+        "(did|has) {robot} (arrive|make it|deliver|get there) [yet]",
     ),
 )
 
@@ -189,50 +253,43 @@ EMERGENCY_STOP = IntentSpec(
     name="EmergencyStopIntent",
     slots=(ROBOT,),
     commands_robots=True,
-    samples=(
-        "emergency stop",
-        "emergency stop {robot}",
-        "emergency stop for {robot}",
-        "hit the emergency stop",
-        "stop {robot}",
-        "stop {robot} now",
-        "stop {robot} immediately",
-        "halt {robot}",
-        "freeze {robot}",
-        "{robot} stop",
-        "{robot} halt",
-        "{robot} freeze",
-        "{robot} stop moving",
-        "tell {robot} to stop",
-        "make {robot} stop",
-        "stop all motion",
-        "halt everything",
-        "freeze everything",
+    essentials=("emergency stop", "stop {robot}"),
+    templates=(
+        "emergency stop [{robot}|for {robot}|everything|now]",
+        "(hit|press|pull) the (emergency stop|e stop|kill switch) [now]",
+        "(stop|halt|freeze|abort) {robot} [now|immediately|right now|at once|right away]",
+        "{robot} (stop|halt|freeze|stop moving|stand still|hold still|stop right there|stop now|"
+        "stay where you are|don't move)",
+        "(tell|make|get) {robot} [to] (stop|halt|freeze|stop moving|stand still)",
+        "(stop|halt|freeze|kill) all (motion|movement|robot motion)",
+        "(stop|halt|freeze|abort) (everything|it all|the mission|the task) [now|right now]",
+        "(stop|halt) (stop|halt) [stop|halt]",
+        "(whoa|woah|wait) (stop|halt) {robot}",
+        "(abort|cancel) (the|that) (command|move|delivery|task) for {robot}",
+        "(emergency|urgent) (halt|freeze|shutdown) [now]",
+        "{robot} (abort|cancel) (that|the task|the delivery|the move)",
     ),
 )
 
 WEATHER = IntentSpec(
     name="WeatherIntent",
-    samples=(
-        "what is the weather",
-        "what's the weather",
-        "what is the weather like",
-        "what's the weather like",
-        "what is the weather today",
-        "what's the weather today",
-        "how is the weather",
-        "how's the weather",
-        "tell me the weather",
-        "give me the weather",
-        "is it sunny or rainy",
-        "is it sunny",
-        "is it rainy",
-        "is it raining",
-        "what's the weather for the experiment",
-        # The robots' own question (vahr.protocol.assistant.WEATHER_QUESTION) and its variants.
-        "what the weather is",
-        "what the weather is like",
-        "tell me what the weather is",
+    # The robots' own question (vahr.protocol.assistant.WEATHER_QUESTION) and its variants.
+    essentials=("what is the weather", "what the weather is", "tell me what the weather is"),
+    templates=(
+        "[so|um|okay|hey] (what is|what's) the weather [like] [today|now|right now|outside|at the "
+        "moment|for the experiment|in the experiment]",
+        "[so|um|okay] (how is|how's) the weather [today|outside|now]",
+        "[<ask>] (tell|give) me the weather [today|now|please]",
+        "is it (sunny|rainy|raining|going to rain|nice out|sunny or rainy|sunny outside|wet "
+        "outside|dry) [today|now|outside]",
+        "(what's|what is) the (forecast|weather report|weather forecast) [today|for today]",
+        "[<ask>] weather (report|update|please|check)",
+        "(what|how) the weather is [like] [today]",
+        "[<ask>] (tell me|let me know) what the weather is [like] [today]",
+        "(will|does) it rain today",
+        "(is the weather|is it) (good|bad|nice) [today|outside]",
+        "(what's|what is) it like outside",
+        "[<ask>] (check|look up) the weather [for me]",
     ),
 )
 

@@ -168,7 +168,7 @@ def test_slot_types_come_from_the_fleet(model: dict[str, Any], fleet: Fleet) -> 
     assert vocabulary.FLEET_GROUP == generator.FLEET_GROUP_ID
 
 
-def test_robot_command_intents_have_at_least_fifteen_samples(model: dict[str, Any]) -> None:
+def test_robot_command_intents_have_at_least_sixty_samples(model: dict[str, Any]) -> None:
     intents = {intent["name"]: intent for intent in language_model(model)["intents"]}
     for name in (
         "NavigateIntent",
@@ -178,7 +178,7 @@ def test_robot_command_intents_have_at_least_fifteen_samples(model: dict[str, An
         "EmergencyStopIntent",
     ):
         samples = intents[name]["samples"]
-        assert len(set(samples)) >= 15, name
+        assert len(set(samples)) >= 60, name
 
 
 def test_no_utterance_is_shared_between_intents(model: dict[str, Any]) -> None:
