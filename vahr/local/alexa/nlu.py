@@ -1,45 +1,59 @@
-"""Natural-language understanding built from the skill's interaction model.
+"""Natural-language understanding built from the skill's interaction model, as Alexa does it.
 
-Each sample utterance becomes a pattern (its `{slot}` references capture words); an
-utterance is matched against every pattern and the best match wins: first the one whose
-slot values all resolve against their slot types, then the most specific (the most literal
-words). Slot values resolve against the custom slot types' values and synonyms, giving
-Alexa's entity-resolution outcome (ER_SUCCESS_MATCH with the value's id and name, or
-ER_SUCCESS_NO_MATCH). Built-in intents get Alexa's usual phrases; anything else is
-AMAZON.FallbackIntent.
+Understanding an utterance takes three steps, each from the same generated model:
+
+1. Slot values are found first (`slot_finder`): names of the ROBOT and ZONE values, with
+   misheard words matched approximately, and unknown names ("robot nine") kept unresolved.
+2. The intent is chosen by a classifier (`intent_classifier`) trained on the expanded sample
+   utterances with the slots abstracted, plus the simulator's stand-ins for Alexa's own data
+   (`background`: built-in intents and out-of-domain requests). Its confidence is calibrated;
+   below `CONFIDENCE_THRESHOLD` the answer is AMAZON.FallbackIntent.
+3. The values found are given to the intent's slots by their type and order (`slot_roles`).
+
+Slot values resolve as Alexa's entity resolution does (ER_SUCCESS_MATCH with the value's id
+and name, or ER_SUCCESS_NO_MATCH). The trained classifier is cached on disk under a hash
+of its training data, and can be built on a background thread so that `vahr up` does not
+wait for it; the first utterance does.
 """
 
 from __future__ import annotations
 
 import json
-import re
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from rapidfuzz import fuzz, process
+
 from vahr.errors import VahrError
+from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
+from vahr.local.alexa.intent_classifier import IntentClassifier, default_cache_dir, load_or_train
+from vahr.local.alexa.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize
+from vahr.local.alexa.slot_roles import assign_slots
+from vahr.skill_model.generator import FLEET_ROBOT_ID
+from vahr.skill_model.intents import ROBOT_TYPE
+
+__all__ = [
+    "CONFIDENCE_THRESHOLD",
+    "DEFAULT_MODEL",
+    "FALLBACK",
+    "InteractionModel",
+    "SlotValue",
+    "Understanding",
+    "normalize",
+]
 
 # The interaction model ships with the package (in a checkout, a link to skill-package/).
 DEFAULT_MODEL = (
     Path(__file__).with_name("skill-package") / "interactionModels" / "custom" / "en-US.json"
 )
 FALLBACK = "AMAZON.FallbackIntent"
-# The phrases Alexa's built-in intents answer to (a representative subset).
-BUILTIN_SAMPLES = {
-    "AMAZON.HelpIntent": ["help", "help me", "what can i say", "what can i do", "what can you do"],
-    "AMAZON.StopIntent": ["stop", "off", "shut up", "be quiet", "that's all", "never mind"],
-    "AMAZON.CancelIntent": ["cancel", "cancel that", "forget it", "nothing"],
-    "AMAZON.NavigateHomeIntent": ["go home", "go to the home screen"],
-    "AMAZON.YesIntent": ["yes", "yeah", "sure", "yes please"],
-    "AMAZON.NoIntent": ["no", "no thanks", "nope"],
-}
-_WORD = re.compile(r"[^a-z0-9' ]+")
-_SLOT_REF = re.compile(r"\{([A-Za-z0-9_.]+)\}")
-
-
-def normalize(text: str) -> str:
-    """Lower case, punctuation dropped (apostrophes kept), single spaces."""
-    return " ".join(_WORD.sub(" ", text.lower().replace("-", " ")).split())
+# An intent is taken only when the calibrated probability says it is more likely than all
+# the others together; anything less is the fallback, as a wrong action is worse than asking.
+CONFIDENCE_THRESHOLD = 0.5
+# How long the first utterance may wait for a classifier still training in the background.
+BUILD_TIMEOUT_S = 300.0
 
 
 @dataclass(frozen=True)
@@ -51,6 +65,8 @@ class SlotValue:
     spoken: str
     id: str | None = None
     canonical: str | None = None
+    # 100 for an exact name; lower when a misheard word was read as a name's word.
+    similarity: float = 100.0
 
     @property
     def resolved(self) -> bool:
@@ -63,118 +79,203 @@ class Understanding:
     slots: dict[str, SlotValue] = field(default_factory=dict)
     # The names of every slot the intent declares, filled or not.
     declared: tuple[str, ...] = ()
+    # The sample utterance closest to what was said (None for the fallback).
     sample: str | None = None
-
-
-@dataclass(frozen=True)
-class _Pattern:
-    intent: str
-    sample: str
-    regex: re.Pattern[str]
-    slots: tuple[str, ...]
-    literal_words: int
-
-
-@dataclass(frozen=True)
-class _SlotType:
-    name: str
-    # normalized phrase -> (id, canonical name)
-    phrases: dict[str, tuple[str, str]]
+    # The calibrated probability of `intent` (of the best intent, for a fallback).
+    confidence: float = 1.0
+    # What the classifier would have chosen, when it fell short of the threshold.
+    best_guess: str | None = None
 
 
 class InteractionModel:
-    """An `interactionModels/custom/<locale>.json`, ready to understand utterances."""
+    """An `interactionModels/custom/<locale>.json`, ready to understand utterances.
 
-    def __init__(self, document: dict[str, Any]) -> None:
+    With `background=True` the classifier is loaded (or trained) on a thread; the first
+    `understand` waits for it. `cache_dir=None` keeps nothing on disk.
+    """
+
+    def __init__(
+        self,
+        document: dict[str, Any],
+        *,
+        cache_dir: Path | None = None,
+        background: bool = False,
+        use_cache: bool = True,
+    ) -> None:
         try:
             language = document["interactionModel"]["languageModel"]
             self.invocation_name: str = language["invocationName"]
             intents = language["intents"]
+            self._slot_types = [_slot_type(t) for t in language.get("types", [])]
+            self.intent_slots: dict[str, dict[str, str]] = {
+                intent["name"]: {slot["name"]: slot["type"] for slot in intent.get("slots", [])}
+                for intent in intents
+            }
+            samples = {intent["name"]: list(intent.get("samples", [])) for intent in intents}
         except (KeyError, TypeError) as err:
             raise VahrError(f"the interaction model lacks {err}") from err
-        self.slot_types: dict[str, _SlotType] = {}
-        for slot_type in language.get("types", []):
-            phrases: dict[str, tuple[str, str]] = {}
-            for value in slot_type.get("values", []):
-                name = value["name"]["value"]
-                value_id = value.get("id") or name
-                for phrase in [name, *value["name"].get("synonyms", [])]:
-                    phrases.setdefault(normalize(phrase), (value_id, name))
-            self.slot_types[slot_type["name"]] = _SlotType(slot_type["name"], phrases)
-        self.intent_slots: dict[str, dict[str, str]] = {}
-        self._patterns: list[_Pattern] = []
-        for intent in intents:
-            name = intent["name"]
-            slots = {slot["name"]: slot["type"] for slot in intent.get("slots", [])}
-            self.intent_slots[name] = slots
-            samples = intent.get("samples") or BUILTIN_SAMPLES.get(name, [])
-            for sample in samples:
-                self._patterns.append(_compile(name, sample))
+        self._samples: dict[str, list[tuple[str, str]]] = {}
+        texts: list[str] = []
+        labels: list[str] = []
+        for name, phrases in samples.items():
+            for sample in phrases:
+                abstracted = self._abstract_sample(name, sample)
+                self._samples.setdefault(name, []).append((abstracted, sample))
+                texts.append(abstracted)
+                labels.append(name)
+        for name, phrases in built_in_phrases().items():
+            if name in self.intent_slots:
+                for phrase in phrases:
+                    self._samples.setdefault(name, []).append((phrase, phrase))
+                    texts.append(phrase)
+                    labels.append(name)
+        if FALLBACK in self.intent_slots:
+            texts += out_of_domain_phrases()
+            labels += [FALLBACK] * (len(texts) - len(labels))
+        known = {word for text in texts for word in text.split()}
+        self._finder = SlotFinder(
+            self._slot_types,
+            [
+                (sample, self.intent_slots[name])
+                for name, phrases in samples.items()
+                for sample in phrases
+            ],
+            known,
+        )
+        robot_values = [
+            value for t in self._slot_types if t.name == ROBOT_TYPE for value in t.names.values()
+        ]
+        self._robots = frozenset(v for v, _ in robot_values if v != FLEET_ROBOT_ID)
+        self._fleet_name = next((n for v, n in robot_values if v == FLEET_ROBOT_ID), "all robots")
+        self.training = (texts, labels)
+        self.cached: bool | None = None
+        self._classifier: IntentClassifier | None = None
+        self._failure: BaseException | None = None
+        self._ready = threading.Event()
+        cache = (cache_dir or default_cache_dir()) if use_cache else None
+
+        def build() -> None:
+            try:
+                self._classifier, self.cached = load_or_train(texts, labels, cache)
+            except BaseException as err:  # reported to whoever waits for the classifier
+                self._failure = err
+            finally:
+                self._ready.set()
+
+        if background:
+            threading.Thread(target=build, name="vahr-nlu-build", daemon=True).start()
+        else:
+            build()
 
     @classmethod
-    def load(cls, path: Path | None = None) -> InteractionModel:
+    def load(cls, path: Path | None = None, **options: Any) -> InteractionModel:
         file = path or DEFAULT_MODEL
         try:
-            return cls(json.loads(Path(file).read_text()))
+            document = json.loads(Path(file).read_text())
         except OSError as err:
             raise VahrError(f"cannot read the interaction model {file}: {err.strerror}") from err
         except ValueError as err:
             raise VahrError(f"the interaction model {file} is not valid JSON: {err}") from err
+        return cls(document, **options)
+
+    def wait_ready(self, timeout_s: float = BUILD_TIMEOUT_S) -> IntentClassifier:
+        """The classifier, once built; raises VahrError if building failed or timed out."""
+        if not self._ready.wait(timeout_s):
+            raise VahrError(f"the intent classifier was not ready within {timeout_s:.0f} s")
+        if self._classifier is None:
+            raise VahrError(f"the intent classifier could not be built: {self._failure}")
+        return self._classifier
 
     def resolve(self, slot_type: str, spoken: str) -> tuple[str, str] | None:
-        """(id, canonical name) of the slot type's value matching `spoken`, if any."""
-        known = self.slot_types.get(slot_type)
-        return known.phrases.get(normalize(spoken)) if known else None
+        """(id, canonical name) of the slot type's value named exactly `spoken`, if any."""
+        for known in self._slot_types:
+            if known.name == slot_type:
+                return known.names.get(normalize(spoken))
+        return None
 
     def slot_value(self, intent: str, slot: str, spoken: str) -> SlotValue:
+        """`spoken` as a value of the intent's slot: the slot type's value it names, if one
+        does (misheard words allowed), else unresolved."""
         slot_type = self.intent_slots.get(intent, {}).get(slot, "")
-        match = self.resolve(slot_type, spoken)
+        words = normalize(spoken).split()
+        matches = [m for m in self._finder.find(words) if m.type == slot_type]
+        whole = len(matches) == 1 and matches[0].id is not None
+        match = matches[0] if whole else None
         return SlotValue(
             name=slot,
             type=slot_type,
-            spoken=spoken,
-            id=match[0] if match else None,
-            canonical=match[1] if match else None,
+            spoken=match.spoken if match else spoken,
+            id=match.id if match else None,
+            canonical=match.canonical if match else None,
+            similarity=match.similarity if match else 100.0,
         )
+
+    def find_slots(self, utterance: str) -> tuple[list[str], list[SlotMatch]]:
+        words = normalize(utterance).split()
+        return words, self._finder.find(words)
 
     def understand(self, utterance: str) -> Understanding:
         """The intent and slots Alexa would hear in `utterance` (inside the skill)."""
-        text = normalize(utterance)
-        best: tuple[tuple[int, int, int], Understanding] | None = None
-        for pattern in self._patterns:
-            found = pattern.regex.fullmatch(text)
-            if found is None:
-                continue
-            slots = {
-                slot: self.slot_value(pattern.intent, slot, found[f"s{index}"])
-                for index, slot in enumerate(pattern.slots)
-            }
-            resolved = sum(1 for value in slots.values() if value.resolved)
-            score = (int(resolved == len(slots)), pattern.literal_words, resolved)
-            if best is None or score > best[0]:
-                declared = tuple(self.intent_slots.get(pattern.intent, {}))
-                best = (score, Understanding(pattern.intent, slots, declared, pattern.sample))
-        if best is None:
-            return Understanding(FALLBACK)
-        return best[1]
+        classifier = self.wait_ready()
+        words, matches = self.find_slots(utterance)
+        if not words:
+            return Understanding(FALLBACK, confidence=1.0)
+        abstracted = _abstract(words, matches)
+        intent, confidence = classifier.scores(abstracted).best
+        if intent == FALLBACK or confidence < CONFIDENCE_THRESHOLD:
+            guess = None if intent == FALLBACK else intent
+            return Understanding(FALLBACK, confidence=confidence, best_guess=guess)
+        declared = self.intent_slots.get(intent, {})
+        slots = {
+            name: SlotValue(name, declared[name], m.spoken, m.id, m.canonical, m.similarity)
+            for name, m in assign_slots(
+                declared, matches, words, self._robots, self._fleet_name
+            ).items()
+        }
+        return Understanding(
+            intent,
+            slots,
+            tuple(declared),
+            self.nearest_sample(intent, abstracted),
+            confidence,
+        )
+
+    def nearest_sample(self, intent: str, abstracted: str) -> str | None:
+        """The intent's sample utterance whose words are closest to `abstracted`."""
+        samples = self._samples.get(intent) or []
+        if not samples:
+            return None
+        best = process.extractOne(
+            abstracted, [text for text, _ in samples], scorer=fuzz.token_sort_ratio
+        )
+        return samples[best[2]][1] if best else None
+
+    def _abstract_sample(self, intent: str, sample: str) -> str:
+        types = self.intent_slots.get(intent, {})
+        words = [
+            types.get(word[1:-1], word) if word.startswith("{") else normalize(word)
+            for word in sample.split()
+        ]
+        return " ".join(word for word in words if word)
 
 
-def _compile(intent: str, sample: str) -> _Pattern:
-    parts: list[str] = []
-    slots: list[str] = []
-    literal = 0
-    position = 0
-    for found in _SLOT_REF.finditer(sample):
-        words = normalize(sample[position : found.start()])
-        if words:
-            parts.append(r"\s*".join(re.escape(word) for word in words.split()))
-            literal += len(words.split())
-        parts.append(f"(?P<s{len(slots)}>.+?)")
-        slots.append(found[1])
-        position = found.end()
-    tail = normalize(sample[position:])
-    if tail:
-        parts.append(r"\s*".join(re.escape(word) for word in tail.split()))
-        literal += len(tail.split())
-    regex = re.compile(r"\s*".join(parts).replace(r"\s*\s*", r"\s*"))
-    return _Pattern(intent, sample, regex, tuple(slots), literal)
+def _slot_type(document: dict[str, Any]) -> SlotTypeValues:
+    names: dict[str, tuple[str, str]] = {}
+    for value in document.get("values", []):
+        name = value["name"]["value"]
+        value_id = value.get("id") or name
+        for phrase in [name, *value["name"].get("synonyms", [])]:
+            names.setdefault(normalize(phrase), (value_id, name))
+    return SlotTypeValues(document["name"], names)
+
+
+def _abstract(words: list[str], matches: list[SlotMatch]) -> str:
+    """The words with each slot value replaced by its type: "send ROBOT to ZONE"."""
+    out: list[str] = []
+    index = 0
+    for match in matches:
+        out += words[index : match.start]
+        out.append(match.type)
+        index = match.end
+    out += words[index:]
+    return " ".join(out)

@@ -1,0 +1,120 @@
+"""What the simulator knows beyond the skill's model: Alexa's built-in intents and the world.
+
+Real Alexa trains its built-in intents (help, stop, cancel, ...) and its out-of-domain
+detection on Amazon's own data; the skill's model lists those intents without samples. The
+simulator stands in for that data with the phrases below, written as templates (the syntax
+of `vahr.skill_model.templates`): the usual ways of asking for help or stopping, and
+everyday requests a voice assistant hears that this skill does not handle. The out-of-domain
+phrases train `AMAZON.FallbackIntent`; none of them is, or is derived from, a sentence of the
+development set (`vahr nlu --eval`).
+"""
+
+from __future__ import annotations
+
+from vahr.skill_model.templates import expand
+
+BUILT_IN_TEMPLATES: dict[str, tuple[str, ...]] = {
+    "AMAZON.HelpIntent": (
+        "[please] help [me|me out|please]",
+        "(what|how) can i (say|do|ask)",
+        "what can you do [for me]",
+        "how does (this|it) work",
+        "i need (help|some help|assistance)",
+        "what are my options",
+        "(what|which) commands (are there|can i use|do you know)",
+        "i don't know what to (say|do)",
+    ),
+    "AMAZON.StopIntent": (
+        "stop",
+        "off",
+        "shut up",
+        "be quiet",
+        "(that's|that is) (all|it|enough)",
+        "never mind",
+        "i'm done",
+        "(we're|we are) done",
+        "enough",
+    ),
+    "AMAZON.CancelIntent": (
+        "cancel [that|it|this|please]",
+        "forget (it|that|about it)",
+        "nothing",
+        "no thanks",
+        "don't (bother|worry about it)",
+        "scratch that",
+    ),
+    "AMAZON.NavigateHomeIntent": ("go home", "go to the home screen", "(home|main) (screen|menu)"),
+}
+
+OUT_OF_DOMAIN_TEMPLATES: tuple[str, ...] = (
+    "(play|put on) [some] (music|jazz|the radio|a song|my playlist|a podcast)",
+    "(set|start) a timer for (five|ten|twenty) minutes",
+    "(set|wake me up with) an alarm for (six|seven) [am|in the morning]",
+    "what time is it [now|in tokyo|in london]",
+    "what's the date [today]",
+    "tell me a (joke|story|fun fact|riddle)",
+    "(turn|switch) (on|off) the (lights|lamp|tv|heating|fan)",
+    "(dim|brighten) the lights [in the kitchen]",
+    "(add|put) (milk|eggs|bread|coffee) (to|on) my shopping list",
+    "what's on my (calendar|schedule|agenda) [today|tomorrow]",
+    "(call|text|message) (mom|dad|my sister|the office)",
+    "how (tall|old|far away|big) is (the moon|mount everest|the eiffel tower)",
+    "who (won|is winning) the (game|match|election) [last night]",
+    "what's the capital of (france|peru|canada)",
+    "(translate|how do you say) (hello|thank you) in (spanish|german|french)",
+    "read me the (news|headlines)",
+    "(turn|volume) (up|down) [the volume]",
+    "(order|buy) [me] (a pizza|more paper towels|batteries)",
+    "how do i (bake|make) (bread|pancakes|a cake)",
+    "what's (two|five) (plus|times) (three|seven)",
+    "spell (necessary|rhythm)",
+    "define (serendipity|entropy)",
+    "who (are you|made you|is your favorite singer)",
+    "what's your (name|favorite color)",
+    "(i'm|i am) (hungry|tired|bored)",
+    "good (morning|night|evening)",
+    "how are you [today]",
+    "(sing|recite) (a song|a poem|happy birthday)",
+    "(open|launch) (spotify|netflix|youtube)",
+    "(lock|unlock) the (front door|car)",
+    "where is the (nearest|closest) (gas station|pharmacy|coffee shop)",
+    "how long is my commute [today]",
+    "remind me to (call mom|take out the trash|buy milk) [tomorrow|later]",
+    "what's the traffic like [today]",
+    "flip a coin",
+    "roll a die",
+    "what's the score of the (football|baseball) game",
+    "how many (ounces|cups) (are|is) in a (pound|liter)",
+    "(find|show) me a (recipe|movie|restaurant)",
+    "what movies are playing [tonight]",
+    "what's the stock price of (amazon|apple)",
+    "make a (note|list)",
+    "what's the meaning of life",
+    "(bake|make) me (a sandwich|some coffee|breakfast)",
+    "the puzzle is (hard|almost done)",
+    "where did i put the (puzzle piece|corner piece)",
+    "this (piece|puzzle) doesn't fit",
+    "(hmm|okay|well) let me think",
+    "i'll do the puzzle (now|first)",
+    "can you (dance|draw|paint)",
+    "(charge|clean|paint|repair) the robots",
+    "make the robots (dance|sing|spin)",
+    "(how many|which) robots (do you have|are there)",
+    "who built the robots",
+    "what is a robot",
+    "(the|my) (keyboard|mouse|screen) (is broken|is not working)",
+    "(shall|should) we take a break",
+)
+
+
+def built_in_phrases() -> dict[str, list[str]]:
+    """Each built-in intent's phrases, expanded."""
+    return {
+        intent: [sentence for template in templates for sentence in expand(template)]
+        for intent, templates in BUILT_IN_TEMPLATES.items()
+    }
+
+
+def out_of_domain_phrases() -> list[str]:
+    """Everyday requests the skill does not handle, expanded."""
+    return [sentence for template in OUT_OF_DOMAIN_TEMPLATES for sentence in expand(template)]

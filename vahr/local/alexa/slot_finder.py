@@ -1,0 +1,201 @@
+"""Finding slot values in an utterance: the first step of the simulator's understanding.
+
+Every name of every value of the custom slot types (ROBOT, ZONE) is looked for in the
+words, the longest first. A word the model has never seen is first compared with the slot
+types' own words (rapidfuzz), so a misheard "plasebot" still finds "placebot"; words the
+model knows ("two", "robots") are never bent into another, since a changed number or letter
+would name another robot or zone. Two kinds of span need more than a name:
+
+- a bare letter ("to b") is a zone only where the samples put a zone: after a word that
+  comes before `{zone}` in some sample and before a word that follows one (or at an end),
+  so the "a" of "deliver a package" stays a word;
+- a head word of a type followed by a number, a letter or an unknown word ("robot nine",
+  "zone f") is a value of that type that does not resolve, so the skill asks for it
+  rather than acting on a guess.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import defaultdict
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from rapidfuzz import fuzz, process
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Mapping
+
+# Misheard words closer than this (rapidfuzz ratio, 0-100) to a word of a slot name are read
+# as that word; below it they stay unknown.
+FUZZY_CUTOFF = 75.0
+_WORD_NUMBERS = (
+    "zero one two three four five six seven eight nine ten eleven twelve thirteen fourteen "
+    "fifteen sixteen seventeen eighteen nineteen twenty"
+).split()
+NUMBER_WORDS = frozenset(_WORD_NUMBERS)
+_NOT_A_WORD = re.compile(r"[^a-z0-9' ]+")
+_DIGITS = re.compile(r"\d+")
+_LETTER_DIGIT = re.compile(r"(?<=[a-z])(?=\d)|(?<=\d)(?=[a-z])")
+_ARTICLES = frozenset({"the", "a", "an"})
+
+
+def normalize(text: str) -> str:
+    """Lower case, punctuation dropped (apostrophes kept), numbers spelled out, single spaces:
+    "Send PlaceBot-1 to Zone B!" -> "send placebot one to zone b"."""
+    text = _NOT_A_WORD.sub(" ", text.lower().replace("-", " "))
+    text = _LETTER_DIGIT.sub(" ", text)
+    return " ".join(_DIGITS.sub(_spell, text).split())
+
+
+def _spell(found: re.Match[str]) -> str:
+    number = int(found[0])
+    return _WORD_NUMBERS[number] if number < len(_WORD_NUMBERS) else found[0]
+
+
+@dataclass(frozen=True)
+class SlotMatch:
+    """A span of words naming a value of a slot type (`id` None when it does not resolve)."""
+
+    type: str
+    start: int
+    end: int
+    spoken: str
+    id: str | None
+    canonical: str | None
+    # 100 for an exact name, lower when a misheard word was read as a name's word.
+    similarity: float
+
+
+@dataclass(frozen=True)
+class SlotTypeValues:
+    """One custom slot type: normalized name -> (value id, canonical name)."""
+
+    name: str
+    names: Mapping[str, tuple[str, str]]
+
+
+class SlotFinder:
+    """Finds the slot values in normalized words, given the slot types and the samples."""
+
+    def __init__(
+        self,
+        slot_types: Iterable[SlotTypeValues],
+        samples: Iterable[tuple[str, Mapping[str, str]]],
+        known_words: Iterable[str],
+    ) -> None:
+        """`samples` are (sample text, its slot name -> type); `known_words` are every word
+        the classifier was trained on, which are never corrected into slot words."""
+        self._names: dict[tuple[str, ...], list[tuple[str, str, str]]] = defaultdict(list)
+        self._heads: dict[str, str] = {}
+        slot_words: set[str] = set()
+        for slot_type in slot_types:
+            owners: dict[str, set[str]] = defaultdict(set)
+            for name, (value_id, canonical) in slot_type.names.items():
+                words = tuple(name.split())
+                self._names[words].append((slot_type.name, value_id, canonical))
+                slot_words.update(words)
+                for word in words:
+                    owners[word].add(value_id)
+            # A word shared by several values ("robot", "zone") names the type, not a value.
+            for word, ids in owners.items():
+                if len(ids) > 1 and word not in _ARTICLES:
+                    self._heads.setdefault(word, slot_type.name)
+        self._longest = max((len(words) for words in self._names), default=1)
+        self._slot_words = sorted(slot_words)
+        self._before: dict[str, set[str]] = defaultdict(set)
+        self._after: dict[str, set[str]] = defaultdict(set)
+        sample_words: set[str] = set()
+        for sample, types in samples:
+            words = sample.split()
+            for index, word in enumerate(words):
+                slot = types.get(word[1:-1]) if word.startswith("{") else None
+                if slot is None:
+                    sample_words.add(word)
+                    continue
+                if index > 0 and not words[index - 1].startswith("{"):
+                    self._before[slot].add(words[index - 1])
+                if index + 1 < len(words) and not words[index + 1].startswith("{"):
+                    self._after[slot].add(words[index + 1])
+        self._known = frozenset({*known_words, *sample_words, *slot_words, *NUMBER_WORDS})
+
+    def correct(self, words: list[str]) -> tuple[list[str], list[float]]:
+        """The words with misheard slot words corrected, and each word's similarity."""
+        corrected: list[str] = []
+        similarity: list[float] = []
+        for word in words:
+            if word in self._known or len(word) < 4:
+                corrected.append(word)
+                similarity.append(100.0)
+                continue
+            best = process.extractOne(
+                word, self._slot_words, scorer=fuzz.ratio, score_cutoff=FUZZY_CUTOFF
+            )
+            if best is None:
+                corrected.append(word)
+                similarity.append(100.0)
+            else:
+                corrected.append(best[0])
+                similarity.append(float(best[1]))
+        return corrected, similarity
+
+    def find(self, words: list[str]) -> list[SlotMatch]:
+        """The slot values in `words` (normalized), left to right, never overlapping."""
+        corrected, similarity = self.correct(words)
+        found: list[SlotMatch] = []
+        index = 0
+        while index < len(corrected):
+            match = self._name_at(corrected, words, similarity, index) or self._unknown_at(
+                corrected, words, index
+            )
+            if match is None:
+                index += 1
+                continue
+            found.append(match)
+            index = match.end
+        return found
+
+    def _name_at(
+        self, corrected: list[str], words: list[str], similarity: list[float], start: int
+    ) -> SlotMatch | None:
+        for length in range(min(self._longest, len(corrected) - start), 0, -1):
+            end = start + length
+            owners = self._names.get(tuple(corrected[start:end]))
+            if not owners:
+                continue
+            for type_name, value_id, canonical in owners:
+                if length == 1 and len(corrected[start]) == 1:
+                    if not self._in_slot_context(type_name, corrected, start, end):
+                        continue
+                return SlotMatch(
+                    type=type_name,
+                    start=start,
+                    end=end,
+                    spoken=" ".join(words[start:end]),
+                    id=value_id,
+                    canonical=canonical,
+                    similarity=min(similarity[start:end]),
+                )
+        return None
+
+    def _in_slot_context(self, type_name: str, words: list[str], start: int, end: int) -> bool:
+        before_ok = start == 0 or words[start - 1] in self._before[type_name]
+        after_ok = end == len(words) or words[end] in self._after[type_name]
+        return before_ok and after_ok
+
+    def _unknown_at(self, corrected: list[str], words: list[str], start: int) -> SlotMatch | None:
+        type_name = self._heads.get(corrected[start])
+        if type_name is None or start + 1 >= len(corrected):
+            return None
+        following = corrected[start + 1]
+        if not (following in NUMBER_WORDS or len(following) == 1 or following not in self._known):
+            return None
+        return SlotMatch(
+            type=type_name,
+            start=start,
+            end=start + 2,
+            spoken=" ".join(words[start : start + 2]),
+            id=None,
+            canonical=None,
+            similarity=100.0,
+        )

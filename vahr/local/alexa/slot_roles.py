@@ -1,0 +1,120 @@
+"""Giving the slot values found in an utterance to the chosen intent's slots.
+
+An intent with one slot of a type takes the one value of that type. Several values for one
+slot are never guessed between: the robots that together make the whole fleet are the fleet
+("robot one and robot two" -> `all`); of several zones the one after "to" is the
+destination ("from the loading zone to zone b"); anything else stays unresolved, so the skill
+asks. The sequential delivery has two robots and two zones: robots in the order spoken
+unless "after", "once" or "until" puts the later-named robot first ("robot two goes after
+robot one"); a zone belongs to the robot named before it, and a single zone said before
+both robots or after both applies to both ("robot one and then robot two deliver to zone d").
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+from vahr.skill_model.generator import FLEET_ROBOT_ID
+from vahr.skill_model.intents import ROBOT_TYPE
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping, Set
+
+    from vahr.local.alexa.slot_finder import SlotMatch
+
+# Words before a robot that make it the one to go first although it is named second.
+_AFTER = frozenset({"after", "once", "until", "till", "for", "behind"})
+# Words before a zone that mark it as where to go.
+_DESTINATION = frozenset({"to", "into", "towards", "toward", "at", "in"})
+
+
+def assign_slots(
+    declared: Mapping[str, str],
+    matches: list[SlotMatch],
+    words: list[str],
+    robots: Set[str],
+    fleet_name: str,
+) -> dict[str, SlotMatch]:
+    """Slot name -> the value it takes, for the slots of `declared` (name -> type).
+
+    `robots` are the ids of the fleet's robots (not the fleet's own id), `fleet_name` the
+    fleet value's name."""
+    by_type: dict[str, list[str]] = {}
+    for name, slot_type in declared.items():
+        by_type.setdefault(slot_type, []).append(name)
+    if _is_sequence(by_type):
+        return _sequence(by_type, matches, words)
+    filled: dict[str, SlotMatch] = {}
+    for slot_type, names in by_type.items():
+        values = [match for match in matches if match.type == slot_type]
+        chosen = _one_each(values, len(names), words, robots, fleet_name)
+        for name, value in zip(names, chosen, strict=False):
+            if value is not None:
+                filled[name] = value
+    return filled
+
+
+def _is_sequence(by_type: Mapping[str, list[str]]) -> bool:
+    return [len(names) for names in by_type.values()] == [2, 2]
+
+
+def _one_each(
+    values: list[SlotMatch], slots: int, words: list[str], robots: Set[str], fleet_name: str
+) -> list[SlotMatch | None]:
+    if not values:
+        return []
+    if slots > 1 or len(values) == 1 or len({v.id for v in values}) == 1:
+        return list(values[:slots])
+    return [_merge(values, words, robots, fleet_name)]
+
+
+def _merge(
+    values: list[SlotMatch], words: list[str], robots: Set[str], fleet_name: str
+) -> SlotMatch:
+    """One value standing for several named where one was expected."""
+    ids = {value.id for value in values}
+    spoken = " and ".join(value.spoken for value in values)
+    first = values[0]
+    if first.type == ROBOT_TYPE and (ids == set(robots) or ids == {*robots, FLEET_ROBOT_ID}):
+        # Robots named one by one where one robot is expected are all of them only when
+        # together they are the fleet.
+        return replace(first, spoken=spoken, id=FLEET_ROBOT_ID, canonical=fleet_name)
+    destinations = [v for v in values if v.start > 0 and words[v.start - 1] in _DESTINATION]
+    if len(destinations) == 1:
+        return destinations[0]
+    return replace(first, spoken=spoken, id=None, canonical=None)
+
+
+def _sequence(
+    by_type: Mapping[str, list[str]], matches: list[SlotMatch], words: list[str]
+) -> dict[str, SlotMatch]:
+    (robot_type, robot_slots), (zone_type, zone_slots) = sorted(
+        by_type.items(), key=lambda item: item[0] != ROBOT_TYPE
+    )
+    robots = [m for m in matches if m.type == robot_type]
+    zones = [m for m in matches if m.type == zone_type]
+    if len(robots) >= 2 and robots[1].start > 0 and words[robots[1].start - 1] in _AFTER:
+        robots = [robots[1], robots[0], *robots[2:]]
+    filled: dict[str, SlotMatch] = dict(zip(robot_slots, robots, strict=False))
+    order = {id(robot): rank for rank, robot in enumerate(robots[:2])}
+    owned: dict[int, SlotMatch] = {}
+    unowned: list[SlotMatch] = []
+    for zone in zones:
+        before = [r for r in robots[:2] if r.end <= zone.start]
+        owner = max(before, key=lambda r: r.end) if before else None
+        after_all = len(robots) >= 2 and len(before) == 2 and len(zones) == 1
+        if owner is None or after_all:
+            unowned.append(zone)
+        elif order[id(owner)] not in owned:
+            owned[order[id(owner)]] = zone
+        else:
+            unowned.append(zone)
+    if len(zones) == 1 and unowned and len(robots) != 1:
+        # One zone before or after both robots: both deliver there.
+        return {**filled, zone_slots[0]: unowned[0], zone_slots[1]: unowned[0]}
+    for rank in range(2):
+        if rank not in owned and unowned:
+            owned[rank] = unowned.pop(0)
+    filled.update({zone_slots[rank]: zone for rank, zone in owned.items()})
+    return filled
