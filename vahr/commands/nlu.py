@@ -1,19 +1,34 @@
-"""`vahr nlu "UTTERANCE"`: how the interaction model understands an utterance (nothing runs)."""
+"""`vahr nlu "UTTERANCE"`: how the simulator understands an utterance (nothing runs), and
+`vahr nlu --eval [FILE]`: accuracy on a labelled set (the shipped development set by default)."""
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import argparse
 
+    from vahr.local.alexa.nlu import InteractionModel, Understanding
+
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("utterance", help='what a person says, e.g. "send robot one to zone b"')
+    from vahr.local.alexa.evaluation import DEVELOPMENT_SET
+
+    parser.add_argument(
+        "utterance", nargs="?", help='what a person says, e.g. "send robot one to zone b"'
+    )
     parser.add_argument(
         "--model", type=Path, help="interaction model JSON (default: skill-package en-US)"
+    )
+    parser.add_argument(
+        "--eval",
+        type=Path,
+        nargs="?",
+        const=DEVELOPMENT_SET,
+        metavar="FILE",
+        help="score a labelled set (YAML) instead; without FILE, the shipped development set",
     )
     parser.add_argument("--json", action="store_true", help="print JSON")
 
@@ -23,29 +38,74 @@ def run(args: argparse.Namespace) -> int:
     from vahr.local.alexa.nlu import InteractionModel
     from vahr.local.alexa.simulator import strip_invocation
 
-    if not args.utterance.strip():
+    if args.eval is not None:
+        if args.utterance:
+            raise VahrError("give an utterance or --eval, not both")
+        return _evaluate(InteractionModel.load(args.model), args.eval, args.json)
+    if args.utterance is None or not args.utterance.strip():
         raise VahrError("the utterance is empty")
     model = InteractionModel.load(args.model)
     understood = model.understand(strip_invocation(model.invocation_name, args.utterance))
-    slots = {
-        name: {
-            "value": value.spoken if (value := understood.slots.get(name)) else None,
-            "id": value.id if value else None,
-        }
-        for name in understood.declared or tuple(understood.slots)
-    }
+    printed = describe(understood)
     if args.json:
-        print(
-            json.dumps({"intent": understood.intent, "slots": slots, "sample": understood.sample})
-        )
+        print(json.dumps(printed))
         return 0
-    print(f"intent  {understood.intent}")
+    print(f"intent      {understood.intent}  (confidence {understood.confidence:.2f})")
+    if understood.best_guess:
+        print(f"best guess  {understood.best_guess} (below the threshold)")
     if understood.sample:
-        print(f"sample  {understood.sample}")
-    for name, slot in slots.items():
+        print(f"nearest     {understood.sample}")
+    for name, slot in printed["slots"].items():
         if slot["value"] is None:
-            print(f"slot    {name}: (empty)")
+            print(f"slot        {name}: (empty)")
+        elif slot["id"] is None:
+            print(f"slot        {name}: {slot['value']!r} (ER_SUCCESS_NO_MATCH)")
         else:
-            outcome = f"-> {slot['id']}" if slot["id"] else "(ER_SUCCESS_NO_MATCH)"
-            print(f"slot    {name}: {slot['value']!r} {outcome}")
+            how = "" if slot["similarity"] == 100 else f", heard at {slot['similarity']:.0f}%"
+            print(f"slot        {name}: {slot['value']!r} -> {slot['id']}{how}")
+    return 0
+
+
+def describe(understood: Understanding) -> dict[str, Any]:
+    """The JSON of `vahr nlu --json`: `intent` and `slots` {NAME: {value, id}} (a contract in
+    DESIGN.md), plus each slot's resolution, the confidence and the nearest sample."""
+    slots: dict[str, dict[str, Any]] = {}
+    for name in understood.declared or tuple(understood.slots):
+        value = understood.slots.get(name)
+        if value is None:
+            slots[name] = {"value": None, "id": None, "resolution": None}
+            continue
+        slots[name] = {
+            "value": value.spoken,
+            "id": value.id,
+            "resolution": "ER_SUCCESS_MATCH" if value.resolved else "ER_SUCCESS_NO_MATCH",
+            "name": value.canonical,
+            "similarity": round(value.similarity, 1),
+        }
+    return {
+        "intent": understood.intent,
+        "slots": slots,
+        "confidence": round(understood.confidence, 4),
+        "best_guess": understood.best_guess,
+        "sample": understood.sample,
+    }
+
+
+def _evaluate(model: InteractionModel, file: Path, as_json: bool) -> int:
+    from vahr.local.alexa.evaluation import LabelledSet, evaluate
+    from vahr.local.alexa.nlu import FALLBACK
+
+    report = evaluate(model, LabelledSet.load(file))
+    if as_json:
+        print(json.dumps(report.to_json()))
+        return 0
+    print(report.table())
+    misses = [s for s in report.scored if s.outcome not in ("right", "fallback")]
+    misses += [s for s in report.scored if s.outcome == "fallback" and s.item.intent != FALLBACK]
+    if misses:
+        print("\nnot understood as labelled:")
+    for scored in misses:
+        got = scored.understood
+        slots = {name: value.id for name, value in got.slots.items()}
+        print(f"  {scored.outcome:<8} {scored.item.text!r} -> {got.intent} {slots}")
     return 0

@@ -106,6 +106,7 @@ NAVIGATE = IntentSpec(
         "<ask> (move|relocate|reposition) {robot} (over|across) <to> {zone}",
         "<ask> (let's|lets) (get|send|move|take) {robot} <way> <to> {zone}",
         "<ask> (bring|get|send) {robot} <way> (here|over) to {zone}",
+        "<ask> (get|set|start) {robot} (moving|going|driving|heading|rolling) <way> <to> {zone}",
     ),
 )
 
@@ -113,7 +114,12 @@ DELIVER = IntentSpec(
     name="DeliverIntent",
     slots=(ROBOT, ZONE),
     commands_robots=True,
-    essentials=("have {robot} deliver a package to {zone}", "deliver a package to {zone}"),
+    essentials=(
+        "have {robot} deliver a package to {zone}",
+        "deliver a package to {zone}",
+        "have {robot} deliver",
+        "let {robot} deliver",
+    ),
     templates=(
         "<ask> (have|let|make) {robot} <carry> <cargo> <way> to {zone} <end>",
         "<ask> (tell|ask|get) {robot} to <carry> <cargo> <way> to {zone} <end>",
@@ -134,7 +140,8 @@ DELIVER = IntentSpec(
         "{robot} deliver (to|at|for) {zone} <end>",
         "<ask> (have|let) {robot} deliver (to|at|for) {zone} <end>",
         "<ask> (tell|ask) {robot} to deliver (to|at|for) {zone} <end>",
-        "<ask> (have|let|tell|ask) {robot} (to deliver|deliver) <cargo> <end>",
+        "<ask> (have|let) {robot} (deliver|make a delivery|do a delivery) [<cargo>] <end>",
+        "<ask> (tell|ask|get) {robot} to (deliver|make a delivery|do a delivery) [<cargo>] <end>",
         "<ask> <carry> <cargo> <way> to {zone} <end>",
         "<ask> (make|do|run) a delivery to {zone} <end>",
         "<ask> (start|begin|do|make) a delivery (with|using) {robot}",

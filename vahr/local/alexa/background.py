@@ -52,6 +52,8 @@ OUT_OF_DOMAIN_TEMPLATES: tuple[str, ...] = (
     "(set|wake me up with) an alarm for (six|seven) [am|in the morning]",
     "what time is it [now|in tokyo|in london]",
     "what's the date [today]",
+    "(what|which) (day|month|year) is it [today]",
+    "how much (does|do) (a robot|the robots|it|this) cost",
     "tell me a (joke|story|fun fact|riddle)",
     "(turn|switch) (on|off) the (lights|lamp|tv|heating|fan)",
     "(dim|brighten) the lights [in the kitchen]",

@@ -1,7 +1,8 @@
 """Choosing the intent: a linear classifier over words with the slot values abstracted.
 
 Training (scikit-learn): TF-IDF over word unigrams, word bigrams and the character n-grams
-inside words, a logistic regression with balanced class weights, and temperature scaling
+inside words, a logistic regression with balanced class weights (the built-in
+intents have far fewer phrases than the skill's), and temperature scaling
 fitted on held-out predictions (`CalibratedClassifierCV(method="temperature",
 ensemble=False)`: 5-fold out-of-fold decisions calibrate one temperature; the final
 regression is fitted on every sample). The training sentences are the generated samples,
@@ -27,8 +28,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-# Bump when the features, the estimator or the export change: it invalidates every cache.
-FORMAT = 1
+# What the cached model depends on besides its data; change it with `features`, `fit` or the
+# export, and every cache is invalidated.
+TRAINING = "2: tfidf(words, bigrams, chars 3-5; sublinear), logreg(balanced), temperature(5 folds)"
 MARKERS = frozenset({"ROBOT", "ZONE"})
 CALIBRATION_FOLDS = 5
 
@@ -57,6 +59,12 @@ class IntentScores:
     @property
     def best(self) -> tuple[str, float]:
         return self.ranked[0]
+
+    def without(self, label: str) -> IntentScores:
+        """The scores with `label` set aside and the others renormalized."""
+        kept = [(name, p) for name, p in self.ranked if name != label]
+        total = sum(p for _, p in kept) or 1.0
+        return IntentScores([(name, p / total) for name, p in kept])
 
 
 class IntentClassifier:
@@ -95,7 +103,13 @@ class IntentClassifier:
 
 def training_key(texts: list[str], labels: list[str]) -> str:
     """A hash of everything a trained model depends on."""
-    digest = hashlib.sha256(json.dumps([FORMAT, texts, labels]).encode())
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        learner = version("scikit-learn")
+    except PackageNotFoundError:
+        learner = "absent"
+    digest = hashlib.sha256(json.dumps([TRAINING, learner, texts, labels]).encode())
     return digest.hexdigest()
 
 
@@ -156,7 +170,7 @@ def train(texts: list[str], labels: list[str]) -> dict[str, Any]:
     [temperature] = member.calibrators
     coefficients = regression.coef_.T.tolist()
     return {
-        "format": FORMAT,
+        "training": TRAINING,
         # The calibrated wrapper encodes the labels; the regression's classes are their codes.
         "classes": [str(calibrated.classes_[code]) for code in regression.classes_],
         "vocabulary": {name: int(index) for name, index in vectorizer.vocabulary_.items()},

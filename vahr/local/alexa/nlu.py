@@ -49,6 +49,9 @@ DEFAULT_MODEL = (
     Path(__file__).with_name("skill-package") / "interactionModels" / "custom" / "en-US.json"
 )
 FALLBACK = "AMAZON.FallbackIntent"
+# The classifier's label for a bare answer to "which robot?" ("robot one", "to zone b"),
+# learnt from the slots' elicitation samples; it is never an intent of its own.
+SLOT_ANSWER = "vahr.SlotAnswer"
 # An intent is taken only when the calibrated probability says it is more likely than all
 # the others together; anything less is the fallback, as a wrong action is worse than asking.
 CONFIDENCE_THRESHOLD = 0.5
@@ -112,6 +115,12 @@ class InteractionModel:
                 for intent in intents
             }
             samples = {intent["name"]: list(intent.get("samples", [])) for intent in intents}
+            answers = {
+                (intent["name"], answer)
+                for intent in intents
+                for slot in intent.get("slots", [])
+                for answer in slot.get("samples", [])
+            }
         except (KeyError, TypeError) as err:
             raise VahrError(f"the interaction model lacks {err}") from err
         self._samples: dict[str, list[tuple[str, str]]] = {}
@@ -129,6 +138,9 @@ class InteractionModel:
                     self._samples.setdefault(name, []).append((phrase, phrase))
                     texts.append(phrase)
                     labels.append(name)
+        for name, answer in sorted(answers):
+            texts.append(self._abstract_sample(name, answer))
+            labels.append(SLOT_ANSWER)
         if FALLBACK in self.intent_slots:
             texts += out_of_domain_phrases()
             labels += [FALLBACK] * (len(texts) - len(labels))
@@ -139,7 +151,8 @@ class InteractionModel:
                 (sample, self.intent_slots[name])
                 for name, phrases in samples.items()
                 for sample in phrases
-            ],
+            ]
+            + [(answer, self.intent_slots[name]) for name, answer in sorted(answers)],
             known,
         )
         robot_values = [
@@ -221,7 +234,8 @@ class InteractionModel:
         if not words:
             return Understanding(FALLBACK, confidence=1.0)
         abstracted = _abstract(words, matches)
-        intent, confidence = classifier.scores(abstracted).best
+        # Outside a dialog there is no question to answer: the answer reading is set aside.
+        intent, confidence = classifier.scores(abstracted).without(SLOT_ANSWER).best
         if intent == FALLBACK or confidence < CONFIDENCE_THRESHOLD:
             guess = None if intent == FALLBACK else intent
             return Understanding(FALLBACK, confidence=confidence, best_guess=guess)
@@ -238,6 +252,30 @@ class InteractionModel:
             tuple(declared),
             self.nearest_sample(intent, abstracted),
             confidence,
+        )
+
+    def answer(self, utterance: str, intent: str, slot: str) -> SlotValue | None:
+        """`utterance` read as the answer to a question for `slot` of `intent` ("which
+        robot?"), or None when it is rather a request of its own ("where are the robots")
+        or names no value of the slot's type."""
+        classifier = self.wait_ready()
+        slot_type = self.intent_slots.get(intent, {}).get(slot)
+        words, matches = self.find_slots(utterance)
+        values = [match for match in matches if match.type == slot_type]
+        if not values:
+            return None
+        best, confidence = classifier.scores(_abstract(words, matches)).best
+        request = best not in (SLOT_ANSWER, FALLBACK, intent)
+        if request and confidence >= CONFIDENCE_THRESHOLD:
+            return None
+        value = values[0] if len({v.id for v in values}) == 1 else None
+        return SlotValue(
+            name=slot,
+            type=slot_type or "",
+            spoken=value.spoken if value else " and ".join(v.spoken for v in values),
+            id=value.id if value else None,
+            canonical=value.canonical if value else None,
+            similarity=value.similarity if value else 100.0,
         )
 
     def nearest_sample(self, intent: str, abstracted: str) -> str | None:

@@ -12,7 +12,7 @@ import re
 import threading
 import time
 import uuid
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 from vahr.local.alexa import envelope
@@ -162,27 +162,22 @@ class AlexaSimulator:
         return self._send(utterance, request, understanding)
 
     def _understand(self, text: str) -> Understanding:
-        understanding = self.model.understand(text)
         assert self._session is not None
         if self._session.eliciting is None:
-            return understanding
+            return self.model.understand(text)
         pending, slot_name = self._session.eliciting
-        if understanding.intent == pending.intent or understanding.intent.startswith("AMAZON."):
-            if understanding.intent != "AMAZON.FallbackIntent":
-                return understanding
         # An answer to "which zone?" is the slot value alone (or wrapped in a few words).
-        value = self.model.slot_value(pending.intent, slot_name, text)
-        if not value.resolved:
-            for candidate in _strip_fillers(text):
-                found = self.model.slot_value(pending.intent, slot_name, candidate)
-                if found.resolved:
-                    value = found
-                    break
-        if not value.resolved and understanding.intent != "AMAZON.FallbackIntent":
-            return understanding
-        return Understanding(
-            pending.intent, {**pending.slots, slot_name: value}, pending.declared, None
-        )
+        value = self.model.answer(text, pending.intent, slot_name)
+        if value is not None:
+            return Understanding(
+                pending.intent, {**pending.slots, slot_name: value}, pending.declared
+            )
+        understanding = self.model.understand(text)
+        if understanding.intent == pending.intent:
+            # The same request said again in full keeps what was already given.
+            slots = {**pending.slots, **understanding.slots}
+            return replace(understanding, slots=slots)
+        return understanding
 
     def _send(self, utterance: str, request: Any, understanding: Understanding | None) -> Turn:
         session = self._session or _Session()
@@ -244,9 +239,3 @@ def _elicitation(
             str(slot_name),
         )
     return None
-
-
-def _strip_fillers(text: str) -> list[str]:
-    """Shorter forms of an answer: "to zone b please" -> "zone b please", "zone b", ..."""
-    words = text.split()
-    return [" ".join(words[i:j]) for i in range(len(words)) for j in range(len(words), i, -1)]

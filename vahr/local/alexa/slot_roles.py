@@ -94,7 +94,10 @@ def _sequence(
     )
     robots = [m for m in matches if m.type == robot_type]
     zones = [m for m in matches if m.type == zone_type]
-    if len(robots) >= 2 and robots[1].start > 0 and words[robots[1].start - 1] in _AFTER:
+    # "robot two goes after robot one": the robot named second goes first, and the sentence
+    # is about the one named first.
+    swapped = len(robots) >= 2 and robots[1].start > 0 and words[robots[1].start - 1] in _AFTER
+    if swapped:
         robots = [robots[1], robots[0], *robots[2:]]
     filled: dict[str, SlotMatch] = dict(zip(robot_slots, robots, strict=False))
     order = {id(robot): rank for rank, robot in enumerate(robots[:2])}
@@ -104,9 +107,12 @@ def _sequence(
         before = [r for r in robots[:2] if r.end <= zone.start]
         owner = max(before, key=lambda r: r.end) if before else None
         after_all = len(robots) >= 2 and len(before) == 2 and len(zones) == 1
-        if owner is None or after_all:
+        if after_all and swapped:
+            owner = robots[1]
+        elif owner is None or after_all:
             unowned.append(zone)
-        elif order[id(owner)] not in owned:
+            continue
+        if order[id(owner)] not in owned:
             owned[order[id(owner)]] = zone
         else:
             unowned.append(zone)

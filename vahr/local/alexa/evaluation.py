@@ -1,0 +1,161 @@
+"""Scoring the simulator's understanding on a labelled set of utterances (`vahr nlu --eval`).
+
+A set is a YAML file: `utterances`, each with its `text`, expected `intent` and expected
+`slots` (slot name -> value id; a slot not listed is expected empty), and `out_of_domain`,
+sentences the skill should not act on. Each utterance ends in one of four outcomes:
+
+- right: the intent and every slot's id are the expected ones;
+- wrong: an action other than what was said: another intent (AMAZON.FallbackIntent aside),
+  or a slot resolved to another robot or zone than said (for an out-of-domain sentence, any
+  custom intent);
+- fallback: AMAZON.FallbackIntent (what an out-of-domain sentence should get);
+- asks: the right intent with a slot missing or unresolved, so the skill asks for it (for an
+  out-of-domain sentence, a built-in intent such as help).
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import msgspec
+
+from vahr.errors import VahrError
+from vahr.local.alexa.nlu import FALLBACK
+from vahr.local.alexa.simulator import strip_invocation
+
+if TYPE_CHECKING:
+    from vahr.local.alexa.nlu import InteractionModel, Understanding
+
+DEVELOPMENT_SET = Path(__file__).resolve().parent / "data" / "devset-en-US.yaml"
+OUTCOMES = ("right", "wrong", "fallback", "asks")
+OUT_OF_DOMAIN = "(out of domain)"
+
+
+class LabelledUtterance(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    text: str
+    intent: str
+    slots: dict[str, str] = {}
+
+
+class LabelledSet(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    utterances: list[LabelledUtterance] = []
+    out_of_domain: list[str] = []
+
+    @classmethod
+    def load(cls, path: Path) -> LabelledSet:
+        try:
+            source = path.read_bytes()
+        except OSError as err:
+            raise VahrError(f"cannot read {path}: {err.strerror}") from err
+        try:
+            return msgspec.yaml.decode(source, type=cls)
+        except msgspec.ValidationError as err:
+            raise VahrError(f"{path}: {err}") from err
+        except msgspec.DecodeError as err:
+            raise VahrError(f"{path} is not valid YAML: {err}") from err
+
+    def items(self) -> list[LabelledUtterance]:
+        return [*self.utterances, *(LabelledUtterance(t, FALLBACK) for t in self.out_of_domain)]
+
+
+@dataclass
+class Tally:
+    """Outcomes for one intent (or all)."""
+
+    counts: Counter[str] = field(default_factory=Counter)
+
+    @property
+    def total(self) -> int:
+        return sum(self.counts.values())
+
+    def rate(self, outcome: str) -> float:
+        return self.counts[outcome] / self.total if self.total else 0.0
+
+    def to_json(self) -> dict[str, Any]:
+        rates = {f"{outcome}_rate": round(self.rate(outcome), 4) for outcome in OUTCOMES}
+        return {"n": self.total, **{o: self.counts[o] for o in OUTCOMES}, **rates}
+
+
+@dataclass(frozen=True)
+class Scored:
+    item: LabelledUtterance
+    outcome: str
+    understood: Understanding
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "text": self.item.text,
+            "expected": {"intent": self.item.intent, "slots": self.item.slots},
+            "got": {
+                "intent": self.understood.intent,
+                "slots": {name: value.id for name, value in self.understood.slots.items()},
+                "confidence": round(self.understood.confidence, 3),
+            },
+            "outcome": self.outcome,
+        }
+
+
+@dataclass
+class Report:
+    """What `vahr nlu --eval` prints: tallies per expected intent, in-domain, out of domain."""
+
+    per_intent: dict[str, Tally]
+    in_domain: Tally
+    out_of_domain: Tally
+    scored: list[Scored]
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "in_domain": self.in_domain.to_json(),
+            "out_of_domain": self.out_of_domain.to_json(),
+            "per_intent": {name: tally.to_json() for name, tally in self.per_intent.items()},
+            "mistakes": [s.to_json() for s in self.scored if s.outcome != "right"],
+        }
+
+    def table(self) -> str:
+        lines = [f"{'intent':<28} {'n':>4} {'right':>7} {'wrong':>7} {'fallback':>9} {'asks':>7}"]
+        rows = [*self.per_intent.items(), ("in domain", self.in_domain)]
+        rows.append((OUT_OF_DOMAIN, self.out_of_domain))
+        for name, tally in rows:
+            lines.append(
+                f"{name:<28} {tally.total:>4} {tally.rate('right'):>7.1%} "
+                f"{tally.rate('wrong'):>7.1%} {tally.rate('fallback'):>9.1%} "
+                f"{tally.rate('asks'):>7.1%}"
+            )
+        return "\n".join(lines)
+
+
+def outcome(model: InteractionModel, item: LabelledUtterance, got: Understanding) -> str:
+    if got.intent == FALLBACK:
+        return "fallback"
+    if item.intent == FALLBACK:
+        return "asks" if got.intent.startswith("AMAZON.") else "wrong"
+    if got.intent != item.intent:
+        return "wrong"
+    said = {name: value.id for name, value in got.slots.items()}
+    declared = model.intent_slots.get(item.intent, {})
+    if any(said.get(name) not in (None, item.slots.get(name)) for name in declared):
+        return "wrong"
+    if all(said.get(name) == item.slots.get(name) for name in declared):
+        return "right"
+    return "asks"
+
+
+def evaluate(model: InteractionModel, labelled: LabelledSet) -> Report:
+    """Understand every utterance of `labelled` and tally the outcomes."""
+    per_intent: dict[str, Tally] = {}
+    in_domain, out_of_domain = Tally(), Tally()
+    scored = []
+    for item in labelled.items():
+        understood = model.understand(strip_invocation(model.invocation_name, item.text))
+        result = outcome(model, item, understood)
+        scored.append(Scored(item, result, understood))
+        if item.intent == FALLBACK:
+            out_of_domain.counts[result] += 1
+            continue
+        per_intent.setdefault(item.intent, Tally()).counts[result] += 1
+        in_domain.counts[result] += 1
+    return Report(dict(sorted(per_intent.items())), in_domain, out_of_domain, scored)
