@@ -107,6 +107,7 @@ NAVIGATE = IntentSpec(
         "<ask> (let's|lets) (get|send|move|take) {robot} <way> <to> {zone}",
         "<ask> (bring|get|send) {robot} <way> (here|over) to {zone}",
         "<ask> (get|set|start) {robot} (moving|going|driving|heading|rolling) <way> <to> {zone}",
+        "<ask> (go|drive|head|move) <way> <to> {zone} (with|using|on) {robot} <end>",
     ),
 )
 

@@ -106,6 +106,16 @@ OUT_OF_DOMAIN_TEMPLATES: tuple[str, ...] = (
     "what is a robot",
     "(the|my) (keyboard|mouse|screen) (is broken|is not working)",
     "(shall|should) we take a break",
+    # Questions about the world open with the same words as questions about the robots.
+    "(where|what) (is|are) (the|my|your|our) (keys|phone|wallet|bathroom|kitchen|car|office"
+    "|boss|password|address|budget|plan)",
+    "(how|what) is the (economy|stock market|new job|project|team|family|baby) (doing|like)",
+    "what is the (boiling point|speed|weight|size|color) of (water|sound|gold|the earth)",
+    "(what|how) (is|are) (you|things|your day|the kids|your family) (doing|going|up to)",
+    "(thanks|thank you) [a lot|so much|very much]",
+    "(what's up|what's new|what's happening)",
+    "(here|off) we go",
+    "(is|are) (it|we|they) (time|ready|late) [yet]",
 )
 
 
