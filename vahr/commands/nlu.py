@@ -93,15 +93,13 @@ def describe(understood: Understanding) -> dict[str, Any]:
 
 def _evaluate(model: InteractionModel, file: Path, as_json: bool) -> int:
     from vahr.local.alexa.evaluation import LabelledSet, evaluate
-    from vahr.local.alexa.nlu import FALLBACK
 
     report = evaluate(model, LabelledSet.load(file))
     if as_json:
         print(json.dumps(report.to_json()))
         return 0
     print(report.table())
-    misses = [s for s in report.scored if s.outcome not in ("right", "fallback")]
-    misses += [s for s in report.scored if s.outcome == "fallback" and s.item.intent != FALLBACK]
+    misses = [scored for scored in report.scored if not scored.as_labelled]
     if misses:
         print("\nnot understood as labelled:")
     for scored in misses:

@@ -135,7 +135,9 @@ class LocalStack:
         assert self.dataplane is not None, "start() first"
         log = CommandLog()
         self.dataplane.publish_observers.append(log.observe)
-        model = InteractionModel.load(model_file)
+        # The classifier loads (or trains, when its cache is cold) while the rest starts;
+        # the first utterance waits for it.
+        model = InteractionModel.load(model_file, background=True)
         handler = load_skill_handler(
             self.api_url,
             ack_timeout_s=ack_timeout_s,

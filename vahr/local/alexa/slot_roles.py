@@ -2,9 +2,10 @@
 
 An intent with one slot of a type takes the one value of that type. Several values for one
 slot are never guessed between: the robots that together make the whole fleet are the fleet
-("robot one and robot two" -> `all`); of several zones the one after "to" is the
-destination ("from the loading zone to zone b"); anything else stays unresolved, so the skill
-asks. The sequential delivery has two robots and two zones: robots in the order spoken
+("robot one and robot two" -> `all`); of several zones the destination is the one not
+named as an origin ("from the loading zone to zone b", "to zone c instead of zone a");
+anything else ("to zone a or zone b", "to zone a, no, zone b") stays unresolved, so the
+skill asks. The sequential delivery has two robots and two zones: robots in the order spoken
 unless "after", "once" or "until" puts the later-named robot first ("robot two goes after
 robot one"); a zone belongs to the robot named before it, and a single zone said before
 both robots or after both applies to both ("robot one and then robot two deliver to zone d").
@@ -25,8 +26,8 @@ if TYPE_CHECKING:
 
 # Words before a robot that make it the one to go first although it is named second.
 _AFTER = frozenset({"after", "once", "until", "till", "for", "behind"})
-# Words before a zone that mark it as where to go.
-_DESTINATION = frozenset({"to", "into", "towards", "toward", "at", "in"})
+# Words before a zone that mark it as where a robot comes from, not where it goes.
+_ORIGIN = frozenset({"from", "of"})
 
 
 def assign_slots(
@@ -80,7 +81,7 @@ def _merge(
         # Robots named one by one where one robot is expected are all of them only when
         # together they are the fleet.
         return replace(first, spoken=spoken, id=FLEET_ROBOT_ID, canonical=fleet_name)
-    destinations = [v for v in values if v.start > 0 and words[v.start - 1] in _DESTINATION]
+    destinations = [v for v in values if v.start == 0 or words[v.start - 1] not in _ORIGIN]
     if len(destinations) == 1:
         return destinations[0]
     return replace(first, spoken=spoken, id=None, canonical=None)

@@ -1,0 +1,39 @@
+"""The exported intent classifier answers exactly as the scikit-learn pipeline it came from."""
+
+from __future__ import annotations
+
+import pytest
+
+from vahr.local.alexa.intent_classifier import IntentClassifier, features, fit, train
+from vahr.local.alexa.nlu import InteractionModel
+
+
+@pytest.fixture(scope="module")
+def training() -> tuple[list[str], list[str]]:
+    model = InteractionModel.load(use_cache=False, background=True)
+    texts, labels = model.training
+    return texts, labels
+
+
+def test_the_export_gives_sklearns_probabilities(training: tuple[list[str], list[str]]) -> None:
+    # Given the pipeline fitted on the generated samples and its plain-number export
+    texts, labels = training
+    pipeline = fit(texts, labels)
+    exported = IntentClassifier(train(texts, labels))
+    # When both score utterances seen and unseen in training
+    probes = [*texts[::40], "ROBOT please trundle over to ZONE", "play a song", "qwerty"]
+    expected = pipeline.predict_proba(probes)
+    # Then the probabilities agree to rounding error, class by class
+    classes = list(pipeline.classes_)
+    for probe, row in zip(probes, expected, strict=True):
+        got = dict(exported.scores(probe).ranked)
+        for name, probability in zip(classes, row, strict=True):
+            assert got[name] == pytest.approx(probability, abs=1e-9), (probe, name)
+
+
+def test_features_count_slot_values_and_skip_characters_of_markers() -> None:
+    found = features("send ROBOT to ZONE")
+    assert "k:ROBOT=1" in found and "k:ZONE=1" in found
+    assert "w:send" in found and "b:<s> send" in found and "b:ZONE </s>" in found
+    assert "c: se" in found
+    assert not any(f.startswith("c:") and "ROB" in f for f in found)
