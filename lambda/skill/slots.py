@@ -1,6 +1,7 @@
 """Read a slot from an IntentRequest: what the person said and which id it resolved to.
 
-Alexa's entity resolution is trusted first (ER_SUCCESS_MATCH carries the id). When a
+Alexa's entity resolution is trusted first (ER_SUCCESS_MATCH carries the id), unless it
+matched the words to several values. When a
 request carries no resolutions (a hand-built envelope, a test console), the spoken value is
 looked up in the fleet's names, so the same words work either way.
 """
@@ -53,6 +54,11 @@ def read_slot(
                 authority.status.code.value if authority.status and authority.status.code else None
             )
             if code == MATCH and authority.values and authority.values[0].value:
+                matched = {wrapper.value.id for wrapper in authority.values if wrapper.value}
+                if len(matched) > 1:
+                    # The words fit several values ("robot" for either robot): taking the
+                    # first would act on a guess, so the slot counts as unresolved.
+                    return SlotReading(name, heard, None)
                 resolved = authority.values[0].value.id
                 return SlotReading(name, heard, resolved if resolved in known_ids else None)
         # Resolutions were present and none matched (ER_SUCCESS_NO_MATCH).

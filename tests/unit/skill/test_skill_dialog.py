@@ -39,6 +39,12 @@ def elicited(response: dict[str, Any]) -> tuple[str, dict[str, Any]]:
             f"I don't know a robot called the blue robot. Which robot: {ROBOTS}?",
         ),
         (
+            # Alexa matched "robot" to both robots: the skill asks rather than take the first.
+            "alexa_navigate_robot_ambiguous",
+            "robot",
+            f"I don't know a robot called robot. Which robot: {ROBOTS}?",
+        ),
+        (
             "alexa_deliver_to_loading",
             "zone",
             "Packages are picked up in the loading zone. Where should placebot one deliver "
