@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from vahr.local.alexa.intent_classifier import IntentClassifier, features, fit, train
+from vahr.local.alexa.intent_classifier import IntentClassifier, export, features, fit
 from vahr.local.alexa.nlu import InteractionModel
 
 
@@ -19,7 +19,7 @@ def test_the_export_gives_sklearns_probabilities(training: tuple[list[str], list
     # Given the pipeline fitted on the generated samples and its plain-number export
     texts, labels = training
     pipeline = fit(texts, labels)
-    exported = IntentClassifier(train(texts, labels))
+    exported = IntentClassifier(export(pipeline))
     # When both score utterances seen and unseen in training
     probes = [*texts[::40], "ROBOT please trundle over to ZONE", "play a song", "qwerty"]
     expected = pipeline.predict_proba(probes)

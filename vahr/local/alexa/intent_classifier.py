@@ -168,19 +168,22 @@ def fit(texts: list[str], labels: list[str]) -> Any:
 
 def train(texts: list[str], labels: list[str]) -> dict[str, Any]:
     """Fit the pipeline and export it as plain numbers."""
-    pipeline = fit(texts, labels)
+    return export(fit(texts, labels))
+
+
+def export(pipeline: Any) -> dict[str, Any]:
+    """The fitted pipeline as plain numbers (what `IntentClassifier` reads)."""
     vectorizer, calibrated = pipeline[0], pipeline[1]
     [member] = calibrated.calibrated_classifiers_
     regression = member.estimator
     [temperature] = member.calibrators
-    coefficients = regression.coef_.T.tolist()
     return {
         "training": TRAINING,
         # The calibrated wrapper encodes the labels; the regression's classes are their codes.
         "classes": [str(calibrated.classes_[code]) for code in regression.classes_],
         "vocabulary": {name: int(index) for name, index in vectorizer.vocabulary_.items()},
         "idf": vectorizer.idf_.tolist(),
-        "weights": coefficients,
+        "weights": regression.coef_.T.tolist(),
         "intercept": regression.intercept_.tolist(),
         "beta": float(temperature.beta_),
     }

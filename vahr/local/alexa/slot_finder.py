@@ -95,9 +95,10 @@ class SlotFinder:
                 name_words = tuple(name.split())
                 self._names[name_words].append((slot_type.name, value_id, canonical))
                 slot_words.update(name_words)
-                for word in name_words:
-                    owners[word].add(value_id)
-            # A word shared by several values ("robot", "zone") names the type, not a value.
+                if len(name_words) > 1:
+                    owners[name_words[-2]].add(value_id)
+            # The word right before what tells values apart ("robot" one, "zone" a), when
+            # several values share it, names the type ("drop" of "drop zone a" does not).
             for word, ids in owners.items():
                 if len(ids) > 1 and word not in _ARTICLES:
                     self._heads.setdefault(word, slot_type.name)
