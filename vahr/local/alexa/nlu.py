@@ -31,7 +31,7 @@ from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
 from vahr.local.alexa.intent_classifier import IntentClassifier, default_cache_dir, load_or_train
 from vahr.local.alexa.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize
 from vahr.local.alexa.slot_roles import assign_slots
-from vahr.skill_model.generator import FLEET_ROBOT_ID
+from vahr.protocol import FLEET_GROUP
 from vahr.skill_model.intents import ROBOT_TYPE
 
 __all__ = [
@@ -158,8 +158,8 @@ class InteractionModel:
         robot_values = [
             value for t in self._slot_types if t.name == ROBOT_TYPE for value in t.names.values()
         ]
-        self._robots = frozenset(v for v, _ in robot_values if v != FLEET_ROBOT_ID)
-        self._fleet_name = next((n for v, n in robot_values if v == FLEET_ROBOT_ID), "all robots")
+        self._robots = frozenset(v for v, _ in robot_values if v != FLEET_GROUP)
+        self._fleet_name = next((n for v, n in robot_values if v == FLEET_GROUP), "all robots")
         self.training = (texts, labels)
         self.cached: bool | None = None
         self._classifier: IntentClassifier | None = None

@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from vahr.skill_model.generator import FLEET_ROBOT_ID
+from vahr.protocol import FLEET_GROUP
 from vahr.skill_model.intents import ROBOT_TYPE
 
 if TYPE_CHECKING:
@@ -77,10 +77,10 @@ def _merge(
     ids = {value.id for value in values}
     spoken = " and ".join(value.spoken for value in values)
     first = values[0]
-    if first.type == ROBOT_TYPE and (ids == set(robots) or ids == {*robots, FLEET_ROBOT_ID}):
+    if first.type == ROBOT_TYPE and (ids == set(robots) or ids == {*robots, FLEET_GROUP}):
         # Robots named one by one where one robot is expected are all of them only when
         # together they are the fleet.
-        return replace(first, spoken=spoken, id=FLEET_ROBOT_ID, canonical=fleet_name)
+        return replace(first, spoken=spoken, id=FLEET_GROUP, canonical=fleet_name)
     destinations = [v for v in values if v.start == 0 or words[v.start - 1] not in _ORIGIN]
     if len(destinations) == 1:
         return destinations[0]
