@@ -50,7 +50,8 @@ class IntentSpec:
     name: str
     slots: tuple[SlotSpec, ...] = ()
     templates: tuple[str, ...] = ()
-    # Samples kept whatever the draw: the skill's example phrases and the question robots ask.
+    # Samples kept whatever the draw: the skill's example phrases, the question robots ask,
+    # and the simulated participant's script (vahr.experiment.participant).
     essentials: tuple[str, ...] = ()
     # Robot-command intents need at least 60 varied samples (a test holds them to it).
     commands_robots: bool = False
@@ -120,6 +121,7 @@ DELIVER = IntentSpec(
         "deliver a package to {zone}",
         "have {robot} deliver",
         "let {robot} deliver",
+        "tell {robot} to deliver a package to {zone}",
     ),
     templates=(
         "<ask> (have|let|make) {robot} <carry> <cargo> <way> to {zone} <end>",
@@ -156,7 +158,10 @@ WEATHER_DELIVERY = IntentSpec(
     name="WeatherDeliveryIntent",
     slots=(ROBOT,),
     commands_robots=True,
-    essentials=("have {robot} deliver based on the weather",),
+    essentials=(
+        "have {robot} deliver based on the weather",
+        "tell {robot} to do the weather delivery",
+    ),
     templates=(
         "<ask> (have|let|make) {robot} (deliver|make a delivery|do a delivery|navigate|go) "
         "<weather_basis> <end>",
@@ -192,7 +197,10 @@ SEQUENTIAL_DELIVERY = IntentSpec(
     name="SequentialDeliveryIntent",
     slots=(FIRST_ROBOT, FIRST_ZONE, SECOND_ROBOT, SECOND_ZONE),
     commands_robots=True,
-    essentials=("{firstRobot} deliver to {firstZone} then {secondRobot} deliver to {secondZone}",),
+    essentials=(
+        "{firstRobot} deliver to {firstZone} then {secondRobot} deliver to {secondZone}",
+        "have {firstRobot} deliver to {firstZone} and then {secondRobot} deliver to {secondZone}",
+    ),
     templates=(
         "<ask> (have|let) {firstRobot} deliver [<cargo>] to {firstZone} (and then|then|and after "
         "that|after that|followed by) {secondRobot} [deliver|delivers] [<cargo>] to {secondZone}",

@@ -124,26 +124,7 @@ class InteractionModel:
         except (KeyError, TypeError) as err:
             raise VahrError(f"the interaction model lacks {err}") from err
         self._samples: dict[str, list[tuple[str, str]]] = {}
-        texts: list[str] = []
-        labels: list[str] = []
-        for name, phrases in samples.items():
-            for sample in phrases:
-                abstracted = self._abstract_sample(name, sample)
-                self._samples.setdefault(name, []).append((abstracted, sample))
-                texts.append(abstracted)
-                labels.append(name)
-        for name, phrases in built_in_phrases().items():
-            if name in self.intent_slots:
-                for phrase in phrases:
-                    self._samples.setdefault(name, []).append((phrase, phrase))
-                    texts.append(phrase)
-                    labels.append(name)
-        for name, answer in sorted(answers):
-            texts.append(self._abstract_sample(name, answer))
-            labels.append(SLOT_ANSWER)
-        if FALLBACK in self.intent_slots:
-            texts += out_of_domain_phrases()
-            labels += [FALLBACK] * (len(texts) - len(labels))
+        texts, labels = self._training_data(samples, sorted(answers))
         known = {word for text in texts for word in text.split()}
         self._finder = SlotFinder(
             self._slot_types,
@@ -180,6 +161,34 @@ class InteractionModel:
         else:
             build()
 
+    def _training_data(
+        self, samples: dict[str, list[str]], answers: list[tuple[str, str]]
+    ) -> tuple[list[str], list[str]]:
+        """The classifier's sentences and labels: the samples with slots abstracted, the
+        built-in intents' phrases, the slots' answers, and the out-of-domain requests."""
+        texts: list[str] = []
+        labels: list[str] = []
+        for name, phrases in samples.items():
+            for sample in phrases:
+                abstracted = self._abstract_sample(name, sample)
+                self._samples.setdefault(name, []).append((abstracted, sample))
+                texts.append(abstracted)
+                labels.append(name)
+        for name, phrases in built_in_phrases().items():
+            if name in self.intent_slots:
+                for phrase in phrases:
+                    self._samples.setdefault(name, []).append((phrase, phrase))
+                    texts.append(phrase)
+                    labels.append(name)
+        for name, answer in answers:
+            texts.append(self._abstract_sample(name, answer))
+            labels.append(SLOT_ANSWER)
+        if FALLBACK in self.intent_slots:
+            background = out_of_domain_phrases()
+            texts += background
+            labels += [FALLBACK] * len(background)
+        return texts, labels
+
     @classmethod
     def load(cls, path: Path | None = None, **options: Any) -> InteractionModel:
         file = path or DEFAULT_MODEL
@@ -198,30 +207,6 @@ class InteractionModel:
         if self._classifier is None:
             raise VahrError(f"the intent classifier could not be built: {self._failure}")
         return self._classifier
-
-    def resolve(self, slot_type: str, spoken: str) -> tuple[str, str] | None:
-        """(id, canonical name) of the slot type's value named exactly `spoken`, if any."""
-        for known in self._slot_types:
-            if known.name == slot_type:
-                return known.names.get(normalize(spoken))
-        return None
-
-    def slot_value(self, intent: str, slot: str, spoken: str) -> SlotValue:
-        """`spoken` as a value of the intent's slot: the slot type's value it names, if one
-        does (misheard words allowed), else unresolved."""
-        slot_type = self.intent_slots.get(intent, {}).get(slot, "")
-        words = normalize(spoken).split()
-        matches = [m for m in self._finder.find(words) if m.type == slot_type]
-        whole = len(matches) == 1 and matches[0].id is not None
-        match = matches[0] if whole else None
-        return SlotValue(
-            name=slot,
-            type=slot_type,
-            spoken=match.spoken if match else spoken,
-            id=match.id if match else None,
-            canonical=match.canonical if match else None,
-            similarity=match.similarity if match else 100.0,
-        )
 
     def find_slots(self, utterance: str) -> tuple[list[str], list[SlotMatch]]:
         words = normalize(utterance).split()
