@@ -205,6 +205,8 @@ def test_a_bare_robot_name_outside_a_dialog_is_no_command(model: InteractionMode
     assert model.understand("robot two").intent in (FALLBACK, "StatusIntent")
     answer = model.answer("robot two", "NavigateIntent", "robot")
     assert answer is not None and answer.id == "placebot2"
+    both = model.answer("both of them", "NavigateIntent", "robot")
+    assert both is not None and both.id == "all"
     # A request of its own is not an answer, and an answer must name the slot's type.
     assert model.answer("where are the robots", "NavigateIntent", "robot") is None
     assert model.answer("zone b", "NavigateIntent", "robot") is None

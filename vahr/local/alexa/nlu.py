@@ -225,12 +225,8 @@ class InteractionModel:
             guess = None if intent == FALLBACK else intent
             return Understanding(FALLBACK, confidence=confidence, best_guess=guess)
         declared = self.intent_slots.get(intent, {})
-        slots = {
-            name: SlotValue(name, declared[name], m.spoken, m.id, m.canonical, m.similarity)
-            for name, m in assign_slots(
-                declared, matches, words, self._robots, self._fleet_name
-            ).items()
-        }
+        assigned = assign_slots(declared, matches, words, self._robots, self._fleet_name)
+        slots = {name: _slot_value(name, declared[name], m) for name, m in assigned.items()}
         return Understanding(
             intent,
             slots,
@@ -244,7 +240,7 @@ class InteractionModel:
         robot?"), or None when it is rather a request of its own ("where are the robots")
         or names no value of the slot's type."""
         classifier = self.wait_ready()
-        slot_type = self.intent_slots.get(intent, {}).get(slot)
+        slot_type = self.intent_slots.get(intent, {}).get(slot, "")
         words, matches = self.find_slots(utterance)
         values = [match for match in matches if match.type == slot_type]
         if not values:
@@ -253,15 +249,9 @@ class InteractionModel:
         request = best not in (SLOT_ANSWER, FALLBACK, intent)
         if request and confidence >= CONFIDENCE_THRESHOLD:
             return None
-        value = values[0] if len({v.id for v in values}) == 1 else None
-        return SlotValue(
-            name=slot,
-            type=slot_type or "",
-            spoken=value.spoken if value else " and ".join(v.spoken for v in values),
-            id=value.id if value else None,
-            canonical=value.canonical if value else None,
-            similarity=value.similarity if value else 100.0,
-        )
+        # Several values are read as in a request ("robot one and robot two" is the fleet).
+        value = assign_slots({slot: slot_type}, values, words, self._robots, self._fleet_name)
+        return _slot_value(slot, slot_type, value[slot])
 
     def nearest_sample(self, intent: str, abstracted: str) -> str | None:
         """The intent's sample utterance whose words are closest to `abstracted`."""
@@ -290,6 +280,10 @@ def _slot_type(document: dict[str, Any]) -> SlotTypeValues:
         for phrase in [name, *value["name"].get("synonyms", [])]:
             names.setdefault(normalize(phrase), (value_id, name))
     return SlotTypeValues(document["name"], names)
+
+
+def _slot_value(name: str, slot_type: str, match: SlotMatch) -> SlotValue:
+    return SlotValue(name, slot_type, match.spoken, match.id, match.canonical, match.similarity)
 
 
 def _abstract(words: list[str], matches: list[SlotMatch]) -> str:
