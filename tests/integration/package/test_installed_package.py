@@ -30,6 +30,9 @@ if TYPE_CHECKING:
 ROOT = Path(__file__).resolve().parents[3]
 INSTALL_TIMEOUT_S = 600
 START_TIMEOUT_S = 60.0
+# Building the wheel and installing it with its dependencies (scikit-learn among them) has
+# its own deadline above; the suite's 120 s per test must not cut it short on a busy machine.
+pytestmark = pytest.mark.timeout(INSTALL_TIMEOUT_S + 120)
 
 
 def copy_of_the_checkout(destination: Path) -> Path:
