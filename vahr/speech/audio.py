@@ -80,8 +80,10 @@ def convert_to_pcm16k(data: bytes, file_type: str) -> bytes:
     if sox is None:
         raise SpeechError("sox is not installed (Debian: apt-get install sox)")
     try:
+        # -R: repeatable dither, so the same input always gives the same samples (the
+        # spoken evaluation set is rendered byte for byte alike on every run).
         done = subprocess.run(
-            [sox, "-t", file_type, "-", "-t", "raw", "-r", str(SAMPLE_RATE), "-c", "1",
+            [sox, "-R", "-t", file_type, "-", "-t", "raw", "-r", str(SAMPLE_RATE), "-c", "1",
              "-b", "16", "-e", "signed-integer", "-L", "-"],
             input=data,
             capture_output=True,
