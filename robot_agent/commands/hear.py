@@ -1,4 +1,12 @@
-"""`robot-agent hear FILE.wav [--json]`: recognize and interpret an assistant's answer."""
+"""`robot-agent hear`: recognize and interpret an assistant's answer, and measure how well.
+
+- `hear FILE.wav [--json]`: what was heard, the intent, the confidence, the phrases that
+  decided it and, when it is unknown, why;
+- `hear --make-eval-set DIR [--phrasings FILE]`: speak the evaluation set (or another
+  phrasings file) into DIR, the same bytes on every run;
+- `hear --eval DIR [--json]`: hear every clip of DIR and print right, wrong-intent and
+  fallback (unknown) rates per condition and intent.
+"""
 
 from __future__ import annotations
 
@@ -12,11 +20,18 @@ from vahr.speech.errors import SpeechError
 if TYPE_CHECKING:
     import argparse
 
+    from robot_agent.voice.port import Heard
+
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("file", type=Path, help="WAV file (any rate and channels; - for stdin)")
     parser.add_argument(
-        "--json", action="store_true", help='print {"text", "intent", "confidence"}'
+        "file", type=Path, nargs="?", help="WAV file (any rate and channels; - for stdin)"
+    )
+    parser.add_argument(
+        "--json",
+        action="store_true",
+        help='print {"text", "intent", "confidence", "evidence", "reason"} (with --eval: '
+        "the rates)",
     )
     parser.add_argument(
         "--answers",
@@ -24,9 +39,42 @@ def configure(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="weather answers file (default: the bundled weather_answers.yaml)",
     )
+    parser.add_argument(
+        "--eval", type=Path, metavar="DIR", help="score every clip of a set made by --make-eval-set"
+    )
+    parser.add_argument(
+        "--make-eval-set", type=Path, metavar="DIR", help="speak the evaluation set into DIR"
+    )
+    parser.add_argument(
+        "--phrasings",
+        type=Path,
+        default=None,
+        help="with --make-eval-set: the phrasings file (default: the bundled evaluation set)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
+    chosen = [name for name in ("file", "eval", "make_eval_set") if getattr(args, name)]
+    if len(chosen) != 1:
+        raise VahrError("give one of FILE, --eval DIR or --make-eval-set DIR")
+    if args.make_eval_set:
+        return _make_eval_set(args)
+    if args.eval:
+        return _evaluate(args)
+    return _hear_file(args)
+
+
+def heard_json(heard: Heard) -> dict[str, object]:
+    return {
+        "text": heard.text,
+        "intent": heard.intent,
+        "confidence": heard.confidence,
+        "evidence": list(heard.evidence),
+        "reason": heard.reason,
+    }
+
+
+def _hear_file(args: argparse.Namespace) -> int:
     import sys
 
     from robot_agent.voice.understanding import offline_understanding
@@ -42,9 +90,48 @@ def run(args: argparse.Namespace) -> int:
     except SpeechError as err:
         raise VahrError(f"{path}: {err}") from err
     if args.json:
-        print(
-            json.dumps({"text": heard.text, "intent": heard.intent, "confidence": heard.confidence})
-        )
+        print(json.dumps(heard_json(heard)))
     else:
-        print(f"{heard.intent}\t{heard.confidence:.3f}\t{heard.text}")
+        why = ", ".join(heard.evidence) if heard.intent != "unknown" else heard.reason
+        print(f"{heard.intent}\t{heard.confidence:.3f}\t{heard.text}\t({why})")
+    return 0
+
+
+def _make_eval_set(args: argparse.Namespace) -> int:
+    from robot_agent.voice.evaluation import EVALUATION_SET, Phrasings, manifest_json, render
+    from vahr.speech.tts import EspeakSynthesizer
+
+    source: Path = args.phrasings or EVALUATION_SET
+    phrasings = Phrasings.load(source)
+    directory: Path = args.make_eval_set
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        manifest = render(phrasings, directory, EspeakSynthesizer, source=source.name)
+    except SpeechError as err:
+        raise VahrError(str(err)) from err
+    except OSError as err:
+        raise VahrError(f"{directory}: {err.strerror}") from err
+    print(manifest_json(manifest, directory))
+    return 0
+
+
+def _evaluate(args: argparse.Namespace) -> int:
+    import time
+
+    from robot_agent.voice.evaluation import score
+    from robot_agent.voice.understanding import offline_understanding
+
+    try:
+        understanding = offline_understanding(args.answers)
+        report = score(args.eval, understanding.hear, time.perf_counter)
+    except SpeechError as err:
+        raise VahrError(str(err)) from err
+    if args.json:
+        print(json.dumps(report.to_json()))
+        return 0
+    print(report.table())
+    print(f"unrelated speech accepted as an answer: {report.unrelated().rate('wrong'):.1%}")
+    for miss in report.misses:
+        print(f"  {miss['file']}: said {miss['said']!r}, heard {miss['heard']!r} -> "
+              f"{miss['intent']} ({miss['reason'] or 'decided'})")  # fmt: skip
     return 0

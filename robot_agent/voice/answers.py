@@ -1,14 +1,16 @@
 """The assistant's expected weather answers, read from `weather_answers.yaml`.
 
-The same file feeds the offline recognizer's grammar, the local interpreter and the CDK
-Lex bot, so what the robot can hear and what it understands never drift apart.
+The same file feeds the offline recognizer's language model (every sentence in it), the
+local interpreter (the cues, negations and the rules for what is no answer) and the CDK
+Lex bot (the intents' sentences), so what the robot can hear and what it understands
+never drift apart.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import yaml
 
@@ -21,13 +23,36 @@ if TYPE_CHECKING:
 
 ANSWERS_FILE = Path(__file__).with_name("weather_answers.yaml")
 INTENTS: tuple[WeatherIntent, ...] = WEATHERS
+_WORD_LISTS = ("negations", "clause_breaks", "question_openers", "robot_talk")
+
+
+@dataclass(frozen=True)
+class Cues:
+    """What decides: per intent, the words and phrases that say it (`said`), and those
+    that say it only when denied (`denied`: "not a cloud" is sunny)."""
+
+    said: dict[WeatherIntent, tuple[tuple[str, ...], ...]]
+    denied: dict[WeatherIntent, tuple[tuple[str, ...], ...]]
+    negations: frozenset[str]
+    negation_reach: int
+    clause_breaks: frozenset[str]
+    question_openers: frozenset[str]
+    robot_talk: frozenset[str]
+
+    def words(self) -> set[str]:
+        phrases = [*self.said.values(), *self.denied.values()]
+        found = {word for group in phrases for phrase in group for word in phrase}
+        return found | set(self.negations)
 
 
 @dataclass(frozen=True)
 class WeatherAnswers:
-    """Sample phrasings per intent (normalized, in file order, without duplicates)."""
+    """Sample phrasings per intent and sentences that are no answer (normalized, in file
+    order, without duplicates), and the cues the interpreter decides by."""
 
     phrases: dict[WeatherIntent, tuple[str, ...]]
+    not_answers: tuple[str, ...] = ()
+    cues: Cues | None = None
 
     def intent_of(self, phrase: str) -> WeatherIntent:
         """The intent whose samples include `phrase` exactly (after normalizing), or unknown."""
@@ -39,6 +64,18 @@ class WeatherAnswers:
 
     def all_phrases(self) -> list[str]:
         return [phrase for samples in self.phrases.values() for phrase in samples]
+
+    def corpus(self) -> list[str]:
+        """Every sentence the recognizer's language model is built from: the answers, what
+        is no answer, and each cue alone (so every cue is a word the robot can hear)."""
+        cues = self.cues
+        alone = [] if cues is None else [
+            " ".join(phrase)
+            for table in (cues.said, cues.denied)
+            for phrases in table.values()
+            for phrase in phrases
+        ]
+        return [*self.all_phrases(), *self.not_answers, *alone]
 
     @classmethod
     def parse(cls, document: object, source: str = "weather answers") -> WeatherAnswers:
@@ -67,7 +104,14 @@ class WeatherAnswers:
                     kept.append(phrase)
                 seen[phrase] = intent
             phrases[intent] = tuple(kept)
-        return cls(phrases)
+        not_answers = _sentences(document.get("not_answers", []), "not_answers", source)
+        for sentence in not_answers:
+            if sentence in seen:
+                raise SpeechError(
+                    f"{source}: {sentence!r} is under both intents.{seen[sentence]} and not_answers"
+                )
+        cues = _cues(document, source) if "cues" in document else None
+        return cls(phrases, not_answers, cues)
 
     @classmethod
     def load(cls, path: Path = ANSWERS_FILE) -> WeatherAnswers:
@@ -78,6 +122,45 @@ class WeatherAnswers:
         except yaml.YAMLError as err:
             raise SpeechError(f"{path}: not valid YAML: {err}") from err
         return cls.parse(document, str(path))
+
+
+def _sentences(value: object, key: str, source: str) -> tuple[str, ...]:
+    if not isinstance(value, list):
+        raise SpeechError(f"{source}: {key} must be a list of sentences")
+    kept = [normalize(str(item)) for item in value]
+    if not all(kept):
+        raise SpeechError(f"{source}: {key} has an empty sentence")
+    return tuple(dict.fromkeys(kept))
+
+
+def _phrase_lists(value: object, key: str, source: str) -> dict[WeatherIntent, Any]:
+    if not isinstance(value, dict) or sorted(set(value) - set(INTENTS)):
+        raise SpeechError(f"{source}: {key} must map sunny and/or rainy to lists of words")
+    found: dict[WeatherIntent, tuple[tuple[str, ...], ...]] = {}
+    for intent, phrases in value.items():
+        found[intent] = tuple(tuple(p.split()) for p in _sentences(phrases, f"{key}.{intent}", source))
+    return found
+
+
+def _cues(document: dict[str, Any], source: str) -> Cues:
+    cues = document["cues"]
+    if not isinstance(cues, dict):
+        raise SpeechError(f"{source}: cues must be a mapping of sunny, rainy and denied")
+    denied = cues.get("denied", {})
+    said = _phrase_lists({k: v for k, v in cues.items() if k != "denied"}, "cues", source)
+    lists = {key: frozenset(_sentences(document.get(key, []), key, source)) for key in _WORD_LISTS}
+    reach = document.get("negation_reach", 3)
+    if not isinstance(reach, int) or not 1 <= reach <= 8:
+        raise SpeechError(f"{source}: negation_reach must be a whole number of words, 1 to 8")
+    return Cues(
+        said=said,
+        denied=_phrase_lists(denied, "cues.denied", source),
+        negations=lists["negations"],
+        negation_reach=reach,
+        clause_breaks=lists["clause_breaks"],
+        question_openers=lists["question_openers"],
+        robot_talk=lists["robot_talk"],
+    )
 
 
 def as_intent(value: str) -> WeatherIntent:

@@ -34,8 +34,11 @@ def synthesizer_for(config: AgentConfig) -> Synthesizer:
 def understanding_for(thing: str, config: AgentConfig) -> Understanding:
     """pocketsphinx, then the local interpreter or Lex as `voice.interpreter` says."""
     from robot_agent.voice.answers import WeatherAnswers
-    from robot_agent.voice.understanding import Understanding, offline_understanding
-    from vahr.speech.stt import GrammarRecognizer
+    from robot_agent.voice.understanding import (
+        Understanding,
+        offline_understanding,
+        recognizers,
+    )
 
     if config.voice.interpreter == "local":
         return offline_understanding()
@@ -72,7 +75,8 @@ def understanding_for(thing: str, config: AgentConfig) -> Understanding:
         credentials=provider.get,
         endpoint_url=lex.endpoint_url,
     )
-    return Understanding(GrammarRecognizer(WeatherAnswers.load().all_phrases()), interpreter)
+    exact, wider = recognizers(WeatherAnswers.load())
+    return Understanding(exact, interpreter, open_recognizer=wider)
 
 
 def room(*, thing: str, config: AgentConfig, link: Link) -> RoomVoice:

@@ -1,29 +1,45 @@
-"""Interpretation: from recognized text to sunny, rainy or unknown.
+"""Interpretation: from recognized text to sunny, rainy or unknown, and why.
 
-`LocalInterpreter` works offline from the same sample phrasings the Lex bot is built from.
-It accepts a sample said exactly, a sample said first with more words after it (the skill
-may add a sentence after "The weather is sunny."), and near misses of a whole sample
-(a word misheard by a free-form recognizer). Text that matches samples of both intents,
-or nothing, is unknown.
+`LocalInterpreter` reads the answer for the cues of `weather_answers.yaml` (sunny: "sun",
+"clear skies", "warm"...; rainy: "rain", "pouring", "wet"...), so it understands phrasings
+nobody listed, as long as they say the weather with words it knows. A negation at most
+`negation_reach` words before a cue, with no clause break between ("no rain", "not a
+single drop of rain", "it won't rain"), denies it: a denied cue says nothing, except the
+cues that only count denied ("not a cloud in the sky" is sunny). It decides only when the
+answer is one-sided:
+
+- cues of one intent and none of the other: that intent;
+- cues of both ("sunny now, rain later"), none, or only denied ones ("no rain today"):
+  unknown, with the reason;
+- a question ("will it rain today") or robot talk ("it is sunny, so I am delivering to
+  zone A": an answer never mentions the robots' work): unknown, whatever the cues.
+
+The words that decided (each cue and the words before it that could have denied it) are
+returned as positions, so the caller can ask how sure the recognizer was of exactly those.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from difflib import SequenceMatcher
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
 from vahr.speech.text import normalize
 
 if TYPE_CHECKING:
-    from robot_agent.voice.answers import WeatherAnswers
+    from robot_agent.voice.answers import Cues, WeatherAnswers
     from robot_agent.voice.port import WeatherIntent
 
 
 @dataclass(frozen=True)
 class Interpretation:
+    """The intent, how sure the interpreter is (0..1), the phrases that decided it, why it
+    is unknown when it is, and the positions of the words it rests on."""
+
     intent: WeatherIntent
     confidence: float
+    evidence: tuple[str, ...] = ()
+    reason: str = ""
+    decisive: tuple[int, ...] = field(default=(), compare=False)
 
 
 class Interpreter(Protocol):
@@ -32,53 +48,99 @@ class Interpreter(Protocol):
         ...
 
 
-UNKNOWN = Interpretation("unknown", 0.0)
-# The score of a whole sample found inside a longer text.
-_WHOLE_SAMPLE = 0.8
+UNKNOWN = Interpretation("unknown", 0.0, reason="nothing said")
+
+
+@dataclass(frozen=True)
+class _Cue:
+    intent: WeatherIntent
+    start: int
+    end: int
+    denied_by: int | None  # position of the negation, if any
+    only_denied: bool  # a cue that counts only when denied
+
+    def phrase(self, words: list[str]) -> str:
+        first = self.denied_by if self.denied_by is not None else self.start
+        return " ".join(words[first : self.end])
 
 
 class LocalInterpreter:
-    """Matches text against the sample phrasings of `weather_answers.yaml`."""
+    """Finds the cues of `weather_answers.yaml` in the text and decides on them."""
 
-    def __init__(self, answers: WeatherAnswers, *, min_similarity: float = 0.85) -> None:
-        self.answers = answers
-        self.min_similarity = min_similarity
+    def __init__(self, answers: WeatherAnswers) -> None:
+        if answers.cues is None:
+            raise ValueError("the weather answers have no cues")
+        self.cues: Cues = answers.cues
 
     def interpret(self, text: str) -> Interpretation:
-        spoken = normalize(text)
-        if not spoken:
+        words = normalize(text).split()
+        if not words:
             return UNKNOWN
-        words = spoken.split()
-        best: dict[WeatherIntent, float] = {}
-        for intent, samples in self.answers.phrases.items():
-            for sample in samples:
-                score = self._score(spoken, words, sample)
-                if score > best.get(intent, 0.0):
-                    best[intent] = score
-        if not best:
-            return UNKNOWN
-        ranked = sorted(best.items(), key=lambda item: item[1], reverse=True)
-        intent, score = ranked[0]
-        # Both intents matched ("sunny now, rain later", or two near misses): do not guess.
-        runner_up = ranked[1][1] if len(ranked) > 1 else 0.0
-        if runner_up >= _WHOLE_SAMPLE or runner_up >= score - 0.05:
-            return UNKNOWN
-        return Interpretation(intent, round(score, 3))
+        cues = self.cues
+        talk = sorted({w for w in words if w in cues.robot_talk})
+        if talk:
+            return Interpretation("unknown", 0.0, reason=f"robot talk ({', '.join(talk)})")
+        if words[0] in cues.question_openers and words[1:2] != ["not"]:
+            return Interpretation("unknown", 0.0, reason=f"a question ({words[0]} ...)")
+        found = self._find(words)
+        affirmed: dict[WeatherIntent, list[_Cue]] = {}
+        denied: list[_Cue] = []
+        for cue in found:
+            if cue.only_denied == (cue.denied_by is not None):
+                affirmed.setdefault(cue.intent, []).append(cue)
+            elif cue.denied_by is not None:
+                denied.append(cue)
+        if len(affirmed) > 1:
+            phrases = tuple(c.phrase(words) for group in affirmed.values() for c in group)
+            return Interpretation("unknown", 0.0, phrases, "both sunny and rainy")
+        if not affirmed:
+            if denied:
+                phrases = tuple(c.phrase(words) for c in denied)
+                return Interpretation("unknown", 0.0, phrases, "the weather only denied")
+            return Interpretation("unknown", 0.0, reason="no weather word")
+        intent, chosen = next(iter(affirmed.items()))
+        decisive = sorted({i for cue in chosen for i in self._span(words, cue)})
+        evidence = tuple(dict.fromkeys(c.phrase(words) for c in chosen))
+        return Interpretation(intent, 1.0, evidence, decisive=tuple(decisive))
 
-    def _score(self, spoken: str, words: list[str], sample: str) -> float:
-        if spoken == sample:
-            return 1.0
-        sample_words = sample.split()
-        # The sample opens the answer, or is a whole sentence inside it.
-        if _contains_sentence(words, sample_words):
-            return 0.9 if words[: len(sample_words)] == sample_words else _WHOLE_SAMPLE
-        similarity = SequenceMatcher(None, spoken, sample).ratio()
-        return similarity * 0.9 if similarity >= self.min_similarity else 0.0
+    def _find(self, words: list[str]) -> list[_Cue]:
+        """Every cue in `words`, longest first where two overlap."""
+        candidates: list[tuple[int, int, WeatherIntent, bool]] = []
+        for only_denied, table in ((False, self.cues.said), (True, self.cues.denied)):
+            for intent, phrases in table.items():
+                for phrase in phrases:
+                    size = len(phrase)
+                    for start in range(len(words) - size + 1):
+                        if tuple(words[start : start + size]) == phrase:
+                            candidates.append((start, start + size, intent, only_denied))
+        candidates.sort(key=lambda c: (c[0], -(c[1] - c[0])))
+        cues: list[_Cue] = []
+        taken = -1
+        for start, end, intent, only_denied in candidates:
+            if start < taken:
+                continue
+            denied_by = self._negation(words, start, since=taken)
+            cues.append(_Cue(intent, start, end, denied_by, only_denied))
+            taken = end
+        return cues
 
+    def _negation(self, words: list[str], start: int, *, since: int) -> int | None:
+        """The position of a negation that reaches the cue starting at `start`, if any.
+        A negation denies the nearest cue after it only: "no rain the sun is out" denies
+        the rain, not the sun (`since` is where the previous cue ended)."""
+        nearest = max(-1, since - 1, start - 1 - self.cues.negation_reach)
+        for position in range(start - 1, nearest, -1):
+            if words[position] in self.cues.negations:
+                return position
+            if words[position] in self.cues.clause_breaks:
+                return None
+        return None
 
-def _contains_sentence(words: list[str], sample: list[str]) -> bool:
-    # Short samples ("sunny") would match inside unrelated sentences ("not sunny"):
-    # only samples of two words or more count when embedded in a longer text.
-    if len(sample) < 2 or len(sample) > len(words):
-        return False
-    return any(words[i : i + len(sample)] == sample for i in range(len(words) - len(sample) + 1))
+    def _span(self, words: list[str], cue: _Cue) -> range:
+        """The cue and the words before it that a negation would have stood among."""
+        first = cue.start
+        while first > 0 and cue.start - first < self.cues.negation_reach:
+            if words[first - 1] in self.cues.clause_breaks:
+                break
+            first -= 1
+        return range(first, cue.end)

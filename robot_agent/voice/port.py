@@ -17,11 +17,15 @@ WeatherIntent = Literal["sunny", "rainy", "unknown"]
 
 @dataclass(frozen=True)
 class Heard:
-    """What the robot understood of the assistant's spoken answer."""
+    """What the robot understood of the assistant's spoken answer: the text heard (empty
+    when the audio was not trusted), the intent, a confidence (0..1), the phrases that
+    decided it, and why it is `unknown` when it is."""
 
     text: str
     intent: WeatherIntent
     confidence: float
+    evidence: tuple[str, ...] = ()
+    reason: str = ""
 
 
 class Voice(Protocol):

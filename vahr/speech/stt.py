@@ -60,15 +60,39 @@ _MARGIN_SAMPLES = SAMPLE_RATE * 150 // 1000
 
 
 @dataclass(frozen=True)
+class HeardWord:
+    """One recognized word and the decoder's posterior probability for it (0..1)."""
+
+    text: str
+    posterior: float
+
+
+@dataclass(frozen=True)
+class Alternative:
+    """Another reading of the same audio from the decoder's N-best list, with its score
+    relative to the best reading (pocketsphinx log units, 0 for the best, below 0 else)."""
+
+    text: str
+    score: float
+
+
+@dataclass(frozen=True)
 class Recognition:
-    """What was heard: `text` is the best guess, `accepted` says whether to trust it."""
+    """What was heard: `text` is the best guess, `accepted` says whether to trust it,
+    `words` are its words with their posteriors (when the recognizer knows them) and
+    `reason` says why it was not accepted."""
 
     text: str
     confidence: float
     accepted: bool
+    words: tuple[HeardWord, ...] = ()
+    reason: str = ""
+    alternatives: tuple[Alternative, ...] = ()
 
 
-NOTHING_HEARD = Recognition("", 0.0, False)
+NOTHING_HEARD = Recognition("", 0.0, False, reason="no speech")
+# The reason of a recognition that is sure the speech is one of the grammar's decoys.
+NOT_AN_ANSWER = "recognized as no answer"
 
 
 class Recognizer(Protocol):
@@ -150,17 +174,23 @@ class GrammarRecognizer:
         grammar_score = self._score_per_frame("grammar", audio)
         hypothesis = self._decoder.hyp()
         text = hypothesis.hypstr if hypothesis is not None else ""
-        if grammar_score is None or text not in self.phrases or self._too_slow(text, audio):
-            return Recognition(text, 0.0, False)
+        decoy = text in self.decoys
+        if grammar_score is None or not (decoy or text in self.phrases):
+            return Recognition(text, 0.0, False, reason="not recognized")
+        if self._too_slow(text, audio):
+            return Recognition(text, 0.0, False, reason="not recognized")
         if not self.verify:
-            return Recognition(text, 1.0, True)
-        # Only a candidate answer is worth the second pass.
+            return Recognition(text, 0.0 if decoy else 1.0, not decoy, reason=_reason(decoy))
         phone_score = self._score_per_frame("phones", audio)
         if phone_score is None:
-            return Recognition(text, 0.0, False)
+            return Recognition(text, 0.0, False, reason="not recognized")
         ratio = grammar_score - phone_score
-        confidence = 1.0 / (1.0 + math.exp(-(ratio - RATIO_MIDPOINT) / RATIO_SCALE))
-        return Recognition(text, round(confidence, 3), confidence >= self.min_confidence)
+        confidence = round(1.0 / (1.0 + math.exp(-(ratio - RATIO_MIDPOINT) / RATIO_SCALE)), 3)
+        sure = confidence >= self.min_confidence
+        # A decoy heard with confidence is speech recognized as no answer: `reason` says so,
+        # so a caller with a second recognizer knows not to try it.
+        reason = _reason(decoy) if sure else "not recognized"
+        return Recognition(text, confidence, sure and not decoy, reason=reason)
 
     def _too_slow(self, text: str, audio: Audio) -> bool:
         voiced = sum(end - start for start, end in self.detector.segments(audio)) / SAMPLE_RATE
@@ -179,6 +209,10 @@ class GrammarRecognizer:
             return None
         # The binding hands the score back exponentiated; take the log again.
         return float(self._logmath.log(hypothesis.score)) / frames
+
+
+def _reason(decoy: bool) -> str:
+    return NOT_AN_ANSWER if decoy else ""
 
 
 class GoogleRecognizer:

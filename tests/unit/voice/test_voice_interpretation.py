@@ -1,4 +1,5 @@
-"""The local interpreter and the answer definitions it shares with the Lex bot."""
+"""The local interpreter and the answer definitions it shares with the recognizer and the
+Lex bot: cues, negation, and what is no answer."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from robot_agent.voice.answers import WeatherAnswers, normalize
+from robot_agent.voice.evaluation import EVALUATION_SET, TUNING_SET, Phrasings
 from robot_agent.voice.interpreter import LocalInterpreter
 from vahr.speech.errors import SpeechError
 
@@ -15,54 +17,108 @@ if TYPE_CHECKING:
 
 
 @pytest.fixture(scope="module")
-def interpreter() -> LocalInterpreter:
-    return LocalInterpreter(WeatherAnswers.load())
+def answers() -> WeatherAnswers:
+    return WeatherAnswers.load()
 
 
-def test_the_shipped_answers_hold_the_skills_exact_sentences() -> None:
-    # Given the file the CDK Lex bot is generated from
-    answers = WeatherAnswers.load()
+@pytest.fixture(scope="module")
+def interpreter(answers: WeatherAnswers) -> LocalInterpreter:
+    return LocalInterpreter(answers)
+
+
+def test_the_shipped_answers_hold_the_skills_exact_sentences(answers: WeatherAnswers) -> None:
+    # Given the file the recognizer, the interpreter and the CDK Lex bot are built from
     # Then the skill's own answers are samples of the right intents
     assert answers.intent_of("The weather is sunny.") == "sunny"
     assert answers.intent_of("The weather is rainy.") == "rainy"
-    assert len(answers.phrases["sunny"]) >= 4 and len(answers.phrases["rainy"]) >= 4
+    assert len(answers.phrases["sunny"]) >= 40 and len(answers.phrases["rainy"]) >= 40
+
+
+def test_every_sample_is_understood_as_its_intent_and_every_not_answer_as_unknown(
+    answers: WeatherAnswers, interpreter: LocalInterpreter
+) -> None:
+    wrong = [
+        (sample, intent, interpreter.interpret(sample))
+        for intent, samples in answers.phrases.items()
+        for sample in samples
+        if interpreter.interpret(sample).intent != intent
+    ]
+    wrong += [
+        (sentence, "unknown", interpreter.interpret(sentence))
+        for sentence in answers.not_answers
+        if interpreter.interpret(sentence).intent != "unknown"
+    ]
+    assert wrong == []
+
+
+@pytest.mark.parametrize("held_out", [EVALUATION_SET, TUNING_SET], ids=["eval", "tuning"])
+def test_no_spoken_test_sentence_is_among_what_the_hearing_is_built_from(
+    answers: WeatherAnswers, held_out: Path
+) -> None:
+    # Given the sentences the language model and the grammar are built from
+    built_from = set(answers.corpus())
+    # Then none of the evaluation or tuning sentences is one of them
+    assert Phrasings.load(held_out).normalized() & built_from == set()
+
+
+def test_the_evaluation_and_tuning_sets_share_no_sentence_and_no_voice() -> None:
+    evaluation, tuning = Phrasings.load(EVALUATION_SET), Phrasings.load(TUNING_SET)
+    assert evaluation.normalized() & tuning.normalized() == set()
+    assert set(evaluation.voices) & set(tuning.voices) == set()
+    assert sum(len(texts) for texts in evaluation.answers.values()) >= 40
+    assert len(evaluation.voices) == 3 and sorted(evaluation.snr_db) == [10, 20]
 
 
 @pytest.mark.parametrize(
-    ("text", "intent"),
+    ("text", "intent", "evidence"),
     [
-        ("The weather is sunny.", "sunny"),
-        ("the weather is rainy", "rainy"),
-        ("It's raining.", "rainy"),
-        ("THE SUN IS SHINING!", "sunny"),
+        ("The weather is sunny.", "sunny", ("sunny",)),
+        ("It's raining.", "rainy", ("raining",)),
+        # Open phrasing: no sample says these.
+        ("not a cloud in the sky", "sunny", ("not a cloud",)),
+        ("it is pouring", "rainy", ("pouring",)),
+        ("grey and wet all day", "rainy", ("wet",)),
+        ("lovely and warm", "sunny", ("warm",)),
+        # A denied cue says nothing; the other one decides.
+        ("it is not raining it is sunny", "sunny", ("sunny",)),
+        ("no sun today only rain", "rainy", ("rain",)),
         # The skill may add a sentence after its answer.
-        ("The weather is rainy. Anything else?", "rainy"),
-        # A free-form recognizer's near miss of a whole sample.
-        ("the weather is sunnny", "sunny"),
+        ("the weather is rainy is there anything else", "rainy", ("rainy",)),
     ],
 )
-def test_samples_and_close_variants_are_understood(
-    interpreter: LocalInterpreter, text: str, intent: str
+def test_cues_decide_and_are_reported(
+    interpreter: LocalInterpreter, text: str, intent: str, evidence: tuple[str, ...]
 ) -> None:
-    assert interpreter.interpret(text).intent == intent
+    meaning = interpreter.interpret(text)
+    assert (meaning.intent, meaning.evidence) == (intent, evidence)
 
 
 @pytest.mark.parametrize(
-    "text",
-    ["", "   ", "what time is it", "the weather is cloudy", "please deliver to zone B",
-     "it is sunny now but it will rain today"],
-)  # fmt: skip
-def test_anything_else_is_unknown(interpreter: LocalInterpreter, text: str) -> None:
-    heard = interpreter.interpret(text)
-    assert heard.intent == "unknown"
-    assert heard.confidence == 0.0
+    ("text", "reason"),
+    [
+        ("", "nothing said"),
+        ("what time is it", "a question (what ...)"),
+        ("will it rain today", "a question (will ...)"),
+        ("no rain today", "the weather only denied"),
+        ("it won't rain", "the weather only denied"),
+        ("it is cloudy", "no weather word"),
+        ("it is sunny now but it will rain later", "both sunny and rainy"),
+        ("thank you it is sunny so i am delivering to zone a", "robot talk (delivering, zone)"),
+    ],
+)
+def test_anything_else_is_unknown_with_the_reason(
+    interpreter: LocalInterpreter, text: str, reason: str
+) -> None:
+    meaning = interpreter.interpret(text)
+    assert (meaning.intent, meaning.confidence, meaning.reason) == ("unknown", 0.0, reason)
 
 
-def test_an_exact_sample_is_more_certain_than_a_near_miss(interpreter: LocalInterpreter) -> None:
-    exact = interpreter.interpret("it is sunny today")
-    near = interpreter.interpret("it is sunny to day")
-    assert exact.confidence == 1.0
-    assert 0.0 < near.confidence < exact.confidence
+def test_the_decisive_words_are_the_cue_and_where_a_negation_could_stand(
+    interpreter: LocalInterpreter,
+) -> None:
+    # "will" sits where "won't" would deny the rain; "it" opens the clause
+    assert interpreter.interpret("it will rain today").decisive == (1, 2)
+    assert interpreter.interpret("it is pouring").decisive == (1, 2)
 
 
 def test_normalize_drops_punctuation_and_case() -> None:
@@ -77,6 +133,9 @@ def test_normalize_drops_punctuation_and_case() -> None:
         ("intents: {sunny: [a], rainy: [b], foggy: [c]}", "unknown intents ['foggy']"),
         ("intents: {sunny: [It is nice], rainy: [it is NICE]}", "listed under both"),
         ("intents: {sunny: ['!!'], rainy: [b]}", "empty phrase"),
+        ("intents: {sunny: [a], rainy: [b]}\nnot_answers: [A]", "under both intents.sunny and not_answers"),
+        ("intents: {sunny: [a], rainy: [b]}\ncues: {foggy: [fog]}", "cues must map sunny and/or rainy"),
+        ("intents: {sunny: [a], rainy: [b]}\ncues: {sunny: [sun]}\nnegation_reach: 0", "negation_reach"),
         ("intents: [unclosed", "not valid YAML"),
     ],
 )
