@@ -6,25 +6,20 @@ instead (every way of giving a weather answer it knows, and what else may be sai
 trigram model with back-off is built from them at start-up (pocketsphinx's own
 `ArpaBoLM`), and the decoder may string the model's words in any order, weighted by how
 the examples use them: "it is pouring" is heard although no example says it. Speech
-outside the examples still comes out as the model's words, so each result carries what
-is needed to judge it:
+outside the examples still comes out as the model's words, so each word carries its
+posterior probability in the decoder's word lattice: a word the audio hardly supports
+over its rivals ("will rain" against "no rain") has a low one, and the caller decides
+what to trust from the words that matter to it.
 
-- every word's posterior probability in the decoder's word lattice: a word that the
-  audio hardly supports over its rivals ("will rain" against "no rain") has a low one;
-- the fit: the search path's acoustic score per frame against an unconstrained phone
-  loop over the same audio (all senones scored, so both are measured against the same
-  per-frame best), mapped to 0..1. Speech made of the model's words follows the phone
-  loop closely; other speech, forced into those words, falls behind.
-
-Silence never reaches the decoder (energy detection first). The caller decides what to
-accept from the words and their posteriors; a fit below `min_fit` is rejected here.
+A phone-loop likelihood ratio, as `GrammarRecognizer` uses, was measured here too and
+dropped: with a back-off model, answers and unrelated speech scored alike (tuning set,
+docs/voice.md), and it doubled the time. Silence never reaches the decoder (energy
+detection first).
 """
 
 from __future__ import annotations
 
 import io
-import itertools
-import math
 import tempfile
 import threading
 from pathlib import Path
@@ -32,21 +27,13 @@ from typing import TYPE_CHECKING
 
 from vahr.speech.audio import SAMPLE_RATE, SpeechDetector
 from vahr.speech.errors import SpeechError
-from vahr.speech.stt import NOTHING_HEARD, Alternative, HeardWord, Recognition
+from vahr.speech.stt import NOTHING_HEARD, HeardWord, Recognition
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
     from vahr.speech.audio import Audio
 
-# Logistic mapping of the per-frame acoustic log-likelihood ratio of the search path
-# against the phone loop (pocketsphinx log units, base 1.0001) to the fit. Set on the
-# tuning set only (robot_agent/voice/data/hearing-tuning.yaml, docs/voice.md).
-FIT_MIDPOINT = -12.0
-FIT_SCALE = 4.0
-DEFAULT_MIN_FIT = 0.5
-# Readings of the N-best list kept for the caller.
-N_BEST = 10
 # How much of the probability mass an ARPA back-off keeps for unseen word sequences.
 DISCOUNT_MASS = 0.5
 _FILLERS = frozenset({"<s>", "</s>", "<sil>", "[NOISE]", "[SPEECH]", "[BREATH]", "[COUGH]"})
@@ -67,26 +54,20 @@ def arpa_model(sentences: Iterable[str]) -> str:
 
 
 class LanguageModelRecognizer:
-    """pocketsphinx with an n-gram model of example sentences, word posteriors and a
-    phone-loop fit."""
+    """pocketsphinx with an n-gram model of example sentences, and word posteriors."""
 
     def __init__(
-        self,
-        sentences: Iterable[str],
-        *,
-        min_fit: float = DEFAULT_MIN_FIT,
-        detector: SpeechDetector | None = None,
+        self, sentences: Iterable[str], *, detector: SpeechDetector | None = None
     ) -> None:
         from pocketsphinx import Decoder, get_model_path
 
         self.sentences = tuple(dict.fromkeys(sentences))
-        self.min_fit = min_fit
         self.detector = detector or SpeechDetector()
-        model = Path(get_model_path())
+        model = Path(get_model_path()) / "en-us"
         self.vocabulary = frozenset(w for s in self.sentences for w in s.split())
         # Only the model's words from the 130,000 of the dictionary: the search is built
         # in milliseconds instead of seconds.
-        pronunciations = _pronunciations(model / "en-us" / "cmudict-en-us.dict", self.vocabulary)
+        pronunciations = _pronunciations(model / "cmudict-en-us.dict", self.vocabulary)
         missing = sorted(self.vocabulary - {line.split(" ", 1)[0] for line in pronunciations})
         if missing:
             raise SpeechError(f"words missing from the pronunciation dictionary: {missing}")
@@ -95,16 +76,15 @@ class LanguageModelRecognizer:
             dictionary.write_text("".join(pronunciations), encoding="utf-8")
             arpa = Path(folder) / "sentences.arpa"
             arpa.write_text(arpa_model(self.sentences), encoding="utf-8")
+            # No second (flat) pass: it doubled the time and changed no result on the
+            # tuning set.
             self._decoder = Decoder(
-                lm=None,
+                lm=str(arpa),
                 dict=str(dictionary),
                 loglevel="FATAL",
-                compallsen=True,
+                fwdflat=False,
                 samprate=float(SAMPLE_RATE),
             )
-            self._decoder.add_lm_file("sentences", str(arpa))
-        self._decoder.add_allphone_file("phones", str(model / "en-us" / "en-us-phone.lm.bin"))
-        self._logmath = self._decoder.get_logmath()
         # One decoder, one utterance at a time.
         self._lock = threading.Lock()
 
@@ -112,38 +92,16 @@ class LanguageModelRecognizer:
         if not self.detector.segments(audio):
             return NOTHING_HEARD
         with self._lock:
-            sentence_score = self._score_per_frame("sentences", audio)
-            words = self._words()
-            text = " ".join(word.text for word in words)
-            if sentence_score is None or not words:
-                return Recognition(text, 0.0, False, words, "nothing recognizable")
-            alternatives = self._alternatives()
-            phone_score = self._score_per_frame("phones", audio)
-        if phone_score is None:
-            return Recognition(text, 0.0, False, words, "nothing recognizable")
-        ratio = sentence_score - phone_score
-        self.last_ratio = ratio
-        fit = round(1.0 / (1.0 + math.exp(-(ratio - FIT_MIDPOINT) / FIT_SCALE)), 3)
-        if fit < self.min_fit:
-            return Recognition(
-                text, fit, False, words, "does not sound like these words", alternatives
-            )
-        return Recognition(text, fit, True, words, alternatives=alternatives)
-
-    def _alternatives(self) -> tuple[Alternative, ...]:
-        """Up to `N_BEST` distinct readings, best first, scores relative to the best."""
-        found: dict[str, float] = {}
-        for hypothesis in itertools.islice(self._decoder.nbest(), N_BEST * 3):
-            if hypothesis.score <= 0.0:
-                continue
-            text = " ".join(hypothesis.hypstr.split())
-            found.setdefault(text, float(self._logmath.log(hypothesis.score)))
-            if len(found) >= N_BEST:
-                break
-        if not found:
-            return ()
-        best = max(found.values())
-        return tuple(Alternative(text, round(score - best, 1)) for text, score in found.items())
+            decoder = self._decoder
+            decoder.start_utt()
+            decoder.process_raw(audio.pcm, full_utt=True)
+            decoder.end_utt()
+            words = self._words() if decoder.hyp() is not None else ()
+        if not words:
+            return Recognition("", 0.0, False, reason="nothing recognizable")
+        text = " ".join(word.text for word in words)
+        # The confidence of the whole is that of its least certain word.
+        return Recognition(text, min(word.posterior for word in words), True, words)
 
     def _words(self) -> tuple[HeardWord, ...]:
         found = []
@@ -153,19 +111,6 @@ class LanguageModelRecognizer:
             # An alternative pronunciation is reported as `word(2)`.
             found.append(HeardWord(segment.word.split("(")[0], round(float(segment.prob), 3)))
         return tuple(found)
-
-    def _score_per_frame(self, search: str, audio: Audio) -> float | None:
-        decoder = self._decoder
-        decoder.activate_search(search)
-        decoder.start_utt()
-        decoder.process_raw(audio.pcm, full_utt=True)
-        decoder.end_utt()
-        hypothesis = decoder.hyp()
-        frames = decoder.n_frames()
-        if hypothesis is None or hypothesis.score <= 0.0 or frames == 0:
-            return None
-        # The binding hands the score back exponentiated; take the log again.
-        return float(self._logmath.log(hypothesis.score)) / frames
 
 
 def _pronunciations(dictionary: Path, words: frozenset[str]) -> list[str]:

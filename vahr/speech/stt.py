@@ -68,15 +68,6 @@ class HeardWord:
 
 
 @dataclass(frozen=True)
-class Alternative:
-    """Another reading of the same audio from the decoder's N-best list, with its score
-    relative to the best reading (pocketsphinx log units, 0 for the best, below 0 else)."""
-
-    text: str
-    score: float
-
-
-@dataclass(frozen=True)
 class Recognition:
     """What was heard: `text` is the best guess, `accepted` says whether to trust it,
     `words` are its words with their posteriors (when the recognizer knows them) and
@@ -87,7 +78,6 @@ class Recognition:
     accepted: bool
     words: tuple[HeardWord, ...] = ()
     reason: str = ""
-    alternatives: tuple[Alternative, ...] = ()
 
 
 NOTHING_HEARD = Recognition("", 0.0, False, reason="no speech")

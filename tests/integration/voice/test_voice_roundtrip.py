@@ -1,6 +1,6 @@
 """Acceptance: espeak-ng speaks the assistant's answers, pocketsphinx and the local
 interpreter understand every one, clean and with white noise at 20 dB SNR, in two voices;
-silence and an unrelated sentence come back unknown."""
+silence and unrelated sentences come back unknown, with the reason."""
 
 from __future__ import annotations
 
@@ -69,9 +69,10 @@ def test_silence_and_an_unrelated_sentence_are_unknown(
         cases[text] = tts.synthesize(text)
         cases[f"{text} (20 dB SNR)"] = add_white_noise(cases[text], 20.0, rng)
     heard = {name: understanding.hear(audio) for name, audio in cases.items()}
-    assert {name: (h.intent, h.text) for name, h in heard.items()} == {
-        name: ("unknown", "") for name in cases
-    }
+    # Then none is taken for an answer, each says why, and nothing is heard in silence
+    assert {name: h.intent for name, h in heard.items()} == {name: "unknown" for name in cases}
+    assert all(h.reason for h in heard.values())
+    assert (heard["silence"].text, heard["silence"].reason) == ("", "no speech")
 
 
 def test_a_sentence_after_the_answer_does_not_hide_it(understanding: Understanding) -> None:
