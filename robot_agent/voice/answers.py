@@ -69,12 +69,16 @@ class WeatherAnswers:
         """Every sentence the recognizer's language model is built from: the answers, what
         is no answer, and each cue alone (so every cue is a word the robot can hear)."""
         cues = self.cues
-        alone = [] if cues is None else [
-            " ".join(phrase)
-            for table in (cues.said, cues.denied)
-            for phrases in table.values()
-            for phrase in phrases
-        ]
+        alone = (
+            []
+            if cues is None
+            else [
+                " ".join(phrase)
+                for table in (cues.said, cues.denied)
+                for phrases in table.values()
+                for phrase in phrases
+            ]
+        )
         return [*self.all_phrases(), *self.not_answers, *alone]
 
     @classmethod
@@ -138,7 +142,9 @@ def _phrase_lists(value: object, key: str, source: str) -> dict[WeatherIntent, A
         raise SpeechError(f"{source}: {key} must map sunny and/or rainy to lists of words")
     found: dict[WeatherIntent, tuple[tuple[str, ...], ...]] = {}
     for intent, phrases in value.items():
-        found[intent] = tuple(tuple(p.split()) for p in _sentences(phrases, f"{key}.{intent}", source))
+        found[intent] = tuple(
+            tuple(p.split()) for p in _sentences(phrases, f"{key}.{intent}", source)
+        )
     return found
 
 

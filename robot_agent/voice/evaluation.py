@@ -118,7 +118,9 @@ def render(
             clean: Audio = tts.synthesize(text)
             for snr in conditions:
                 condition = condition_name(snr)
-                audio = clean if snr is None else add_white_noise(clean, snr, _noise(phrasings, voice, name, condition))
+                audio = clean
+                if snr is not None:
+                    audio = add_white_noise(clean, snr, _noise(phrasings, voice, name, condition))
                 relative = f"{condition}/{voice}/{name}.wav"
                 path = directory / relative
                 path.parent.mkdir(parents=True, exist_ok=True)
@@ -133,7 +135,8 @@ def render(
 
 def _noise(phrasings: Phrasings, voice: str, name: str, condition: str) -> np.random.Generator:
     # Seeded by the clip, not by rendering order: any subset renders the same noise.
-    return np.random.default_rng([phrasings.seed, zlib.crc32(f"{voice}/{name}/{condition}".encode())])
+    clip = zlib.crc32(f"{voice}/{name}/{condition}".encode())
+    return np.random.default_rng([phrasings.seed, clip])
 
 
 def load_manifest(directory: Path) -> Manifest:

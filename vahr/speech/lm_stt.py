@@ -56,9 +56,7 @@ def arpa_model(sentences: Iterable[str]) -> str:
 class LanguageModelRecognizer:
     """pocketsphinx with an n-gram model of example sentences, and word posteriors."""
 
-    def __init__(
-        self, sentences: Iterable[str], *, detector: SpeechDetector | None = None
-    ) -> None:
+    def __init__(self, sentences: Iterable[str], *, detector: SpeechDetector | None = None) -> None:
         from pocketsphinx import Decoder, get_model_path
 
         self.sentences = tuple(dict.fromkeys(sentences))

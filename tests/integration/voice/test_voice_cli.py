@@ -119,13 +119,18 @@ def test_make_eval_set_is_identical_on_every_run_and_eval_scores_it(
     phrasings.write_text(SMALL_SET)
     made = []
     for name in ("one", "two"):
-        assert main(["hear", "--make-eval-set", str(tmp_path / name), "--phrasings", str(phrasings)]) == 0
+        assert (
+            main(["hear", "--make-eval-set", str(tmp_path / name), "--phrasings", str(phrasings)])
+            == 0
+        )
         made.append(json.loads(capsys.readouterr().out))
     # Then both hold 3 sentences x 1 voice x (clean, 20 dB), byte for byte the same
     assert made[0]["clips"] == made[1]["clips"] == 6
     assert made[0]["sha256"] == made[1]["sha256"]
     for clip in json.loads((tmp_path / "one" / "manifest.json").read_text())["clips"]:
-        assert (tmp_path / "one" / clip["file"]).read_bytes() == (tmp_path / "two" / clip["file"]).read_bytes()
+        assert (tmp_path / "one" / clip["file"]).read_bytes() == (
+            tmp_path / "two" / clip["file"]
+        ).read_bytes()
     # When the set is scored
     assert main(["hear", "--eval", str(tmp_path / "one"), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)

@@ -133,9 +133,18 @@ def test_normalize_drops_punctuation_and_case() -> None:
         ("intents: {sunny: [a], rainy: [b], foggy: [c]}", "unknown intents ['foggy']"),
         ("intents: {sunny: [It is nice], rainy: [it is NICE]}", "listed under both"),
         ("intents: {sunny: ['!!'], rainy: [b]}", "empty phrase"),
-        ("intents: {sunny: [a], rainy: [b]}\nnot_answers: [A]", "under both intents.sunny and not_answers"),
-        ("intents: {sunny: [a], rainy: [b]}\ncues: {foggy: [fog]}", "cues must map sunny and/or rainy"),
-        ("intents: {sunny: [a], rainy: [b]}\ncues: {sunny: [sun]}\nnegation_reach: 0", "negation_reach"),
+        (
+            "intents: {sunny: [a], rainy: [b]}\nnot_answers: [A]",
+            "under both intents.sunny and not_answers",
+        ),
+        (
+            "intents: {sunny: [a], rainy: [b]}\ncues: {foggy: [fog]}",
+            "cues must map sunny and/or rainy",
+        ),
+        (
+            "intents: {sunny: [a], rainy: [b]}\ncues: {sunny: [sun]}\nnegation_reach: 0",
+            "negation_reach",
+        ),
         ("intents: [unclosed", "not valid YAML"),
     ],
 )
