@@ -5,6 +5,8 @@ station.
 - `tts`: text-to-speech (espeak-ng offline; Amazon Polly and gTTS optional);
 - `stt`: speech-to-text (pocketsphinx with a grammar of the phrases to expect, which the
   caller supplies: the robot's weather answers, the room's questions, an interaction model);
+- `lm_stt`: speech-to-text in open phrasing (pocketsphinx with a language model built from
+  the caller's example sentences, and each word's posterior);
 - `text`: how phrases are normalized before they are compared or put in a grammar;
 - `room`: the room channel, speech as audio over a `vahr.protocol.link.Link`, and its message;
 - `errors`: `SpeechError`, the one error this package raises.

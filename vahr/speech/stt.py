@@ -16,7 +16,7 @@ result is checked two ways before it is accepted:
 Silence never reaches the decoder: an energy detector finds no speech first. When the
 audio holds several sentences (the skill may add one after its answer), the prefixes
 ending at each pause are tried as well and the most confident accepted one wins.
-pocketsphinx is imported here and nowhere else.
+pocketsphinx is imported here and in `lm_stt` (the open recognizer), nowhere else.
 """
 
 from __future__ import annotations
