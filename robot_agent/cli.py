@@ -13,7 +13,10 @@ SUBCOMMANDS: Subcommands = {
     "run": ("robot_agent.commands.run", "run one robot: receive commands, drive, report state"),
     "provision": ("robot_agent.commands.provision", "create a robot's certificate, key and config"),
     "speak": ("robot_agent.commands.speak", "render text to a WAV file with the robot's voice"),
-    "hear": ("robot_agent.commands.hear", "recognize and interpret speech in a WAV file"),
+    "hear": (
+        "robot_agent.commands.hear",
+        "hear an answer in a WAV file; make or score the spoken evaluation set",
+    ),
 }
 
 
