@@ -78,6 +78,7 @@ def swarm_fleet(count: int, *, prefix: str = "swarm", base: Fleet | None = None)
         zones=base.zones,
         groups=[Group(id=FLEET_GROUP, spoken=["all robots"], robots=things)],
         experiment_thing=base.experiment_thing,
+        floor=base.floor,
     ).validate()
 
 

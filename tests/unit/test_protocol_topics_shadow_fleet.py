@@ -128,6 +128,18 @@ def test_the_default_fleet_is_the_papers(fleet: Fleet) -> None:
             "robots: [{thing: r, spoken: [x], start: {x: zero, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\n",
             "robots.0.start.x",
         ),
+        (
+            "robots: [{thing: r, spoken: [x], start: {x: 0, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\nfloor: {width: 0, height: 4}\n",
+            "floor.width",
+        ),
+        (
+            "robots: [{thing: r, spoken: [x], start: {x: 0, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\nfloor: {width: 5, height: 4, arms: {B: {x: 1, y: 1}}}\n",
+            "floor.arms",
+        ),
+        (
+            "robots: [{thing: r, spoken: [x], start: {x: 0, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\nfloor: {width: 5, height: 4, doors: []}\n",
+            "floor.doors",
+        ),
         ("robots: {", "fleet"),
         ("just a string", "fleet"),
     ],
@@ -136,6 +148,33 @@ def test_a_broken_fleet_file_names_the_field(text: str, field: str) -> None:
     with pytest.raises(ProtocolError) as raised:
         Fleet.from_yaml(text)
     assert raised.value.field == field, str(raised.value)
+
+
+def test_the_default_fleet_draws_the_papers_floor(fleet: Fleet) -> None:
+    # Given the bundled fleet.yaml, when the station asks for the floor to draw
+    floor = fleet.layout()
+    # Then it is the paper's warehouse: the room, the conveyor, an arm per zone, the LED
+    assert (floor.width, floor.height) == (10.5, 8.0)
+    assert floor.conveyor is not None and floor.led is not None
+    assert set(floor.arms) == set(fleet.zone_ids)
+    assert len(floor.walls) >= 4
+
+
+def test_a_fleet_file_without_a_floor_still_loads_and_gets_one_around_it() -> None:
+    # Given a fleet file written before the floor existed
+    fleet = Fleet.from_yaml(
+        "robots: [{thing: r, spoken: [x], start: {x: -2, y: 1}}]\n"
+        "zones: [{id: LOADING, spoken: [l], pose: {x: 3, y: 1}, arm: loader},"
+        " {id: A, spoken: [a], pose: {x: 6, y: 5, theta: 1.5708}, arm: unloader}]\n"
+    )
+    # When the floor is asked for
+    floor = fleet.layout()
+    # Then it surrounds every zone and start pose with a margin, walled all round
+    assert floor.origin.x == -3.0 and floor.origin.y == -0.5
+    assert floor.width == 10.5 and floor.height == 7.0
+    assert len(floor.walls) == 4
+    # and each arm stands ahead of its zone, along the zone's heading
+    assert floor.arms["A"].x == 6.0 and floor.arms["A"].y == 5.9
 
 
 def test_a_missing_fleet_file_is_one_clear_error(tmp_path: object) -> None:

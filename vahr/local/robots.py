@@ -56,7 +56,11 @@ def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
         if g.robots or g.id == FLEET_GROUP
     ]
     return Fleet(
-        robots=robots, zones=base.zones, groups=groups, experiment_thing=base.experiment_thing
+        robots=robots,
+        zones=base.zones,
+        groups=groups,
+        experiment_thing=base.experiment_thing,
+        floor=base.floor,
     ).validate()
 
 

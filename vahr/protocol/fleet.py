@@ -1,4 +1,9 @@
-"""The fleet model: robots, zones and groups, loaded from `fleet.yaml` (a contract)."""
+"""The fleet model: robots, zones, groups and the floor, loaded from `fleet.yaml` (a contract).
+
+The floor (`Floor`: size, walls, the conveyor, where the arms and the task III LED stand) is
+what the operator station draws; it is optional, and a fleet file without it gets one
+derived from its zones and robots (`Fleet.layout`).
+"""
 
 from __future__ import annotations
 
@@ -39,6 +44,47 @@ class Pose(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
         return math.hypot(self.x - other.x, self.y - other.y)
 
 
+class Point(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """A point on the floor in the `map` frame, in metres."""
+
+    x: float
+    y: float
+
+
+class Segment(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """A straight piece of wall from `start` to `end`."""
+
+    start: Point
+    end: Point
+
+
+class Conveyor(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """The belt that brings packages to the loading arm: its centre line and width."""
+
+    start: Point
+    end: Point
+    width: Annotated[float, msgspec.Meta(gt=0)] = 0.5
+
+
+class Floor(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """The floor as drawn: the rectangle from `origin` of `width` by `height` metres, its
+    walls, the conveyor, where each zone's arm stands (by zone id) and the task III LED."""
+
+    width: Annotated[float, msgspec.Meta(gt=0)]
+    height: Annotated[float, msgspec.Meta(gt=0)]
+    origin: Point = Point(0.0, 0.0)
+    walls: list[Segment] = []
+    conveyor: Conveyor | None = None
+    arms: dict[str, Point] = {}
+    led: Point | None = None
+
+
+# A derived floor leaves this much room around the zones and the robots' start poses.
+FLOOR_MARGIN_M = 1.0
+# A derived arm stands this far ahead of its zone, along the zone's heading.
+ARM_OFFSET_M = 0.9
+
+
 class Robot(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """One robot: its thing name, the names people call it, and where it starts."""
 
@@ -72,6 +118,7 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
     zones: Annotated[list[Zone], msgspec.Meta(min_length=1)]
     groups: list[Group] = []
     experiment_thing: str = "vahr-experiment"
+    floor: Floor | None = None
 
     def validate(self) -> Fleet:
         """Check the rules that span fields; return self. `from_yaml` calls this."""
@@ -91,6 +138,13 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
                 if member not in self.robot_things:
                     raise ProtocolError(
                         f"groups.{index}.robots", f"{member!r} is not a robot of the fleet"
+                    )
+        if self.floor is not None:
+            with_arms = {zone.id for zone in self.zones if zone.arm is not None}
+            for zone_id in self.floor.arms:
+                if zone_id not in with_arms:
+                    raise ProtocolError(
+                        "floor.arms", f"{zone_id!r} is not a zone with an arm (arm: in zones)"
                     )
         return self
 
@@ -134,9 +188,39 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
                 return zone
         return None
 
+    def layout(self) -> Floor:
+        """The floor to draw: `floor` from the file, completed with a derived arm for each
+        zone with an arm it does not place; without `floor`, one derived from the zones and
+        the robots' start poses (a rectangle around them with `FLOOR_MARGIN_M` to spare)."""
+        floor = self.floor or _derived_floor(self)
+        arms = dict(floor.arms)
+        for zone in self.zones:
+            if zone.arm is not None and zone.id not in arms:
+                arms[zone.id] = Point(
+                    round(zone.pose.x + ARM_OFFSET_M * math.cos(zone.pose.theta), 3),
+                    round(zone.pose.y + ARM_OFFSET_M * math.sin(zone.pose.theta), 3),
+                )
+        return msgspec.structs.replace(floor, arms=arms)
+
     def spoken_name(self, thing: str) -> str:
         """The name a person would use for a robot: the first of its spoken names."""
         return self.robot(thing).spoken[0]
+
+
+def _derived_floor(fleet: Fleet) -> Floor:
+    xs = [z.pose.x - z.radius for z in fleet.zones] + [z.pose.x + z.radius for z in fleet.zones]
+    ys = [z.pose.y - z.radius for z in fleet.zones] + [z.pose.y + z.radius for z in fleet.zones]
+    xs += [robot.start.x for robot in fleet.robots]
+    ys += [robot.start.y for robot in fleet.robots]
+    left, bottom = min(xs) - FLOOR_MARGIN_M, min(ys) - FLOOR_MARGIN_M
+    right, top = max(xs) + FLOOR_MARGIN_M, max(ys) + FLOOR_MARGIN_M
+    corners = [Point(left, bottom), Point(right, bottom), Point(right, top), Point(left, top)]
+    return Floor(
+        width=right - left,
+        height=top - bottom,
+        origin=corners[0],
+        walls=[Segment(corners[i], corners[(i + 1) % 4]) for i in range(4)],
+    )
 
 
 def _require_unique(field: str, values: list[str]) -> None:
