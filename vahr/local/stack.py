@@ -8,7 +8,9 @@ service identity, and serves the data-plane HTTP API. `stop()` undoes all of it.
 
 from __future__ import annotations
 
+import json
 import logging
+import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -21,11 +23,13 @@ from vahr.local.ports import LOOPBACK, ensure_free
 from vahr.local.shadow_service import ShadowService
 from vahr.local.shadow_store import ShadowStore
 from vahr.pki import LocalCA
+from vahr.protocol import ProtocolError, topics
+from vahr.protocol.station import ORIGIN_PATTERN, Heard
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.local.alexa.simulator import AlexaSimulator
+    from vahr.local.alexa.simulator import AlexaSimulator, Turn
 
 log = logging.getLogger(__name__)
 
@@ -144,7 +148,15 @@ class LocalStack:
             fleet_file=str(fleet_file) if fleet_file else None,
             log_level=log_level,
         )
-        simulator = AlexaSimulator(model, handler, command_log=log.take)
+        service = self._service_client
+
+        def publish_turn(turn: Turn) -> None:
+            # Every exchange, whoever spoke, for the operator station's conversation.
+            if service is not None:
+                payload = json.dumps(turn.to_message(), separators=(",", ":")).encode()
+                service.publish(topics.ASSISTANT_TURNS, payload, qos=1, wait=False)
+
+        simulator = AlexaSimulator(model, handler, command_log=log.take, on_turn=publish_turn)
         self.alexa = simulator
 
         def say(request: dict[str, Any]) -> tuple[int, dict[str, Any]]:
@@ -154,7 +166,11 @@ class LocalStack:
                 return 200, ended.to_json() if ended else {"session_open": False}
             if not isinstance(utterance, str) or not utterance.strip():
                 return 400, {"code": 400, "message": "utterance: a non-empty string is required"}
-            return 200, simulator.say(utterance).to_json()
+            try:
+                origin, heard = _speaker(request)
+            except ProtocolError as err:
+                return 400, {"code": 400, "message": str(err)}
+            return 200, simulator.say(utterance, origin=origin, heard=heard).to_json()
 
         self.dataplane.local_routes[("POST", "/vahr/say")] = say
         return simulator
@@ -179,3 +195,20 @@ class LocalStack:
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
+
+
+def _speaker(request: dict[str, Any]) -> tuple[str, dict[str, Any] | None]:
+    """Who spoke (`origin`, default "say") and what a recognizer heard, from a say request."""
+    import msgspec
+
+    origin = request.get("origin", "say")
+    if not isinstance(origin, str) or not re.fullmatch(ORIGIN_PATTERN, origin):
+        raise ProtocolError("origin", "must be a short lower-case word such as station-voice")
+    heard = request.get("heard")
+    if heard is None:
+        return origin, None
+    try:
+        checked = msgspec.convert(heard, Heard)
+    except msgspec.ValidationError as err:
+        raise ProtocolError("heard", str(err)) from err
+    return origin, msgspec.to_builtins(checked)

@@ -10,6 +10,8 @@ ALL_EVENTS = "vahr/robots/+/events"
 ALL_PRESENCE = "vahr/robots/+/presence"
 ALL_SHADOW_UPDATES = "$aws/things/+/shadow/update"
 ALL_SHADOW_UPDATES_ACCEPTED = "$aws/things/+/shadow/update/accepted"
+# Every classic shadow's whole document after each accepted update (what the station draws).
+ALL_SHADOW_DOCUMENTS = "$aws/things/+/shadow/update/documents"
 # Every topic: `#` does not match topics that start with `$`, so AWS's need their own filter.
 EVERY_TOPIC = "#"
 EVERY_AWS_TOPIC = "$aws/#"
@@ -125,3 +127,13 @@ def parse_room_topic(topic: str) -> tuple[str, str] | None:
     """`vahr/room/{thing}/{robot|assistant}` -> (thing, speaker), else None."""
     found = _ROOM_TOPIC.match(topic)
     return (found["thing"], found["speaker"]) if found else None
+
+
+# The operator station's topics (docs/station.md).
+# Every exchange with the local Alexa simulator (`vahr up`'s), one message per turn; AWS's
+# Alexa publishes nothing here.
+ASSISTANT_TURNS = "vahr/assistant/turns"
+# The running experiment session as the station shows it (retained; `vahr experiment`).
+EXPERIMENT_STATUS = "vahr/experiment/status"
+# What the participant did on the station (interactions, puzzle pieces), for the session's log.
+EXPERIMENT_INPUT = "vahr/experiment/input"

@@ -11,6 +11,10 @@ posterior probability in the decoder's word lattice: a word the audio hardly sup
 over its rivals ("will rain" against "no rain") has a low one, and the caller decides
 what to trust from the words that matter to it.
 
+Words the pronunciation dictionary lacks (made-up robot names such as "placebot") get the
+pronunciations `vahr.speech.pronounce` guesses; only a word with no guess at all is an
+error.
+
 A phone-loop likelihood ratio, as `GrammarRecognizer` uses, was measured here too and
 dropped: with a back-off model, answers and unrelated speech scored alike (tuning set,
 docs/voice.md), and it doubled the time. Silence never reaches the decoder (energy
@@ -27,6 +31,7 @@ from typing import TYPE_CHECKING
 
 from vahr.speech.audio import SAMPLE_RATE, SpeechDetector
 from vahr.speech.errors import SpeechError
+from vahr.speech.pronounce import guesses
 from vahr.speech.stt import NOTHING_HEARD, HeardWord, Recognition
 
 if TYPE_CHECKING:
@@ -68,7 +73,7 @@ class LanguageModelRecognizer:
         pronunciations = _pronunciations(model / "cmudict-en-us.dict", self.vocabulary)
         missing = sorted(self.vocabulary - {line.split(" ", 1)[0] for line in pronunciations})
         if missing:
-            raise SpeechError(f"words missing from the pronunciation dictionary: {missing}")
+            pronunciations += _guessed(model / "cmudict-en-us.dict", missing)
         with tempfile.TemporaryDirectory() as folder:
             dictionary = Path(folder) / "words.dict"
             dictionary.write_text("".join(pronunciations), encoding="utf-8")
@@ -115,3 +120,24 @@ def _pronunciations(dictionary: Path, words: frozenset[str]) -> list[str]:
     """The lines of `dictionary` for `words`, alternative pronunciations (`word(2)`) too."""
     with dictionary.open(encoding="utf-8") as lines:
         return [line for line in lines if line.split(" ", 1)[0].split("(")[0] in words]
+
+
+def _guessed(dictionary: Path, words: list[str]) -> list[str]:
+    """Dictionary lines for words the dictionary lacks, from `pronounce.guesses` (a made-up
+    word may be two dictionary words run together, so the whole dictionary is looked in)."""
+    first: dict[str, str] = {}
+    with dictionary.open(encoding="utf-8") as lines:
+        for line in lines:
+            entry, _, phones = line.strip().partition(" ")
+            if "(" not in entry:
+                first.setdefault(entry, phones)
+    found = []
+    for word in words:
+        readings = guesses(word, first.get)
+        if not readings:
+            raise SpeechError(f"no pronunciation for {word!r}: not a dictionary word")
+        found += [
+            f"{word if index == 0 else f'{word}({index + 1})'} {phones}\n"
+            for index, phones in enumerate(readings)
+        ]
+    return found

@@ -3,16 +3,19 @@
 It strips the wake word and invocation ("Alexa, ask robot fleet to ..."), opens and keeps
 a session (attributes carried across turns, Dialog.ElicitSlot answered by a bare slot
 value), builds the ASK envelope, and calls the skill handler in-process. One turn at a
-time, as one person speaks to one device.
+time, as one person speaks to one device. Each turn, once answered, goes to `on_turn` (the
+local stack publishes it on `topics.ASSISTANT_TURNS` for the operator station).
 """
 
 from __future__ import annotations
 
+import logging
 import re
 import threading
 import time
 import uuid
 from dataclasses import dataclass, field, replace
+from datetime import UTC, datetime
 from typing import TYPE_CHECKING, Any
 
 from vahr.local.alexa import envelope
@@ -22,6 +25,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from vahr.local.alexa.nlu import InteractionModel
+
+log = logging.getLogger(__name__)
 
 _TAGS = re.compile(r"<[^>]+>")
 _EXIT = {"exit", "quit", "goodbye", "good bye", "bye"}
@@ -41,9 +46,14 @@ class Turn:
     request_type: str
     reprompt: str | None = None
     card: dict[str, Any] | None = None
+    # Who spoke ("say": the HTTP API; "station", "station-voice": the operator station...).
+    origin: str = "say"
+    # For speech: what the recognizer heard (transcript, confidence...), as it reported it.
+    heard: dict[str, Any] | None = None
+    at: datetime = field(default_factory=lambda: datetime.now(UTC))
 
     def to_json(self) -> dict[str, Any]:
-        return {
+        body = {
             "speech": self.speech,
             "intent": self.intent,
             "slots": self.slots,
@@ -52,7 +62,15 @@ class Turn:
             "session_open": self.session_open,
             "request_type": self.request_type,
             "reprompt": self.reprompt,
+            "origin": self.origin,
         }
+        if self.heard is not None:
+            body["heard"] = self.heard
+        return body
+
+    def to_message(self) -> dict[str, Any]:
+        """The turn as published on `topics.ASSISTANT_TURNS` (`vahr.protocol.station`)."""
+        return {**self.to_json(), "utterance": self.utterance, "at": self.at.isoformat()}
 
 
 @dataclass
@@ -101,11 +119,13 @@ class AlexaSimulator:
         *,
         identity: envelope.Identity | None = None,
         command_log: Callable[[], list[str]] | None = None,
+        on_turn: Callable[[Turn], None] | None = None,
     ) -> None:
         self.model = model
         self.handler = handler
         self.identity = identity or envelope.Identity()
         self._command_log = command_log or (lambda: [])
+        self.on_turn = on_turn
         self._session: _Session | None = None
         self._lock = threading.Lock()
         invocation = re.escape(normalize(model.invocation_name))
@@ -121,17 +141,36 @@ class AlexaSimulator:
     def session_open(self) -> bool:
         return self._session is not None
 
-    def say(self, utterance: str) -> Turn:
-        """Speak one utterance; returns the skill's answer and what the turn did."""
+    def say(
+        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+    ) -> Turn:
+        """Speak one utterance; returns the skill's answer and what the turn did.
+
+        `origin` says who spoke and `heard` what a recognizer made of their speech; both
+        travel with the turn to `on_turn`.
+        """
         with self._lock:
-            return self._say(utterance)
+            turn = self._say(utterance)
+            turn.origin, turn.heard = origin, heard
+            self._announce(turn)
+            return turn
 
     def end_session(self) -> Turn | None:
         """End an open session as the user walking away would (reason USER_INITIATED)."""
         with self._lock:
             if self._session is None:
                 return None
-            return self._send("", envelope.session_ended_request(), None)
+            turn = self._send("", envelope.session_ended_request(), None)
+            self._announce(turn)
+            return turn
+
+    def _announce(self, turn: Turn) -> None:
+        if self.on_turn is None:
+            return
+        try:
+            self.on_turn(turn)
+        except Exception:  # whoever watches must not break the conversation
+            log.exception("the turn observer failed")
 
     def _say(self, utterance: str) -> Turn:
         text = normalize(utterance)

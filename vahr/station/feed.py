@@ -1,0 +1,449 @@
+"""What the station's pages show, kept from the broker's messages and pushed to every page.
+
+`Feed` is transport-free: an MQTT client routes messages to its `on_*` handlers (`routes`),
+and each page holds a `Subscriber` that receives first a snapshot of everything, then one
+message per change, in the order the feed saw them. Messages are JSON objects with a
+`type`:
+
+- `snapshot`: the fleet and its floor, every robot (reported shadow, presence, the last
+  event, the progress of the drive under way), the conversation so far, the commands seen
+  and their acknowledgments, the experiment session;
+- `shadow`: a robot's whole reported state after an accepted update, with its version;
+- `presence`: a robot came online or went offline;
+- `event`: anything a robot did (progress, arrived, said, heard, interpreted...);
+- `command`: a command seen on a command topic (from the assistant, the console, a robot);
+- `ack`: the first answer of a robot to a command, with the time it took from the command
+  being seen here (the acknowledgment latency the conversation shows);
+- `turn`: one exchange with the assistant;
+- `experiment`: the running session (or `null` when none).
+
+Nothing here waits on a page: a page that falls `SUBSCRIBER_LIMIT` messages behind is
+dropped, and its browser reconnects and starts again from a snapshot.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import threading
+import time
+from collections import OrderedDict, deque
+from typing import TYPE_CHECKING, Any
+
+import msgspec
+
+from vahr.protocol import (
+    FLEET_GROUP,
+    ProtocolError,
+    decode_command,
+    decode_event,
+    decode_presence,
+    topics,
+)
+from vahr.protocol.station import decode_experiment_status, decode_turn
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from vahr.protocol import Fleet
+
+log = logging.getLogger(__name__)
+
+# Messages a page may fall behind before it is dropped (it reconnects from a snapshot).
+SUBSCRIBER_LIMIT = 20_000
+# Conversation entries (turns, console commands, robots' exchanges) kept for a new page.
+CONVERSATION_LIMIT = 400
+# Commands whose acknowledgments are followed; older ones are forgotten.
+COMMANDS_LIMIT = 1_000
+# The robots' exchanges with the assistant, shown in the conversation.
+EXCHANGE_EVENTS = frozenset({"said", "heard", "interpreted"})
+# Events after which a robot is no longer driving (its progress is over).
+DRIVE_ENDS = frozenset(
+    {"arrived", "done", "failed", "cancelled", "stopped", "stuck", "rejected", "delivered"}
+)
+Json = dict[str, Any]
+
+
+def now_ms() -> float:
+    return time.time() * 1000
+
+
+class Subscriber:
+    """One page's queue of encoded messages."""
+
+    def __init__(self, limit: int = SUBSCRIBER_LIMIT) -> None:
+        self._limit = limit
+        self._pending: deque[bytes] = deque()
+        self._ready = threading.Condition()
+        self.closed = False
+        self.overflowed = False
+
+    def push(self, message: bytes) -> None:
+        with self._ready:
+            if self.closed:
+                return
+            if len(self._pending) >= self._limit:
+                self.overflowed = self.closed = True
+                self._pending.clear()
+            else:
+                self._pending.append(message)
+            self._ready.notify()
+
+    def take(self, timeout_s: float) -> list[bytes] | None:
+        """Every message waiting (after up to `timeout_s` for one); None once closed."""
+        with self._ready:
+            if not self._pending and not self.closed:
+                self._ready.wait(timeout_s)
+            if self.closed:
+                return None
+            taken = list(self._pending)
+            self._pending.clear()
+            return taken
+
+    def close(self) -> None:
+        with self._ready:
+            self.closed = True
+            self._ready.notify()
+
+
+def fleet_view(fleet: Fleet) -> Json:
+    """The fleet as the page draws it: robots with their keys, zones with theirs, the floor."""
+    zone_keys: dict[str, str] = {}
+    for zone in fleet.zones:
+        key = zone.id[0]
+        if key not in zone_keys.values():
+            zone_keys[zone.id] = key
+    floor = msgspec.to_builtins(fleet.layout())
+    return {
+        "robots": [
+            {
+                "thing": robot.thing,
+                "name": robot.spoken[0],
+                "key": str(index + 1) if index < 9 else None,
+                "start": msgspec.to_builtins(robot.start),
+            }
+            for index, robot in enumerate(fleet.robots)
+        ],
+        "zones": [
+            {
+                "id": zone.id,
+                "name": zone.spoken[0],
+                "pose": msgspec.to_builtins(zone.pose),
+                "radius": zone.radius,
+                "arm": zone.arm,
+                "key": zone_keys.get(zone.id),
+            }
+            for zone in fleet.zones
+        ],
+        "floor": floor,
+        "experiment_thing": fleet.experiment_thing,
+    }
+
+
+class Feed:
+    """The station's view of the fleet, the conversation and the experiment."""
+
+    def __init__(self, fleet: Fleet, *, clock: Callable[[], float] = now_ms) -> None:
+        self.fleet = fleet
+        self.view = fleet_view(fleet)
+        self._clock = clock
+        self._things = frozenset(fleet.robot_things)
+        self._lock = threading.Lock()
+        self._subscribers: list[Subscriber] = []
+        self._robots: dict[str, Json] = {
+            thing: {
+                "reported": None,
+                "version": None,
+                "online": None,
+                "last_seen": None,
+                "last_event": None,
+                "progress": None,
+            }
+            for thing in fleet.robot_things
+        }
+        self._conversation: deque[Json] = deque(maxlen=CONVERSATION_LIMIT)
+        self._commands: OrderedDict[str, Json] = OrderedDict()
+        self._experiment: Json | None = None
+        self.closed = False
+
+    # -- pages ----------------------------------------------------------------------------
+
+    def subscribe(self, limit: int = SUBSCRIBER_LIMIT) -> Subscriber:
+        """A new page's queue, starting with a snapshot; nothing is missed in between."""
+        subscriber = Subscriber(limit)
+        with self._lock:
+            subscriber.push(_encode({"type": "snapshot", **self._snapshot()}))
+            if self.closed:
+                subscriber.close()
+            else:
+                self._subscribers.append(subscriber)
+        return subscriber
+
+    def unsubscribe(self, subscriber: Subscriber) -> None:
+        subscriber.close()
+        with self._lock:
+            if subscriber in self._subscribers:
+                self._subscribers.remove(subscriber)
+
+    @property
+    def subscribers(self) -> int:
+        with self._lock:
+            return len(self._subscribers)
+
+    def snapshot(self) -> Json:
+        with self._lock:
+            return self._snapshot()
+
+    def _snapshot(self) -> Json:
+        return {
+            "fleet": self.view,
+            "robots": {thing: dict(state) for thing, state in self._robots.items()},
+            "conversation": list(self._conversation),
+            "commands": {key: dict(value) for key, value in self._commands.items()},
+            "experiment": self._experiment,
+            "server_time": self._clock(),
+        }
+
+    def close(self) -> None:
+        """End every page's stream (the server is stopping)."""
+        with self._lock:
+            self.closed = True
+            subscribers, self._subscribers = self._subscribers, []
+        for subscriber in subscribers:
+            subscriber.close()
+
+    def _broadcast(self, message: Json) -> None:
+        """Send `message` to every page; call with the lock held, so order is kept."""
+        encoded = _encode(message)
+        dropped = []
+        for subscriber in self._subscribers:
+            subscriber.push(encoded)
+            if subscriber.closed:
+                dropped.append(subscriber)
+        for subscriber in dropped:
+            log.info("a station page fell too far behind; it will reconnect")
+            self._subscribers.remove(subscriber)
+
+    # -- the broker's messages -------------------------------------------------------------
+
+    def routes(self, *, turns: bool) -> list[tuple[str, Callable[[str, bytes], None]]]:
+        """(filter, handler) pairs to subscribe; `turns` adds the local simulator's turns."""
+        found = [
+            (topics.ALL_SHADOW_DOCUMENTS, self.on_shadow_documents),
+            (topics.ALL_PRESENCE, self.on_presence),
+            (topics.ALL_EVENTS, self.on_event),
+            (topics.ALL_ROBOT_CMDS, self.on_command),
+            (topics.FLEET_CMD, self.on_command),
+            (topics.EXPERIMENT_STATUS, self.on_experiment_status),
+        ]
+        if turns:
+            found.append((topics.ASSISTANT_TURNS, self.on_turn))
+        return found
+
+    def on_shadow_documents(self, topic: str, payload: bytes) -> None:
+        parsed = topics.parse_shadow_topic(topic)
+        if parsed is None or parsed[1] is not None or parsed[0] not in self._things:
+            return  # named shadows and things outside the fleet are not drawn
+        try:
+            current = json.loads(payload)["current"]
+            reported = current["state"].get("reported") or {}
+            version = int(current["version"])
+        except (ValueError, KeyError, TypeError, AttributeError):
+            log.warning("ignoring an unreadable shadow document on %s", topic)
+            return
+        if not isinstance(reported, dict):
+            return
+        self._shadow(parsed[0], reported, version, self._clock())
+
+    def load_shadow(self, thing: str, document: bytes) -> None:
+        """A robot's shadow as read at start-up (GetThingShadow's body)."""
+        try:
+            body = json.loads(document)
+            reported = body.get("state", {}).get("reported") or {}
+            version = int(body.get("version", 0))
+            stamps = _timestamps(body.get("metadata", {}).get("reported", {}))
+        except (ValueError, TypeError, AttributeError):
+            log.warning("ignoring an unreadable shadow document of %s", thing)
+            return
+        if isinstance(reported, dict) and thing in self._things:
+            self._shadow(thing, reported, version, max(stamps) * 1000 if stamps else None)
+
+    def _shadow(self, thing: str, reported: Json, version: int, seen: float | None) -> None:
+        with self._lock:
+            robot = self._robots[thing]
+            if robot["version"] is not None and version <= robot["version"]:
+                return  # an older document than one already shown (start-up read raced)
+            robot.update(reported=reported, version=version)
+            if seen is not None:
+                robot["last_seen"] = max(robot["last_seen"] or 0, seen)
+            if reported.get("status") != "navigating":
+                robot["progress"] = None
+            self._acknowledged_by_shadow(thing, reported)
+            self._broadcast(
+                {
+                    "type": "shadow",
+                    "thing": thing,
+                    "reported": reported,
+                    "version": version,
+                    "last_seen": robot["last_seen"],
+                }
+            )
+
+    def on_presence(self, topic: str, payload: bytes) -> None:
+        parsed = topics.parse_robot_topic(topic)
+        if parsed is None or parsed[0] not in self._things:
+            return
+        try:
+            presence = decode_presence(payload)
+        except ProtocolError as err:
+            log.warning("ignoring presence on %s: %s", topic, err)
+            return
+        thing = parsed[0]
+        with self._lock:
+            robot = self._robots[thing]
+            robot["online"] = presence.online
+            if presence.online:
+                robot["last_seen"] = max(robot["last_seen"] or 0, self._clock())
+            self._broadcast(
+                {
+                    "type": "presence",
+                    "thing": thing,
+                    "online": presence.online,
+                    "last_seen": robot["last_seen"],
+                }
+            )
+
+    def on_event(self, topic: str, payload: bytes) -> None:
+        parsed = topics.parse_robot_topic(topic)
+        if parsed is None or parsed[0] not in self._things:
+            return
+        try:
+            event = decode_event(payload)
+        except ProtocolError as err:
+            log.warning("ignoring an event on %s: %s", topic, err)
+            return
+        if event.thing != parsed[0]:
+            return  # a robot speaking for another is not believed
+        body: Json = msgspec.to_builtins(event)
+        now = self._clock()
+        with self._lock:
+            robot = self._robots[event.thing]
+            robot["last_seen"] = now
+            robot["last_event"] = body
+            if event.event == "progress":
+                robot["progress"] = body
+            elif event.event in DRIVE_ENDS:
+                robot["progress"] = None
+            if event.command_id is not None:
+                self._acknowledged(event.command_id, event.thing, event.event, now)
+            message = {"type": "event", **body, "last_seen": now}
+            if event.event in EXCHANGE_EVENTS:
+                self._conversation.append({**message, "robots": [event.thing]})
+            self._broadcast(message)
+
+    def on_command(self, topic: str, payload: bytes) -> None:
+        parsed = topics.parse_robot_topic(topic)
+        if topic != topics.FLEET_CMD and (parsed is None or parsed[1] != "cmd"):
+            return
+        try:
+            command = decode_command(payload)
+        except ProtocolError:
+            return  # the robot rejects it and says why; its event shows that
+        target = parsed[0] if parsed is not None else "fleet"
+        things = sorted(self._things) if target == "fleet" else [target]
+        body: Json = {
+            "type": "command",
+            "id": command.id,
+            "target": target,
+            "robots": things,
+            "action": command.action,
+            "params": msgspec.to_builtins(command.params),
+            "source": command.source,
+            "seen": self._clock(),
+            "acks": {},
+        }
+        with self._lock:
+            if command.id in self._commands:
+                return  # the same command twice (a retry) is one command
+            self._commands[command.id] = body
+            while len(self._commands) > COMMANDS_LIMIT:
+                self._commands.popitem(last=False)
+            # The assistant's commands are shown inside its turn; the others on their own.
+            if command.source != "alexa":
+                self._conversation.append(body)
+            self._broadcast(body)
+
+    def _acknowledged(self, command_id: str, thing: str, how: str, at: float) -> None:
+        command = self._commands.get(command_id)
+        if command is None or thing in command["acks"] or thing not in command["robots"]:
+            return
+        latency = round(max(0.0, at - command["seen"]), 1)
+        command["acks"][thing] = {"event": how, "latency_ms": latency}
+        self._broadcast(
+            {"type": "ack", "id": command_id, "thing": thing, "event": how, "latency_ms": latency}
+        )
+
+    def _acknowledged_by_shadow(self, thing: str, reported: Json) -> None:
+        last = reported.get("last_command")
+        if isinstance(last, dict) and isinstance(last.get("id"), str):
+            self._acknowledged(last["id"], thing, str(last.get("result")), self._clock())
+
+    def on_turn(self, topic: str, payload: bytes) -> None:
+        try:
+            turn = msgspec.to_builtins(decode_turn(payload))
+        except ProtocolError as err:
+            log.warning("ignoring a turn: %s", err)
+            return
+        self.add_turn(turn)
+
+    def add_turn(self, turn: Json) -> None:
+        """One exchange with the assistant (from the broker, or the station's own)."""
+        with self._lock:
+            robots = set()
+            for command_id in turn.get("commands") or []:
+                robots.update(self._commands.get(command_id, {}).get("robots", []))
+            for slot in (turn.get("slots") or {}).values():
+                value = slot.get("id") if isinstance(slot, dict) else None
+                if value in self._things:
+                    robots.add(value)
+                elif value == FLEET_GROUP:
+                    robots.update(self._things)
+            message = {"type": "turn", **turn, "robots": sorted(robots)}
+            self._conversation.append(message)
+            self._broadcast(message)
+
+    def on_experiment_status(self, topic: str, payload: bytes) -> None:
+        if not payload:
+            self.set_experiment(None)  # the session ended (or its runner went away)
+            return
+        try:
+            status = decode_experiment_status(payload)
+        except ProtocolError as err:
+            log.warning("ignoring the experiment status: %s", err)
+            return
+        self.set_experiment(msgspec.to_builtins(status))
+
+    def set_experiment(self, status: Json | None) -> None:
+        with self._lock:
+            self._experiment = status
+            self._broadcast({"type": "experiment", "status": status})
+
+    @property
+    def experiment(self) -> Json | None:
+        with self._lock:
+            return self._experiment
+
+
+def _encode(message: Json) -> bytes:
+    return msgspec.json.encode(message)
+
+
+def _timestamps(metadata: object) -> list[float]:
+    """Every `timestamp` leaf of a shadow's metadata (seconds since the epoch)."""
+    if isinstance(metadata, dict):
+        if isinstance(metadata.get("timestamp"), int | float) and len(metadata) == 1:
+            return [float(metadata["timestamp"])]
+        return [stamp for value in metadata.values() for stamp in _timestamps(value)]
+    if isinstance(metadata, list):
+        return [stamp for value in metadata for stamp in _timestamps(value)]
+    return []

@@ -1,0 +1,326 @@
+"""The station's HTTP server: the page, its files, the event stream and the API.
+
+It binds 127.0.0.1 unless told otherwise. Bound elsewhere (a tablet on the lab network), it
+requires a token, printed at start-up in the station's URL: the first page load carries it
+as `?token=`, which sets a cookie for the page's later requests. Every request is checked:
+
+- the `Host` header must name this server (a page elsewhere cannot rebind its own name to
+  this address and read the station), and a POST with an `Origin` must come from it;
+- a POST must say what it carries (`application/json`, or `audio/wav` for push-to-talk),
+  which a form on another site cannot send without asking first, and must be small:
+  `MAX_JSON_BYTES`, or `MAX_AUDIO_BYTES` for a clip (whose length `voice` checks again);
+- at most `MAX_STREAMS` pages are streamed to at once.
+
+The event stream (`GET /api/stream`) is server-sent events: one `data:` line per feed
+message, a comment every `KEEPALIVE_S` so a dead connection is noticed.
+"""
+
+from __future__ import annotations
+
+import hmac
+import logging
+import secrets
+import sys
+import threading
+from http.cookies import CookieError, SimpleCookie
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+from typing import TYPE_CHECKING
+from urllib.parse import parse_qs, urlsplit
+
+from vahr.errors import VahrError
+from vahr.local.ports import LOOPBACK
+from vahr.station.app import Reply, error_reply, json_reply
+
+if TYPE_CHECKING:
+    from vahr.station.app import StationApp
+
+log = logging.getLogger(__name__)
+
+STATIC = Path(__file__).with_name("static")
+MAX_JSON_BYTES = 16 * 1024
+# 16 kHz mono 16-bit is 32 kB a second: a megabyte is half a minute, twice the longest clip.
+MAX_AUDIO_BYTES = 1024 * 1024
+MAX_STREAMS = 32
+KEEPALIVE_S = 15.0
+COOKIE = "vahr_station"
+CONTENT_TYPES = {
+    ".html": "text/html; charset=utf-8",
+    ".css": "text/css; charset=utf-8",
+    ".js": "text/javascript; charset=utf-8",
+    ".svg": "image/svg+xml",
+    ".png": "image/png",
+}
+# The page loads only its own files; speech comes back as a blob it plays.
+SECURITY_HEADERS = {
+    "Content-Security-Policy": (
+        "default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' data:; "
+        "media-src 'self' blob:; connect-src 'self'; worker-src 'self'; "
+        "frame-ancestors 'none'; base-uri 'none'; form-action 'self'"
+    ),
+    "X-Content-Type-Options": "nosniff",
+    "Referrer-Policy": "no-referrer",
+    "Cache-Control": "no-store",
+}
+LOOPBACK_NAMES = ("127.0.0.1", "localhost", "[::1]")
+
+
+def is_loopback(host: str) -> bool:
+    return host in ("127.0.0.1", "localhost", "::1")
+
+
+class _Handler(BaseHTTPRequestHandler):
+    protocol_version = "HTTP/1.1"
+    disable_nagle_algorithm = True
+    server: _Server
+
+    # -- plumbing -------------------------------------------------------------------------
+
+    def _send(self, reply: Reply, extra: dict[str, str] | None = None) -> None:
+        self.send_response(reply.status)
+        self.send_header("Content-Type", reply.content_type)
+        self.send_header("Content-Length", str(len(reply.body)))
+        for name, value in {**SECURITY_HEADERS, **(extra or {})}.items():
+            self.send_header(name, value)
+        self.end_headers()
+        if self.command != "HEAD":
+            self.wfile.write(reply.body)
+
+    def _refuse(self, status: int, message: str) -> None:
+        # A refused request's body may not have been read: close rather than misread it.
+        self.close_connection = True
+        self._send(error_reply(status, message), {"Connection": "close"})
+
+    def _checked(self) -> tuple[str, dict[str, str]] | None:
+        """The path and query of an acceptable request, or None once refused."""
+        station = self.server.station
+        host = self.headers.get("Host", "")
+        if not station.host_allowed(host):
+            self._refuse(421, f"this station does not answer to the host {host!r}")
+            return None
+        url = urlsplit(self.path)
+        query = {k: v[-1] for k, v in parse_qs(url.query).items()}
+        if station.token is not None and not self._authorized(query):
+            self._refuse(401, "this station needs its token: open the URL it printed")
+            return None
+        origin = self.headers.get("Origin")
+        if self.command == "POST" and origin is not None and origin != f"http://{host}":
+            self._refuse(403, f"requests from {origin} are not accepted")
+            return None
+        return url.path, query
+
+    def _authorized(self, query: dict[str, str]) -> bool:
+        token = self.server.station.token
+        assert token is not None
+        offered = [query.get("token", "")]
+        header = self.headers.get("Authorization", "")
+        if header.startswith("Bearer "):
+            offered.append(header.removeprefix("Bearer "))
+        try:
+            cookie = SimpleCookie(self.headers.get("Cookie", ""))
+            if COOKIE in cookie:
+                offered.append(cookie[COOKIE].value)
+        except CookieError:
+            pass
+        return any(hmac.compare_digest(token.encode(), o.encode()) for o in offered if o)
+
+    def _body(self, limit: int) -> bytes | None:
+        if "chunked" in self.headers.get("Transfer-Encoding", "").lower():
+            self._refuse(411, "send the body with a Content-Length, not chunked")
+            return None
+        try:
+            length = int(self.headers.get("Content-Length") or 0)
+        except ValueError:
+            self._refuse(400, "Content-Length is not a number")
+            return None
+        if length < 0 or length > limit:
+            self._refuse(413, f"the body is {length} bytes; at most {limit} are accepted")
+            return None
+        return self.rfile.read(length) if length else b""
+
+    # -- methods --------------------------------------------------------------------------
+
+    def do_GET(self) -> None:  # noqa: N802
+        checked = self._checked()
+        if checked is None:
+            return
+        path, query = checked
+        station = self.server.station
+        if path == "/api/stream":
+            self._stream()
+            return
+        extra: dict[str, str] = {}
+        if path in ("/", "/index.html"):
+            reply = station.file("index.html")
+            if station.token is not None and query.get("token"):
+                # The page's own later requests (the stream, the API) carry the cookie.
+                extra["Set-Cookie"] = f"{COOKIE}={station.token}; Path=/; HttpOnly; SameSite=Strict"
+        elif path == "/favicon.ico":
+            reply = station.file("favicon.svg")
+        elif path.startswith("/static/"):
+            reply = station.file(path.removeprefix("/static/"))
+        elif path == "/api/health":
+            reply = json_reply({"ok": True})
+        elif path == "/api/snapshot":
+            reply = json_reply(station.app.feed.snapshot())
+        else:
+            reply = error_reply(404, f"nothing at {path}")
+        self._send(reply, extra)
+
+    do_HEAD = do_GET
+
+    def do_POST(self) -> None:  # noqa: N802
+        checked = self._checked()
+        if checked is None:
+            return
+        path, _ = checked
+        app = self.server.station.app
+        kind = self.headers.get("Content-Type", "").split(";")[0].strip().lower()
+        if path == "/api/voice":
+            if kind not in ("audio/wav", "audio/x-wav", "audio/wave"):
+                self._refuse(415, "push-to-talk sends audio/wav")
+                return
+            body = self._body(MAX_AUDIO_BYTES)
+            if body is not None:
+                self._send(app.voice(body))
+            return
+        if not app.is_json_route("POST", path):
+            self._refuse(404, f"nothing to POST at {path}")
+            return
+        if kind != "application/json":
+            self._refuse(415, "send application/json")
+            return
+        body = self._body(MAX_JSON_BYTES)
+        if body is not None:
+            self._send(app.handle_json("POST", path, body))
+
+    def do_PUT(self) -> None:  # noqa: N802
+        self._refuse(405, f"{self.command} is not used here")
+
+    do_DELETE = do_PATCH = do_OPTIONS = do_PUT
+
+    def _stream(self) -> None:
+        station = self.server.station
+        if not station.open_stream():
+            self._refuse(503, f"at most {MAX_STREAMS} pages at once")
+            return
+        feed = station.app.feed
+        subscriber = feed.subscribe()
+        self.close_connection = True
+        try:
+            self.send_response(200)
+            self.send_header("Content-Type", "text/event-stream")
+            self.send_header("Connection", "close")
+            for name, value in SECURITY_HEADERS.items():
+                self.send_header(name, value)
+            self.end_headers()
+            # The browser reconnects a second after a lost stream, and gets a new snapshot.
+            self.wfile.write(b"retry: 1000\n\n")
+            self.wfile.flush()
+            while True:
+                messages = subscriber.take(KEEPALIVE_S)
+                if messages is None:
+                    break
+                if messages:
+                    self.wfile.write(b"".join(b"data: " + m + b"\n\n" for m in messages))
+                else:
+                    self.wfile.write(b": keepalive\n\n")
+                self.wfile.flush()
+        except OSError:
+            pass  # the page went away
+        finally:
+            feed.unsubscribe(subscriber)
+            station.close_stream()
+
+    def log_message(self, format: str, *args: object) -> None:  # noqa: A002
+        log.debug("%s " + format, self.address_string(), *args)
+
+
+class _Server(ThreadingHTTPServer):
+    daemon_threads = True
+    station: StationServer
+
+    def handle_error(self, request: object, client_address: object) -> None:
+        if isinstance(sys.exc_info()[1], ConnectionError):
+            return
+        log.exception("station connection from %s failed", client_address)
+
+
+class StationServer:
+    """Serve a `StationApp` on host:port in a background thread; `stop()` joins it."""
+
+    def __init__(
+        self, app: StationApp, *, host: str = LOOPBACK, port: int, token: str | None = None
+    ) -> None:
+        self.app = app
+        self.host = host
+        # Off the loopback interface the station is reachable by others: a token guards it.
+        self.token = token or (None if is_loopback(host) else secrets.token_urlsafe(18))
+        self._files = {p.name: p for p in STATIC.iterdir() if p.suffix in CONTENT_TYPES}
+        self._streams = 0
+        self._streams_lock = threading.Lock()
+        self._started = False
+        try:
+            self._server = _Server((host, port), _Handler)
+        except OSError as err:
+            raise VahrError(f"cannot listen on {host}:{port} for the station: {err}") from err
+        self._server.station = self
+        self._thread = threading.Thread(
+            target=self._server.serve_forever, name="vahr-station", kwargs={"poll_interval": 0.2}
+        )
+
+    @property
+    def port(self) -> int:
+        port: int = self._server.server_address[1]
+        return port
+
+    @property
+    def url(self) -> str:
+        """The page's address, with the token when one is needed."""
+        shown = LOOPBACK if self.host in ("0.0.0.0", "") else self.host  # noqa: S104
+        if ":" in shown:
+            shown = f"[{shown}]"
+        base = f"http://{shown}:{self.port}/"
+        return f"{base}?token={self.token}" if self.token else base
+
+    def host_allowed(self, host: str) -> bool:
+        if self.token is not None:
+            return True  # reachable by any name on the network; the token decides
+        return host in {f"{name}:{self.port}" for name in LOOPBACK_NAMES}
+
+    def file(self, name: str) -> Reply:
+        path = self._files.get(name)
+        if path is None:
+            return error_reply(404, f"no file {name}")
+        return Reply(200, path.read_bytes(), CONTENT_TYPES[path.suffix])
+
+    def open_stream(self) -> bool:
+        with self._streams_lock:
+            if self._streams >= MAX_STREAMS:
+                return False
+            self._streams += 1
+            return True
+
+    def close_stream(self) -> None:
+        with self._streams_lock:
+            self._streams -= 1
+
+    def start(self) -> StationServer:
+        self._thread.start()
+        self._started = True
+        return self
+
+    def stop(self) -> None:
+        """Stop serving (safe before `start` and twice)."""
+        self.app.feed.close()  # ends every stream, so their threads finish
+        if self._started:
+            self._started = False
+            self._server.shutdown()
+            self._thread.join(timeout=5)
+        self._server.server_close()
+
+    def __enter__(self) -> StationServer:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()

@@ -1,0 +1,110 @@
+"""What push-to-talk listens for: sentences made from the skill's interaction model.
+
+Every sample utterance of every intent is written out with its slots filled, each slot
+going through all of its type's values and synonyms across the copies of the sample (so
+every value appears in every sample's context once, without multiplying out samples with
+several slots), plus the built-in intents' phrases and the invocation forms ("ask robot
+fleet to ..."). The interaction model is generated from `fleet.yaml`, so the robots' and
+zones' names follow the fleet. Numbers are spelled out, as people say them.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from vahr.errors import VahrError
+from vahr.local.alexa.nlu import BUILTIN_SAMPLES, DEFAULT_MODEL
+from vahr.speech.text import normalize
+
+if TYPE_CHECKING:
+    from vahr.speech.lm_stt import LanguageModelRecognizer
+
+_SLOT = re.compile(r"\{([A-Za-z0-9_.]+)\}")
+_ONES = "zero one two three four five six seven eight nine ten eleven twelve thirteen fourteen fifteen sixteen seventeen eighteen nineteen".split()  # noqa: E501
+_TENS = "_ _ twenty thirty forty fifty sixty seventy eighty ninety".split()
+# Ways of leaving a session, which the simulator answers like Alexa does.
+EXITS = ("exit", "goodbye", "stop", "cancel")
+
+
+def spell_numbers(text: str) -> str:
+    """Whole numbers under 100 written as words ("placebot 2" -> "placebot two")."""
+    return " ".join(_spelled(word) if word.isdigit() else word for word in text.split())
+
+
+def _spelled(number: str) -> str:
+    value = int(number)
+    if value >= 100:
+        return number
+    if value < 20:
+        return _ONES[value]
+    tens, ones = divmod(value, 10)
+    return _TENS[tens] + (f" {_ONES[ones]}" if ones else "")
+
+
+def _phrase(text: str) -> str:
+    return spell_numbers(normalize(text))
+
+
+def sentences(document: dict[str, Any]) -> list[str]:
+    """The sentences of an interaction model (its JSON), normalized, without repeats."""
+    try:
+        language = document["interactionModel"]["languageModel"]
+        invocation = _phrase(language["invocationName"])
+        values = {
+            slot_type["name"]: [
+                _phrase(phrase)
+                for value in slot_type.get("values", [])
+                for phrase in [value["name"]["value"], *value["name"].get("synonyms", [])]
+            ]
+            for slot_type in language.get("types", [])
+        }
+        found: list[str] = []
+        for intent in language["intents"]:
+            types = {slot["name"]: slot["type"] for slot in intent.get("slots", [])}
+            samples = intent.get("samples") or BUILTIN_SAMPLES.get(intent["name"], [])
+            for sample in samples:
+                filled = _filled(sample, types, values)
+                found += filled
+                found.append(f"ask {invocation} to {filled[0]}")
+    except (KeyError, TypeError) as err:
+        raise VahrError(f"the interaction model lacks {err}") from err
+    found += [f"open {invocation}", f"alexa open {invocation}", *EXITS]
+    return list(dict.fromkeys(s for s in found if s))
+
+
+def _filled(sample: str, types: dict[str, str], values: dict[str, list[str]]) -> list[str]:
+    """Copies of `sample` with its slots filled, every value of every slot used once."""
+    slots = _SLOT.findall(sample)
+    choices = [values.get(types.get(slot, ""), []) or [slot.lower()] for slot in slots]
+    copies = max((len(options) for options in choices), default=1)
+    filled = []
+    for copy in range(copies):
+        text = sample
+        for position, options in enumerate(choices):
+            # Slots of one sample go through their values out of step with each other.
+            chosen = options[(copy + 7 * position) % len(options)]
+            text = _SLOT.sub(lambda _, value=chosen: value, text, count=1)
+        filled.append(_phrase(text))
+    return filled
+
+
+def load_model(model_file: Path | None = None) -> dict[str, Any]:
+    file = model_file or DEFAULT_MODEL
+    try:
+        loaded: dict[str, Any] = json.loads(Path(file).read_text(encoding="utf-8"))
+    except OSError as err:
+        raise VahrError(f"cannot read the interaction model {file}: {err.strerror}") from err
+    except ValueError as err:
+        raise VahrError(f"the interaction model {file} is not valid JSON: {err}") from err
+    return loaded
+
+
+def command_recognizer(model_file: Path | None = None) -> LanguageModelRecognizer:
+    """The push-to-talk recognizer for the interaction model at `model_file` (default: the
+    one that ships with the package)."""
+    from vahr.speech.lm_stt import LanguageModelRecognizer
+
+    return LanguageModelRecognizer(sentences(load_model(model_file)))
