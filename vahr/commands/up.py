@@ -17,6 +17,7 @@ if TYPE_CHECKING:
     from vahr.protocol import Event
 
 DEFAULT_API_PORT = 8180
+DEFAULT_STATION_PORT = 8181
 DEFAULT_STATE_DIR = Path(".state")
 
 
@@ -32,6 +33,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--mqtt-port", type=int, default=1883, help="plaintext loopback MQTT port, 0 for none"
     )
     parser.add_argument("--mqtts-port", type=int, default=8883, help="mTLS MQTT port (8883)")
+    parser.add_argument(
+        "--station-port",
+        type=int,
+        default=DEFAULT_STATION_PORT,
+        help=f"operator station page on 127.0.0.1 (default {DEFAULT_STATION_PORT}), 0 for none",
+    )
     parser.add_argument(
         "--sim-speed-factor", type=float, default=1.0, help="simulated time runs this much faster"
     )
@@ -51,9 +58,9 @@ def run(args: argparse.Namespace) -> int:
     from vahr.local.system import LocalSystem, SystemConfig
 
     setup_logging(args.log_level)
-    for flag in ("api_port", "mqtts_port", "mqtt_port"):
+    for flag in ("api_port", "mqtts_port", "mqtt_port", "station_port"):
         value = getattr(args, flag)
-        if not 0 <= value <= 65535 or (value == 0 and flag != "mqtt_port"):
+        if not 0 <= value <= 65535 or (value == 0 and flag not in ("mqtt_port", "station_port")):
             raise VahrError(f"--{flag.replace('_', '-')} {value}: not a usable port")
     if args.sim_speed_factor <= 0:
         raise VahrError("--sim-speed-factor must be more than 0")
@@ -67,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
         ack_timeout_s=args.ack_timeout,
         voice=not args.no_voice,
         log_level=args.log_level,
+        station_port=args.station_port or None,
     )
     stopping = threading.Event()
     # SIGTERM ends the run like Ctrl-C does; both just set the event the main thread waits on.
@@ -110,7 +118,7 @@ def _banner(endpoints: dict[str, str | None], things: list[str], voice: bool) ->
     if endpoints["mqtt"]:
         lines.append(f"  mqtt        {endpoints['mqtt']}   (plaintext, loopback only)")
     lines += [
-        f"  dashboard   {endpoints['dashboard']}   (robot states as JSON: /vahr/status)",
+        f"  station     {endpoints['station'] or '(off)'}   (the operator station page)",
         f"  robots      {', '.join(things)} (sim backend{', room voice' if voice else ''})",
         '  talk to it: vahr say "send robot one to zone b"   (Ctrl-C stops everything)',
     ]

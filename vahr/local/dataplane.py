@@ -7,7 +7,8 @@ Publish (to the local broker, QoS and retain honoured), Get/Update/DeleteThingSh
 ...). SigV4 headers are accepted and not checked: it listens on 127.0.0.1 only.
 
 Paths under `/vahr/` are the local stack's own (the Alexa simulator's `say`, health and
-the billing meter); AWS uses none of them.
+the billing meter; `/vahr/dashboard` redirects to the operator station); AWS uses none of
+them.
 """
 
 from __future__ import annotations
@@ -17,7 +18,6 @@ import logging
 import sys
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
@@ -47,7 +47,6 @@ ERROR_TYPES = {
     500: "InternalFailureException",
     503: "ServiceUnavailableException",
 }
-DASHBOARD = Path(__file__).with_name("dashboard.html")
 MAX_PUBLISH_BYTES = 128 * 1024  # AWS IoT's message size limit
 LIST_PAGE_MAX = 100
 
@@ -76,6 +75,8 @@ class DataPlane:
         # Called with (topic, payload) after each publish (the simulator's command log).
         self.publish_observers: list[Callable[[str, bytes], None]] = []
         self.local_routes: dict[tuple[str, str], Callable[[Json], tuple[int, Json]]] = {}
+        # GET paths answered with a redirect (the old dashboard, now the operator station).
+        self.redirects: dict[str, str] = {}
 
     def handle(self, method: str, raw_path: str, body: bytes) -> tuple[int, bytes]:
         """One request -> (status, response body)."""
@@ -176,8 +177,6 @@ class DataPlane:
     def _local(self, method: str, path: str, body: bytes) -> tuple[int, bytes]:
         if (method, path) == ("GET", "/vahr/health"):
             return 200, _encode({"ok": True})
-        if (method, path) == ("GET", "/vahr/dashboard"):
-            return 200, DASHBOARD.read_bytes()
         if (method, path) == ("GET", "/vahr/meter"):
             return 200, _encode(self.meter.snapshot())
         if (method, path) == ("POST", "/vahr/meter/reset"):
@@ -223,14 +222,20 @@ class _Handler(BaseHTTPRequestHandler):
     def _serve(self) -> None:
         length = int(self.headers.get("Content-Length") or 0)
         body = self.rfile.read(length) if length else b""
+        target = self.server.dataplane.redirects.get(self.path.split("?", 1)[0])
+        if target is not None and self.command == "GET":
+            self.send_response(302)
+            self.send_header("Location", target)
+            self.send_header("Content-Length", "0")
+            self.end_headers()
+            return
         try:
             status, payload = self.server.dataplane.handle(self.command, self.path, body)
         except Exception:  # the server must answer even when a bug bites
             log.exception("data plane request %s %s failed", self.command, self.path)
             status, payload = _error(500, "Internal service failure")
         self.send_response(status)
-        html = self.path.split("?", 1)[0] == "/vahr/dashboard" and status == 200
-        self.send_header("Content-Type", "text/html; charset=utf-8" if html else "application/json")
+        self.send_header("Content-Type", "application/json")
         self.send_header("Content-Length", str(len(payload)))
         if status >= 400:
             self.send_header("x-amzn-ErrorType", ERROR_TYPES.get(status, "InvalidRequestException"))

@@ -1,5 +1,6 @@
 """The whole system on one machine: the local stack, the Alexa simulator with the skill,
-the room assistant robots talk to, and one robot-agent process per robot.
+the room assistant robots talk to, the operator station, and one robot-agent process per
+robot.
 
 `LocalSystem` is what `vahr up` and `vahr demo` run. It reports each robot event to a
 callback (the live lines of `vahr up`) and can wait until every robot is online.
@@ -7,6 +8,7 @@ callback (the live lines of `vahr up`) and can wait until every robot is online.
 
 from __future__ import annotations
 
+import json
 import logging
 import shutil
 import threading
@@ -16,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from vahr.errors import VahrError
 from vahr.local.mqtt import MqttClient
+from vahr.local.ports import ensure_free
 from vahr.local.robots import RobotProcesses, fleet_of, write_fleet
 from vahr.local.shadow_store import ShadowError
 from vahr.local.stack import LocalStack, StackConfig
@@ -27,6 +30,7 @@ if TYPE_CHECKING:
 
     from vahr.local.alexa.simulator import AlexaSimulator
     from vahr.protocol import Fleet
+    from vahr.station.station import Station
 
 log = logging.getLogger(__name__)
 
@@ -44,6 +48,8 @@ class SystemConfig:
     ack_timeout_s: float | None = None
     voice: bool = True
     log_level: str = "WARNING"
+    # The operator station's port on 127.0.0.1 (0: any free port; None: no station).
+    station_port: int | None = None
 
 
 class LocalSystem:
@@ -68,6 +74,8 @@ class LocalSystem:
         self._watcher: MqttClient | None = None
         self._room: Any = None
         self._room_client: MqttClient | None = None
+        self._station_client: MqttClient | None = None
+        self.station: Station | None = None
         self._online: dict[str, bool] = {}
         self._changed = threading.Condition()
 
@@ -78,16 +86,21 @@ class LocalSystem:
     def endpoints(self) -> dict[str, str | None]:
         """What `vahr up --json` prints first (DESIGN.md, Command-line surface)."""
         assert self.stack.ca is not None
+        station = self.station.url if self.station is not None else None
         return {
             "api": self.stack.api_url,
             "mqtt": self.stack.mqtt_url,
             "mqtts": self.stack.mqtts_url,
             "ca": str(self.stack.ca.ca_file),
-            "dashboard": f"{self.stack.api_url}/vahr/dashboard",
+            "station": station,
+            # The page `vahr up` served before the station, kept as another name for it.
+            "dashboard": station,
         }
 
     def start(self) -> LocalSystem:
         cfg = self.config
+        if cfg.station_port:
+            ensure_free(cfg.station_port, "operator station")
         try:
             fleet_file = write_fleet(self.fleet, cfg.state_dir / "fleet.yaml")
             self.stack.start()
@@ -101,6 +114,8 @@ class LocalSystem:
             self._watcher.subscribe(topics.ALL_PRESENCE, self._on_presence)
             if self.voice_enabled:
                 self._start_room()
+            if cfg.station_port is not None:
+                self._start_station(cfg.station_port)
             self.robots = RobotProcesses(
                 fleet_file=fleet_file,
                 things=list(self.fleet.robot_things),
@@ -132,6 +147,32 @@ class LocalSystem:
 
         self._room_client = MqttClient(self.stack.service_endpoint()).connect()
         self._room = offline_room_assistant(self._room_client, ask).start()
+
+    def _start_station(self, port: int) -> None:
+        """The operator station on this stack: the simulator in-process, shadows read from
+        the store, every turn seen on the broker."""
+        from vahr.station.assistant import SimulatorAssistant
+        from vahr.station.station import Station, StationConfig
+
+        assert self.alexa is not None and self.stack.dataplane is not None
+        self._station_client = MqttClient(
+            self.stack.service_endpoint(), client_id="vahr-station-local"
+        ).connect()
+        self.station = Station(
+            StationConfig(port=port, voice=self.config.voice),
+            self.fleet,
+            link=self._station_client,
+            assistant=SimulatorAssistant(self.alexa),
+            read_shadow=self._stored_shadow,
+        ).start()
+        self.stack.dataplane.redirects["/vahr/dashboard"] = self.station.url
+
+    def _stored_shadow(self, thing: str) -> bytes | None:
+        store = self.stack.store
+        try:
+            return json.dumps(store.get(thing)).encode() if store is not None else None
+        except ShadowError:  # not reported yet
+            return None
 
     def wait_online(self, timeout_s: float = 30.0) -> None:
         """Block until every robot said it is online, or raise naming those that did not."""
@@ -196,10 +237,13 @@ class LocalSystem:
         if self._room is not None:
             self._room.stop()
             self._room = None
-        for client in (self._room_client, self._watcher):
+        if self.station is not None:
+            self.station.stop()
+            self.station = None
+        for client in (self._room_client, self._watcher, self._station_client):
             if client is not None:
                 client.stop()
-        self._room_client = self._watcher = None
+        self._room_client = self._watcher = self._station_client = None
         self.stack.stop()
 
     def __enter__(self) -> LocalSystem:

@@ -1,0 +1,103 @@
+// The station's API from the page: JSON requests, and speaking a reply aloud.
+
+export class ApiError extends Error {}
+
+export async function post(path, body) {
+  let response;
+  try {
+    response = await fetch(path, {
+      method: "POST",
+      headers: { "Content-Type": "application/json" },
+      body: JSON.stringify(body ?? {}),
+    });
+  } catch (err) {
+    throw new ApiError("The station does not answer; is it still running?");
+  }
+  return answer(response);
+}
+
+export async function postWav(blob) {
+  let response;
+  try {
+    response = await fetch("/api/voice", {
+      method: "POST",
+      headers: { "Content-Type": "audio/wav" },
+      body: blob,
+    });
+  } catch (err) {
+    throw new ApiError("The station does not answer; is it still running?");
+  }
+  return answer(response);
+}
+
+async function answer(response) {
+  let body = {};
+  try {
+    body = await response.json();
+  } catch (err) {
+    body = {};
+  }
+  if (!response.ok) {
+    throw new ApiError(body.error || `The station answered ${response.status}.`);
+  }
+  return body;
+}
+
+// How replies are spoken: the browser's own voice, espeak-ng on the station's computer
+// (its audio played here), or not at all. Remembered in this browser.
+const VOICE_KEY = "vahr-station-reply-voice";
+
+export function replyVoice() {
+  const chosen = localStorage.getItem(VOICE_KEY);
+  if (chosen) return chosen;
+  // Without any browser voice (a headless browser, some tablets) espeak-ng is the default.
+  const voices = "speechSynthesis" in window ? speechSynthesis.getVoices() : [];
+  return voices.length ? "browser" : "espeak";
+}
+
+export function setReplyVoice(value) {
+  localStorage.setItem(VOICE_KEY, value);
+}
+
+let playing = null;
+
+// Speak `text`; resolves when it has been spoken (or at once when muted or on failure).
+export async function speak(text) {
+  if (!text) return;
+  const voice = replyVoice();
+  if (voice === "off") return;
+  if (voice === "browser" && "speechSynthesis" in window && speechSynthesis.getVoices().length) {
+    await new Promise((resolve) => {
+      const utterance = new SpeechSynthesisUtterance(text);
+      utterance.onend = resolve;
+      utterance.onerror = resolve;
+      speechSynthesis.cancel();
+      speechSynthesis.speak(utterance);
+    });
+    return;
+  }
+  let response;
+  try {
+    response = await fetch("/api/speech", {
+      method: "POST",
+      headers: { "Content-Type": "application/json" },
+      body: JSON.stringify({ text }),
+    });
+  } catch (err) {
+    return;
+  }
+  if (!response.ok) return;
+  const url = URL.createObjectURL(await response.blob());
+  try {
+    if (playing) playing.pause();
+    const audio = new Audio(url);
+    playing = audio;
+    await new Promise((resolve) => {
+      audio.onended = resolve;
+      audio.onerror = resolve;
+      audio.play().catch(resolve);
+    });
+  } finally {
+    URL.revokeObjectURL(url);
+  }
+}

@@ -1,0 +1,191 @@
+// The conversation: every exchange with the assistant in order (what was said or heard,
+// the intent and slots understood, the reply, the commands it sent and how fast the robots
+// acknowledged them), the orders from the keyboard and mouse, and the robots' own
+// exchanges with the assistant. Filterable by robot.
+
+import { sourceName } from "./robots.js";
+
+const ORIGINS = {
+  "station-voice": "You, by voice",
+  station: "You, typed",
+  "station-weather": "Weather button",
+  say: "vahr say",
+  console: "Console",
+};
+const FALLBACK = "AMAZON.FallbackIntent";
+
+function node(tag, className, content) {
+  const made = document.createElement(tag);
+  if (className) made.className = className;
+  if (content !== undefined) made.textContent = content;
+  return made;
+}
+
+function clock(at) {
+  const date = at ? new Date(at) : new Date();
+  return date.toLocaleTimeString([], { hour: "2-digit", minute: "2-digit", second: "2-digit" });
+}
+
+function quoted(text) {
+  const q = node("q", "", text);
+  return q;
+}
+
+export class Conversation {
+  constructor(list, filters, { commands, names }) {
+    this.list = list;
+    this.filters = filters;
+    this.commands = commands; // id -> command (shared with the page's store)
+    this.names = names; // thing -> spoken name
+    this.filter = null;
+    this.refreshers = new Map(); // command id -> [functions that redraw what shows it]
+  }
+
+  build(fleet, entries) {
+    this.list.replaceChildren();
+    this.refreshers.clear();
+    this.filters.replaceChildren();
+    const chips = [[null, "All"], ...fleet.robots.slice(0, 8).map((r) => [r.thing, r.name])];
+    for (const [thing, label] of chips) {
+      const chip = node("button", "chip", label);
+      chip.type = "button";
+      chip.setAttribute("aria-pressed", String(thing === this.filter));
+      chip.addEventListener("click", () => this.setFilter(thing));
+      chip.dataset.thing = thing ?? "";
+      this.filters.appendChild(chip);
+    }
+    for (const entry of entries) this.add(entry, false);
+    this.showEmpty();
+    this.list.scrollTop = this.list.scrollHeight;
+  }
+
+  setFilter(thing) {
+    this.filter = thing;
+    for (const chip of this.filters.children) chip.setAttribute("aria-pressed", String((chip.dataset.thing || null) === thing));
+    for (const item of this.list.querySelectorAll(".entry")) item.hidden = !this.visible(item);
+    this.showEmpty();
+    this.list.scrollTop = this.list.scrollHeight;
+  }
+
+  visible(item) {
+    return this.filter === null || (item.dataset.robots || "").split(" ").includes(this.filter);
+  }
+
+  showEmpty() {
+    const shown = [...this.list.querySelectorAll(".entry")].some((item) => !item.hidden);
+    let empty = this.list.querySelector(".empty");
+    if (shown && empty) empty.remove();
+    if (!shown && !empty) {
+      empty = node("li", "empty", this.filter ? "Nothing with this robot yet." : "Nothing said yet. Hold “Hold to talk”, type below, or use vahr say.");
+      this.list.appendChild(empty);
+    }
+  }
+
+  // One conversation message from the feed (turn, command, or a robot's exchange event).
+  add(message, live = true) {
+    let item = null;
+    if (message.type === "turn") item = this.turn(message);
+    else if (message.type === "command") item = this.command(message);
+    else if (message.type === "event") item = this.exchange(message);
+    if (!item) return;
+    const atBottom = this.list.scrollHeight - this.list.scrollTop - this.list.clientHeight < 40;
+    item.dataset.robots = (message.robots || []).join(" ");
+    item.hidden = !this.visible(item);
+    this.list.querySelector(".empty")?.remove();
+    this.list.appendChild(item);
+    this.showEmpty();
+    // Follow new entries only if the reader was already at the end: never pull them away.
+    if (!live || atBottom) this.list.scrollTop = this.list.scrollHeight;
+  }
+
+  acknowledged(commandId) {
+    for (const redraw of this.refreshers.get(commandId) || []) redraw();
+  }
+
+  watch(commandId, redraw) {
+    if (!this.refreshers.has(commandId)) this.refreshers.set(commandId, []);
+    this.refreshers.get(commandId).push(redraw);
+    redraw();
+  }
+
+  commandLine(commandId) {
+    const command = this.commands[commandId];
+    if (!command) return `command ${commandId.slice(0, 8)}`;
+    const zone = command.params?.zone ? ` ${command.params.zone}` : "";
+    const who = command.target === "fleet" ? "every robot" : this.names[command.target] || command.target;
+    const acks = Object.entries(command.acks || {});
+    let how = "waiting for an acknowledgment";
+    if (acks.length) {
+      const worst = Math.max(...acks.map(([, ack]) => ack.latency_ms));
+      const rejected = acks.filter(([, ack]) => ack.event === "rejected").map(([thing]) => this.names[thing] || thing);
+      how = rejected.length ? `rejected by ${rejected.join(", ")}` : `acknowledged in ${Math.round(worst)} ms`;
+      if (command.target === "fleet") how += ` (${acks.length}/${command.robots.length})`;
+    }
+    return `${command.action}${zone} → ${who}: ${how}`;
+  }
+
+  turn(message) {
+    const item = node("li", "entry turn");
+    item.append(node("span", "who", ORIGINS[message.origin] || message.origin || "Someone"), node("time", "", clock(message.at)));
+    const said = node("div", "said");
+    said.appendChild(quoted(message.utterance || "(session ended)"));
+    item.appendChild(said);
+    if (message.heard) {
+      const sure = Math.round((message.heard.confidence ?? 0) * 100);
+      item.appendChild(node("div", "heard", `heard in ${Number(message.heard.seconds ?? 0).toFixed(1)} s of speech · ${sure}% sure`));
+    }
+    const understood = node("div", "understood");
+    if (message.intent) understood.appendChild(node("span", `tag intent${message.intent === FALLBACK ? " bad" : ""}`, message.intent));
+    for (const [name, slot] of Object.entries(message.slots || {})) {
+      if (!slot) continue;
+      const resolved = slot.id ? ` → ${slot.id}` : slot.value ? " (no match)" : "";
+      understood.appendChild(node("span", "tag", `${name}: ${slot.value ?? "—"}${resolved}`));
+    }
+    if (understood.children.length) item.appendChild(understood);
+    item.appendChild(node("div", `reply${message.intent === FALLBACK ? " sorry" : ""}`, message.speech || "(no reply)"));
+    const meta = node("div", "meta");
+    item.appendChild(meta);
+    const ids = message.commands || [];
+    const redraw = () => {
+      const parts = [`reply in ${Math.round(message.latency_ms ?? 0)} ms`];
+      parts.push(ids.length ? ids.map((id) => this.commandLine(id)).join(" · ") : "no command");
+      meta.textContent = parts.join(" · ");
+    };
+    if (ids.length) for (const id of ids) this.watch(id, redraw);
+    else redraw();
+    return item;
+  }
+
+  command(message) {
+    const robotSource = message.source.startsWith("robot:");
+    const item = node("li", `entry ${robotSource ? "robot-exchange" : "console"}`);
+    const who = robotSource ? `${this.names[message.source.slice(6)] || message.source.slice(6)}, to a robot` : sourceName(message.source).replace(/^./, (c) => c.toUpperCase());
+    item.append(node("span", "who", who), node("time", "", clock(message.seen)));
+    const said = node("div", "said");
+    item.appendChild(said);
+    this.watch(message.id, () => { said.textContent = this.commandLine(message.id); });
+    return item;
+  }
+
+  exchange(message) {
+    const name = this.names[message.thing] || message.thing;
+    const item = node("li", "entry robot-exchange");
+    let who, body;
+    if (message.event === "said") {
+      who = `${name} to the assistant`;
+      body = quoted(message.text || "");
+    } else if (message.event === "heard") {
+      who = `The assistant to ${name}`;
+      body = quoted(message.text || "(nothing heard)");
+    } else {
+      who = `${name} understood`;
+      const sure = message.confidence !== undefined && message.confidence !== null ? ` (${Math.round(message.confidence * 100)}% sure)` : "";
+      body = node("span", `tag ${message.intent && message.intent !== "unknown" ? "ok" : "bad"}`, `${message.intent || "nothing"}${sure}`);
+    }
+    item.append(node("span", "who", who), node("time", "", clock(message.at)));
+    const said = node("div", "said");
+    said.appendChild(body);
+    item.appendChild(said);
+    return item;
+  }
+}

@@ -1,0 +1,395 @@
+// The floor, top-down, drawn from fleet.yaml, with every robot where it was last reported.
+//
+// Robots report their pose now and then (every second on the local stack, far less often
+// on AWS), so between reports the map moves each robot along its path: a straight line
+// from the last reported pose toward the destination zone, at the speed its reports imply
+// (or that of its previous drive). A report that disagrees is eased into over a moment,
+// never jumped to, and a robot is never drawn sliding backwards along its path.
+
+const SVG = "http://www.w3.org/2000/svg";
+const DEFAULT_SPEED = 0.5; // metres a second: the simulator's, until reports say otherwise
+const EASE_MS = 600;
+const TURN_RATE = 5; // radians a second at which the drawn heading follows
+const LABELS_UP_TO = 12; // more robots than this: numbers only, no names under them
+
+function el(name, attributes = {}, parent = null) {
+  const node = document.createElementNS(SVG, name);
+  for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, value);
+  if (parent) parent.appendChild(node);
+  return node;
+}
+
+const now = () => performance.now();
+const distance = (a, b) => Math.hypot(a.x - b.x, a.y - b.y);
+const smooth = (t) => 1 - Math.pow(1 - Math.min(Math.max(t, 0), 1), 3);
+const angleDelta = (a, b) => Math.atan2(Math.sin(b - a), Math.cos(b - a));
+
+// Where one robot is drawn: reported poses in, a position at any moment out.
+class Motion {
+  constructor(pose) {
+    this.anchor = { x: pose.x, y: pose.y, t: now() };
+    this.theta = pose.theta ?? 0;
+    this.heading = this.theta;
+    this.target = null;
+    this.speed = DEFAULT_SPEED;
+    this.offset = { x: 0, y: 0, t: 0 };
+    this.last = null;
+  }
+
+  position(t) {
+    let { x, y } = this.anchor;
+    if (this.target) {
+      const remaining = distance(this.anchor, this.target);
+      const travelled = Math.min(remaining, (this.speed * (t - this.anchor.t)) / 1000);
+      if (remaining > 1e-6) {
+        x += ((this.target.x - x) * travelled) / remaining;
+        y += ((this.target.y - y) * travelled) / remaining;
+      }
+    }
+    const fade = 1 - smooth((t - this.offset.t) / EASE_MS);
+    return { x: x + this.offset.x * fade, y: y + this.offset.y * fade };
+  }
+
+  get settling() {
+    return now() - this.offset.t < EASE_MS;
+  }
+
+  get driving() {
+    return this.target !== null && distance(this.position(now()), this.target) > 0.01;
+  }
+
+  // A reported `pose`; `target` is the destination's pose while driving, else null.
+  report(pose, target) {
+    const t = now();
+    const shown = this.position(t);
+    if (target && this.last && this.last.target && distance(this.last.target, target) < 1e-6) {
+      const seconds = (t - this.last.t) / 1000;
+      const covered = distance(this.last.pose, pose);
+      if (seconds > 0.05 && covered > 0.01) {
+        // The speed the reports imply, blended with what was believed before.
+        this.speed = 0.5 * this.speed + 0.5 * Math.min(Math.max(covered / seconds, 0.02), 100);
+      }
+    }
+    let anchor = { x: pose.x, y: pose.y, t };
+    if (target && distance(shown, target) < distance(pose, target)) {
+      // The robot is behind where it was drawn: hold the drawn place rather than back up;
+      // the speed just measured lets the report catch up.
+      anchor = { x: shown.x, y: shown.y, t };
+    }
+    this.offset = { x: shown.x - anchor.x, y: shown.y - anchor.y, t };
+    this.anchor = anchor;
+    this.target = target;
+    if (pose.theta !== undefined && pose.theta !== null) this.theta = pose.theta;
+    this.last = target ? { pose: { x: pose.x, y: pose.y }, t, target } : null;
+  }
+
+  headingAt(t, dt) {
+    let wanted = this.theta;
+    if (this.target) {
+      const at = this.position(t);
+      if (distance(at, this.target) > 0.05) wanted = Math.atan2(this.target.y - at.y, this.target.x - at.x);
+    }
+    const step = TURN_RATE * dt;
+    const delta = angleDelta(this.heading, wanted);
+    this.heading += Math.abs(delta) <= step ? delta : Math.sign(delta) * step;
+    return this.heading;
+  }
+}
+
+export class MapView {
+  constructor(svg, { onRobot, onZone }) {
+    this.svg = svg;
+    this.onRobot = onRobot;
+    this.onZone = onZone;
+    this.robots = new Map(); // thing -> {node parts, motion}
+    this.zones = new Map();
+    this.arms = new Map();
+    this.frame = null;
+    this.lastFrame = now();
+    this.selected = null;
+  }
+
+  // -- drawing the floor ---------------------------------------------------------------
+
+  build(fleet) {
+    this.fleet = fleet;
+    this.svg.replaceChildren();
+    this.robots.clear();
+    this.zones.clear();
+    this.arms.clear();
+    const floor = fleet.floor;
+    const xs = [floor.origin.x, floor.origin.x + floor.width];
+    const ys = [floor.origin.y, floor.origin.y + floor.height];
+    for (const robot of fleet.robots) { xs.push(robot.start.x); ys.push(robot.start.y); }
+    for (const zone of fleet.zones) {
+      xs.push(zone.pose.x - zone.radius, zone.pose.x + zone.radius);
+      ys.push(zone.pose.y - zone.radius, zone.pose.y + zone.radius);
+    }
+    const margin = 0.45;
+    const left = Math.min(...xs) - margin, right = Math.max(...xs) + margin;
+    const bottom = Math.min(...ys) - margin, top = Math.max(...ys) + margin + 0.35;
+    // Map y points up; SVG's points down: every y is drawn as -y.
+    this.svg.setAttribute("viewBox", `${left} ${-top} ${right - left} ${top - bottom}`);
+    this.svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
+    this.scale = Math.max(1, Math.max(right - left, top - bottom) / 13);
+    this.labels = fleet.robots.length <= LABELS_UP_TO;
+
+    const layers = {};
+    for (const name of ["floor", "fixtures", "zones", "paths", "robots"]) layers[name] = el("g", { class: `layer-${name}` }, this.svg);
+    this.layers = layers;
+
+    el("rect", { class: "floor", x: floor.origin.x, y: -(floor.origin.y + floor.height), width: floor.width, height: floor.height }, layers.floor);
+    for (let x = Math.ceil(floor.origin.x); x < floor.origin.x + floor.width; x += 1) {
+      el("line", { class: "grid-line", x1: x, x2: x, y1: -floor.origin.y, y2: -(floor.origin.y + floor.height) }, layers.floor);
+    }
+    for (let y = Math.ceil(floor.origin.y); y < floor.origin.y + floor.height; y += 1) {
+      el("line", { class: "grid-line", y1: -y, y2: -y, x1: floor.origin.x, x2: floor.origin.x + floor.width }, layers.floor);
+    }
+    for (const wall of floor.walls) {
+      el("line", { class: "wall", x1: wall.start.x, y1: -wall.start.y, x2: wall.end.x, y2: -wall.end.y }, layers.floor);
+    }
+    if (floor.conveyor) this.drawConveyor(floor.conveyor, layers.fixtures);
+    for (const zone of fleet.zones) this.drawZone(zone, layers.zones);
+    for (const [zoneId, at] of Object.entries(floor.arms || {})) this.drawArm(zoneId, at, layers.fixtures);
+    if (floor.led) this.drawLed(floor.led, layers.fixtures);
+    fleet.robots.forEach((robot, index) => this.drawRobot(robot, index, layers));
+  }
+
+  drawConveyor(conveyor, parent) {
+    const { start, end, width } = conveyor;
+    const length = distance(start, end);
+    const angle = (-Math.atan2(end.y - start.y, end.x - start.x) * 180) / Math.PI;
+    const group = el("g", { class: "conveyor", transform: `translate(${start.x} ${-start.y}) rotate(${angle})` }, parent);
+    el("title", {}, group).textContent = "Conveyor";
+    el("rect", { class: "conveyor-belt", x: 0, y: -width / 2, width: length, height: width, rx: 0.04 }, group);
+    for (let s = 0.18; s < length - 0.05; s += 0.26) {
+      const h = width * 0.28;
+      el("path", { class: "conveyor-chevron", d: `M ${s} ${-h} L ${s + 0.1} 0 L ${s} ${h}` }, group);
+    }
+  }
+
+  drawZone(zone, parent) {
+    // The box is the arrival circle's square with room around it; a robot stops at its
+    // centre, so the letter sits in the top-left corner and the name along the bottom.
+    const half = zone.radius + 0.22;
+    const { x, y } = zone.pose;
+    const group = el("g", { class: `zone${zone.arm === "loader" ? " loading" : ""}`, "data-zone": zone.id, role: "button", "aria-label": `Zone ${zone.name}` }, parent);
+    el("title", {}, group).textContent = zone.name;
+    el("rect", { class: "zone-body", x: x - half, y: -y - half, width: 2 * half, height: 2 * half, rx: 0.16 }, group);
+    const big = zone.id.length <= 2 ? zone.id : zone.key;
+    const letter = el("text", { class: "zone-letter", x: x - half + 0.26, y: -y - half + 0.3, "font-size": big ? 0.42 : 0.2 }, group);
+    letter.textContent = big || zone.name;
+    if (!big) letter.setAttribute("x", x);
+    const name = el("text", { class: "zone-name", x, y: -y + half - 0.09, "font-size": 0.16 }, group);
+    name.textContent = zone.name;
+    group.addEventListener("click", () => this.onZone(zone.id));
+    this.zones.set(zone.id, { group, zone, half });
+  }
+
+  drawArm(zoneId, at, parent) {
+    const zone = this.fleet.zones.find((z) => z.id === zoneId);
+    if (!zone) return;
+    const group = el("g", { class: "arm" }, parent);
+    el("title", {}, group).textContent = zone.arm === "loader" ? "Loading arm" : `Unloading arm of zone ${zone.id}`;
+    const length = Math.min(0.45, distance(at, zone.pose) * 0.6);
+    const toward = Math.atan2(zone.pose.y - at.y, zone.pose.x - at.x);
+    el("line", { class: "arm-link", x1: at.x, y1: -at.y, x2: at.x + length * Math.cos(toward), y2: -(at.y + length * Math.sin(toward)) }, group);
+    el("circle", { class: "arm-base", cx: at.x, cy: -at.y, r: 0.12 }, group);
+    this.arms.set(zoneId, group);
+  }
+
+  drawLed(at, parent) {
+    const group = el("g", { class: "led" }, parent);
+    el("title", {}, group).textContent = "Task III LED: lights when both robots delivered to D in order";
+    el("circle", { class: "led-body", cx: at.x, cy: -at.y, r: 0.13 }, group);
+    el("text", { class: "led-label", x: at.x - 0.22, y: -at.y + 0.06, "font-size": 0.17, "text-anchor": "end" }, group).textContent = "task III LED";
+    this.led = group;
+  }
+
+  drawRobot(robot, index, layers) {
+    const group = el("g", { class: "robot", "data-thing": robot.thing, role: "button", "aria-label": robot.name }, layers.robots);
+    el("title", {}, group).textContent = robot.name;
+    el("circle", { class: "robot-ring", r: 0.42 }, group);
+    const rotor = el("g", {}, group);
+    const body = el("circle", { class: "robot-body", r: 0.28 }, rotor);
+    el("path", { class: "robot-nose", d: "M 0.25 0 L 0.09 0.1 L 0.09 -0.1 Z" }, rotor);
+    const number = el("text", { class: "robot-number", "font-size": 0.24, y: 0.01 }, group);
+    number.textContent = robot.key ?? String(index + 1);
+    const cargo = el("rect", { class: "robot-cargo", x: 0.14, y: -0.42, width: 0.2, height: 0.2, rx: 0.04, visibility: "hidden" }, group);
+    let label = null, detail = null;
+    if (this.labels) {
+      label = el("text", { class: "robot-label", y: -0.03, "font-size": 0.22 * this.scale }, group);
+      label.textContent = robot.name;
+      detail = el("text", { class: "robot-detail", y: 0.22 * this.scale, "font-size": 0.18 * this.scale }, group);
+    }
+    const path = el("line", { class: "path", visibility: "hidden" }, layers.paths);
+    const destination = el("circle", { class: "destination", r: 0.36, visibility: "hidden" }, layers.paths);
+    group.addEventListener("click", (event) => { event.stopPropagation(); this.onRobot(robot.thing); });
+    const motion = new Motion(robot.start);
+    this.robots.set(robot.thing, { group, rotor, body, cargo, label, detail, path, destination, motion, state: {} });
+    this.place(robot.thing, now(), 0);
+  }
+
+  // -- state ---------------------------------------------------------------------------
+
+  zonePose(zoneId) {
+    return this.zones.get(zoneId)?.zone.pose ?? null;
+  }
+
+  // A robot's whole state changed (shadow, presence, an event): redraw what it shows.
+  update(thing, robot) {
+    const drawn = this.robots.get(thing);
+    if (!drawn) return;
+    const reported = robot.reported || {};
+    const status = robot.online === false ? "offline" : reported.status || "idle";
+    drawn.state = { status, reported, online: robot.online, lastSeen: robot.last_seen, progress: robot.progress };
+    drawn.group.classList.toggle("offline", robot.online === false);
+    drawn.body.style.fill = `var(--${statusColour(status)})`;
+    drawn.cargo.setAttribute("visibility", reported.cargo ? "visible" : "hidden");
+    if (drawn.detail) drawn.detail.textContent = describe(drawn.state);
+    drawn.path.style.stroke = drawn.destination.style.stroke = `var(--${statusColour(status)})`;
+    this.updateArms();
+  }
+
+  // A reported pose (from the shadow or an event): move the robot's motion.
+  report(thing, pose, destinationZone, driving) {
+    const drawn = this.robots.get(thing);
+    if (!drawn || !pose) return;
+    const target = driving ? this.zonePose(destinationZone) : null;
+    drawn.motion.report(pose, target);
+    this.animate();
+  }
+
+  setLed(on) {
+    this.led?.classList.toggle("on", Boolean(on));
+  }
+
+  select(thing) {
+    this.selected = thing;
+    for (const [name, drawn] of this.robots) drawn.group.classList.toggle("selected", name === thing);
+    this.svg.classList.toggle("map-armed", Boolean(thing));
+  }
+
+  updateArms() {
+    const working = new Set();
+    for (const drawn of this.robots.values()) {
+      const { status, reported } = drawn.state;
+      if ((status === "loading" || status === "unloading") && reported.zone) working.add(reported.zone);
+    }
+    for (const [zoneId, arm] of this.arms) arm.classList.toggle("working", working.has(zoneId));
+  }
+
+  // -- moving ----------------------------------------------------------------------------
+
+  animate() {
+    if (this.frame === null) {
+      this.lastFrame = now();
+      this.frame = requestAnimationFrame((t) => this.tick(t));
+    }
+  }
+
+  tick() {
+    this.frame = null;
+    const t = now();
+    const dt = Math.min(0.1, (t - this.lastFrame) / 1000);
+    this.lastFrame = t;
+    let busy = false;
+    for (const thing of this.robots.keys()) busy = this.place(thing, t, dt) || busy;
+    if (busy) this.animate();
+  }
+
+  // Draw one robot at time t; true while it is still moving (or settling, or turning).
+  place(thing, t, dt) {
+    const drawn = this.robots.get(thing);
+    const { motion } = drawn;
+    const at = motion.position(t);
+    const heading = motion.headingAt(t, dt);
+    drawn.group.setAttribute("transform", `translate(${at.x.toFixed(3)} ${(-at.y).toFixed(3)})`);
+    if (drawn.label) this.placeLabel(drawn, at);
+    drawn.rotor.setAttribute("transform", `rotate(${((-heading * 180) / Math.PI).toFixed(1)})`);
+    const target = motion.target;
+    const show = target && distance(at, target) > 0.05 ? "visible" : "hidden";
+    drawn.path.setAttribute("visibility", show);
+    drawn.destination.setAttribute("visibility", show);
+    if (target) {
+      drawn.path.setAttribute("x1", at.x.toFixed(3));
+      drawn.path.setAttribute("y1", (-at.y).toFixed(3));
+      drawn.path.setAttribute("x2", target.x);
+      drawn.path.setAttribute("y2", -target.y);
+      drawn.destination.setAttribute("cx", target.x);
+      drawn.destination.setAttribute("cy", -target.y);
+    }
+    const turning = Math.abs(angleDelta(motion.heading, motion.target ? heading : motion.theta)) > 0.01;
+    return motion.driving || motion.settling || turning;
+  }
+
+  // Names go beside a robot on the side facing the middle of the floor, clear of the zone
+  // it stands in, so they never cover a zone's letter.
+  placeLabel(drawn, at) {
+    const floor = this.fleet.floor;
+    const side = at.x > floor.origin.x + floor.width / 2 ? -1 : 1;
+    let offset = 0.42;
+    for (const { zone, half } of this.zones.values()) {
+      if (Math.abs(at.x - zone.pose.x) <= half && Math.abs(at.y - zone.pose.y) <= half) {
+        offset = Math.max(offset, side * (zone.pose.x - at.x) + half + 0.1);
+      }
+    }
+    const x = (side * offset).toFixed(3);
+    const anchor = side > 0 ? "start" : "end";
+    if (drawn.labelAt === `${x}${anchor}`) return;
+    drawn.labelAt = `${x}${anchor}`;
+    for (const text of [drawn.label, drawn.detail]) {
+      text.setAttribute("x", x);
+      text.setAttribute("text-anchor", anchor);
+    }
+  }
+
+  // Where a robot is drawn now (tests and benchmarks read it).
+  drawnPosition(thing) {
+    const drawn = this.robots.get(thing);
+    return drawn ? drawn.motion.position(now()) : null;
+  }
+}
+
+export function statusColour(status) {
+  return {
+    idle: "idle",
+    navigating: "navigating",
+    loading: "loading",
+    unloading: "loading",
+    waiting: "waiting",
+    stopped: "stopped",
+    stuck: "stuck",
+    error: "error",
+    offline: "offline",
+  }[status] || "idle";
+}
+
+const zoneNames = {};
+
+export function setZoneNames(zones) {
+  for (const zone of zones) zoneNames[zone.id] = zone.name;
+}
+
+// How a zone is named in running text: its id when it is a letter ("B"), else its name.
+export function zoneText(id) {
+  if (!id) return "";
+  return id.length <= 2 || !zoneNames[id] ? id : zoneNames[id];
+}
+
+export function describe(state, { where = true } = {}) {
+  const { status, reported } = state;
+  if (status === "offline") {
+    const seen = state.lastSeen ? new Date(state.lastSeen).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit", second: "2-digit" }) : "never";
+    return `offline · last seen ${seen}`;
+  }
+  if (status === "navigating") {
+    const fraction = state.progress?.progress;
+    const to = reported.destination ? `to ${zoneText(reported.destination)}` : "driving";
+    return fraction !== undefined && fraction !== null ? `${to} · ${Math.round(fraction * 100)}%` : to;
+  }
+  if (status === "idle") return where && reported.zone ? `at ${zoneText(reported.zone)}` : "idle";
+  if (status === "loading") return "loading";
+  if (status === "unloading") return `unloading at ${zoneText(reported.zone)}`;
+  return status;
+}

@@ -1,0 +1,211 @@
+// The keyboard-and-mouse panel: the paper's baseline method. Select a robot (a click on the
+// map or here, or keys 1-9), then a zone (a click, or its key: A-D, L) to send it there; the
+// arms load and unload on arrival. Esc stops every robot. "Ask the weather" asks the
+// assistant, as the paper's keyboard participants did.
+
+import { post } from "./api.js";
+import { statusColour, zoneText } from "./map.js";
+import { typing } from "./talk.js";
+
+function button(label, className = "btn") {
+  const made = document.createElement("button");
+  made.type = "button";
+  made.className = className;
+  if (label !== undefined) made.textContent = label;
+  return made;
+}
+
+function key(letter) {
+  const kbd = document.createElement("kbd");
+  kbd.textContent = letter;
+  return kbd;
+}
+
+export class Panel {
+  constructor({ robots, zones, stopAll, weather, status, note, interactions, onSelect, names, commands }) {
+    this.commands = commands;
+    this.robotsBox = robots;
+    this.zonesBox = zones;
+    this.status = status;
+    this.note = note;
+    this.interactions = interactions;
+    this.onSelect = onSelect;
+    this.names = names;
+    this.selected = null;
+    this.ordersAllowed = true;
+    this.pending = new Map(); // command id -> what the status line says about it
+    stopAll.addEventListener("click", () => this.stopAll());
+    weather.addEventListener("click", () => this.askWeather());
+    this.weatherButton = weather;
+    document.addEventListener("keydown", (event) => this.onKey(event));
+  }
+
+  build(fleet) {
+    this.fleet = fleet;
+    this.robotButtons = new Map();
+    this.zoneButtons = new Map();
+    this.robotsBox.replaceChildren();
+    this.zonesBox.replaceChildren();
+    for (const robot of fleet.robots.filter((r) => r.key)) {
+      const made = button(undefined);
+      const dot = document.createElement("span");
+      dot.className = "robot-dot";
+      made.append(key(robot.key), dot, document.createTextNode(robot.name));
+      made.setAttribute("aria-pressed", "false");
+      made.dataset.thing = robot.thing;
+      made.addEventListener("click", () => this.onSelect(robot.thing));
+      this.robotsBox.appendChild(made);
+      this.robotButtons.set(robot.thing, { made, dot });
+    }
+    if (fleet.robots.length > this.robotButtons.size) {
+      const select = document.createElement("select");
+      select.className = "robot-select";
+      select.setAttribute("aria-label", "Any robot");
+      select.appendChild(new Option(`All ${fleet.robots.length} robots…`, ""));
+      for (const robot of fleet.robots) select.appendChild(new Option(robot.name, robot.thing));
+      select.addEventListener("change", () => { if (select.value) this.onSelect(select.value); });
+      this.robotsBox.appendChild(select);
+    }
+    for (const zone of fleet.zones) {
+      // A one-letter zone's button is its key cap; others say their name beside it.
+      const letter = zone.id.length === 1 && zone.key === zone.id;
+      const made = button(undefined, letter ? "btn btn-key" : "btn");
+      if (zone.key) made.appendChild(key(zone.key));
+      if (!letter) made.appendChild(document.createTextNode(zoneLabel(zone)));
+      made.setAttribute("aria-label", `Zone ${zone.id === zone.key ? zone.id : zone.name}`);
+      made.dataset.zone = zone.id;
+      made.addEventListener("click", () => this.navigate(this.selected, zone.id));
+      this.zonesBox.appendChild(made);
+      this.zoneButtons.set(zone.id, made);
+    }
+    this.refresh();
+  }
+
+  colour(thing, status) {
+    const parts = this.robotButtons?.get(thing);
+    if (parts) parts.dot.style.background = `var(--${statusColour(status)})`;
+  }
+
+  select(thing) {
+    this.selected = thing;
+    for (const [name, { made }] of this.robotButtons) made.setAttribute("aria-pressed", String(name === thing));
+    this.refresh();
+  }
+
+  // While a voice session runs, orders are given by voice: the panel only selects and stops.
+  allowOrders(allowed, note) {
+    this.ordersAllowed = allowed;
+    this.note.dataset.session = note ? "true" : "false";
+    if (note) this.note.textContent = note;
+    this.refresh();
+  }
+
+  refresh() {
+    for (const made of this.zoneButtons?.values() ?? []) {
+      made.disabled = !this.selected || !this.ordersAllowed;
+      const zone = made.dataset.zone;
+      made.title = this.selected ? `Send ${this.names[this.selected]} to ${zone}` : `Zone ${zone}: select a robot first`;
+    }
+  }
+
+  tell(message, bad = false) {
+    this.status.textContent = message;
+    this.status.classList.toggle("error", bad);
+  }
+
+  // -- orders --------------------------------------------------------------------------
+
+  async order(body, describe) {
+    const sent = post("/api/command", body);
+    const result = sent.then((answer) => ({ commands: [answer.id] }), (err) => ({ error: err.message }));
+    this.interactions.attach(result);
+    this.tell(`${describe}…`);
+    try {
+      const { id } = await sent;
+      this.pending.set(id, describe);
+      this.tell(`${describe}: sent, waiting for the robot.`);
+      // The robot may have answered before the station did.
+      for (const [thing, ack] of Object.entries(this.commands[id]?.acks || {})) this.acknowledged(id, thing, ack);
+      return id;
+    } catch (err) {
+      this.tell(err.message, true);
+      return null;
+    }
+  }
+
+  navigate(thing, zone) {
+    if (!thing) {
+      this.tell("Select a robot first: click it on the map, or press its number.", true);
+      return;
+    }
+    if (!this.ordersAllowed) return;
+    return this.order({ robot: thing, action: "navigate", zone }, `${this.names[thing]} to ${zoneText(zone)}`);
+  }
+
+  async stopAll() {
+    const sent = post("/api/stop", {});
+    this.interactions.attach(sent.then((answer) => ({ commands: [answer.id] }), (err) => ({ error: err.message })));
+    try {
+      const { id } = await sent;
+      this.pending.set(id, "Stop all");
+      this.tell("Stop all: sent.");
+    } catch (err) {
+      this.tell(err.message, true);
+    }
+  }
+
+  async askWeather() {
+    this.weatherButton.disabled = true;
+    const sent = post("/api/say", { utterance: "what is the weather", origin: "station-weather" });
+    this.interactions.attach(sent.then(
+      (turn) => ({ asks: true, speech: turn.speech, intent: turn.intent, commands: turn.commands || [] }),
+      (err) => ({ asks: true, error: err.message }),
+    ));
+    this.tell("Asking the assistant for the weather…");
+    try {
+      const turn = await sent;
+      this.tell(`The assistant: “${turn.speech}”`);
+      const { speak } = await import("./api.js");
+      await speak(turn.speech);
+    } catch (err) {
+      this.tell(err.message, true);
+    } finally {
+      this.weatherButton.disabled = false;
+    }
+  }
+
+  // A robot acknowledged (or rejected) a command this panel sent.
+  acknowledged(id, thing, ack) {
+    const describe = this.pending.get(id);
+    if (!describe) return;
+    const name = this.names[thing] || thing;
+    if (ack.event === "rejected") this.tell(`${describe}: ${name} rejected it.`, true);
+    else this.tell(`${describe}: acknowledged by ${name} in ${Math.round(ack.latency_ms)} ms.`);
+  }
+
+  onKey(event) {
+    if (event.repeat || event.ctrlKey || event.metaKey || event.altKey || typing(event.target)) return;
+    if (event.key === "Escape") {
+      event.preventDefault();
+      this.stopAll();
+      return;
+    }
+    const robot = this.fleet?.robots.find((r) => r.key && r.key === event.key);
+    if (robot) {
+      event.preventDefault();
+      this.onSelect(robot.thing);
+      return;
+    }
+    const zone = this.fleet?.zones.find((z) => z.key && z.key.toLowerCase() === event.key.toLowerCase());
+    if (zone) {
+      event.preventDefault();
+      this.navigate(this.selected, zone.id);
+    }
+  }
+}
+
+// "Zone A" for a one-letter zone, else its spoken name with a capital ("Loading zone").
+export function zoneLabel(zone) {
+  if (zone.id.length === 1) return `Zone ${zone.id}`;
+  return zone.name.charAt(0).toUpperCase() + zone.name.slice(1);
+}

@@ -1,0 +1,190 @@
+// Push-to-talk: hold the button (or the space bar), speak, let go. The page records the
+// microphone as 16 kHz mono 16-bit PCM, sends it as a WAV file, and shows what was heard,
+// how sure the recognizer was, and the assistant's reply, which it then speaks.
+
+import { ApiError, postWav, speak } from "./api.js";
+
+const RATE = 16000;
+const SHORTEST_MS = 300;
+
+export function wavFile(chunks, rate) {
+  let length = 0;
+  for (const chunk of chunks) length += chunk.length;
+  const samples = new Float32Array(length);
+  let offset = 0;
+  for (const chunk of chunks) { samples.set(chunk, offset); offset += chunk.length; }
+  const pcm = rate === RATE ? samples : resample(samples, rate, RATE);
+  const buffer = new ArrayBuffer(44 + pcm.length * 2);
+  const view = new DataView(buffer);
+  const ascii = (at, text) => { for (let i = 0; i < text.length; i += 1) view.setUint8(at + i, text.charCodeAt(i)); };
+  ascii(0, "RIFF"); view.setUint32(4, 36 + pcm.length * 2, true); ascii(8, "WAVE");
+  ascii(12, "fmt "); view.setUint32(16, 16, true); view.setUint16(20, 1, true); view.setUint16(22, 1, true);
+  view.setUint32(24, RATE, true); view.setUint32(28, RATE * 2, true); view.setUint16(32, 2, true); view.setUint16(34, 16, true);
+  ascii(36, "data"); view.setUint32(40, pcm.length * 2, true);
+  for (let i = 0; i < pcm.length; i += 1) {
+    const s = Math.max(-1, Math.min(1, pcm[i]));
+    view.setInt16(44 + i * 2, s < 0 ? s * 0x8000 : s * 0x7fff, true);
+  }
+  return new Blob([buffer], { type: "audio/wav" });
+}
+
+function resample(samples, from, to) {
+  const out = new Float32Array(Math.floor((samples.length * to) / from));
+  for (let i = 0; i < out.length; i += 1) {
+    const at = (i * from) / to;
+    const left = Math.floor(at);
+    const right = Math.min(left + 1, samples.length - 1);
+    out[i] = samples[left] + (samples[right] - samples[left]) * (at - left);
+  }
+  return out;
+}
+
+export class Talk {
+  constructor({ button, level, state, interactions, onTurn, metrics }) {
+    this.button = button;
+    this.level = level;
+    this.state = state;
+    this.interactions = interactions;
+    this.onTurn = onTurn;
+    this.metrics = metrics;
+    this.recording = null;
+    this.busy = false;
+    if (!navigator.mediaDevices?.getUserMedia) {
+      button.disabled = true;
+      this.say("Push-to-talk needs a microphone and a secure page: open the station on this computer (http://127.0.0.1) or over https.");
+      return;
+    }
+    button.addEventListener("pointerdown", (event) => {
+      if (event.button !== 0) return;
+      event.preventDefault();
+      button.setPointerCapture?.(event.pointerId);
+      this.press("button");
+    });
+    for (const kind of ["pointerup", "pointercancel", "lostpointercapture"]) {
+      button.addEventListener(kind, () => this.release());
+    }
+    button.addEventListener("keydown", (event) => { if (event.key === "Enter" && !event.repeat) this.press("key"); });
+    button.addEventListener("keyup", (event) => { if (event.key === "Enter") this.release(); });
+    document.addEventListener("keydown", (event) => {
+      if (event.code !== "Space" || event.repeat || typing(event.target)) return;
+      event.preventDefault();
+      this.press("key");
+    });
+    document.addEventListener("keyup", (event) => {
+      if (event.code !== "Space" || typing(event.target)) return;
+      event.preventDefault();
+      this.release();
+    });
+  }
+
+  say(html) {
+    this.state.textContent = html;
+  }
+
+  async press(how) {
+    if (this.recording || this.busy) return;
+    const pressedAt = Date.now();
+    const interaction = this.interactions.start("voice", "push-to-talk", pressedAt);
+    const recording = { chunks: [], pressedAt, interaction, released: false, ready: null };
+    this.recording = recording;
+    this.button.dataset.state = "listening";
+    this.button.querySelector(".talk-label").textContent = "Listening… let go to send";
+    this.say("Listening…");
+    recording.ready = this.open(recording).catch((err) => {
+      recording.error = err;
+    });
+  }
+
+  async open(recording) {
+    const stream = await navigator.mediaDevices.getUserMedia({ audio: { channelCount: 1, echoCancellation: true, noiseSuppression: true } });
+    const context = new AudioContext({ sampleRate: RATE });
+    await context.audioWorklet.addModule("/static/capture-worklet.js");
+    const source = context.createMediaStreamSource(stream);
+    const capture = new AudioWorkletNode(context, "capture");
+    capture.port.onmessage = (message) => {
+      if (recording.released) return;
+      recording.chunks.push(message.data.samples);
+      this.level.style.width = `${Math.min(100, Math.round(message.data.peak * 140))}%`;
+    };
+    source.connect(capture);
+    recording.audio = { stream, context, source, capture };
+    if (recording.released) this.close(recording);
+  }
+
+  close(recording) {
+    const audio = recording.audio;
+    if (!audio) return;
+    audio.source.disconnect();
+    audio.capture.port.onmessage = null;
+    for (const track of audio.stream.getTracks()) track.stop();
+    audio.context.close();
+    recording.audio = null;
+  }
+
+  async release() {
+    const recording = this.recording;
+    if (!recording || recording.released) return;
+    recording.released = true;
+    const releasedAt = performance.now();
+    this.recording = null;
+    this.level.style.width = "0";
+    await recording.ready;
+    this.close(recording);
+    const rate = RATE;
+    this.busy = true;
+    this.button.dataset.state = "thinking";
+    this.button.querySelector(".talk-label").textContent = "Understanding…";
+    const { interaction } = recording;
+    interaction.counts = true;
+    try {
+      if (recording.error) throw new ApiError(`The microphone is not available: ${recording.error.message || recording.error}`);
+      if (Date.now() - recording.pressedAt < SHORTEST_MS || !recording.chunks.length) {
+        interaction.counts = false;
+        this.say("Hold the button while you speak, and let go when you are done.");
+        return;
+      }
+      const result = await postWav(wavFile(recording.chunks, rate));
+      this.show(result);
+      this.metrics?.ptt.push({ reply_shown_ms: performance.now() - releasedAt, recognizer_ms: result.recognizer_ms, transcript: result.heard.transcript });
+      const turn = result.turn;
+      interaction.text = result.heard.transcript || "(nothing heard)";
+      interaction.speech = result.speech;
+      interaction.intent = turn?.intent ?? null;
+      interaction.commands = turn?.commands ?? [];
+      interaction.asks = turn?.intent === "WeatherIntent";
+      if (!result.understood) interaction.error = "not understood";
+      if (turn) this.onTurn?.(turn);
+      await speak(result.speech);
+    } catch (err) {
+      interaction.error = String(err.message || err);
+      this.say(err.message || String(err));
+    } finally {
+      this.busy = false;
+      this.button.dataset.state = "idle";
+      this.button.querySelector(".talk-label").textContent = "Hold to talk";
+      this.interactions.end(interaction, Date.now());
+    }
+  }
+
+  show(result) {
+    const { heard } = result;
+    this.state.replaceChildren();
+    if (heard.transcript) {
+      const said = document.createElement("span");
+      said.className = "transcript";
+      said.textContent = `“${heard.transcript}”`;
+      this.state.append("Heard ", said, ` (${Math.round(heard.confidence * 100)}% sure). `);
+    } else {
+      this.state.append("Heard no speech. ");
+    }
+    const reply = document.createElement("span");
+    reply.className = "reply";
+    reply.dataset.understood = String(result.understood);
+    reply.textContent = result.speech;
+    this.state.append(reply);
+  }
+}
+
+export function typing(target) {
+  return target instanceof HTMLElement && (target.isContentEditable || ["INPUT", "TEXTAREA", "SELECT"].includes(target.tagName));
+}
