@@ -1,7 +1,8 @@
 """The session's wire: records every command and robot event, and sends the console's commands.
 
-It is the lab's one MQTT client (`vahr.local.mqtt`) subscribed to every robot's events and
-to every command topic (robot and fleet), handing each live message to a callback. The
+It is the lab's one MQTT client (`vahr.local.mqtt`) subscribed to every robot's events, to
+every command topic (robot and fleet) and to what the participant does on the operator
+station (`topics.EXPERIMENT_INPUT`), handing each live message to a callback. The
 session is persistent (a client id fixed per experiment session, and a session expiry), so
 while the recorder is down after a crash the broker queues the QoS 1 messages it misses and
 delivers them when the session resumes. The keyboard-and-mouse method's console publishes
@@ -22,7 +23,7 @@ if TYPE_CHECKING:
 
     from vahr.protocol.broker import ClientCredentials
 
-WIRE_TOPICS = (topics.ALL_EVENTS, topics.ALL_ROBOT_CMDS, topics.FLEET_CMD)
+WIRE_TOPICS = (topics.ALL_EVENTS, topics.ALL_ROBOT_CMDS, topics.FLEET_CMD, topics.EXPERIMENT_INPUT)
 # Long enough to outlive any crash of a session's recorder.
 SESSION_EXPIRY_S = 7 * 24 * 3600
 
@@ -36,6 +37,7 @@ class Bus:
         on_message: Callable[[str, bytes], None],
         client_id: str,
         tls: ClientCredentials | None = None,
+        will: tuple[str, bytes] | None = None,
     ) -> None:
         address = parse_broker_url(url)
         if address.tls and tls is None:
@@ -46,6 +48,7 @@ class Bus:
             ),
             client_id=client_id,
             session_expiry_s=SESSION_EXPIRY_S,
+            will=will,
         )
         # Robots retain their last `delivered` event; a retained message replays the past
         # when the recorder (re)subscribes, and logging it inside a task would count an old
@@ -59,5 +62,5 @@ class Bus:
     def stop(self) -> None:
         self._client.stop()
 
-    def publish(self, topic: str, payload: bytes) -> None:
-        self._client.publish(topic, payload)
+    def publish(self, topic: str, payload: bytes, *, retain: bool = False) -> None:
+        self._client.publish(topic, payload, retain=retain)

@@ -5,16 +5,28 @@ Transport-free: the MQTT adapter (`bus.Bus`) calls `on_message(topic, payload)`.
 the task in progress; each robot event is applied to the world and any change (an arm
 loading or unloading, the LED) is logged right after it. Malformed messages are logged as
 such rather than dropped, so the log shows everything the participant caused.
+
+What the participant did on the operator station (`topics.EXPERIMENT_INPUT`: clicks, key
+presses, push-to-talk, the observer's puzzle count) is logged too, as interactions and
+observer input of this session, at the times the page measured moved onto this machine's
+clock (`vahr.protocol.station.on_clock`).
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import threading
 from typing import TYPE_CHECKING, Any
 
-from vahr.experiment.eventlog import Kind
+from vahr.experiment.eventlog import Kind, now
 from vahr.protocol import ProtocolError, decode_command, decode_event, encode, topics
+from vahr.protocol.station import Interaction, decode_station_input, on_clock
+
+logger = logging.getLogger(__name__)
+# Interactions from the station are named apart from the observer's and the participant
+# model's (`{task}-{n}`).
+STATION_PREFIX = "station-"
 
 if TYPE_CHECKING:
     from vahr.experiment.eventlog import EventLog
@@ -24,20 +36,27 @@ if TYPE_CHECKING:
 class Recorder:
     """Logs the wire; `changed` is notified after every logged robot event."""
 
-    def __init__(self, log: EventLog, world: World) -> None:
+    def __init__(self, log: EventLog, world: World, *, session: str | None = None) -> None:
         self.log = log
         self.world = world
+        # The session's name: station input for any other session is not this log's.
+        self.session = session
+        self.closed = False
         self.task: str | None = None
         self.changed = threading.Condition()
         self._lock = threading.Lock()
         self._task_commands: set[str] = set()
 
     def on_message(self, topic: str, payload: bytes) -> None:
+        if self.closed:
+            return
         parsed = topics.parse_robot_topic(topic)
         if topic == topics.FLEET_CMD or (parsed is not None and parsed[1] == "cmd"):
             self._command(topic, payload, target=parsed[0] if parsed else "fleet")
         elif parsed is not None and parsed[1] == "events":
             self._event(topic, payload)
+        elif topic == topics.EXPERIMENT_INPUT:
+            self._station_input(payload)
 
     def _command(self, topic: str, payload: bytes, *, target: str) -> None:
         try:
@@ -77,6 +96,46 @@ class Recorder:
                 self.log.append(Kind.WORLD, change, task=self.task)
         with self.changed:
             self.changed.notify_all()
+
+    def _station_input(self, payload: bytes) -> None:
+        received = now()
+        try:
+            message = decode_station_input(payload)
+        except ProtocolError as err:
+            logger.warning("ignoring station input: %s", err)
+            return
+        if self.session is None or message.session != self.session:
+            return  # another session's, or a station left open from an earlier one
+        at = on_clock(message.at, message.sent, received)
+        with self._lock:
+            if not isinstance(message, Interaction):
+                body = {"what": "puzzle_piece", "count": message.count, "source": "station"}
+                self.log.append(Kind.OBSERVER, body, task=self.task, at=at)
+                return
+            data: dict[str, Any] = {
+                "id": STATION_PREFIX + message.id,
+                "channel": message.channel,
+                "text": message.text,
+                "source": "station",
+            }
+            if message.phase == "started":
+                self.log.append(Kind.INTERACTION_STARTED, data, task=self.task, at=at)
+                return
+            data["commands"] = list(message.commands)
+            if not message.counts:
+                data["counts"] = False
+            if message.asks:
+                data["asks"] = True
+            for name in ("speech", "intent", "error"):
+                value = getattr(message, name)
+                if value is not None:
+                    data[name] = value
+            self.log.append(Kind.INTERACTION_ENDED, data, task=self.task, at=at)
+
+    def close(self) -> None:
+        """Log nothing more (the session is about to end)."""
+        with self._lock:
+            self.closed = True
 
     def set_task(self, task: str | None, commands: set[str] | None = None) -> None:
         """Tag what follows with `task`; `commands` are its commands already logged (resume)."""

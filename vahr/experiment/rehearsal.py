@@ -20,6 +20,7 @@ from vahr.experiment.session import (
     rebuild_world,
     run_tasks,
 )
+from vahr.experiment.station_link import WILL, StatusBroadcast
 from vahr.experiment.tasks import default_seed
 from vahr.experiment.timing import Person
 
@@ -45,17 +46,31 @@ def run_live(
 ) -> SessionVerdict:
     """Record the wire into the session's log while `performer_for(console)` runs the tasks,
     then end the session; return the judge's verdict."""
-    recorder = Recorder(session.log, rebuild_world(fleet, session))
+    recorder = Recorder(session.log, rebuild_world(fleet, session), session=session.spec.name)
     bus = Bus(
-        broker_url, recorder.on_message, client_id=f"vahr-experiment-{session.spec.name}", tls=tls
+        broker_url,
+        recorder.on_message,
+        client_id=f"vahr-experiment-{session.spec.name}",
+        tls=tls,
+        will=WILL,
     )
     bus.start()
+    # The operator station shows the session from its status (vahr.experiment.station_link).
+    status = StatusBroadcast(
+        session, recorder, lambda topic, payload, retain: bus.publish(topic, payload, retain=retain)
+    ).start()
+    ended = False
     try:
         console = Console(bus.publish, session.spec.method)
         run_tasks(session, recorder, performer_for(console), announce=announce)
+        # Nothing is logged after the end: a late robot event must not follow it.
+        recorder.close()
+        verdict = end_session(session)
+        ended = True
     finally:
+        status.stop(ended=ended)
         bus.stop()
-    return end_session(session)
+    return verdict
 
 
 def simulated_performer(

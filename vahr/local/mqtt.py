@@ -56,8 +56,15 @@ class MqttClient:
     """One MQTT 5 connection. Handlers run on paho's network thread: keep them short."""
 
     def __init__(
-        self, endpoint: MqttEndpoint, *, client_id: str | None = None, session_expiry_s: int = 0
+        self,
+        endpoint: MqttEndpoint,
+        *,
+        client_id: str | None = None,
+        session_expiry_s: int = 0,
+        will: tuple[str, bytes] | None = None,
     ) -> None:
+        """`will` is a (topic, payload) the broker publishes, retained, if this client goes
+        away without saying goodbye (an empty payload clears what was retained there)."""
         self.endpoint = endpoint
         self.session_expiry_s = session_expiry_s
         self._client = paho.Client(
@@ -65,6 +72,8 @@ class MqttClient:
             client_id=client_id or f"vahr-{uuid.uuid4().hex[:12]}",
             protocol=MQTTProtocolVersion.MQTTv5,
         )
+        if will is not None:
+            self._client.will_set(will[0], will[1], qos=1, retain=True)
         if endpoint.credentials is not None:
             creds = endpoint.credentials.check_files()
             try:

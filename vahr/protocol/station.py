@@ -103,6 +103,7 @@ class TaskStatus(msgspec.Struct, frozen=True, omit_defaults=True):
 
     state: Literal["waiting", "running", "success", "failure"]
     reason: Text = ""
+    title: ShortText = ""
     started_at: Timestamp | None = None
     ended_at: Timestamp | None = None
 
@@ -125,6 +126,8 @@ class ExperimentStatus(msgspec.Struct, frozen=True, kw_only=True, omit_defaults=
     # The command actions the method may send in the current task (the paper's procedure).
     allowed: list[str] = []
     puzzle: int = 0
+    # The task III LED on the floor (it lights when the task succeeds).
+    led_on: bool = False
     started_at: Timestamp | None = None
     ended: bool = False
     at: Timestamp | None = None
