@@ -13,6 +13,10 @@ SUBCOMMANDS: Subcommands = {
     "up": ("vahr.commands.up", "run the broker, shadows, data plane, Alexa simulator and robots"),
     "say": ("vahr.commands.say", "say an utterance to the running system as a person to Alexa"),
     "console": ("vahr.commands.console", "talk to the running system interactively"),
+    "station": (
+        "vahr.commands.station",
+        "serve the operator station page (map, panel, push-to-talk) for any deployment",
+    ),
     "nlu": ("vahr.commands.nlu", "show how an utterance is understood, without executing it"),
     "demo": ("vahr.commands.demo", "run the paper's scenario end to end on this machine"),
     "experiment": ("vahr.commands.experiment", "run one experiment session (tasks I-III)"),

@@ -1,0 +1,105 @@
+"""`vahr station`: the operator station page against any VAHR deployment.
+
+Against the local stack: `vahr station --broker mqtt://127.0.0.1:1883 --api
+http://127.0.0.1:8180`. Against AWS IoT Core: `--broker mqtts://ENDPOINT:8883` with an
+operator certificate (`--cert`, `--key`, `--ca`) and `--api https://ENDPOINT` (the iot-data
+endpoint; docs/station.md). `vahr up` serves its own station already.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import sys
+import threading
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from vahr.cli_dispatch import add_logging_flag, setup_logging
+
+if TYPE_CHECKING:
+    import argparse
+
+DEFAULT_PORT = 8181
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--broker",
+        required=True,
+        help="the deployment's MQTT broker: mqtt://HOST:PORT (loopback) or mqtts://HOST:PORT "
+        "with --cert, --key and --ca (AWS IoT Core, vahr up's mqtts)",
+    )
+    parser.add_argument("--cert", type=Path, help="operator certificate for an mqtts:// broker")
+    parser.add_argument("--key", type=Path, help="its private key")
+    parser.add_argument("--ca", type=Path, help="the CA that signed the broker's certificate")
+    parser.add_argument(
+        "--api",
+        help="the iot-data endpoint: vahr up's api URL, or https://ENDPOINT on AWS "
+        "(shadows at start-up, and the assistant for push-to-talk)",
+    )
+    parser.add_argument("--fleet", type=Path, help="fleet file (default: fleet.yaml)")
+    parser.add_argument(
+        "--model", type=Path, help="interaction model (default: the skill's en-US model)"
+    )
+    parser.add_argument(
+        "--host",
+        default="127.0.0.1",
+        help="address to serve the page on (default 127.0.0.1; elsewhere a token is required)",
+    )
+    parser.add_argument(
+        "--port", type=int, default=DEFAULT_PORT, help=f"page port (default {DEFAULT_PORT})"
+    )
+    parser.add_argument("--token", help="the token to require (default: a new one, off loopback)")
+    parser.add_argument("--no-voice", action="store_true", help="no push-to-talk")
+    parser.add_argument("--json", action="store_true", help="print the page's address as JSON")
+    add_logging_flag(parser)
+    parser.set_defaults(log_level="WARNING")
+
+
+def run(args: argparse.Namespace) -> int:
+    from vahr.errors import VahrError
+    from vahr.protocol import load_fleet
+    from vahr.protocol.broker import ClientCredentials
+    from vahr.station.deployment import Deployment, build_station
+    from vahr.station.station import StationConfig
+
+    setup_logging(args.log_level)
+    if not 0 <= args.port <= 65535:
+        raise VahrError(f"--port {args.port}: not a usable port")
+    if args.token is not None and len(args.token) < 16:
+        raise VahrError("--token must be at least 16 characters")
+    tls = None
+    if args.cert or args.key or args.ca:
+        if not (args.cert and args.key and args.ca):
+            raise VahrError("--cert, --key and --ca go together")
+        tls = ClientCredentials(cert_file=args.cert, key_file=args.key, ca_file=args.ca)
+    deployment = Deployment(broker=args.broker, fleet=load_fleet(args.fleet), tls=tls, api=args.api)
+    config = StationConfig(
+        port=args.port,
+        host=args.host,
+        token=args.token,
+        voice=not args.no_voice,
+        model_file=args.model,
+    )
+    stopping = threading.Event()
+    previous = {
+        signum: signal.signal(signum, lambda *_: stopping.set())
+        for signum in (signal.SIGINT, signal.SIGTERM)
+    }
+    station = build_station(config, deployment)
+    try:
+        station.start()
+        if args.json:
+            print(json.dumps({"station": station.url, "token": station.server.token}), flush=True)
+        else:
+            print(f"VAHR station: {station.url}   (Ctrl-C stops it)", flush=True)
+        stopping.wait()
+    finally:
+        station.stop()
+        station.link.stop()
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+    if not args.json:
+        print("vahr station: stopped", file=sys.stderr)
+    return 0

@@ -1,0 +1,142 @@
+"""A station against any VAHR deployment: the local stack (`vahr up`) or AWS IoT Core.
+
+It connects to the deployment's broker as an operator (client id `vahr-station-...`; on AWS
+with a certificate under the operator policy) and reads each robot's shadow once through
+the iot-data endpoint (`--api`). The assistant depends on what `--api` is:
+
+- a local stack (it answers `GET /vahr/health`): its Alexa simulator, over `POST /vahr/say`;
+  every turn, whoever spoke, arrives on `topics.ASSISTANT_TURNS`;
+- AWS's iot-data endpoint: an Alexa simulator in this process in front of the real skill
+  handler, configured for that endpoint (the AWS credentials of the environment need the
+  skill's iot-data rights, docs/station.md). Alexa itself publishes no turns, so the
+  conversation holds the station's own turns and the robots' exchanges.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import urllib.error
+import urllib.request
+import uuid
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from vahr.errors import VahrError
+from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.protocol import topics
+from vahr.protocol.broker import parse_broker_url
+from vahr.station.assistant import HttpAssistant, SimulatorAssistant
+from vahr.station.feed import Feed
+from vahr.station.station import Station
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from pathlib import Path
+
+    from vahr.protocol import Fleet
+    from vahr.protocol.broker import ClientCredentials
+    from vahr.station.assistant import Assistant
+    from vahr.station.station import StationConfig
+
+log = logging.getLogger(__name__)
+
+CLIENT_ID_PREFIX = "vahr-station-"
+HEALTH_TIMEOUT_S = 3.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class Deployment:
+    broker: str
+    fleet: Fleet
+    tls: ClientCredentials | None = None
+    api: str | None = None
+    ack_timeout_s: float | None = None
+
+
+def is_local_stack(api: str) -> bool:
+    """Whether `api` is a local stack's data plane (which also serves `/vahr/health`)."""
+    try:
+        with urllib.request.urlopen(
+            f"{api.rstrip('/')}/vahr/health", timeout=HEALTH_TIMEOUT_S
+        ) as r:
+            return bool(json.loads(r.read()).get("ok"))
+    except (urllib.error.URLError, TimeoutError, OSError, ValueError, AttributeError):
+        return False
+
+
+def build_station(config: StationConfig, deployment: Deployment) -> Station:
+    """Connect to the deployment and build its station (not started)."""
+    address = parse_broker_url(deployment.broker)
+    if address.tls and deployment.tls is None:
+        raise VahrError(f"broker {deployment.broker} needs --cert, --key and --ca for mTLS")
+    link = MqttClient(
+        MqttEndpoint(
+            host=address.host,
+            port=address.port,
+            credentials=deployment.tls if address.tls else None,
+        ),
+        client_id=f"{CLIENT_ID_PREFIX}{uuid.uuid4().hex[:12]}",
+    )
+    feed = Feed(deployment.fleet)
+    api = deployment.api
+    local = api is not None and is_local_stack(api)
+    assistant: Assistant | None = None
+    if api is not None and local:
+        assistant = HttpAssistant(api)
+    elif api is not None:
+        assistant = _simulator_for(api, config.model_file, deployment, feed, link)
+    link.connect()
+    try:
+        return Station(
+            config,
+            deployment.fleet,
+            link=link,
+            assistant=assistant,
+            read_shadow=_shadow_reader(api) if api is not None else None,
+            turns=local,
+            feed=feed,
+        )
+    except BaseException:
+        link.stop()
+        raise
+
+
+def _simulator_for(
+    api: str, model_file: Path | None, deployment: Deployment, feed: Feed, link: MqttClient
+) -> Assistant:
+    """The Alexa simulator and the real skill in this process, for AWS's iot-data endpoint."""
+    from vahr.local.alexa.commands_seen import CommandLog
+    from vahr.local.alexa.nlu import InteractionModel
+    from vahr.local.alexa.simulator import AlexaSimulator
+    from vahr.local.alexa.skill import load_skill_handler
+
+    commands = CommandLog()
+    # The skill publishes through iot-data; its commands are seen coming back from the broker.
+    for topic_filter in (topics.ALL_ROBOT_CMDS, topics.FLEET_CMD):
+        link.subscribe(topic_filter, commands.observe)
+    simulator = AlexaSimulator(
+        InteractionModel.load(model_file),
+        load_skill_handler(api, ack_timeout_s=deployment.ack_timeout_s),
+        command_log=commands.take,
+        on_turn=lambda turn: feed.add_turn(turn.to_message()),
+    )
+    return SimulatorAssistant(simulator)
+
+
+def _shadow_reader(api: str) -> Callable[[str], bytes | None]:
+    from skill.errors import GatewayError, MissingCredentials
+    from skill.iot_data import IotDataGateway, client_for
+
+    gateway = IotDataGateway(client_for(api))
+
+    def read(thing: str) -> bytes | None:
+        try:
+            return gateway.get_shadow(thing)
+        except MissingCredentials as err:
+            raise VahrError(f"cannot read the shadow of {thing}: no AWS credentials") from err
+        except GatewayError as err:
+            log.warning("cannot read the shadow of %s: %s", thing, err)
+            return None
+
+    return read
