@@ -5,8 +5,9 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
-# Debian packages the project runs: the MQTT broker, speech, and ROS 1 for the ros1 backend.
-DEB_PACKAGES := mosquitto espeak-ng sox ros-core python3-rospy python3-actionlib \
+# Debian packages the project runs: the MQTT broker, speech, ROS 1 for the ros1 backend, and
+# chromium for the operator station's browser tests.
+DEB_PACKAGES := mosquitto espeak-ng sox chromium ros-core python3-rospy python3-actionlib \
 	python3-move-base-msgs python3-geometry-msgs python3-actionlib-msgs
 # The pure-Python ROS packages the venv sees through a .pth file (see FIELD-NOTES: pointing
 # the venv at all of dist-packages would leak Debian's older packages into pip's view).

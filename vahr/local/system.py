@@ -100,6 +100,8 @@ class LocalSystem:
     def start(self) -> LocalSystem:
         cfg = self.config
         if cfg.station_port:
+            # The data plane's port first: a conflict is named the same with or without a station.
+            ensure_free(cfg.api_port, "data-plane API")
             ensure_free(cfg.station_port, "operator station")
         try:
             fleet_file = write_fleet(self.fleet, cfg.state_dir / "fleet.yaml")
@@ -159,7 +161,7 @@ class LocalSystem:
             self.stack.service_endpoint(), client_id="vahr-station-local"
         ).connect()
         self.station = Station(
-            StationConfig(port=port, voice=self.config.voice),
+            StationConfig(port=port),
             self.fleet,
             link=self._station_client,
             assistant=SimulatorAssistant(self.alexa),

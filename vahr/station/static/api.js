@@ -60,6 +60,14 @@ export function setReplyVoice(value) {
 }
 
 let playing = null;
+let finishPlaying = null;
+
+// Stop speaking at once (the person pressed to talk again).
+export function hush() {
+  if ("speechSynthesis" in window) speechSynthesis.cancel();
+  if (playing) playing.pause();
+  finishPlaying?.();
+}
 
 // Speak `text`; resolves when it has been spoken (or at once when muted or on failure).
 export async function speak(text) {
@@ -93,10 +101,12 @@ export async function speak(text) {
     const audio = new Audio(url);
     playing = audio;
     await new Promise((resolve) => {
+      finishPlaying = resolve;
       audio.onended = resolve;
       audio.onerror = resolve;
       audio.play().catch(resolve);
     });
+    finishPlaying = null;
   } finally {
     URL.revokeObjectURL(url);
   }

@@ -39,6 +39,17 @@ export class Conversation {
     this.names = names; // thing -> spoken name
     this.filter = null;
     this.refreshers = new Map(); // command id -> [functions that redraw what shows it]
+    // The list follows the newest entry while the reader is at its end, and stays where
+    // the reader scrolled to otherwise: entries never pull the text away from them.
+    this.sticky = true;
+    list.addEventListener("scroll", () => {
+      this.sticky = list.scrollHeight - list.scrollTop - list.clientHeight < 40;
+    });
+    new ResizeObserver(() => this.follow()).observe(list);
+  }
+
+  follow() {
+    if (this.sticky) this.list.scrollTop = this.list.scrollHeight;
   }
 
   build(fleet, entries) {
@@ -54,9 +65,10 @@ export class Conversation {
       chip.dataset.thing = thing ?? "";
       this.filters.appendChild(chip);
     }
-    for (const entry of entries) this.add(entry, false);
+    for (const entry of entries) this.add(entry);
     this.showEmpty();
-    this.list.scrollTop = this.list.scrollHeight;
+    this.sticky = true;
+    this.follow();
   }
 
   setFilter(thing) {
@@ -64,7 +76,8 @@ export class Conversation {
     for (const chip of this.filters.children) chip.setAttribute("aria-pressed", String((chip.dataset.thing || null) === thing));
     for (const item of this.list.querySelectorAll(".entry")) item.hidden = !this.visible(item);
     this.showEmpty();
-    this.list.scrollTop = this.list.scrollHeight;
+    this.sticky = true;
+    this.follow();
   }
 
   visible(item) {
@@ -82,24 +95,23 @@ export class Conversation {
   }
 
   // One conversation message from the feed (turn, command, or a robot's exchange event).
-  add(message, live = true) {
+  add(message) {
     let item = null;
     if (message.type === "turn") item = this.turn(message);
     else if (message.type === "command") item = this.command(message);
     else if (message.type === "event") item = this.exchange(message);
     if (!item) return;
-    const atBottom = this.list.scrollHeight - this.list.scrollTop - this.list.clientHeight < 40;
     item.dataset.robots = (message.robots || []).join(" ");
     item.hidden = !this.visible(item);
     this.list.querySelector(".empty")?.remove();
     this.list.appendChild(item);
     this.showEmpty();
-    // Follow new entries only if the reader was already at the end: never pull them away.
-    if (!live || atBottom) this.list.scrollTop = this.list.scrollHeight;
+    this.follow();
   }
 
   acknowledged(commandId) {
     for (const redraw of this.refreshers.get(commandId) || []) redraw();
+    this.follow();
   }
 
   watch(commandId, redraw) {

@@ -12,7 +12,7 @@ import { Talk } from "./talk.js";
 const $ = (id) => document.getElementById(id);
 
 // Benchmarks and tests read what was drawn when (`?metrics=1`).
-const metrics = new URLSearchParams(location.search).has("metrics") ? { painted: [], ptt: [], messages: 0 } : null;
+const metrics = new URLSearchParams(location.search).has("metrics") ? { painted: [], ptt: [], shown: [], messages: 0 } : null;
 if (metrics) window.vahrMetrics = metrics;
 
 const store = { fleet: null, robots: {}, commands: {}, experiment: null, selected: null, skew: 0 };
@@ -65,7 +65,9 @@ function draw() {
     if (!robot) continue;
     map.update(thing, robot);
     robots.update(thing, robot, store.commands);
-    panel.colour(thing, robot.online === false ? "offline" : robot.reported?.status || "idle");
+    const status = robot.online === false ? "offline" : robot.reported?.status || "idle";
+    panel.colour(thing, status);
+    if (metrics) record(thing, status, robot.reported || {});
   }
   dirty.clear();
   if (metrics && painted.length) {
@@ -76,6 +78,16 @@ function draw() {
       for (const marker of done) metrics.painted.push({ ...marker, at });
     }, 0);
   }
+}
+
+// Each robot's status, cargo and zone as drawn, whenever one of them changes (`?metrics=1`).
+const lastShown = {};
+function record(thing, status, reported) {
+  const shown = { thing, status, cargo: Boolean(reported.cargo), zone: reported.zone ?? null };
+  const key = JSON.stringify(shown);
+  if (lastShown[thing] === key) return;
+  lastShown[thing] = key;
+  metrics.shown.push(shown);
 }
 
 // -- the stream --------------------------------------------------------------------------

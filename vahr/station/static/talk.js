@@ -2,7 +2,7 @@
 // microphone as 16 kHz mono 16-bit PCM, sends it as a WAV file, and shows what was heard,
 // how sure the recognizer was, and the assistant's reply, which it then speaks.
 
-import { ApiError, postWav, speak } from "./api.js";
+import { ApiError, hush, postWav, speak } from "./api.js";
 
 const RATE = 16000;
 const SHORTEST_MS = 300;
@@ -40,12 +40,11 @@ function resample(samples, from, to) {
 }
 
 export class Talk {
-  constructor({ button, level, state, interactions, onTurn, metrics }) {
+  constructor({ button, level, state, interactions, metrics }) {
     this.button = button;
     this.level = level;
     this.state = state;
     this.interactions = interactions;
-    this.onTurn = onTurn;
     this.metrics = metrics;
     this.recording = null;
     this.busy = false;
@@ -83,6 +82,7 @@ export class Talk {
 
   async press(how) {
     if (this.recording || this.busy) return;
+    hush(); // pressing again cuts the last reply short
     const pressedAt = Date.now();
     const interaction = this.interactions.start("voice", "push-to-talk", pressedAt);
     const recording = { chunks: [], pressedAt, interaction, released: false, ready: null };
@@ -96,7 +96,7 @@ export class Talk {
   }
 
   async open(recording) {
-    const stream = await navigator.mediaDevices.getUserMedia({ audio: { channelCount: 1, echoCancellation: true, noiseSuppression: true } });
+    const stream = await navigator.mediaDevices.getUserMedia({ audio: { channelCount: 1, echoCancellation: false, noiseSuppression: false, autoGainControl: false } });
     const context = new AudioContext({ sampleRate: RATE });
     await context.audioWorklet.addModule("/static/capture-worklet.js");
     const source = context.createMediaStreamSource(stream);
@@ -153,17 +153,23 @@ export class Talk {
       interaction.commands = turn?.commands ?? [];
       interaction.asks = turn?.intent === "WeatherIntent";
       if (!result.understood) interaction.error = "not understood";
-      if (turn) this.onTurn?.(turn);
+      this.idle();
+      // The exchange lasts until the reply has been heard (or cut short by a new press).
       await speak(result.speech);
     } catch (err) {
       interaction.error = String(err.message || err);
       this.say(err.message || String(err));
     } finally {
-      this.busy = false;
-      this.button.dataset.state = "idle";
-      this.button.querySelector(".talk-label").textContent = "Hold to talk";
+      this.idle();
       this.interactions.end(interaction, Date.now());
     }
+  }
+
+  idle() {
+    this.busy = false;
+    if (this.recording) return;
+    this.button.dataset.state = "idle";
+    this.button.querySelector(".talk-label").textContent = "Hold to talk";
   }
 
   show(result) {
