@@ -69,23 +69,35 @@ def now_ms() -> float:
 
 
 class Subscriber:
-    """One page's queue of encoded messages."""
+    """One page's queue of encoded messages.
+
+    A message pushed with a `key` (a robot's progress) replaces the one with the same key
+    that the page has not taken yet: a page that falls behind gets each robot's latest
+    progress rather than every step of it.
+    """
 
     def __init__(self, limit: int = SUBSCRIBER_LIMIT) -> None:
         self._limit = limit
-        self._pending: deque[bytes] = deque()
+        self._pending: list[bytes] = []
+        self._keyed: dict[str, int] = {}  # key -> index in _pending
         self._ready = threading.Condition()
         self.closed = False
         self.overflowed = False
 
-    def push(self, message: bytes) -> None:
+    def push(self, message: bytes, key: str | None = None) -> None:
         with self._ready:
             if self.closed:
+                return
+            if key is not None and key in self._keyed:
+                self._pending[self._keyed[key]] = message
                 return
             if len(self._pending) >= self._limit:
                 self.overflowed = self.closed = True
                 self._pending.clear()
+                self._keyed.clear()
             else:
+                if key is not None:
+                    self._keyed[key] = len(self._pending)
                 self._pending.append(message)
             self._ready.notify()
 
@@ -96,8 +108,8 @@ class Subscriber:
                 self._ready.wait(timeout_s)
             if self.closed:
                 return None
-            taken = list(self._pending)
-            self._pending.clear()
+            taken, self._pending = self._pending, []
+            self._keyed.clear()
             return taken
 
     def close(self) -> None:
@@ -212,12 +224,12 @@ class Feed:
         for subscriber in subscribers:
             subscriber.close()
 
-    def _broadcast(self, message: Json) -> None:
+    def _broadcast(self, message: Json, key: str | None = None) -> None:
         """Send `message` to every page; call with the lock held, so order is kept."""
         encoded = _encode(message)
         dropped = []
         for subscriber in self._subscribers:
-            subscriber.push(encoded)
+            subscriber.push(encoded, key)
             if subscriber.closed:
                 dropped.append(subscriber)
         for subscriber in dropped:
@@ -339,7 +351,8 @@ class Feed:
             message = {"type": "event", **body, "last_seen": now}
             if event.event in EXCHANGE_EVENTS:
                 self._conversation.append({**message, "robots": [event.thing]})
-            self._broadcast(message)
+            progress = f"progress:{event.thing}" if event.event == "progress" else None
+            self._broadcast(message, progress)
 
     def on_command(self, topic: str, payload: bytes) -> None:
         parsed = topics.parse_robot_topic(topic)

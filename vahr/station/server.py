@@ -11,8 +11,9 @@ as `?token=`, which sets a cookie for the page's later requests. Every request i
   `MAX_JSON_BYTES`, or `MAX_AUDIO_BYTES` for a clip (whose length `voice` checks again);
 - at most `MAX_STREAMS` pages are streamed to at once.
 
-The event stream (`GET /api/stream`) is server-sent events: one `data:` line per feed
-message, a comment every `KEEPALIVE_S` so a dead connection is noticed.
+The event stream (`GET /api/stream`) is server-sent events: each event is a JSON array of
+the feed messages that were waiting (one, or many when robots report faster than the page
+reads), with a comment every `KEEPALIVE_S` so a dead connection is noticed.
 """
 
 from __future__ import annotations
@@ -222,7 +223,9 @@ class _Handler(BaseHTTPRequestHandler):
                 if messages is None:
                     break
                 if messages:
-                    self.wfile.write(b"".join(b"data: " + m + b"\n\n" for m in messages))
+                    # Everything waiting goes as one event (a JSON array): one task for the
+                    # page however many robots reported meanwhile.
+                    self.wfile.write(b"data: [" + b",".join(messages) + b"]\n\n")
                 else:
                     self.wfile.write(b": keepalive\n\n")
                 self.wfile.flush()

@@ -11,6 +11,8 @@ const DEFAULT_SPEED = 0.5; // metres a second: the simulator's, until reports sa
 const EASE_MS = 600;
 const TURN_RATE = 5; // radians a second at which the drawn heading follows
 const LABELS_UP_TO = 12; // more robots than this: numbers only, no names under them
+// Frames a second the map moves robots at: smooth for a few, calmer (and cheaper) for many.
+const FRAME_MS_FEW = 0, FRAME_MS_MANY = 50, MANY = 20;
 
 function el(name, attributes = {}, parent = null) {
   const node = document.createElementNS(SVG, name);
@@ -105,7 +107,7 @@ export class MapView {
     this.zones = new Map();
     this.arms = new Map();
     this.frame = null;
-    this.lastFrame = now();
+    this.lastFrame = 0;
     this.selected = null;
   }
 
@@ -244,10 +246,17 @@ export class MapView {
     const status = robot.online === false ? "offline" : reported.status || "idle";
     drawn.state = { status, reported, online: robot.online, lastSeen: robot.last_seen, progress: robot.progress };
     drawn.group.classList.toggle("offline", robot.online === false);
-    drawn.body.style.fill = `var(--${statusColour(status)})`;
-    drawn.cargo.setAttribute("visibility", reported.cargo ? "visible" : "hidden");
-    if (drawn.detail) drawn.detail.textContent = describe(drawn.state);
-    drawn.path.style.stroke = drawn.destination.style.stroke = `var(--${statusColour(status)})`;
+    const colour = `var(--${statusColour(status)})`;
+    if (drawn.colour !== colour) {
+      drawn.colour = colour;
+      drawn.body.style.fill = drawn.path.style.stroke = drawn.destination.style.stroke = colour;
+    }
+    const cargo = reported.cargo ? "visible" : "hidden";
+    if (drawn.cargo.getAttribute("visibility") !== cargo) drawn.cargo.setAttribute("visibility", cargo);
+    if (drawn.detail) {
+      const text = describe(drawn.state);
+      if (drawn.detail.textContent !== text) drawn.detail.textContent = text;
+    }
     this.updateArms();
   }
 
@@ -283,14 +292,18 @@ export class MapView {
 
   animate() {
     if (this.frame === null) {
-      this.lastFrame = now();
-      this.frame = requestAnimationFrame((t) => this.tick(t));
+      this.frame = requestAnimationFrame(() => this.tick());
     }
   }
 
   tick() {
     this.frame = null;
     const t = now();
+    const every = this.robots.size > MANY ? FRAME_MS_MANY : FRAME_MS_FEW;
+    if (t - this.lastFrame < every) {
+      this.animate();
+      return;
+    }
     const dt = Math.min(0.1, (t - this.lastFrame) / 1000);
     this.lastFrame = t;
     let busy = false;

@@ -1,15 +1,23 @@
 // The robots panel: per robot its presence, status, zone, cargo, the command under way with
 // its progress, the last result with its reason, and the reported shadow on demand.
+//
+// Each row is built once; an update only rewrites the text that changed, so a hundred
+// robots reporting progress stay cheap to draw.
 
 import { describe, statusColour, zoneText } from "./map.js";
 
 const time = (ms) => (ms ? new Date(ms).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit", second: "2-digit" }) : "never");
 
-function text(tag, className, content) {
-  const node = document.createElement(tag);
-  if (className) node.className = className;
-  if (content !== undefined) node.textContent = content;
-  return node;
+function node(tag, className, content) {
+  const made = document.createElement(tag);
+  if (className) made.className = className;
+  if (content !== undefined) made.textContent = content;
+  return made;
+}
+
+// Set a property only when it changes (reading is cheap, writing makes the browser work).
+function put(target, key, value) {
+  if (target[key] !== value) target[key] = value;
 }
 
 export class RobotsPanel {
@@ -23,25 +31,41 @@ export class RobotsPanel {
     this.list.replaceChildren();
     this.rows.clear();
     fleet.robots.forEach((robot, index) => {
-      const row = text("li", "robot-row");
+      const row = node("li", "robot-row");
       row.dataset.thing = robot.thing;
-      const badge = text("button", "badge", robot.key ?? String(index + 1));
+      const badge = node("button", "badge", robot.key ?? String(index + 1));
       badge.type = "button";
       badge.title = `Select ${robot.name}`;
       badge.setAttribute("aria-label", `Select ${robot.name}`);
       badge.addEventListener("click", () => this.onSelect(robot.thing));
-      const name = text("span", "name", robot.name);
-      const presence = text("span", "presence");
-      const facts = text("div", "facts");
-      const task = text("div", "task");
-      const last = text("div", "last");
-      const details = text("details");
-      const summary = text("summary", "", "Reported shadow");
-      const raw = text("pre");
-      details.append(summary, raw);
-      row.append(badge, name, presence, facts, task, last, details);
+      const presence = node("span", "presence");
+      const presenceText = node("span");
+      presence.append(node("span", "dot"), presenceText);
+      const facts = node("div", "facts");
+      const status = node("span", "status-text");
+      const zone = node("b");
+      const zoneFact = node("span", "", "zone ");
+      zoneFact.appendChild(zone);
+      const cargo = node("span");
+      facts.append(status, zoneFact, cargo);
+      const task = node("div", "task");
+      const taskWhat = node("span", "task-what");
+      const bar = node("span", "progress");
+      const fill = node("span");
+      bar.appendChild(fill);
+      const percent = node("span");
+      const source = node("span", "tag");
+      task.append(taskWhat, bar, percent, source);
+      const last = node("div", "last");
+      const details = node("details");
+      const raw = node("pre");
+      details.append(node("summary", "", "Reported shadow"), raw);
+      // The raw shadow is written only while someone looks at it.
+      details.addEventListener("toggle", () => { if (details.open) raw.textContent = JSON.stringify(parts.reported, null, 2); });
+      row.append(badge, node("span", "name", robot.name), presence, facts, task, last, details);
       this.list.appendChild(row);
-      this.rows.set(robot.thing, { row, badge, presence, facts, task, last, raw, name: robot.name });
+      const parts = { row, badge, presence, presenceText, status, zone, cargo, task, taskWhat, bar, fill, percent, source, last, details, raw, reported: {} };
+      this.rows.set(robot.thing, parts);
     });
   }
 
@@ -53,51 +77,43 @@ export class RobotsPanel {
     const parts = this.rows.get(thing);
     if (!parts) return;
     const reported = robot.reported || {};
+    parts.reported = reported;
     const online = robot.online;
     const status = online === false ? "offline" : reported.status || "idle";
-    parts.row.dataset.status = status;
-    parts.badge.style.background = `var(--${statusColour(status)})`;
-    parts.presence.replaceChildren(text("span", "dot"), text("span", "", online ? "online" : online === false ? `offline · seen ${time(robot.last_seen)}` : "not heard yet"));
+    const colour = `var(--${statusColour(status)})`;
+    if (parts.row.dataset.status !== status) parts.row.dataset.status = status;
+    put(parts.badge.style, "background", colour);
+    put(parts.presenceText, "textContent", online ? "online" : online === false ? `offline · seen ${time(robot.last_seen)}` : "not heard yet");
     parts.presence.classList.toggle("online", Boolean(online));
-
-    const facts = [
-      ["", text("span", "status-text", describe({ status, reported, lastSeen: robot.last_seen, progress: robot.progress }, { where: false }))],
-      ["zone ", text("b", "", reported.zone ? zoneText(reported.zone) : "—")],
-    ];
-    parts.facts.replaceChildren();
-    for (const [label, value] of facts) {
-      const span = text("span", "", label);
-      span.appendChild(value);
-      parts.facts.appendChild(span);
-    }
-    parts.facts.appendChild(reported.cargo ? text("span", "cargo-tag", "package") : text("span", "", "no package"));
-    parts.facts.querySelector(".status-text").style.color = `var(--${statusColour(status)})`;
+    put(parts.status, "textContent", describe({ status, reported, lastSeen: robot.last_seen, progress: robot.progress }, { where: false }));
+    put(parts.status.style, "color", colour);
+    put(parts.zone, "textContent", reported.zone ? zoneText(reported.zone) : "—");
+    put(parts.cargo, "textContent", reported.cargo ? "package" : "no package");
+    put(parts.cargo, "className", reported.cargo ? "cargo-tag" : "");
 
     const last = reported.last_command;
-    parts.task.replaceChildren();
-    if (reported.task) {
-      const command = last ? commands[last.id] : null;
-      const where = reported.destination ? ` → ${zoneText(reported.destination)}` : "";
-      parts.task.appendChild(text("span", "task-what", `${reported.task}${where}`));
+    const working = Boolean(reported.task);
+    parts.task.hidden = !working;
+    if (working) {
+      put(parts.taskWhat, "textContent", `${reported.task}${reported.destination ? ` → ${zoneText(reported.destination)}` : ""}`);
       const fraction = robot.progress?.progress;
-      if (status === "navigating" && fraction !== undefined && fraction !== null) {
-        const bar = text("span", "progress");
-        const fill = text("span");
-        fill.style.width = `${Math.round(fraction * 100)}%`;
-        bar.appendChild(fill);
-        parts.task.append(bar, text("span", "", `${Math.round(fraction * 100)}%`));
+      const driving = status === "navigating" && fraction !== undefined && fraction !== null;
+      parts.bar.hidden = parts.percent.hidden = !driving;
+      if (driving) {
+        put(parts.fill.style, "width", `${Math.round(fraction * 100)}%`);
+        put(parts.percent, "textContent", `${Math.round(fraction * 100)}%`);
       }
-      if (command?.source) parts.task.appendChild(text("span", "tag", `by ${shortSource(command.source)}`));
+      const command = last ? commands[last.id] : null;
+      parts.source.hidden = !command?.source;
+      if (command?.source) put(parts.source, "textContent", `by ${shortSource(command.source)}`);
     }
     if (last) {
-      const reason = last.reason ? `: ${last.reason}` : "";
-      parts.last.textContent = `Last: ${last.action} ${last.result}${reason}`;
+      put(parts.last, "textContent", `Last: ${last.action} ${last.result}${last.reason ? `: ${last.reason}` : ""}`);
       parts.last.classList.toggle("bad", ["rejected", "failed"].includes(last.result));
     } else {
-      parts.last.textContent = "Last: no command yet";
-      parts.last.classList.remove("bad");
+      put(parts.last, "textContent", "Last: no command yet");
     }
-    parts.raw.textContent = JSON.stringify(reported, null, 2);
+    if (parts.details.open) put(parts.raw, "textContent", JSON.stringify(reported, null, 2));
   }
 }
 

@@ -128,7 +128,7 @@ function onShadow(message) {
   const { status, destination, pose, zone } = message.reported;
   const driving = status === "navigating" && destination && zone !== destination;
   map.report(message.thing, pose, destination, Boolean(driving));
-  changed(message.thing, metrics ? { thing: message.thing, version: message.version } : null);
+  changed(message.thing, metrics ? { thing: message.thing, version: message.version, received: performance.timeOrigin + performance.now() } : null);
 }
 
 function onEvent(message) {
@@ -197,9 +197,10 @@ function connect() {
     label.textContent = stream.readyState === EventSource.CLOSED ? "Disconnected: reload the page" : "Reconnecting…";
   };
   stream.onmessage = (event) => {
-    const message = JSON.parse(event.data);
-    if (metrics) metrics.messages += 1;
-    handlers[message.type]?.(message);
+    for (const message of JSON.parse(event.data)) {
+      if (metrics) metrics.messages += 1;
+      handlers[message.type]?.(message);
+    }
   };
 }
 
