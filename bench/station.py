@@ -256,29 +256,39 @@ def report(args: argparse.Namespace, latencies: list[float], result: dict[str, A
     if not latencies:
         raise RuntimeError("no shadow update was seen painted")
     p50, p95 = percentile(latencies, 50), percentile(latencies, 95)
+    arrivals = result["arrivals"]
     ptt = result["ptt"]
-    shown = [p["reply_shown_ms"] for p in ptt]
-    recognizer = [p["recognizer_ms"] for p in ptt]
-    heard = sorted({p["transcript"] for p in ptt})
+    shown = median([p["reply_shown_ms"] for p in ptt])
+    recognizer = median([p["recognizer_ms"] for p in ptt])
+    heard = ", ".join(repr(h) for h in sorted({p["transcript"] for p in ptt}))
+    verdict = "met" if p95 < 100 else "NOT met"
+    rows = [
+        ("shadow update on the broker to painted, p50", f"{p50:.1f} ms"),
+        ("shadow update on the broker to painted, p95 (target under 100 ms)",
+         f"{p95:.1f} ms ({verdict})"),
+        ("of which the broker to the page's receipt, p50 / p95",
+         f"{percentile(arrivals, 50):.1f} / {percentile(arrivals, 95):.1f} ms"),
+        ("shadow updates measured", str(len(latencies))),
+        ("messages the page received", str(result["messages"])),
+        ("page JS heap after warm-up", f"{result['heap_start']:.1f} MB"),
+        (f"page JS heap after {args.minutes:g} minutes (after garbage collection)",
+         f"{result['heap_end']:.1f} MB"),
+        (f"push-to-talk, release to reply shown, median of {len(ptt)} ({CLIP_S:g} s clip)",
+         f"{shown:.0f} ms"),
+        ("the recognizer's own time for the clip, median", f"{recognizer:.0f} ms"),
+    ]  # fmt: skip
+    table = "\n".join(f"| {name} | {value} |" for name, value in rows)
     body = f"""
 {args.robots} robots in swarm mode (speed factor {SPEED_FACTOR:g}) sent back and forth across
 the floor by one fleet command every {LEG_S:g} s for {args.minutes:g} minutes, drawn by one
-station page in headless Chromium (1280x800). The stack, the swarm, the station and the
-browser share the machine's cores.
+station page (`vahr station`) in headless Chromium (1280x800). The stack, the swarm, the
+station, the browser and this script are separate processes sharing the machine's cores.
 
 | measure | value |
 | --- | --- |
-| shadow update on the broker to painted, p50 | {p50:.1f} ms |
-| shadow update on the broker to painted, p95 (target under 100 ms) | {p95:.1f} ms ({"met" if p95 < 100 else "NOT met"}) |
-| of which broker to the page's receipt, p50 / p95 | {percentile(result["arrivals"], 50):.1f} / {percentile(result["arrivals"], 95):.1f} ms |
-| shadow updates measured | {len(latencies)} |
-| messages the page received | {result["messages"]} |
-| page JS heap after warm-up | {result["heap_start"]:.1f} MB |
-| page JS heap after {args.minutes:g} minutes (after garbage collection) | {result["heap_end"]:.1f} MB |
-| push-to-talk, release to reply shown, median of {len(ptt)} ({CLIP_S:g} s clip) | {median(shown):.0f} ms |
-| the recognizer's own time for the clip, median | {median(recognizer):.0f} ms |
+{table}
 
-The clip says "{CLIP}" (espeak-ng); the recognizer heard: {", ".join(repr(h) for h in heard)}.
+The clip says "{CLIP}" (espeak-ng); the recognizer heard: {heard}.
 """
     write_section("station", "Operator station: 100 robots on the map, push-to-talk", body)
 
