@@ -1,9 +1,13 @@
-"""The IoT policy for the people's side of the lab: the experiment recorder and the console.
+"""The IoT policy for the people's side of the lab: the experiment recorder, the console and
+the operator station.
 
 They connect with certificates of their own (not a robot's), under client ids starting with
-`vahr-experiment-` or `vahr-console-`, so they can never take over a robot's session. They
-may send commands to the fleet's robots (the keyboard method) and watch commands, events
-and presence; they cannot speak for a robot or touch any shadow over MQTT.
+`vahr-experiment-`, `vahr-console-` or `vahr-station-`, so they can never take over a
+robot's session. They may send commands to the fleet's robots (the keyboard method) and
+watch commands, events and presence; the station also watches the robots' shadow documents
+(read only), and the station and the recorder exchange the session's status (retained, the
+recorder's last will clearing it) and the participant's input. They cannot speak for a
+robot, and no shadow can be changed or asked for over MQTT.
 """
 
 from __future__ import annotations
@@ -19,17 +23,23 @@ from vahr.protocol import topics
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-CLIENT_ID_PREFIXES = ("vahr-experiment-", "vahr-console-")
+CLIENT_ID_PREFIXES = ("vahr-experiment-", "vahr-console-", "vahr-station-")
 
 
 def operator_policy_document(*, arn_prefix: str, things: Sequence[str]) -> dict[str, Any]:
     """The policy document; `arn_prefix` is `arn:<partition>:iot:<region>:<account>`."""
+    session = (topics.EXPERIMENT_STATUS, topics.EXPERIMENT_INPUT)
+    documents = [topics.shadow(thing, "update/documents") for thing in things]
     watch = [
         topics.ALL_EVENTS.replace("+", "*"),
         topics.ALL_PRESENCE.replace("+", "*"),
         *(topics.robot_cmd(thing) for thing in things),
         topics.FLEET_CMD,
     ]
+    # Filters with MQTT's `+` are literal in a topicfilter resource: these allow exactly the
+    # wildcard subscriptions the recorder and the station make; what they receive through
+    # them is still limited to the topics listed for iot:Receive.
+    wildcard_filters = [topics.ALL_ROBOT_CMDS, topics.ALL_SHADOW_DOCUMENTS]
     return {
         "Version": "2012-10-17",
         "Statement": [
@@ -52,13 +62,30 @@ def operator_policy_document(*, arn_prefix: str, things: Sequence[str]) -> dict[
                 "Sid": "WatchCommandsEventsPresence",
                 "Effect": "Allow",
                 "Action": "iot:Subscribe",
-                "Resource": [f"{arn_prefix}:topicfilter/{topic}" for topic in watch],
+                "Resource": [
+                    f"{arn_prefix}:topicfilter/{topic}"
+                    for topic in (*watch, *wildcard_filters, *session)
+                ],
             },
             {
                 "Sid": "ReceiveCommandsEventsPresence",
                 "Effect": "Allow",
                 "Action": "iot:Receive",
-                "Resource": [f"{arn_prefix}:topic/{topic}" for topic in watch],
+                "Resource": [
+                    f"{arn_prefix}:topic/{topic}" for topic in (*watch, *documents, *session)
+                ],
+            },
+            {
+                "Sid": "ShareTheSession",
+                "Effect": "Allow",
+                "Action": "iot:Publish",
+                "Resource": [f"{arn_prefix}:topic/{topic}" for topic in session],
+            },
+            {
+                "Sid": "KeepTheSessionStatus",
+                "Effect": "Allow",
+                "Action": "iot:RetainPublish",
+                "Resource": f"{arn_prefix}:topic/{topics.EXPERIMENT_STATUS}",
             },
         ],
     }

@@ -30,6 +30,7 @@ def operator(tmp_path_factory: pytest.TempPathFactory, fleet: Fleet) -> IotPolic
 def test_the_recorder_and_console_connect_under_their_own_client_ids(operator: IotPolicy) -> None:
     assert operator.can_connect("vahr-experiment-P01-vahr-trial1")
     assert operator.can_connect("vahr-console-lab")
+    assert operator.can_connect("vahr-station-0f3a9c2b11d4")
     # Never as a robot: that would take over the robot's session
     assert not operator.can_connect("placebot1")
     assert not operator.can_connect("vahr-experiment")  # the experiment thing's name
@@ -59,3 +60,34 @@ def test_the_console_cannot_speak_for_a_robot_or_touch_shadows(
     # Commands to things outside the fleet are not the console's to send
     assert not operator.can_publish(topics.robot_cmd("intruder"))
     assert not operator.can_subscribe("#")
+
+
+def test_the_station_watches_shadow_documents_and_wildcard_commands_of_the_fleet_only(
+    operator: IotPolicy, fleet: Fleet
+) -> None:
+    # The station subscribes with MQTT wildcards, as the recorder does
+    assert operator.can_subscribe(topics.ALL_SHADOW_DOCUMENTS)
+    assert operator.can_subscribe(topics.ALL_ROBOT_CMDS)
+    for thing in fleet.robot_things:
+        assert operator.can_receive(topics.shadow(thing, "update/documents"))
+    # but receives the documents of the fleet's robots only, and changes no shadow
+    assert not operator.can_receive(topics.shadow(fleet.experiment_thing, "update/documents"))
+    assert not operator.can_receive(topics.shadow("intruder", "update/documents"))
+    for thing in fleet.robot_things:
+        assert not operator.can_publish(topics.shadow(thing, "get"))
+        assert not operator.can_publish(topics.shadow(thing, "update"))
+    assert not operator.can_subscribe(topics.shadow_filter())
+
+
+def test_the_recorder_and_the_station_share_the_session(operator: IotPolicy) -> None:
+    # The recorder keeps the session's status retained (and its will clears it)
+    assert operator.can_publish(topics.EXPERIMENT_STATUS, retain=True)
+    assert operator.can_subscribe(topics.EXPERIMENT_STATUS)
+    assert operator.can_receive(topics.EXPERIMENT_STATUS)
+    # The station sends the participant's input, which the recorder receives
+    assert operator.can_publish(topics.EXPERIMENT_INPUT)
+    assert operator.can_subscribe(topics.EXPERIMENT_INPUT)
+    assert operator.can_receive(topics.EXPERIMENT_INPUT)
+    # Nothing else is retained, and the assistant's turns are not the operators' to send
+    assert not operator.can_publish(topics.EXPERIMENT_INPUT, retain=True)
+    assert not operator.can_publish(topics.ASSISTANT_TURNS)
