@@ -1,0 +1,224 @@
+"""The station's feed: what a page is told, in which order, from the broker's messages."""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING, Any
+
+import pytest
+
+from vahr.protocol import Event, EventPose, Presence, encode, new_command, topics, utc_now
+from vahr.station.feed import Feed, Subscriber, fleet_view
+
+if TYPE_CHECKING:
+    from vahr.protocol import Fleet
+
+
+class Clock:
+    def __init__(self) -> None:
+        self.ms = 1_000_000.0
+
+    def __call__(self) -> float:
+        return self.ms
+
+
+@pytest.fixture
+def clock() -> Clock:
+    return Clock()
+
+
+@pytest.fixture
+def feed(fleet: Fleet, clock: Clock) -> Feed:
+    return Feed(fleet, clock=clock)
+
+
+def messages(subscriber: Subscriber) -> list[dict[str, Any]]:
+    taken = subscriber.take(0) or []
+    return [json.loads(m) for m in taken]
+
+
+def event(kind: str, thing: str = "placebot1", **fields: Any) -> bytes:
+    return encode(Event(event=kind, thing=thing, at=utc_now(), **fields))  # type: ignore[arg-type]
+
+
+def documents(reported: dict[str, Any], version: int) -> bytes:
+    return json.dumps(
+        {"previous": None, "current": {"state": {"reported": reported}, "version": version}}
+    ).encode()
+
+
+def test_a_page_starts_from_a_snapshot_of_the_fleet_and_its_floor(feed: Feed) -> None:
+    page = feed.subscribe()
+    (snapshot,) = messages(page)
+    assert snapshot["type"] == "snapshot"
+    view = snapshot["fleet"]
+    assert [r["key"] for r in view["robots"]] == ["1", "2"]
+    assert {z["id"]: z["key"] for z in view["zones"]} == {
+        "LOADING": "L", "A": "A", "B": "B", "C": "C", "D": "D"
+    }  # fmt: skip
+    assert view["floor"]["width"] == 10.5 and len(view["floor"]["arms"]) == 5
+    assert set(snapshot["robots"]) == {"placebot1", "placebot2"}
+    assert snapshot["experiment"] is None
+
+
+def test_shadow_documents_reach_pages_in_order_and_old_versions_are_ignored(feed: Feed) -> None:
+    page = feed.subscribe()
+    messages(page)
+    topic = topics.shadow("placebot1", "update/documents")
+    # When the robot's shadow changes twice, then an older document arrives late
+    feed.on_shadow_documents(topic, documents({"status": "navigating", "destination": "B"}, 4))
+    feed.on_shadow_documents(topic, documents({"status": "idle", "zone": "B"}, 5))
+    feed.load_shadow(
+        "placebot1", json.dumps({"state": {"reported": {"status": "x"}}, "version": 3}).encode()
+    )
+    # Then the page is told the two changes, in order, and nothing older
+    told = messages(page)
+    assert [(m["type"], m["version"], m["reported"]["status"]) for m in told] == [
+        ("shadow", 4, "navigating"),
+        ("shadow", 5, "idle"),
+    ]
+    assert feed.snapshot()["robots"]["placebot1"]["reported"] == {"status": "idle", "zone": "B"}
+
+
+def test_things_outside_the_fleet_and_named_shadows_are_not_drawn(feed: Feed) -> None:
+    page = feed.subscribe()
+    messages(page)
+    feed.on_shadow_documents(topics.shadow("intruder", "update/documents"), documents({}, 1))
+    feed.on_shadow_documents(
+        topics.shadow("placebot1", "update/documents", "cfg"), documents({}, 1)
+    )
+    feed.on_shadow_documents(topics.shadow("placebot1", "update/documents"), b"not json")
+    feed.on_event(topics.robot_events("placebot1"), event("arrived", thing="placebot2", zone="B"))
+    assert messages(page) == []
+
+
+def test_a_command_is_acknowledged_once_per_robot_with_its_latency(
+    feed: Feed, clock: Clock
+) -> None:
+    page = feed.subscribe()
+    messages(page)
+    command = new_command("navigate", {"zone": "B"}, source="console")
+    # Given a command seen on the robot's topic
+    feed.on_command(topics.robot_cmd("placebot1"), encode(command))
+    # When the robot accepts it 12 ms later, then its shadow says so too
+    clock.ms += 12
+    feed.on_event(topics.robot_events("placebot1"), event("accepted", command_id=command.id))
+    clock.ms += 5
+    feed.on_shadow_documents(
+        topics.shadow("placebot1", "update/documents"),
+        documents(
+            {"last_command": {"id": command.id, "action": "navigate", "result": "accepted"}}, 9
+        ),
+    )
+    told = messages(page)
+    # Then the page is told the command, one acknowledgment with its latency, the shadow
+    assert [m["type"] for m in told] == ["command", "ack", "event", "shadow"]
+    assert told[0]["target"] == "placebot1" and told[0]["source"] == "console"
+    assert told[1] == {
+        "type": "ack", "id": command.id, "thing": "placebot1", "event": "accepted", "latency_ms": 12.0
+    }  # fmt: skip
+    # And a console order is part of the conversation a new page starts from
+    conversation = feed.snapshot()["conversation"]
+    assert conversation[-1]["id"] == command.id and conversation[-1]["acks"]["placebot1"]
+
+
+def test_a_fleet_command_waits_for_every_robot(feed: Feed) -> None:
+    command = new_command("stop", source="console")
+    feed.on_command(topics.FLEET_CMD, encode(command))
+    feed.on_event(
+        topics.robot_events("placebot2"), event("stopped", thing="placebot2", command_id=command.id)
+    )
+    seen = feed.snapshot()["commands"][command.id]
+    assert seen["robots"] == ["placebot1", "placebot2"]
+    assert set(seen["acks"]) == {"placebot2"}
+
+
+def test_turns_name_the_robots_they_concern(feed: Feed) -> None:
+    command = new_command("navigate", {"zone": "C"}, source="alexa")
+    feed.on_command(topics.robot_cmd("placebot2"), encode(command))
+    turn = {
+        "utterance": "send placebot two to zone c",
+        "speech": "Placebot two is on its way to zone C.",
+        "intent": "NavigateIntent",
+        "slots": {"robot": {"value": "placebot two", "id": "placebot2"}},
+        "commands": [command.id],
+        "origin": "station-voice",
+        "heard": {"transcript": "send placebot two to zone c", "confidence": 0.8, "accepted": True},
+    }
+    feed.on_turn(topics.ASSISTANT_TURNS, json.dumps(turn).encode())
+    feed.on_turn(topics.ASSISTANT_TURNS, b'{"utterance": 5}')  # not a turn: ignored
+    conversation = feed.snapshot()["conversation"]
+    # The assistant's own command is shown inside its turn, not on its own
+    assert [entry["type"] for entry in conversation] == ["turn"]
+    assert conversation[0]["robots"] == ["placebot2"]
+    assert conversation[0]["heard"]["confidence"] == 0.8
+
+
+def test_the_robots_own_exchanges_with_the_assistant_are_conversation(feed: Feed) -> None:
+    feed.on_event(
+        topics.robot_events("placebot1"), event("said", text="Alexa, what is the weather?")
+    )
+    feed.on_event(topics.robot_events("placebot1"), event("progress", progress=0.5))
+    feed.on_event(
+        topics.robot_events("placebot1"), event("interpreted", intent="sunny", confidence=0.9)
+    )
+    assert [e["event"] for e in feed.snapshot()["conversation"]] == ["said", "interpreted"]
+
+
+def test_presence_marks_a_robot_offline_and_keeps_when_it_was_last_seen(
+    feed: Feed, clock: Clock
+) -> None:
+    topic = topics.robot_presence("placebot1")
+    feed.on_presence(topic, encode(Presence(online=True, at=utc_now())))
+    seen = clock.ms
+    clock.ms += 60_000
+    feed.on_presence(topic, encode(Presence(online=False, at=utc_now())))
+    robot = feed.snapshot()["robots"]["placebot1"]
+    assert robot["online"] is False and robot["last_seen"] == seen
+
+
+def test_a_page_that_falls_behind_gets_each_robots_latest_progress(feed: Feed) -> None:
+    page = feed.subscribe()
+    messages(page)
+    for step in range(5):
+        pose = EventPose(1.0 + step, 3.0)
+        feed.on_event(
+            topics.robot_events("placebot1"), event("progress", progress=step / 5, pose=pose)
+        )
+    feed.on_event(
+        topics.robot_events("placebot2"), event("progress", thing="placebot2", progress=0.1)
+    )
+    told = messages(page)
+    assert [(m["thing"], m["progress"]) for m in told] == [("placebot1", 0.8), ("placebot2", 0.1)]
+
+
+def test_a_page_too_far_behind_is_dropped_and_reconnects_from_a_snapshot(feed: Feed) -> None:
+    page = feed.subscribe(limit=3)
+    for _ in range(5):
+        feed.on_event(topics.robot_events("placebot1"), event("arrived", zone="B"))
+    assert page.overflowed and page.take(0) is None
+    assert feed.subscribers == 0
+
+
+def test_an_experiment_status_and_its_clearing_reach_pages(feed: Feed) -> None:
+    page = feed.subscribe()
+    messages(page)
+    status = {
+        "session": "P01-keyboard-trial1",
+        "participant": "P01",
+        "method": "keyboard",
+        "trial": 1,
+    }
+    feed.on_experiment_status(topics.EXPERIMENT_STATUS, json.dumps(status).encode())
+    feed.on_experiment_status(topics.EXPERIMENT_STATUS, b'{"session": "bad name!"}')
+    feed.on_experiment_status(topics.EXPERIMENT_STATUS, b"")
+    told = messages(page)
+    assert [m["status"] and m["status"]["session"] for m in told] == ["P01-keyboard-trial1", None]
+
+
+def test_a_fleet_without_a_floor_gets_keys_and_one(fleet: Fleet) -> None:
+    import msgspec
+
+    bare = msgspec.structs.replace(fleet, floor=None)
+    view = fleet_view(bare)
+    assert view["floor"]["width"] > 0 and len(view["floor"]["walls"]) == 4

@@ -1,0 +1,138 @@
+"""Push-to-talk: the clip's checks, the vocabulary from the interaction model, how made-up
+words are pronounced, and what the page is answered for speech, silence and nonsense."""
+
+from __future__ import annotations
+
+import io
+import wave
+from typing import TYPE_CHECKING, Any
+
+import pytest
+
+from vahr.speech.pronounce import arpabet, compound_phones
+from vahr.speech.stt import NOTHING_HEARD, Recognition
+from vahr.station.app import RequestError
+from vahr.station.vocabulary import load_model, sentences, spell_numbers
+from vahr.station.voice import SORRY, PushToTalk, read_clip
+
+if TYPE_CHECKING:
+    from vahr.protocol import Fleet
+    from vahr.speech.audio import Audio
+
+
+def wav(channels: int = 1, width: int = 2, rate: int = 16_000, seconds: float = 1.0) -> bytes:
+    buffer = io.BytesIO()
+    with wave.open(buffer, "wb") as out:
+        out.setnchannels(channels)
+        out.setsampwidth(width)
+        out.setframerate(rate)
+        out.writeframes(bytes(int(seconds * rate) * channels * width))
+    return buffer.getvalue()
+
+
+class Heard:
+    """A recognizer that hears what it is told to."""
+
+    def __init__(self, recognition: Recognition) -> None:
+        self.recognition = recognition
+
+    def recognize(self, audio: Audio) -> Recognition:
+        return self.recognition
+
+
+class Assistant:
+    def __init__(self, intent: str) -> None:
+        self.intent = intent
+        self.asked: list[tuple[str, str, dict[str, Any] | None]] = []
+
+    def ask(
+        self, utterance: str, *, origin: str, heard: dict[str, Any] | None = None
+    ) -> dict[str, Any]:
+        self.asked.append((utterance, origin, heard))
+        return {
+            "speech": "Placebot two is on its way to zone C.",
+            "intent": self.intent,
+            "commands": ["c1"],
+        }
+
+
+def test_a_16_khz_mono_clip_is_read() -> None:
+    assert read_clip(wav(seconds=2.0)).seconds == 2.0
+
+
+@pytest.mark.parametrize(
+    ("data", "status", "words"),
+    [
+        (b"ID3 an mp3 file", 415, "not a WAV file"),
+        (wav(channels=2), 415, "2 channel(s), 16-bit, 16000 Hz"),
+        (wav(rate=44_100), 415, "44100 Hz"),
+        (wav(seconds=21.0), 413, "at most 20 s"),
+        (b"RIFF\x00\x00\x00\x00WAVEjunk", 400, "not readable"),
+    ],
+)
+def test_any_other_clip_is_refused_with_one_line(data: bytes, status: int, words: str) -> None:
+    with pytest.raises(RequestError) as refused:
+        read_clip(data)
+    assert refused.value.status == status and words in refused.value.message
+
+
+def test_speech_heard_goes_to_the_assistant_with_what_was_heard() -> None:
+    assistant = Assistant("NavigateIntent")
+    heard = Recognition("send placebot two to zone c", 0.81, True)
+    result = PushToTalk(assistant, lambda: Heard(heard)).handle(wav())
+    assert result["understood"] is True
+    assert result["speech"] == "Placebot two is on its way to zone C."
+    ((utterance, origin, sent),) = assistant.asked
+    assert (utterance, origin) == ("send placebot two to zone c", "station-voice")
+    assert sent == {
+        "transcript": "send placebot two to zone c",
+        "confidence": 0.81,
+        "accepted": True,
+        "seconds": 1.0,
+    }
+
+
+@pytest.mark.parametrize(
+    ("recognition", "intent", "asked"),
+    [
+        (NOTHING_HEARD, "NavigateIntent", False),  # silence
+        (Recognition("what tell every d", 0.02, False), "NavigateIntent", False),  # unsure
+        (Recognition("to loading", 0.6, True), "AMAZON.FallbackIntent", True),  # not understood
+    ],
+)
+def test_silence_and_what_is_not_understood_get_sorry(
+    recognition: Recognition, intent: str, asked: bool
+) -> None:
+    assistant = Assistant(intent)
+    result = PushToTalk(assistant, lambda: Heard(recognition)).handle(wav())
+    assert (result["understood"], result["speech"]) == (False, SORRY)
+    assert bool(assistant.asked) == asked
+
+
+def test_the_vocabulary_follows_the_interaction_model(fleet: Fleet) -> None:
+    said = sentences(load_model())
+    text = "\n".join(said)
+    # Every name of every robot and zone in fleet.yaml is in it, numbers spelled out
+    for name in [
+        *(n for r in fleet.robots for n in r.spoken),
+        *(n for z in fleet.zones for n in z.spoken),
+    ]:
+        assert spell_numbers(name) in text, name
+    assert "placebot 2" not in text
+    # with the ways of addressing the skill and Alexa's built-in phrases
+    assert any(s.startswith("ask robot fleet to send ") for s in said)
+    assert "open robot fleet" in said and "help" in said
+
+
+def test_numbers_are_spelled_as_people_say_them() -> None:
+    assert spell_numbers("placebot 2 to zone 42") == "placebot two to zone forty two"
+    assert spell_numbers("robot 100") == "robot 100"
+
+
+def test_made_up_words_are_pronounced_two_ways() -> None:
+    dictionary = {"place": "P L EY S", "bot": "B AA T"}
+    assert compound_phones("placebot", dictionary.get) == "P L EY S B AA T"
+    assert compound_phones("zorblax", dictionary.get) is None
+    # espeak-ng's own reading, its mnemonics mapped to ARPAbet
+    assert arpabet("pl@s'Eb0t") == "P L AH S EH B AA T"
+    assert arpabet("tS'A@li") == "CH AA R L IY"

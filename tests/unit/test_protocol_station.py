@@ -1,0 +1,90 @@
+"""The messages of the station's topics: validation in one place, the page's clock mapped."""
+
+from __future__ import annotations
+
+import json
+from datetime import UTC, datetime, timedelta
+
+import pytest
+
+from vahr.protocol import ProtocolError
+from vahr.protocol.station import (
+    ExperimentStatus,
+    Interaction,
+    decode_experiment_status,
+    decode_station_input,
+    decode_turn,
+    on_clock,
+)
+
+NOW = datetime(2026, 11, 23, 10, 0, 0, tzinfo=UTC)
+
+
+def test_an_interaction_round_trips() -> None:
+    body = {"kind": "interaction", "session": "P01-keyboard-trial1", "id": "a1-3",
+            "phase": "ended", "channel": "voice", "at": "2026-11-23T10:00:00Z",
+            "sent": "2026-11-23T10:00:02.5Z", "text": "what is the weather", "asks": True,
+            "speech": "It is sunny."}  # fmt: skip
+    message = decode_station_input(json.dumps(body).encode())
+    assert isinstance(message, Interaction) and message.asks and message.counts
+
+
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        ({"kind": "gossip"}, "kind"),
+        (
+            {
+                "kind": "puzzle",
+                "session": "S",
+                "count": 99,
+                "at": "2026-11-23T10:00:00Z",
+                "sent": "2026-11-23T10:00:00Z",
+            },
+            "count",
+        ),
+        (
+            {
+                "kind": "interaction",
+                "session": "S",
+                "id": "i",
+                "phase": "started",
+                "channel": "click",
+                "at": "2026-11-23T10:00:00",
+                "sent": "2026-11-23T10:00:00Z",
+            },
+            "at",
+        ),
+    ],
+)
+def test_bad_input_names_the_field(body: dict[str, object], field: str) -> None:
+    with pytest.raises(ProtocolError) as raised:
+        decode_station_input(json.dumps(body).encode())
+    assert raised.value.field == field
+
+
+def test_input_over_8_kb_is_refused() -> None:
+    with pytest.raises(ProtocolError, match="payload"):
+        decode_station_input(b"{" + b" " * 9000 + b"}")
+
+
+def test_a_turn_and_a_status_decode() -> None:
+    turn = decode_turn(b'{"utterance": "hi", "speech": "Hello.", "origin": "station"}')
+    assert turn.origin == "station" and turn.commands == []
+    with pytest.raises(ProtocolError):
+        decode_turn(b'{"utterance": "hi", "speech": "Hello.", "origin": "Not An Origin"}')
+    status = decode_experiment_status(
+        b'{"session": "P01-vahr-trial1", "participant": "P01", "method": "vahr", "trial": 1}'
+    )
+    assert status == ExperimentStatus(
+        session="P01-vahr-trial1", participant="P01", method="vahr", trial=1
+    )
+
+
+def test_the_pages_clock_is_moved_onto_the_receivers() -> None:
+    # A tablet whose clock is five minutes fast: the press lasted 2 s before it was sent
+    fast = NOW + timedelta(minutes=5)
+    at = on_clock(fast, fast + timedelta(seconds=2), received=NOW)
+    assert at == NOW - timedelta(seconds=2)
+    # A sent time before the event (a clock stepping back) is no lead at all
+    assert on_clock(NOW, NOW - timedelta(seconds=1), received=NOW) == NOW
