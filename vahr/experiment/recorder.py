@@ -29,6 +29,8 @@ logger = logging.getLogger(__name__)
 STATION_PREFIX = "station-"
 
 if TYPE_CHECKING:
+    from datetime import timedelta
+
     from vahr.experiment.eventlog import EventLog
     from vahr.experiment.world import World
 
@@ -42,6 +44,8 @@ class Recorder:
         # The session's name: station input for any other session is not this log's.
         self.session = session
         self.closed = False
+        # How far each open interaction's page clock is from this one (set at its start).
+        self._offsets: dict[str, timedelta] = {}
         self.task: str | None = None
         self.changed = threading.Condition()
         self._lock = threading.Lock()
@@ -106,7 +110,15 @@ class Recorder:
             return
         if self.session is None or message.session != self.session:
             return  # another session's, or a station left open from an earlier one
-        at = on_clock(message.at, message.sent, received)
+        # The page measured the interaction on its own clock: its start and end move by the
+        # same amount, so its length is the page's (whatever the network did in between).
+        offset = on_clock(message.at, message.sent, received) - message.at
+        if isinstance(message, Interaction):
+            if message.phase == "started":
+                self._offsets[message.id] = offset
+            else:
+                offset = self._offsets.pop(message.id, offset)
+        at = message.at + offset
         with self._lock:
             if not isinstance(message, Interaction):
                 body = {"what": "puzzle_piece", "count": message.count, "source": "station"}
