@@ -4,9 +4,16 @@ turn published."""
 
 from __future__ import annotations
 
+import threading
 from typing import TYPE_CHECKING
 
 import pytest
+
+from vahr.errors import VahrError
+from vahr.local.client import call
+from vahr.local.mqtt import MqttClient
+from vahr.protocol import topics
+from vahr.protocol.station import AssistantTurn, decode_turn
 
 if TYPE_CHECKING:
     from vahr.local.alexa.simulator import AlexaSimulator
@@ -122,3 +129,42 @@ def test_out_of_domain_requests_send_nothing(alexa: AlexaSimulator) -> None:
         assert turn.intent == "AMAZON.FallbackIntent"
         assert turn.commands == []
         alexa.end_session()
+
+
+def test_every_turn_is_published_for_the_station(
+    local_stack: LocalStack, alexa: AlexaSimulator
+) -> None:
+    seen: list[AssistantTurn] = []
+    arrived = threading.Event()
+
+    def on_turn(topic: str, payload: bytes) -> None:
+        seen.append(decode_turn(payload))
+        arrived.set()
+
+    with MqttClient(local_stack.service_endpoint()) as watcher:
+        watcher.subscribe(topics.ASSISTANT_TURNS, on_turn)
+        # When the station's weather button asks the assistant
+        alexa.say("Alexa, ask robot fleet what is the weather", origin="station-weather")
+        assert arrived.wait(10)
+    # Then the turn is on the broker, saying who spoke and what was understood
+    (turn,) = seen
+    assert (turn.origin, turn.intent) == ("station-weather", "WeatherIntent")
+    assert turn.utterance == "Alexa, ask robot fleet what is the weather" and turn.speech
+
+
+def test_say_names_who_spoke_and_refuses_a_bad_name(
+    local_stack: LocalStack, alexa: AlexaSimulator
+) -> None:
+    heard = {"transcript": "where is robot one", "confidence": 0.9, "accepted": True}
+    turn = call(local_stack.api_url, "POST", "/vahr/say",
+                {"utterance": "where is robot one", "origin": "station-voice", "heard": heard})  # fmt: skip
+    assert turn["origin"] == "station-voice" and turn["heard"]["confidence"] == 0.9
+    with pytest.raises(VahrError, match="answered 400: origin: must be a short lower-case word"):
+        call(local_stack.api_url, "POST", "/vahr/say", {"utterance": "hi", "origin": "Not Me!"})
+    with pytest.raises(VahrError, match="answered 400: heard"):
+        call(
+            local_stack.api_url,
+            "POST",
+            "/vahr/say",
+            {"utterance": "hi", "heard": {"confidence": "high"}},
+        )
