@@ -3,8 +3,9 @@
 Every sample utterance of every intent is written out with its slots filled, each slot
 going through all of its type's values and synonyms across the copies of the sample (so
 every value appears in every sample's context once, without multiplying out samples with
-several slots), plus the built-in intents' phrases and the invocation forms ("ask robot
-fleet to ..."). The interaction model is generated from `fleet.yaml`, so the robots' and
+several slots), plus the built-in intents' phrases (those the simulator knows them by,
+`vahr.local.alexa.background`) and the invocation forms ("ask robot fleet to ..."). The
+interaction model is generated from `fleet.yaml`, so the robots' and
 zones' names follow the fleet. Numbers are spelled out, as people say them.
 """
 
@@ -16,7 +17,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from vahr.errors import VahrError
-from vahr.local.alexa.nlu import BUILTIN_SAMPLES, DEFAULT_MODEL
+from vahr.local.alexa.background import built_in_phrases
+from vahr.local.alexa.nlu import DEFAULT_MODEL
 from vahr.speech.text import normalize
 
 if TYPE_CHECKING:
@@ -62,9 +64,10 @@ def sentences(document: dict[str, Any]) -> list[str]:
             for slot_type in language.get("types", [])
         }
         found: list[str] = []
+        built_in = built_in_phrases()
         for intent in language["intents"]:
             types = {slot["name"]: slot["type"] for slot in intent.get("slots", [])}
-            samples = intent.get("samples") or BUILTIN_SAMPLES.get(intent["name"], [])
+            samples = intent.get("samples") or built_in.get(intent["name"], [])
             for sample in samples:
                 filled = _filled(sample, types, values)
                 found += filled
