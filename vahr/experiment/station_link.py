@@ -29,7 +29,7 @@ from vahr.experiment.judge import judge_task, score_goal, task_deliveries, task_
 from vahr.experiment.procedures import PROCEDURE, allowed_actions, conformance, procedure_for
 from vahr.experiment.tasks import TASK_TITLES, TASKS
 from vahr.protocol import topics
-from vahr.protocol.station import ExperimentStatus, TaskStatus
+from vahr.protocol.station import ExperimentStatus, TaskState, TaskStatus
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -60,8 +60,8 @@ def task_statuses(entries: list[LogEntry], session: OpenSession) -> dict[str, Ta
             continue
         if window.end is not None:
             outcome = judge_task(window, plan.goal(task), plan, header)
-            state = "success" if outcome.success else "failure"
-            found[task] = TaskStatus(state, outcome.reason, title, window.start.at, window.end.at)
+            ended: TaskState = "success" if outcome.success else "failure"
+            found[task] = TaskStatus(ended, outcome.reason, title, window.start.at, window.end.at)
             continue
         verdict = score_goal(plan.goal(task), task_deliveries(window.entries))
         problems: list[str] = []
@@ -69,6 +69,7 @@ def task_statuses(entries: list[LogEntry], session: OpenSession) -> dict[str, Ta
             procedure = procedure_for(session.spec.method, task, plan, None)
             robots = [str(r) for r in header.get("robots") or plan.goal(task).zones]
             problems = conformance(procedure, window.entries, robots)
+        state: TaskState
         if problems:
             state, reason = "failure", "; ".join(problems)
         elif verdict.success is None:

@@ -97,11 +97,14 @@ class PuzzleInput(msgspec.Struct, frozen=True, kw_only=True, tag="puzzle", tag_f
 StationInput = Interaction | PuzzleInput
 
 
+TaskState = Literal["waiting", "running", "success", "failure"]
+
+
 class TaskStatus(msgspec.Struct, frozen=True, omit_defaults=True):
     """One task as the judge sees it now: not started, running (with the verdict so far),
     or ended with success or failure and why."""
 
-    state: Literal["waiting", "running", "success", "failure"]
+    state: TaskState
     reason: Text = ""
     title: ShortText = ""
     started_at: Timestamp | None = None

@@ -240,7 +240,7 @@ class Feed:
 
     def routes(self, *, turns: bool) -> list[tuple[str, Callable[[str, bytes], None]]]:
         """(filter, handler) pairs to subscribe; `turns` adds the local simulator's turns."""
-        found = [
+        found: list[tuple[str, Callable[[str, bytes], None]]] = [
             (topics.ALL_SHADOW_DOCUMENTS, self.on_shadow_documents),
             (topics.ALL_PRESENCE, self.on_presence),
             (topics.ALL_EVENTS, self.on_event),

@@ -89,7 +89,7 @@ def _filled(sample: str, types: dict[str, str], values: dict[str, list[str]]) ->
         for position, options in enumerate(choices):
             # Slots of one sample go through their values out of step with each other.
             chosen = options[(copy + 7 * position) % len(options)]
-            text = _SLOT.sub(lambda _, value=chosen: value, text, count=1)
+            text = _SLOT.sub(chosen.replace("\\", "\\\\"), text, count=1)
         filled.append(_phrase(text))
     return filled
 

@@ -47,6 +47,8 @@ def system(tmp_path: Path) -> Iterator[dict[str, Any]]:
                 str(free_port()),
                 "--mqtts-port",
                 str(free_port()),
+                "--station-port",
+                "0",
                 "--sim-speed-factor",
                 str(SPEED),
             ],

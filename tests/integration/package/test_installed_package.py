@@ -17,6 +17,7 @@ import subprocess
 import sys
 import threading
 import time
+import urllib.request
 from pathlib import Path
 from typing import IO, TYPE_CHECKING
 
@@ -156,7 +157,7 @@ def test_vahr_up_and_say_run_from_an_empty_directory(installed: Path, tmp_path: 
     up = subprocess.Popen(
         [str(installed / "vahr"), "up", "--json", "--no-voice", "--robots", "1",
          "--api-port", str(free_port()), "--mqtts-port", str(free_port()), "--mqtt-port", "0",
-         "--sim-speed-factor", "20"],
+         "--station-port", str(free_port()), "--sim-speed-factor", "20"],
         cwd=empty, env=clean_env(), stdout=subprocess.PIPE,
         stderr=(tmp_path / "up.err").open("w"), text=True,
     )  # fmt: skip
@@ -164,7 +165,11 @@ def test_vahr_up_and_say_run_from_an_empty_directory(installed: Path, tmp_path: 
         assert up.stdout is not None
         line = first_line(up.stdout, START_TIMEOUT_S)
         assert line, (tmp_path / "up.err").read_text()
-        api = json.loads(line)["api"]
+        endpoints = json.loads(line)
+        api = endpoints["api"]
+        # The operator station's page and its files ship in the wheel
+        with urllib.request.urlopen(endpoints["station"] + "static/station.js", timeout=10) as js:
+            assert js.status == 200 and b"EventSource" in js.read()
         # And a person speaks to it with the installed `vahr say`
         deadline = time.monotonic() + START_TIMEOUT_S
         while True:

@@ -45,7 +45,8 @@ def system(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]
     process = subprocess.Popen(
         [sys.executable, "-m", "vahr.cli", "up", "--state-dir", str(state),
          "--api-port", str(free_port()), "--mqtt-port", str(free_port()),
-         "--mqtts-port", str(free_port()), "--sim-speed-factor", "20", "--json"],
+         "--mqtts-port", str(free_port()), "--station-port", "0",
+         "--sim-speed-factor", "20", "--json"],
         cwd=ROOT, env=env, stdout=subprocess.PIPE,
         stderr=(state / "up.err").open("wb"), stdin=subprocess.DEVNULL,
     )  # fmt: skip
