@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from vahr.commands.broker_flags import add_broker_flags, client_credentials
 from vahr.errors import VahrError
 
 if TYPE_CHECKING:
@@ -43,15 +44,11 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help=f"where session logs live (default: {DEFAULT_LOG_DIR})",
     )
     parser.add_argument("--fleet", type=Path, default=None, help="fleet file (default: fleet.yaml)")
-    parser.add_argument(
-        "--broker",
+    add_broker_flags(
+        parser,
+        purpose="to record from and send console commands to",
         default="mqtt://127.0.0.1:1883",
-        help="MQTT broker to record from and send console commands to: mqtt://HOST:PORT, "
-        "or mqtts://HOST:PORT with --cert, --key and --ca (AWS IoT Core, vahr up's mqtts)",
     )
-    parser.add_argument("--cert", type=Path, help="client certificate for an mqtts:// broker")
-    parser.add_argument("--key", type=Path, help="client private key for an mqtts:// broker")
-    parser.add_argument("--ca", type=Path, help="CA certificate for an mqtts:// broker")
     parser.add_argument(
         "--api",
         default=None,
@@ -178,13 +175,7 @@ def _run_session(args: argparse.Namespace, fleet: Any, session: Any) -> Any:
         if not args.json:
             print(prefix + line, flush=True)
 
-    tls = None
-    if args.cert or args.key or args.ca:
-        from vahr.protocol.broker import ClientCredentials
-
-        if not (args.cert and args.key and args.ca):
-            raise VahrError("--cert, --key and --ca go together")
-        tls = ClientCredentials(cert_file=args.cert, key_file=args.key, ca_file=args.ca)
+    tls = client_credentials(args)
     verdict = run_live(
         session,
         fleet,

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from vahr.cli_dispatch import add_logging_flag, setup_logging
+from vahr.commands.broker_flags import add_broker_flags, client_credentials
 
 if TYPE_CHECKING:
     import argparse
@@ -24,15 +25,7 @@ DEFAULT_PORT = 8181
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--broker",
-        required=True,
-        help="the deployment's MQTT broker: mqtt://HOST:PORT (loopback) or mqtts://HOST:PORT "
-        "with --cert, --key and --ca (AWS IoT Core, vahr up's mqtts)",
-    )
-    parser.add_argument("--cert", type=Path, help="operator certificate for an mqtts:// broker")
-    parser.add_argument("--key", type=Path, help="its private key")
-    parser.add_argument("--ca", type=Path, help="the CA that signed the broker's certificate")
+    add_broker_flags(parser, purpose="of the deployment (an operator's certificate on AWS)")
     parser.add_argument(
         "--api",
         help="the iot-data endpoint: vahr up's api URL, or https://ENDPOINT on AWS "
@@ -60,7 +53,6 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
     from vahr.protocol import load_fleet
-    from vahr.protocol.broker import ClientCredentials
     from vahr.station.deployment import Deployment, build_station
     from vahr.station.station import StationConfig
 
@@ -69,11 +61,7 @@ def run(args: argparse.Namespace) -> int:
         raise VahrError(f"--port {args.port}: not a usable port")
     if args.token is not None and len(args.token) < 16:
         raise VahrError("--token must be at least 16 characters")
-    tls = None
-    if args.cert or args.key or args.ca:
-        if not (args.cert and args.key and args.ca):
-            raise VahrError("--cert, --key and --ca go together")
-        tls = ClientCredentials(cert_file=args.cert, key_file=args.key, ca_file=args.ca)
+    tls = client_credentials(args)
     deployment = Deployment(broker=args.broker, fleet=load_fleet(args.fleet), tls=tls, api=args.api)
     config = StationConfig(
         port=args.port,

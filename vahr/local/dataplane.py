@@ -15,14 +15,12 @@ from __future__ import annotations
 
 import json
 import logging
-import sys
-import threading
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import TYPE_CHECKING, Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
 from vahr.errors import VahrError
 from vahr.local.ports import LOOPBACK, ensure_free
+from vahr.local.quiet_http import QuietHandler, QuietServer, ServerThread
 from vahr.local.shadow_store import MAX_REQUEST_BYTES, ShadowError
 from vahr.protocol import topics
 
@@ -210,13 +208,7 @@ def _error(status: int, message: str) -> tuple[int, bytes]:
     return status, _encode({"code": status, "message": message})
 
 
-class _Handler(BaseHTTPRequestHandler):
-    # HTTP/1.1 keeps boto3's connection alive between requests (a new TCP connection per
-    # call would add a round trip to every shadow read).
-    protocol_version = "HTTP/1.1"
-    # A response written in two sends (headers, then body) would otherwise wait on Nagle's
-    # algorithm for the client's delayed ACK: about 40 ms per shadow read on loopback.
-    disable_nagle_algorithm = True
+class _Handler(QuietHandler):
     server: _Server
 
     def _serve(self) -> None:
@@ -244,19 +236,10 @@ class _Handler(BaseHTTPRequestHandler):
 
     do_GET = do_POST = do_DELETE = do_PUT = _serve
 
-    def log_message(self, format: str, *args: object) -> None:  # noqa: A002
-        log.debug("%s " + format, self.address_string(), *args)
 
-
-class _Server(ThreadingHTTPServer):
-    daemon_threads = True
+class _Server(QuietServer):
+    what = "data-plane API"
     dataplane: DataPlane
-
-    def handle_error(self, request: object, client_address: object) -> None:
-        # A client closing its kept-alive connection is routine, not a server error.
-        if isinstance(sys.exc_info()[1], ConnectionError):
-            return
-        log.exception("data plane connection from %s failed", client_address)
 
 
 class DataPlaneServer:
@@ -264,34 +247,23 @@ class DataPlaneServer:
 
     def __init__(self, dataplane: DataPlane, port: int) -> None:
         ensure_free(port, "data-plane API")
-        try:
-            self._server = _Server((LOOPBACK, port), _Handler)
-        except OSError as err:
-            raise VahrError(
-                f"cannot listen on {LOOPBACK}:{port} for the data-plane API: {err}"
-            ) from err
-        self._server.dataplane = dataplane
-        self._thread = threading.Thread(
-            target=self._server.serve_forever, name="vahr-dataplane", kwargs={"poll_interval": 0.2}
-        )
+        self._serving = ServerThread(_Server, _Handler, LOOPBACK, port)
+        self._serving.server.dataplane = dataplane  # type: ignore[attr-defined]
 
     @property
     def port(self) -> int:
-        port: int = self._server.server_address[1]
-        return port
+        return self._serving.port
 
     @property
     def url(self) -> str:
         return f"http://{LOOPBACK}:{self.port}"
 
     def start(self) -> DataPlaneServer:
-        self._thread.start()
+        self._serving.start()
         return self
 
     def stop(self) -> None:
-        self._server.shutdown()
-        self._server.server_close()
-        self._thread.join(timeout=5)
+        self._serving.stop()
 
     def __enter__(self) -> DataPlaneServer:
         return self.start()

@@ -21,16 +21,14 @@ from __future__ import annotations
 import hmac
 import logging
 import secrets
-import sys
 import threading
 from http.cookies import CookieError, SimpleCookie
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, urlsplit
 
-from vahr.errors import VahrError
 from vahr.local.ports import LOOPBACK
+from vahr.local.quiet_http import QuietHandler, QuietServer, ServerThread
 from vahr.station.app import Reply, error_reply, json_reply
 
 if TYPE_CHECKING:
@@ -70,9 +68,7 @@ def is_loopback(host: str) -> bool:
     return host in ("127.0.0.1", "localhost", "::1")
 
 
-class _Handler(BaseHTTPRequestHandler):
-    protocol_version = "HTTP/1.1"
-    disable_nagle_algorithm = True
+class _Handler(QuietHandler):
     server: _Server
 
     # -- plumbing -------------------------------------------------------------------------
@@ -235,18 +231,10 @@ class _Handler(BaseHTTPRequestHandler):
             feed.unsubscribe(subscriber)
             station.close_stream()
 
-    def log_message(self, format: str, *args: object) -> None:  # noqa: A002
-        log.debug("%s " + format, self.address_string(), *args)
 
-
-class _Server(ThreadingHTTPServer):
-    daemon_threads = True
+class _Server(QuietServer):
+    what = "station"
     station: StationServer
-
-    def handle_error(self, request: object, client_address: object) -> None:
-        if isinstance(sys.exc_info()[1], ConnectionError):
-            return
-        log.exception("station connection from %s failed", client_address)
 
 
 class StationServer:
@@ -262,20 +250,12 @@ class StationServer:
         self._files = {p.name: p for p in STATIC.iterdir() if p.suffix in CONTENT_TYPES}
         self._streams = 0
         self._streams_lock = threading.Lock()
-        self._started = False
-        try:
-            self._server = _Server((host, port), _Handler)
-        except OSError as err:
-            raise VahrError(f"cannot listen on {host}:{port} for the station: {err}") from err
-        self._server.station = self
-        self._thread = threading.Thread(
-            target=self._server.serve_forever, name="vahr-station", kwargs={"poll_interval": 0.2}
-        )
+        self._serving = ServerThread(_Server, _Handler, host, port)
+        self._serving.server.station = self  # type: ignore[attr-defined]
 
     @property
     def port(self) -> int:
-        port: int = self._server.server_address[1]
-        return port
+        return self._serving.port
 
     @property
     def url(self) -> str:
@@ -309,18 +289,13 @@ class StationServer:
             self._streams -= 1
 
     def start(self) -> StationServer:
-        self._thread.start()
-        self._started = True
+        self._serving.start()
         return self
 
     def stop(self) -> None:
         """Stop serving (safe before `start` and twice)."""
         self.app.feed.close()  # ends every stream, so their threads finish
-        if self._started:
-            self._started = False
-            self._server.shutdown()
-            self._thread.join(timeout=5)
-        self._server.server_close()
+        self._serving.stop()
 
     def __enter__(self) -> StationServer:
         return self.start()
