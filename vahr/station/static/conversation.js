@@ -3,6 +3,7 @@
 // acknowledged them), the orders from the keyboard and mouse, and the robots' own
 // exchanges with the assistant. Filterable by robot.
 
+import { clock, node } from "./dom.js";
 import { sourceName } from "./robots.js";
 
 const ORIGINS = {
@@ -14,17 +15,6 @@ const ORIGINS = {
 };
 const FALLBACK = "AMAZON.FallbackIntent";
 
-function node(tag, className, content) {
-  const made = document.createElement(tag);
-  if (className) made.className = className;
-  if (content !== undefined) made.textContent = content;
-  return made;
-}
-
-function clock(at) {
-  const date = at ? new Date(at) : new Date();
-  return date.toLocaleTimeString([], { hour: "2-digit", minute: "2-digit", second: "2-digit" });
-}
 
 function quoted(text) {
   const q = node("q", "", text);
@@ -138,7 +128,7 @@ export class Conversation {
 
   turn(message) {
     const item = node("li", "entry turn");
-    item.append(node("span", "who", ORIGINS[message.origin] || message.origin || "Someone"), node("time", "", clock(message.at)));
+    item.append(node("span", "who", ORIGINS[message.origin] || message.origin || "Someone"), node("time", "", clock(message.at ?? Date.now())));
     const said = node("div", "said");
     said.appendChild(quoted(message.utterance || "(session ended)"));
     item.appendChild(said);
@@ -172,7 +162,7 @@ export class Conversation {
     const robotSource = message.source.startsWith("robot:");
     const item = node("li", `entry ${robotSource ? "robot-exchange" : "console"}`);
     const who = robotSource ? `${this.names[message.source.slice(6)] || message.source.slice(6)}, to a robot` : sourceName(message.source).replace(/^./, (c) => c.toUpperCase());
-    item.append(node("span", "who", who), node("time", "", clock(message.seen)));
+    item.append(node("span", "who", who), node("time", "", clock(message.seen ?? Date.now())));
     const said = node("div", "said");
     item.appendChild(said);
     this.watch(message.id, () => { said.textContent = this.commandLine(message.id); });
@@ -194,7 +184,7 @@ export class Conversation {
       const sure = message.confidence !== undefined && message.confidence !== null ? ` (${Math.round(message.confidence * 100)}% sure)` : "";
       body = node("span", `tag ${message.intent && message.intent !== "unknown" ? "ok" : "bad"}`, `${message.intent || "nothing"}${sure}`);
     }
-    item.append(node("span", "who", who), node("time", "", clock(message.at)));
+    item.append(node("span", "who", who), node("time", "", clock(message.at ?? Date.now())));
     const said = node("div", "said");
     said.appendChild(body);
     item.appendChild(said);

@@ -141,8 +141,9 @@ function describe(target) {
 }
 
 export class ExperimentView {
-  constructor({ card, chip, briefing, verdicts, clock, puzzle, less, more, names }) {
-    Object.assign(this, { card, chip, briefing, verdicts, clock, puzzle, names });
+  // `now` is the station's time (the page's clock corrected by what the station said).
+  constructor({ card, chip, briefing, verdicts, clock, puzzle, less, more, names, now }) {
+    Object.assign(this, { card, chip, briefing, verdicts, clock, puzzle, names, now });
     this.status = null;
     this.weather = null;
     this.timer = null;
@@ -223,7 +224,7 @@ export class ExperimentView {
       this.clock.textContent = "--:--";
       return;
     }
-    const seconds = Math.max(0, Math.floor((Date.now() - Date.parse(started)) / 1000));
+    const seconds = Math.max(0, Math.floor((this.now() - Date.parse(started)) / 1000));
     this.clock.textContent = `${String(Math.floor(seconds / 60)).padStart(2, "0")}:${String(seconds % 60).padStart(2, "0")}`;
   }
 

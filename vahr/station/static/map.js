@@ -6,6 +6,8 @@
 // (or that of its previous drive). A report that disagrees is eased into over a moment,
 // never jumped to, and a robot is never drawn sliding backwards along its path.
 
+import { clock } from "./dom.js";
+
 const SVG = "http://www.w3.org/2000/svg";
 const DEFAULT_SPEED = 0.5; // metres a second: the simulator's, until reports say otherwise
 const EASE_MS = 600;
@@ -393,8 +395,7 @@ export function zoneText(id) {
 export function describe(state, { where = true } = {}) {
   const { status, reported } = state;
   if (status === "offline") {
-    const seen = state.lastSeen ? new Date(state.lastSeen).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit", second: "2-digit" }) : "never";
-    return `offline · last seen ${seen}`;
+    return `offline · last seen ${clock(state.lastSeen, "never")}`;
   }
   if (status === "navigating") {
     const fraction = state.progress?.progress;

@@ -4,16 +4,9 @@
 // Each row is built once; an update only rewrites the text that changed, so a hundred
 // robots reporting progress stay cheap to draw.
 
+import { clock, node } from "./dom.js";
 import { describe, statusColour, zoneText } from "./map.js";
 
-const time = (ms) => (ms ? new Date(ms).toLocaleTimeString([], { hour: "2-digit", minute: "2-digit", second: "2-digit" }) : "never");
-
-function node(tag, className, content) {
-  const made = document.createElement(tag);
-  if (className) made.className = className;
-  if (content !== undefined) made.textContent = content;
-  return made;
-}
 
 // Set a property only when it changes (reading is cheap, writing makes the browser work).
 function put(target, key, value) {
@@ -83,7 +76,7 @@ export class RobotsPanel {
     const colour = `var(--${statusColour(status)})`;
     if (parts.row.dataset.status !== status) parts.row.dataset.status = status;
     put(parts.badge.style, "background", colour);
-    put(parts.presenceText, "textContent", online ? "online" : online === false ? `offline · seen ${time(robot.last_seen)}` : "not heard yet");
+    put(parts.presenceText, "textContent", online ? "online" : online === false ? `offline · seen ${clock(robot.last_seen, "never")}` : "not heard yet");
     parts.presence.classList.toggle("online", Boolean(online));
     put(parts.status, "textContent", describe({ status, reported, lastSeen: robot.last_seen, progress: robot.progress }, { where: false }));
     put(parts.status.style, "color", colour);

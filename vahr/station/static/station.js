@@ -29,6 +29,7 @@ const panel = new Panel({
 const experiment = new ExperimentView({
   card: $("experiment"), chip: $("session-chip"), briefing: $("briefing"), verdicts: $("verdicts"),
   clock: $("experiment-clock"), puzzle: $("puzzle-count"), less: $("puzzle-less"), more: $("puzzle-more"), names,
+  now: () => Date.now() + store.skew,
 });
 new Talk({ button: $("talk"), level: $("talk-level"), state: $("talk-state"), interactions, metrics });
 
