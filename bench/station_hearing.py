@@ -10,7 +10,7 @@ understood by the simulator's NLU. An outcome is `right` (intent and slots as la
 a slot left to ask for) or `no action` (nothing heard with enough confidence, or the
 fallback intent: the station says "Sorry, I didn't catch that").
 
-The recognizer's threshold (`vahr.speech.lm_stt.DEFAULT_MIN_CONFIDENCE`) is chosen on the
+The recognizer's threshold (`vahr.station.voice.MIN_CONFIDENCE`) is chosen on the
 tuning set by one rule: the most requests right among the thresholds that let at most 10%
 of out-of-domain sentences be acted on. The development set is only measured.
 Run: `.venv/bin/python bench/station_hearing.py`.
@@ -31,9 +31,9 @@ from vahr.local.alexa.evaluation import DEVELOPMENT_SET, LabelledSet, outcome  #
 from vahr.local.alexa.nlu import FALLBACK, InteractionModel  # noqa: E402
 from vahr.local.alexa.simulator import strip_invocation  # noqa: E402
 from vahr.speech.audio import Audio, add_white_noise  # noqa: E402
-from vahr.speech.lm_stt import DEFAULT_MIN_CONFIDENCE  # noqa: E402
 from vahr.speech.tts import EspeakSynthesizer  # noqa: E402
 from vahr.station.vocabulary import command_recognizer  # noqa: E402
+from vahr.station.voice import MIN_CONFIDENCE  # noqa: E402
 
 TUNING_SET = DEVELOPMENT_SET.with_name("tuning-en-US.yaml")
 VOICES = ("en-us+f2", "en-us+m3")
@@ -105,7 +105,7 @@ def main() -> int:
         "| out of domain acted on |\n| --- | --- | --- | --- | --- | --- |"
     )
     tuning_rows = "\n".join(row(f"threshold {t:g}", c) for t, c in tuning.items())
-    development = tally(model, sets["development"], heard["development"], DEFAULT_MIN_CONFIDENCE)
+    development = tally(model, sets["development"], heard["development"], MIN_CONFIDENCE)
     seconds = [s for found in heard.values() for _, _, s in found]
     body = f"""
 Spoken by espeak-ng ({" and ".join(VOICES)} in turn, every third at 20 dB SNR), heard by the
@@ -119,9 +119,9 @@ Tuning set ({TUNING_SET.name}):
 {tuning_rows}
 
 The rule picks {chosen if chosen is not None else "none"}; the station uses
-{DEFAULT_MIN_CONFIDENCE:g}.
+{MIN_CONFIDENCE:g}.
 
-Development set ({DEVELOPMENT_SET.name}), measured only, at {DEFAULT_MIN_CONFIDENCE:g}, beside
+Development set ({DEVELOPMENT_SET.name}), measured only, at {MIN_CONFIDENCE:g}, beside
 the same sentences understood from their text:
 
 {header}

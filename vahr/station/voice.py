@@ -4,9 +4,9 @@ The page records while the button (or the space bar) is held and uploads 16 kHz 
 16-bit WAV. The clip is checked (a WAV, at most `MAX_CLIP_S` long), transcribed offline by
 a recognizer whose vocabulary comes from the skill's interaction model (`vocabulary.py`),
 and a transcript whose least certain word is at least `MIN_CONFIDENCE` goes to the
-assistant as a request (origin `station-voice`), with what the recognizer heard alongside. A clip with no speech, a transcript the recognizer is not
-sure of, or one the assistant does not understand (its fallback intent) changes nothing and
-gets `SORRY`.
+assistant as a request (origin `station-voice`), with what the recognizer heard alongside.
+A clip with no speech, a transcript the recognizer is not sure of, or one the assistant
+does not understand (its fallback intent) changes nothing and gets `SORRY`.
 """
 
 from __future__ import annotations
