@@ -4,6 +4,7 @@
 // exchanges with the assistant. Filterable by robot.
 
 import { clock, node } from "./dom.js";
+import { zoneText } from "./map.js";
 import { sourceName } from "./robots.js";
 
 const ORIGINS = {
@@ -113,7 +114,7 @@ export class Conversation {
   commandLine(commandId) {
     const command = this.commands[commandId];
     if (!command) return `command ${commandId.slice(0, 8)}`;
-    const zone = command.params?.zone ? ` ${command.params.zone}` : "";
+    const zone = command.params?.zone ? ` to ${zoneText(command.params.zone)}` : "";
     const who = command.target === "fleet" ? "every robot" : this.names[command.target] || command.target;
     const acks = Object.entries(command.acks || {});
     let how = "waiting for an acknowledgment";
@@ -123,7 +124,7 @@ export class Conversation {
       how = rejected.length ? `rejected by ${rejected.join(", ")}` : `acknowledged in ${Math.round(worst)} ms`;
       if (command.target === "fleet") how += ` (${acks.length}/${command.robots.length})`;
     }
-    return `${command.action}${zone} → ${who}: ${how}`;
+    return `${who}: ${command.action}${zone} · ${how}`;
   }
 
   turn(message) {
@@ -134,7 +135,7 @@ export class Conversation {
     item.appendChild(said);
     if (message.heard) {
       const sure = Math.round((message.heard.confidence ?? 0) * 100);
-      item.appendChild(node("div", "heard", `heard in ${Number(message.heard.seconds ?? 0).toFixed(1)} s of speech · ${sure}% sure`));
+      item.appendChild(node("div", "heard", `${Number(message.heard.seconds ?? 0).toFixed(1)} s clip · the recognizer was ${sure}% sure`));
     }
     const understood = node("div", "understood");
     if (message.intent) understood.appendChild(node("span", `tag intent${message.intent === FALLBACK ? " bad" : ""}`, message.intent));
