@@ -82,6 +82,12 @@ def run(args: argparse.Namespace) -> int:
             print(json.dumps({"station": station.url, "token": station.server.token}), flush=True)
         else:
             print(f"VAHR station: {station.url}   (Ctrl-C stops it)", flush=True)
+            if station.server.token is not None:
+                print(
+                    f"  from another machine: http://<this machine's address>:{station.server.port}"
+                    f"/?token={station.server.token}",
+                    flush=True,
+                )
         stopping.wait()
     finally:
         station.stop()

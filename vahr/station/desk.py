@@ -65,16 +65,17 @@ class Desk:
         Returns False when no session is running (the input is not logged anywhere);
         raises ProtocolError when the input is malformed.
         """
+        if kind not in ("interaction", "puzzle"):
+            raise ProtocolError("kind", f"{kind!r} is not interaction or puzzle")
         status = self.session()
         if status is None:
             return False
+        # The session is the one running, whatever the page says.
         fields = {**body, "session": status["session"], "kind": kind}
         fields.setdefault("sent", datetime.now(UTC).isoformat())
         shape: type[Interaction] | type[PuzzleInput] = (
             Interaction if kind == "interaction" else PuzzleInput
         )
-        if kind not in ("interaction", "puzzle"):
-            raise ProtocolError("kind", f"{kind!r} is not interaction or puzzle")
         try:
             message = msgspec.convert(fields, shape, strict=False)
         except msgspec.ValidationError as err:

@@ -4,8 +4,9 @@
 Core's with an operator certificate), an assistant, and a way to read a robot's shadow at
 start-up; it subscribes the feed, reads every robot's shadow once, and serves the page.
 
-- `vahr up` builds one on its own stack (`for_local_system`): the simulator in-process.
-- `vahr station` builds one against any deployment (`vahr.commands.station`).
+- `vahr up` builds one on its own stack (`LocalSystem`): the simulator in-process, shadows
+  read from the store;
+- `vahr station` builds one against any deployment (`vahr.station.deployment`).
 """
 
 from __future__ import annotations

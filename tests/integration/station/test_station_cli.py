@@ -1,0 +1,61 @@
+"""`vahr station` against a running local stack: the page's address first, a clean stop,
+and one-line errors for bad flags."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import urllib.request
+from typing import TYPE_CHECKING
+
+import pytest
+
+from tests.support.vahr_up import ROOT, VAHR, clean_env
+from vahr.local.ports import free_port
+
+if TYPE_CHECKING:
+    from vahr.local.stack import LocalStack
+
+
+def test_vahr_station_serves_the_page_for_a_running_stack(stack: LocalStack) -> None:
+    # Given a local stack (broker, shadows, data plane)
+    assert stack.mqtt_url is not None
+    process = subprocess.Popen(
+        [*VAHR, "station", "--broker", stack.mqtt_url, "--api", stack.api_url,
+         "--port", str(free_port()), "--no-voice", "--json"],
+        cwd=ROOT, env=clean_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        assert process.stdout is not None
+        # When it starts, its first line is the page's address (no token on loopback)
+        first = json.loads(process.stdout.readline())
+        assert first["token"] is None and first["station"].startswith("http://127.0.0.1:")
+        # Then the page is served with the fleet it was given
+        with urllib.request.urlopen(first["station"] + "api/snapshot", timeout=10) as answer:
+            snapshot = json.loads(answer.read())
+        assert [r["thing"] for r in snapshot["fleet"]["robots"]] == ["placebot1", "placebot2"]
+    finally:
+        process.send_signal(signal.SIGTERM)
+        assert process.wait(timeout=30) == 0
+
+
+@pytest.mark.parametrize(
+    ("flags", "error"),
+    [
+        (["--port", "70000"], "vahr station: error: --port 70000: not a usable port"),
+        (["--token", "short"], "vahr station: error: --token must be at least 16 characters"),
+        (["--cert", "a.pem"], "vahr station: error: --cert, --key and --ca go together"),
+        (
+            ["--broker", "mqtts://127.0.0.1:1"],
+            "vahr station: error: broker mqtts://127.0.0.1:1 needs --cert, --key and --ca for mTLS",
+        ),
+    ],
+)
+def test_bad_flags_are_one_line(flags: list[str], error: str) -> None:
+    argv = [*VAHR, "station", "--broker", f"mqtt://127.0.0.1:{free_port()}", *flags]
+    result = subprocess.run(
+        argv, cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=60
+    )
+    assert result.returncode == 2
+    assert result.stderr.strip() == error
