@@ -15,6 +15,7 @@ const ORIGINS = {
   console: "Console",
 };
 const FALLBACK = "AMAZON.FallbackIntent";
+const ENTRIES_KEPT = 400; // as many as the station keeps for a new page (feed.py)
 
 
 function quoted(text) {
@@ -96,6 +97,8 @@ export class Conversation {
     item.hidden = !this.visible(item);
     this.list.querySelector(".empty")?.remove();
     this.list.appendChild(item);
+    // The oldest entries go, so a long session does not grow the page without end.
+    while (this.list.children.length > ENTRIES_KEPT) this.list.firstElementChild.remove();
     this.showEmpty();
     this.follow();
   }
@@ -108,6 +111,8 @@ export class Conversation {
   watch(commandId, redraw) {
     if (!this.refreshers.has(commandId)) this.refreshers.set(commandId, []);
     this.refreshers.get(commandId).push(redraw);
+    // Acknowledgments come within seconds: the oldest commands' redraws can go.
+    while (this.refreshers.size > ENTRIES_KEPT) this.refreshers.delete(this.refreshers.keys().next().value);
     redraw();
   }
 

@@ -15,6 +15,7 @@ const $ = (id) => document.getElementById(id);
 const metrics = new URLSearchParams(location.search).has("metrics") ? { painted: [], ptt: [], shown: [], messages: 0 } : null;
 if (metrics) window.vahrMetrics = metrics;
 
+const COMMANDS_KEPT = 1000; // as many as the station's feed follows (feed.py)
 const store = { fleet: null, robots: {}, commands: {}, experiment: null, selected: null, skew: 0 };
 const names = {};
 const interactions = new Interactions();
@@ -170,6 +171,9 @@ const handlers = {
   },
   command(message) {
     store.commands[message.id] = message;
+    // Keep as many commands as the station does: a long session must not grow the page.
+    const ids = Object.keys(store.commands);
+    for (const old of ids.slice(0, Math.max(0, ids.length - COMMANDS_KEPT))) delete store.commands[old];
     if (message.source !== "alexa") conversation.add(message);
   },
   ack(message) {
