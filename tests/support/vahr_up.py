@@ -18,6 +18,7 @@ import time
 from pathlib import Path
 from typing import IO, Any
 
+from vahr.local.lifetime import spawn
 from vahr.local.ports import free_port
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -57,10 +58,11 @@ class Up:
 
 def start_up(state: Path, *extra: str) -> Up:
     """`vahr up --json --no-voice` with every port free and `extra` flags."""
-    process = subprocess.Popen(
+    process = spawn(
         [*VAHR, "up", "--json", "--no-voice", "--state-dir", str(state),
          "--api-port", str(free_port()), "--mqtts-port", str(free_port()), *extra],
-        cwd=ROOT, env=clean_env(), stdout=subprocess.PIPE, stderr=(state / "up.err").open("w"),
+        started_for=state, cwd=ROOT, env=clean_env(), stdout=subprocess.PIPE,
+        stderr=(state / "up.err").open("w"),
         text=True,
     )  # fmt: skip
     first = _first_line(process, START_TIMEOUT_S)

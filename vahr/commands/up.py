@@ -85,6 +85,8 @@ def run(args: argparse.Namespace) -> int:
     system = LocalSystem(config, on_event=lambda event: _print_event(event, args.json))
     try:
         system.start()
+        if system.stack.recovered:
+            print(f"vahr up: recovered: {system.stack.recovered}", file=sys.stderr, flush=True)
         system.wait_online()
         endpoints = system.endpoints()
         if args.json:

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from vahr.errors import VahrError
+from vahr.local.lifetime import spawn
 from vahr.local.ports import LOOPBACK, ensure_free, wait_for_listener
 
 START_TIMEOUT_S = 10.0
@@ -104,8 +105,12 @@ class Mosquitto:
         self.config.state_dir.mkdir(parents=True, exist_ok=True)
         conf = self.config.state_dir / "mosquitto.conf"
         conf.write_text(self.config.render())
-        self._process = subprocess.Popen(
+        self._process = spawn(
             [binary, "-c", str(conf)],
+            started_for=self.config.state_dir,
+            # SIGTERM: mosquitto exits at once on it and saves its persistence first, so
+            # queued QoS 1 commands survive even the death of the process that ran it.
+            death_signal=signal.SIGTERM,
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,

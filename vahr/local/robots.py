@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from vahr.errors import VahrError
+from vahr.local.lifetime import spawn
 from vahr.protocol import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
 
 if TYPE_CHECKING:
@@ -132,8 +133,11 @@ class RobotProcesses:
             log_path = self.log_file(thing)
             log_path.parent.mkdir(parents=True, exist_ok=True)
             with log_path.open("ab") as log_stream:
-                process = subprocess.Popen(
+                # Tied to this process's life: a robot never outlives the `vahr up` that
+                # started it, even one killed with SIGKILL (see `lifetime`).
+                process = spawn(
                     self.command(thing),
+                    started_for=self.state_dir,
                     cwd=ROOT,
                     env=env,
                     stdin=subprocess.DEVNULL,

@@ -20,6 +20,7 @@ from vahr.local.dataplane import DataPlane, DataPlaneServer
 from vahr.local.meter import Meter
 from vahr.local.mqtt import MqttClient, MqttEndpoint
 from vahr.local.ports import LOOPBACK, ensure_free
+from vahr.local.recovery import StateLock, recover
 from vahr.local.shadow_service import ShadowService
 from vahr.local.shadow_store import ShadowStore
 from vahr.pki import LocalCA
@@ -56,6 +57,9 @@ class LocalStack:
         self._service_client: MqttClient | None = None
         self._server: DataPlaneServer | None = None
         self.alexa: AlexaSimulator | None = None
+        self._claim = StateLock(config.state_dir)
+        # One line saying what was put right after an earlier run's crash, or None.
+        self.recovered: str | None = None
 
     @property
     def api_url(self) -> str:
@@ -75,10 +79,25 @@ class LocalStack:
         assert self.ca is not None, "start() first"
         return MqttEndpoint(port=self.config.mqtts_port, credentials=self.ca.service_credentials())
 
+    @property
+    def database(self) -> Path:
+        return self.config.state_dir / "shadows.sqlite3"
+
     def start(self) -> LocalStack:
         cfg = self.config
-        # Check every port first so a conflict is one clear line before anything starts.
-        ensure_free(cfg.api_port, "data-plane API")
+        # The state directory first: a second run on it is refused before any port is
+        # touched, and what a crashed run left (processes holding its ports, an unfinished
+        # database journal) is cleared before anything needs it.
+        unclean_pid = self._claim.acquire()
+        try:
+            self.recovered = recover(cfg.state_dir, unclean_pid=unclean_pid, database=self.database)
+            if self.recovered:
+                log.info("recovered %s: %s", cfg.state_dir, self.recovered)
+            # Then every port, so a conflict is one clear line before anything starts.
+            ensure_free(cfg.api_port, "data-plane API")
+        except BaseException:
+            self._claim.release()
+            raise
         try:
             self.ca = LocalCA.load_or_create(cfg.state_dir)
             acl = write_acl(
@@ -102,7 +121,7 @@ class LocalStack:
                 self.service_endpoint(), client_id="vahr-shadow-service"
             ).connect()
             client = self._service_client
-            self.store = ShadowStore(cfg.state_dir / "shadows.sqlite3")
+            self.store = ShadowStore(self.database)
 
             def publish_answer(topic: str, payload: bytes) -> None:
                 # Answers go out without waiting for PUBACK: the paho network thread that
@@ -189,6 +208,7 @@ class LocalStack:
         if self.broker is not None:
             self.broker.stop()
             self.broker = None
+        self._claim.release()
 
     def __enter__(self) -> LocalStack:
         return self.start()

@@ -23,6 +23,8 @@ from typing import TYPE_CHECKING, Any
 import paho.mqtt.client as paho
 from paho.mqtt.enums import CallbackAPIVersion, MQTTProtocolVersion
 
+from vahr.local.lifetime import spawn
+
 if TYPE_CHECKING:
     from collections.abc import Callable
 
@@ -312,8 +314,10 @@ class AgentProcess:
         self.args = [str(AGENT), "run", "--state-dir", str(state_dir), *args]
         self.log_file = log_file
         self._log = log_file.open("ab")
-        self.process = subprocess.Popen(
+        # Tied to the test run's life: a killed pytest leaves no robot behind.
+        self.process = spawn(
             self.args,
+            started_for=state_dir,
             stdin=subprocess.DEVNULL,
             stdout=self._log,
             stderr=subprocess.STDOUT,

@@ -7,7 +7,6 @@ aborts goals into zone D (as a blocked planner would), and honours preemption.
 
 from __future__ import annotations
 
-import ctypes
 import math
 import os
 import signal
@@ -21,6 +20,7 @@ from robot_agent.config import ExecutorSettings
 from robot_agent.core.clock import ScaledClock
 from robot_agent.core.executor import Executor
 from tests.unit.agent.conftest import Recorder
+from vahr.local.lifetime import spawn
 from vahr.local.ports import free_port, wait_for_listener
 from vahr.protocol import new_command
 
@@ -36,11 +36,6 @@ STEPS = 8
 STEP_S = 0.03
 
 
-def _die_with_parent() -> None:
-    # PR_SET_PDEATHSIG: the master dies with the test run even if pytest is killed.
-    ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)
-
-
 @pytest.fixture(scope="session")
 def ros_master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
     port = free_port()
@@ -51,12 +46,15 @@ def ros_master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
         ROS_HOME=str(home),
         ROS_MASTER_URI=f"http://127.0.0.1:{port}",
     )
-    process = subprocess.Popen(
+    # The master dies with the test run even if pytest is killed (no preexec_fn: pytest
+    # has threads by now, and running Python between fork and exec could deadlock).
+    process = spawn(
         ["rosmaster", "--core", "-p", str(port), "-w", "3"],
+        started_for=home,
+        death_signal=signal.SIGTERM,
         env=env,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
-        preexec_fn=_die_with_parent,
     )
     try:
         wait_for_listener(port, 10, "ROS master")

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import paho.mqtt.client as mqtt
 import pytest
 
+from vahr.local.lifetime import spawn
 from vahr.protocol import decode_presence, topics
 
 if TYPE_CHECKING:
@@ -64,7 +65,7 @@ class RobotAgents:
             for thing in self.fleet.robot_things:
                 log = (self.state_dir / f"{thing}.log").open("wb")
                 self.processes.append(
-                    subprocess.Popen(
+                    spawn(
                         [
                             sys.executable,
                             "-m",
@@ -83,6 +84,7 @@ class RobotAgents:
                             "--state-dir",
                             str(self.state_dir / thing),
                         ],
+                        started_for=self.state_dir,
                         stdout=log,
                         stderr=subprocess.STDOUT,
                         stdin=subprocess.DEVNULL,

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from vahr.cli import main
+from vahr.local.lifetime import spawn
 from vahr.local.ports import free_port
 
 if TYPE_CHECKING:
@@ -32,7 +33,7 @@ def system(tmp_path: Path) -> Iterator[dict[str, Any]]:
     """
     out_file, err_file = tmp_path / "up.out", tmp_path / "up.err"
     with out_file.open("wb") as out, err_file.open("wb") as err:
-        process = subprocess.Popen(
+        process = spawn(
             [
                 sys.executable,
                 "-m",
@@ -52,6 +53,7 @@ def system(tmp_path: Path) -> Iterator[dict[str, Any]]:
                 "--sim-speed-factor",
                 str(SPEED),
             ],
+            started_for=tmp_path / "state",
             stdout=out,
             stderr=err,
             stdin=subprocess.DEVNULL,

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from tests.conftest import load_event
+from vahr.local.lifetime import spawn
 from vahr.local.mqtt import MqttClient, MqttEndpoint
 from vahr.local.room import offline_room_assistant
 from vahr.protocol import encode, new_command, topics
@@ -112,11 +113,12 @@ def test_the_robot_asks_the_weather_by_voice_and_delivers(
     assistant = offline_room_assistant(room_client, skill_ask).start()
     log = EventLog(port, "placebot1")
     env = {**os.environ, "VAHR_ROOM_BROKER": broker, "PYTHONPATH": str(ROOT)}
-    agent = subprocess.Popen(
+    agent = spawn(
         [*AGENT, "run", "--thing", "placebot1", "--broker", broker,
          "--voice", "robot_agent.voice.factories:room", "--sim-speed-factor", "20",
          "--state-dir", str(tmp_path / "agent")],
-        cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=(tmp_path / "agent.log").open("wb"),
+        started_for=tmp_path / "agent", cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
+        stderr=(tmp_path / "agent.log").open("wb"),
     )  # fmt: skip
     try:
         presence = threading.Event()

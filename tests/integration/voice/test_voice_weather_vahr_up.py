@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from tests.integration.voice.test_voice_weather_task import EventLog
+from vahr.local.lifetime import spawn
 from vahr.local.mqtt import MqttClient, MqttEndpoint
 from vahr.local.ports import free_port
 from vahr.protocol import topics
@@ -42,12 +43,12 @@ def read_line(process: subprocess.Popen[bytes], timeout_s: float) -> bytes:
 def system(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]:
     state = tmp_path_factory.mktemp("up")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    process = subprocess.Popen(
+    process = spawn(
         [sys.executable, "-m", "vahr.cli", "up", "--state-dir", str(state),
          "--api-port", str(free_port()), "--mqtt-port", str(free_port()),
          "--mqtts-port", str(free_port()), "--station-port", "0",
          "--sim-speed-factor", "20", "--json"],
-        cwd=ROOT, env=env, stdout=subprocess.PIPE,
+        started_for=state, cwd=ROOT, env=env, stdout=subprocess.PIPE,
         stderr=(state / "up.err").open("wb"), stdin=subprocess.DEVNULL,
     )  # fmt: skip
     try:
