@@ -211,8 +211,21 @@ def _error(status: int, message: str) -> tuple[int, bytes]:
 class _Handler(QuietHandler):
     server: _Server
 
+    # A client that stops sending mid-request holds a thread only this long.
+    timeout = 30
+    # Larger bodies are refused before they are read (AWS IoT's own limit is 128 KB).
+    MAX_BODY_BYTES = MAX_PUBLISH_BYTES + 1024
+
     def _serve(self) -> None:
-        length = int(self.headers.get("Content-Length") or 0)
+        declared = self.headers.get("Content-Length")
+        if declared is not None and not declared.strip().isdigit():
+            # The body's end is unknown, so the connection cannot be used again.
+            self.close_connection = True
+            return self._answer(*_error(400, "Content-Length must be a whole number of bytes"))
+        length = int(declared or 0)
+        if length > self.MAX_BODY_BYTES:
+            self.close_connection = True
+            return self._answer(*_error(413, "The payload exceeds the maximum size allowed"))
         body = self.rfile.read(length) if length else b""
         target = self.server.dataplane.redirects.get(self.path.split("?", 1)[0])
         if target is not None and self.command == "GET":
@@ -226,15 +239,37 @@ class _Handler(QuietHandler):
         except Exception:  # the server must answer even when a bug bites
             log.exception("data plane request %s %s failed", self.command, self.path)
             status, payload = _error(500, "Internal service failure")
+        self._answer(status, payload)
+
+    def _answer(self, status: int, payload: bytes) -> None:
         self.send_response(status)
         self.send_header("Content-Type", "application/json")
         self.send_header("Content-Length", str(len(payload)))
         if status >= 400:
             self.send_header("x-amzn-ErrorType", ERROR_TYPES.get(status, "InvalidRequestException"))
+        if self.close_connection:
+            self.send_header("Connection", "close")
         self.end_headers()
-        self.wfile.write(payload)
+        if self.command != "HEAD":
+            self.wfile.write(payload)
 
-    do_GET = do_POST = do_DELETE = do_PUT = _serve
+    def __getattr__(self, name: str) -> Any:
+        # Any method reaches the router, which answers 405 (or 404) in AWS's error shape;
+        # http.server would answer a method it has no `do_` for with an HTML 501.
+        if name.startswith("do_"):
+            return self._serve
+        raise AttributeError(name)
+
+    def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
+        """http.server's own rejections (a malformed request line, headers too long, ...)
+        in the same JSON shape as every other error."""
+        self.close_connection = True
+        # The request line may not have been parsed: answer as to a GET of nothing.
+        self.command, self.path = self.command or "GET", getattr(self, "path", "") or ""
+        # A mangled request line reads as HTTP/0.9, whose answers have no status line;
+        # every client this API serves speaks HTTP/1.1, so answer in it.
+        self.request_version = "HTTP/1.1"
+        self._answer(*_error(code, message or explain or "Bad request"))
 
 
 class _Server(QuietServer):

@@ -14,6 +14,22 @@ _EXPECTED = re.compile(r"^Expected `(?P<want>[^`]+)`, got `(?P<got>[^`]+)`$")
 _TAG = re.compile(r"^Invalid value '?(?P<value>[^']*)'?$")
 
 
+MAX_SHOWN = 40
+
+
+def shown(value: object) -> str:
+    """A value as an error quotes it: on one line (control characters escaped) and at most
+    MAX_SHOWN characters, so a hostile payload cannot stretch or split the message."""
+    text = _one_line(str(value))
+    return text if len(text) <= MAX_SHOWN else text[: MAX_SHOWN - 1] + "…"
+
+
+def _one_line(text: str) -> str:
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode() for c in text)
+
+
 class ProtocolError(ValueError):
     """A payload that breaks the wire contract.
 
@@ -23,6 +39,7 @@ class ProtocolError(ValueError):
     """
 
     def __init__(self, field: str, reason: str) -> None:
+        field, reason = _one_line(field), _one_line(reason)
         super().__init__(f"{field}: {reason}")
         self.field = field
         self.reason = reason
@@ -47,5 +64,5 @@ def from_validation_error(err: msgspec.ValidationError | msgspec.DecodeError) ->
     if isinstance(err, msgspec.DecodeError) and not path:
         return ProtocolError("payload", f"is not valid JSON ({reason.lower()})")
     if path == "action" and (found := _TAG.match(reason)):
-        return ProtocolError("action", f"'{found['value']}' is not a known action")
+        return ProtocolError("action", f"'{shown(found['value'])}' is not a known action")
     return ProtocolError(path or "payload", reason[:1].lower() + reason[1:])

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Annotated, Literal
 
 import msgspec
 
-from vahr.protocol.errors import ProtocolError, from_validation_error
+from vahr.protocol.errors import ProtocolError, from_validation_error, shown
 
 if TYPE_CHECKING:
     from vahr.protocol.fleet import Fleet
@@ -123,7 +123,7 @@ def new_command(
     """Build a command with a fresh id and the current time, validated like a decoded one."""
     if action not in _COMMAND_TYPES:
         raise ProtocolError(
-            "action", f"'{action}' is not a known action; actions are {', '.join(ACTIONS)}"
+            "action", f"'{shown(action)}' is not a known action; actions are {', '.join(ACTIONS)}"
         )
     raw = {
         "id": command_id or uuid.uuid4().hex,
@@ -170,13 +170,13 @@ def check_against_fleet(command: Command, fleet: Fleet) -> None:
     params = command.params
     if isinstance(params, ZoneParams | SequentialParams) and params.zone not in fleet.zone_ids:
         raise ProtocolError(
-            "params.zone", f"'{params.zone}' is not a zone; zones are {', '.join(fleet.zone_ids)}"
+            "params.zone", f"'{shown(params.zone)}' is not a zone; zones are {', '.join(fleet.zone_ids)}"
         )
     if isinstance(params, SequentialParams) and params.after is not None:
         if params.after not in fleet.robot_things:
             raise ProtocolError(
                 "params.after",
-                f"'{params.after}' is not a robot; robots are {', '.join(fleet.robot_things)}",
+                f"'{shown(params.after)}' is not a robot; robots are {', '.join(fleet.robot_things)}",
             )
 
 
