@@ -9,11 +9,13 @@ module without AWS settings (the local stack, the tests) do not fail or pay for 
 
 from __future__ import annotations
 
+import logging
 from typing import TYPE_CHECKING, Any
 
+from ask_sdk_core.exceptions import SerializationException
 from ask_sdk_core.skill_builder import SkillBuilder
 
-from skill import logs
+from skill import logs, prompts
 from skill.config import SkillConfig
 from skill.handlers.built_in import (
     CancelIntentHandler,
@@ -38,6 +40,7 @@ from skill.interceptors import (
     ResponseLogInterceptor,
 )
 from skill.iot_data import IotDataGateway
+from skill.logs import log_event
 from skill.runtime import SkillRuntime
 
 if TYPE_CHECKING:
@@ -96,7 +99,38 @@ def make_lambda_handler(
     runtime = SkillRuntime.create(config, gateway or IotDataGateway.from_config(config))
     handler: Callable[[dict[str, Any], Any], dict[str, Any]]
     handler = build_skill_builder(runtime).lambda_handler()  # type: ignore[assignment]
-    return handler
+    return _answering_malformed(handler)
+
+
+def _answering_malformed(
+    handler: Callable[[dict[str, Any], Any], dict[str, Any]],
+) -> Callable[[dict[str, Any], Any], dict[str, Any]]:
+    """`handler`, answering an envelope the ASK SDK cannot read with the safe sentence.
+
+    The SDK reads the envelope before any exception handler exists, so a malformed one
+    (a request `type` it does not know, a field of the wrong type) would fail the Lambda
+    invocation, and Alexa would speak its own vague error. A failed skill-id check is not
+    caught: a request meant for another skill must stay refused.
+    """
+
+    def lambda_handler(event: dict[str, Any], context: Any) -> dict[str, Any]:
+        try:
+            return handler(event, context)
+        except SerializationException as err:
+            log_event("malformed_request", logging.ERROR, error=str(err)[:300])
+            return _safe_answer()
+
+    return lambda_handler
+
+
+def _safe_answer() -> dict[str, Any]:
+    return {
+        "version": "1.0",
+        "response": {
+            "outputSpeech": {"type": "SSML", "ssml": f"<speak>{prompts.GENERIC_ERROR}</speak>"},
+            "shouldEndSession": True,
+        },
+    }
 
 
 lambda_handler: Callable[[dict[str, Any], Any], dict[str, Any]]

@@ -14,11 +14,14 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import pytest
 from hypothesis import HealthCheck, Phase, settings
 
 from tests.fuzz.tally import TALLY
+
+if TYPE_CHECKING:
+    import pytest
 
 COMMON = {
     "derandomize": True,

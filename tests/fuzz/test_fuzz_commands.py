@@ -31,7 +31,6 @@ from vahr.protocol import ProtocolError, decode_command, load_fleet, topics
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
-    from pathlib import Path
 
     from vahr.local.broker import Mosquitto
 
@@ -86,9 +85,7 @@ class MemoryLink:
             handler(topic, payload)
 
     def events(self) -> list[dict[str, Any]]:
-        return [
-            json.loads(p) for t, p in self.published if t == topics.robot_events("placebot1")
-        ]
+        return [json.loads(p) for t, p in self.published if t == topics.robot_events("placebot1")]
 
 
 def _agent(link: MemoryLink) -> RobotAgent:
@@ -115,9 +112,7 @@ INBOUND = [topics.robot_cmd("placebot1"), topics.FLEET_CMD, DELTA]
 
 
 @given(
-    inputs=st.lists(
-        st.tuples(st.sampled_from(INBOUND), command_payloads()), min_size=1, max_size=4
-    )
+    inputs=st.lists(st.tuples(st.sampled_from(INBOUND), command_payloads()), min_size=1, max_size=4)
 )
 @settings(max_examples=budget(150))
 def test_the_agent_answers_each_payload_as_the_decoder_judged_it(
@@ -188,9 +183,7 @@ def wire(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[WireTap, Ag
     from vahr.local.ports import free_port
 
     base = tmp_path_factory.mktemp("fuzz-agent")
-    broker: Mosquitto = Mosquitto(
-        BrokerConfig(state_dir=base / "broker", plain_port=free_port())
-    )
+    broker: Mosquitto = Mosquitto(BrokerConfig(state_dir=base / "broker", plain_port=free_port()))
     broker.start()
     tap = WireTap(broker.config.plain_port or 0)
     agent = AgentProcess(

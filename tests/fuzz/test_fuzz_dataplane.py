@@ -29,9 +29,32 @@ if TYPE_CHECKING:
 
 SEGMENTS = st.one_of(
     st.sampled_from(
-        ["topics", "things", "shadow", "api", "ListNamedShadowsForThing", "vahr", "health",
-         "meter", "reset", "say", "status", "dashboard", "placebot1", "fuzzbot", "..", ".",
-         "%2F", "%00", "%", "+", "#", "$aws", "vahr%2Frobots%2Ffuzzbot%2Fcmd", ""]
+        [
+            "topics",
+            "things",
+            "shadow",
+            "api",
+            "ListNamedShadowsForThing",
+            "vahr",
+            "health",
+            "meter",
+            "reset",
+            "say",
+            "status",
+            "dashboard",
+            "placebot1",
+            "fuzzbot",
+            "..",
+            ".",
+            "%2F",
+            "%00",
+            "%",
+            "+",
+            "#",
+            "$aws",
+            "vahr%2Frobots%2Ffuzzbot%2Fcmd",
+            "",
+        ]
     ),  # fmt: skip
     text.map(lambda t: quote(t, safe="")),
     text.map(lambda t: quote(t, safe="/%+$#")),
@@ -70,9 +93,7 @@ HEADER_NAMES = st.one_of(
     st.sampled_from(["Content-Type", "Authorization", "X-Amz-Date", "Accept", "Expect"]),
     st.text(alphabet="abcdefghijklmnopqrstuvwxyz-", min_size=1, max_size=20),
 )
-HEADER_VALUES = st.text(
-    alphabet=st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=60
-)
+HEADER_VALUES = st.text(alphabet=st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=60)
 BODIES = st.one_of(st.just(b""), command_payloads(), shadow_payloads(), st.binary(max_size=200))
 # How the body's length is declared: honestly, not at all, or wrongly (never longer than
 # the body: a server must wait for a body it was promised).

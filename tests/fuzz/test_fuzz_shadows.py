@@ -47,9 +47,7 @@ def _stored(store: ShadowStore, thing: str, name: str | None) -> dict[str, Any] 
     return document
 
 
-@given(
-    requests=st.lists(st.tuples(OPERATIONS, NAMES, shadow_payloads()), min_size=1, max_size=6)
-)
+@given(requests=st.lists(st.tuples(OPERATIONS, NAMES, shadow_payloads()), min_size=1, max_size=6))
 @settings(max_examples=budget(300))
 def test_the_store_accepts_or_rejects_and_a_rejection_changes_nothing(
     requests: list[tuple[str, str | None, bytes]],

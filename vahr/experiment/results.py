@@ -150,6 +150,8 @@ def read_csv(path: Path) -> list[ResultRow]:
         raise VahrError(f"cannot read {path}: {err.strerror}") from err
     except csv.Error as err:
         raise VahrError(f"{path} is not a valid CSV file: {err}") from err
+    except UnicodeDecodeError as err:
+        raise VahrError(f"{path} is not UTF-8 text (byte {err.start} cannot be read)") from err
     if not rows:
         raise VahrError(f"{path} has no rows")
     return rows

@@ -253,6 +253,16 @@ class _Handler(QuietHandler):
         if self.command != "HEAD":
             self.wfile.write(payload)
 
+    def parse_request(self) -> bool:
+        if not super().parse_request():
+            return False
+        if self.request_version == "HTTP/0.9":
+            # A request line of two words (a path with a space or line break in it reads
+            # so): HTTP/0.9 answers carry no status line, which no AWS client can read.
+            self.send_error(400, "Bad request line: HTTP/1.1 is required")
+            return False
+        return True
+
     def __getattr__(self, name: str) -> Any:
         # Any method reaches the router, which answers 405 (or 404) in AWS's error shape;
         # http.server would answer a method it has no `do_` for with an HTML 501.

@@ -127,7 +127,10 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
                 check_thing(robot.thing)
             except ValueError as err:
                 raise ProtocolError(f"robots.{index}.thing", str(err).split(": ", 1)[1]) from err
-        check_thing(self.experiment_thing)
+        try:
+            check_thing(self.experiment_thing)
+        except ValueError as err:
+            raise ProtocolError("experiment_thing", str(err).split(": ", 1)[1]) from err
         _require_unique("robots", [robot.thing for robot in self.robots])
         _require_unique("zones", [zone.id for zone in self.zones])
         _require_unique("groups", [group.id for group in self.groups])

@@ -169,14 +169,15 @@ def check_against_fleet(command: Command, fleet: Fleet) -> None:
     """Zones and peer robots named in a command must exist in the fleet."""
     params = command.params
     if isinstance(params, ZoneParams | SequentialParams) and params.zone not in fleet.zone_ids:
+        zones = ", ".join(fleet.zone_ids)
         raise ProtocolError(
-            "params.zone", f"'{shown(params.zone)}' is not a zone; zones are {', '.join(fleet.zone_ids)}"
+            "params.zone", f"'{shown(params.zone)}' is not a zone; zones are {zones}"
         )
     if isinstance(params, SequentialParams) and params.after is not None:
         if params.after not in fleet.robot_things:
+            robots = ", ".join(fleet.robot_things)
             raise ProtocolError(
-                "params.after",
-                f"'{shown(params.after)}' is not a robot; robots are {', '.join(fleet.robot_things)}",
+                "params.after", f"'{shown(params.after)}' is not a robot; robots are {robots}"
             )
 
 
