@@ -151,7 +151,7 @@ def _best_effort_identity(payload: bytes) -> tuple[str | None, str | None]:
     """The id and action of a rejected payload, when they can be read, for the report."""
     try:
         value: Any = json.loads(payload)
-    except ValueError:
+    except (ValueError, RecursionError):  # nested deeper than the parser goes
         return None, None
     if not isinstance(value, dict):
         return None, None

@@ -22,8 +22,8 @@ THING_VARIABLE = "${iot:Connection.Thing.ThingName}"
 _MARK = "VAHRPOLICYTHING"
 
 # What a robot sends to its own shadow, and the answers it listens for.
-SHADOW_REQUESTS = ("update", "get", "delete")
-SHADOW_RESPONSES = tuple(op for op in topics.SHADOW_OPERATIONS if op not in SHADOW_REQUESTS)
+SHADOW_REQUESTS = topics.SHADOW_REQUESTS
+SHADOW_RESPONSES = topics.SHADOW_RESPONSES
 
 
 def _own(topic: str) -> str:

@@ -126,6 +126,6 @@ class ShadowSync:
 def _json_object(payload: bytes) -> dict[str, Any]:
     try:
         value = json.loads(payload)
-    except ValueError:
+    except (ValueError, RecursionError):  # nested deeper than the parser goes
         return {}
     return value if isinstance(value, dict) else {}

@@ -36,6 +36,11 @@ def json_values(max_leaves: int = 12) -> st.SearchStrategy[Any]:
     )
 
 
+def deep_arrays(depth: int) -> bytes:
+    """JSON nested deeper than parsers recurse (8 KB holds about 4,000 levels)."""
+    return b"[" * depth + b"]" * depth
+
+
 def deeply_nested(depth: int) -> Any:
     value: Any = 1
     for _ in range(depth):
@@ -94,6 +99,10 @@ def command_payloads() -> st.SearchStrategy[bytes]:
         st.binary(max_size=64),
         st.integers(8 * 1024 - 64, 8 * 1024 + 64).map(lambda n: b'{"id":"' + b"x" * n + b'"}'),
         st.integers(10, 200).map(lambda d: encode(deeply_nested(d))),
+        st.integers(900, 4000).map(
+            lambda d: b'{"id":"deep","action":"ping","params":' + deep_arrays(d) + b"}"
+        ),
+        st.integers(900, 4000).map(deep_arrays),
     )
 
 
@@ -120,6 +129,9 @@ def shadow_payloads() -> st.SearchStrategy[bytes]:
         json_values().map(encode),
         st.binary(max_size=64),
         st.integers(3, 12).map(lambda d: encode({"state": {"reported": deeply_nested(d)}})),
+        st.integers(900, 4000).map(
+            lambda d: b'{"state":{"reported":{"a":' + deep_arrays(d) + b"}}}"
+        ),
         st.integers(7 * 1024, 9 * 1024).map(
             lambda n: encode({"state": {"reported": {"blob": "x" * n}}})
         ),

@@ -11,6 +11,7 @@ import pytest
 from vahr.cli import main as vahr_main
 from vahr.errors import VahrError
 from vahr.experiment.results import read_csv
+from vahr.local.shadow_store import ShadowError, ShadowStore
 from vahr.protocol import Fleet, ProtocolError, decode_command
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -63,3 +64,15 @@ def test_a_results_file_that_is_not_utf8_is_refused_in_one_line(
     assert capsys.readouterr().err.strip().splitlines() == [
         f"vahr report: error: {results} is not UTF-8 text (byte 19 cannot be read)"
     ]
+
+
+def test_a_shadow_update_nested_deeper_than_the_parser_goes_is_a_400() -> None:
+    store = ShadowStore(None)
+    for depth, message in (
+        (900, "JSON nests arrays too deeply; maximum is 32 levels"),
+        (4000, "JSON contains too many levels of nesting; maximum is 6"),
+    ):
+        payload = b'{"state":{"reported":{"a":' + b"[" * depth + b"]" * depth + b"}}}"
+        with pytest.raises(ShadowError) as rejected:
+            store.update("placebot1", None, payload)
+        assert (rejected.value.code, rejected.value.message) == (400, message)

@@ -3,8 +3,10 @@
 A robot is known by its certificate's common name (= thing name, `%u` with
 `use_identity_as_username`). Like the cloud policy, a robot may receive its own command
 topic and the fleet topic, publish its own events and presence, read its peers' events and
-presence, and touch only its own shadow topics (classic and named). Patterns cover any
-number of robots, so `vahr up --robots N` needs no new file.
+presence, send requests to its own classic shadow (update, get, delete) and hear only the
+answers on it. Patterns cover any number of robots, so `vahr up --robots N` needs no new
+file. (Like the cloud policy, a robot cannot publish the service's answers, such as a
+forged `update/delta` carrying a command, not even on its own shadow.)
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from typing import TYPE_CHECKING
 
 from vahr.pki import SERVICE_COMMON_NAME
 from vahr.protocol import topics
+from vahr.protocol.topics import SHADOW_REQUESTS, SHADOW_RESPONSES
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -51,7 +54,8 @@ def render_acl(*, service_user: str = SERVICE_COMMON_NAME, open_anonymous: bool 
         f"pattern write {_pattern(topics.robot_presence(_PLACEHOLDER))}",
         f"pattern read {topics.ALL_EVENTS}",
         f"pattern read {topics.ALL_PRESENCE}",
-        f"pattern readwrite {_pattern(topics.shadow_filter(_PLACEHOLDER))}",
+        *(f"pattern write {_pattern(topics.shadow(_PLACEHOLDER, op))}" for op in SHADOW_REQUESTS),
+        *(f"pattern read {_pattern(topics.shadow(_PLACEHOLDER, op))}" for op in SHADOW_RESPONSES),
         # The room: a robot speaks to the assistant and hears only answers meant for it.
         f"pattern write {_pattern(topics.room_robot_speech(_PLACEHOLDER))}",
         f"pattern read {_pattern(topics.room_assistant_speech(_PLACEHOLDER))}",

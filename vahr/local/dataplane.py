@@ -185,7 +185,7 @@ class DataPlane:
             raise ApiError(404, f"No route for {method} {path}")
         try:
             request = json.loads(body or b"{}")
-        except ValueError:
+        except (ValueError, RecursionError):
             raise ApiError(400, "Invalid JSON") from None
         if not isinstance(request, dict):
             raise ApiError(400, "the request body must be a JSON object")

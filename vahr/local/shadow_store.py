@@ -25,6 +25,9 @@ if TYPE_CHECKING:
 MAX_REQUEST_BYTES = 8 * 1024
 MAX_STATE_BYTES = 8 * 1024
 MAX_DEPTH = 6
+# A local bound on objects and arrays together (AWS states none for arrays): the merge and
+# metadata stamping recurse, and a document nested thousands deep must be refused, not crash.
+MAX_NESTING = 32
 MAX_CLIENT_TOKEN_BYTES = 64
 SECTIONS = ("desired", "reported")
 
@@ -73,12 +76,20 @@ def _decode(data: str | bytes) -> Json:
     return decoded
 
 
-def _depth(value: Any) -> int:
-    if isinstance(value, dict):
-        return 1 + max((_depth(v) for v in value.values()), default=0)
-    if isinstance(value, list):
-        return max((_depth(v) for v in value), default=0)
-    return 0
+def _depth(value: Any) -> tuple[int, int]:
+    """(levels of objects, levels of objects and arrays) in `value`. AWS's limit counts
+    objects; the second bounds what the store's recursive merge may meet. Iterative: a
+    hostile document may be nested deeper than Python's recursion limit."""
+    deepest, nesting, pending = 0, 0, [(value, 0, 0)]
+    while pending:
+        item, objects, levels = pending.pop()
+        if isinstance(item, dict):
+            deepest, nesting = max(deepest, objects + 1), max(nesting, levels + 1)
+            pending.extend((inner, objects + 1, levels + 1) for inner in item.values())
+        elif isinstance(item, list):
+            nesting = max(nesting, levels + 1)
+            pending.extend((inner, objects, levels + 1) for inner in item)
+    return deepest, nesting
 
 
 def _stamp(value: Any, timestamp: int) -> Any:
@@ -165,6 +176,11 @@ def _decode_request(payload: bytes, *, required_state: bool) -> Json:
         request = json.loads(text)
     except ValueError:
         raise ShadowError(400, "Invalid JSON") from None
+    except RecursionError:
+        # Deeper than the parser goes, so far deeper than AWS's limit of MAX_DEPTH.
+        raise ShadowError(
+            400, f"JSON contains too many levels of nesting; maximum is {MAX_DEPTH}"
+        ) from None
     if not isinstance(request, dict):
         raise ShadowError(400, "Invalid JSON")
     token = request.get("clientToken")
@@ -279,9 +295,14 @@ class ShadowStore:
                 raise ShadowError(400, "State contains an invalid node", token)
             if section is not None and not isinstance(section, dict):
                 raise ShadowError(400, f"{key.capitalize()} node must be an object", token)
-            if section is not None and _depth(section) > MAX_DEPTH:
+            objects, nesting = _depth(section) if section is not None else (0, 0)
+            if objects > MAX_DEPTH:
                 raise ShadowError(
                     400, f"JSON contains too many levels of nesting; maximum is {MAX_DEPTH}", token
+                )
+            if nesting > MAX_NESTING:
+                raise ShadowError(
+                    400, f"JSON nests arrays too deeply; maximum is {MAX_NESTING} levels", token
                 )
         now = self.now()
         with self._lock:

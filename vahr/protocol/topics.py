@@ -38,6 +38,9 @@ SHADOW_OPERATIONS = (
     "delete/accepted",
     "delete/rejected",
 )
+# What a device sends to its own shadow; the other operations are the service's answers.
+SHADOW_REQUESTS = ("update", "get", "delete")
+SHADOW_RESPONSES = tuple(op for op in SHADOW_OPERATIONS if op not in SHADOW_REQUESTS)
 
 
 def check_thing(thing: str) -> str:

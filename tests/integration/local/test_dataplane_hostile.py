@@ -58,3 +58,20 @@ def test_a_request_line_broken_by_a_line_feed_gets_an_http_11_answer(
     status, _, body = _raw(local_stack, b"GET /vahr/health?a=\n HTTP/1.1\r\nHost: x\r\n\r\n")
     assert status == 400
     assert json.loads(body)["message"] == "Bad request line: HTTP/1.1 is required"
+
+
+def test_a_shadow_nested_deeper_than_the_parser_goes_is_a_400_not_a_500(
+    local_stack: LocalStack,
+) -> None:
+    deep = b"[" * 4000 + b"]" * 4000
+    document = b'{"state":{"reported":{"a":' + deep + b"}}}"
+    status, _, body = _raw(
+        local_stack,
+        b"POST /things/placebot1/shadow HTTP/1.1\r\nHost: x\r\nContent-Length: %d\r\n\r\n"
+        % len(document)
+        + document,
+    )
+    assert status == 400
+    assert json.loads(body) == {
+        "code": 400, "message": "JSON contains too many levels of nesting; maximum is 6",
+    }  # fmt: skip

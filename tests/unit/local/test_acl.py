@@ -13,7 +13,12 @@ def test_robots_get_only_their_own_topics_by_certificate_name() -> None:
     assert "pattern write vahr/robots/%u/events" in lines
     assert "pattern write vahr/robots/%u/presence" in lines
     assert "pattern read vahr/robots/+/events" in lines
-    assert "pattern readwrite $aws/things/%u/shadow/#" in lines
+    assert "pattern write $aws/things/%u/shadow/update" in lines
+    assert "pattern read $aws/things/%u/shadow/update/delta" in lines
+    # A robot cannot forge the shadow service's answers, not even on its own shadow.
+    assert not [
+        line for line in lines if "shadow" in line and "accepted" in line and "write" in line
+    ]
     assert "pattern write vahr/room/%u/robot" in lines
     assert "pattern read vahr/room/%u/assistant" in lines
     # No robot line grants writing to any command topic.

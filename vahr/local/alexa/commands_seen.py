@@ -21,7 +21,7 @@ class CommandLog:
             return
         try:
             command_id = json.loads(payload).get("id")
-        except (ValueError, AttributeError):
+        except (ValueError, AttributeError, RecursionError):
             return
         if isinstance(command_id, str):
             with self._lock:
