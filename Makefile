@@ -17,7 +17,7 @@ ROS_SITE := $(VENV)/ros-site
 export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
 export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 
-.PHONY: demo test lint typecheck pytest setup system-packages bench synth deploy skill-model clean
+.PHONY: demo test test-repeat lint typecheck pytest setup system-packages bench synth deploy skill-model clean
 
 demo: setup
 	$(BIN)/vahr demo
@@ -67,6 +67,12 @@ typecheck: setup
 
 pytest: setup
 	$(BIN)/pytest -q
+
+# The integration tests (processes, brokers, timing) five times in a row: a test that
+# passes only most of the time fails here (see docs/reliability.md).
+test-repeat: setup
+	for run in 1 2 3 4 5; do echo "integration run $$run of 5"; \
+		$(BIN)/pytest -q tests/integration || exit 1; done
 
 bench: setup
 	for script in bench/*.py; do case $$script in */_*) continue;; esac; $(BIN)/python $$script || exit 1; done
