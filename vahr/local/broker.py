@@ -54,6 +54,10 @@ class BrokerConfig:
             # Persistent sessions must keep QoS 1 commands for robots that are away.
             "max_queued_messages 10000",
             "persistent_client_expiration 7d",
+            # Save sessions and queued messages every second, not only on a clean stop:
+            # after a crash (SIGKILL, power loss) a robot's persistent session is still
+            # there, so a command sent while it reconnects is queued, not dropped.
+            "autosave_interval 1",
         ]
         if os.geteuid() == 0:
             # Started as root, mosquitto would drop to the `mosquitto` user, which cannot
