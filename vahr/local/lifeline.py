@@ -31,6 +31,9 @@ def main(argv: list[str]) -> int:
         print("usage: lifeline.py PARENT_PID SIGNAL -- COMMAND [ARG...]", file=sys.stderr)
         return USAGE
     parent, signal_number, command = int(argv[1]), int(argv[2]), argv[4:]
+    if sys.platform != "linux":
+        # No parent-death signal elsewhere: the command runs, without the guarantee.
+        return _exec(command)
     libc = ctypes.CDLL(None, use_errno=True)
     if libc.prctl(PR_SET_PDEATHSIG, signal_number, 0, 0, 0) != 0:
         print(f"lifeline: prctl: {os.strerror(ctypes.get_errno())}", file=sys.stderr)
@@ -38,6 +41,10 @@ def main(argv: list[str]) -> int:
     if os.getppid() != parent:
         # The parent died before the signal was armed: do not start an orphan.
         return ORPHANED
+    return _exec(command)
+
+
+def _exec(command: list[str]) -> int:
     try:
         os.execvp(command[0], command)
     except OSError as err:
