@@ -64,3 +64,39 @@ def test_the_agent_recovers_from_broker_crashes_and_runs_each_command_once(
               f"(all: {', '.join(f'{r:.2f}' for r in recoveries)})")  # fmt: skip
     finally:
         tap.close()
+
+
+@pytest.mark.slow
+def test_the_agent_recovers_from_dropped_connections_and_runs_each_command_once(
+    mosquitto: Mosquitto, start_agent: Callable[..., AgentProcess]
+) -> None:
+    from tests.faults import TcpProxy
+    from tests.integration.agent.harness import WireTap
+
+    # Given an agent whose connection to the broker goes through a relay that can cut it
+    proxy = TcpProxy(mosquitto.config.plain_port or 0)
+    tap = WireTap(mosquitto.config.plain_port or 0)
+    agent = start_agent("placebot1", "--broker", f"mqtt://127.0.0.1:{proxy.port}")
+    try:
+        tap.wait_for(lambda m: m.topic == topics.robot_presence("placebot1"), 30)
+        recoveries = []
+        for drop in range(RESTARTS):
+            # When the connection is cut
+            connections = proxy.accepted
+            assert proxy.drop_all() == 1
+            cut_at = time.monotonic()
+            # Then a command sent at once is queued by the broker (persistent session) and
+            # run exactly once when the agent is back
+            command_id = f"after-drop-{drop}"
+            tap.publish(topics.robot_cmd("placebot1"), command(command_id, "ping"))
+            tap.event("placebot1", "accepted", command_id, timeout_s=RECOVERY_BOUND_S)
+            recoveries.append(time.monotonic() - cut_at)
+            assert proxy.accepted == connections + 1
+            kinds = [e["event"] for e in tap.events("placebot1", command_id)]
+            assert kinds.count("accepted") == 1, kinds
+        assert agent.process.poll() is None, agent.log()[-2000:]
+        print(f"\nlongest recovery after a dropped connection: {max(recoveries):.2f} s "
+              f"(all: {', '.join(f'{r:.2f}' for r in recoveries)})")  # fmt: skip
+    finally:
+        tap.close()
+        proxy.close()
