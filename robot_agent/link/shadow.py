@@ -119,7 +119,12 @@ class ShadowSync:
             return
         # The command travels the same path as one from the command topic (decoding,
         # rejection with a reason, de-duplication), so desired state has no special rules.
-        self._on_desired_command(msgspec.json.encode(command))
+        try:
+            payload = msgspec.json.encode(command)
+        except RecursionError:  # only a document no shadow service would accept
+            log.warning("%s: ignoring a desired command nested too deeply to read", self.thing)
+        else:
+            self._on_desired_command(payload)
         self.clear_desired()
 
 

@@ -39,6 +39,12 @@ def test_a_rejection_quoting_a_long_action_is_short() -> None:
     assert len(str(rejected.value)) < 200
 
 
+def test_a_rejection_naming_an_unknown_field_the_sender_made_up_is_short() -> None:
+    with pytest.raises(ProtocolError) as rejected:
+        decode_command(_command(params={"zone": "A", "k" * 5000: 1}))
+    assert str(rejected.value) == f"params.{'k' * 39}…: is not a known field"
+
+
 def test_a_fleet_with_a_bad_experiment_thing_is_refused_naming_the_field() -> None:
     text = (
         (ROOT / "fleet.yaml")

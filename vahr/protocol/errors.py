@@ -58,7 +58,8 @@ def from_validation_error(err: msgspec.ValidationError | msgspec.DecodeError) ->
     if found := _MISSING.match(reason):
         return ProtocolError(_join(path, found["field"]), "is required but missing")
     if found := _UNKNOWN.match(reason):
-        return ProtocolError(_join(path, found["field"]), "is not a known field")
+        # The name is the sender's own: shown cut short, like any value a payload carries.
+        return ProtocolError(_join(path, shown(found["field"])), "is not a known field")
     if found := _EXPECTED.match(reason):
         return ProtocolError(path or "payload", f"expected {found['want']}, got {found['got']}")
     if isinstance(err, msgspec.DecodeError) and not path:
