@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
+from robot_agent.core.executor import ExecutorSettings
 from tests.integration.agent.harness import command
 from tests.support.swarm import SwarmThread, swarm_fleet
 from vahr.errors import VahrError
@@ -16,6 +17,10 @@ if TYPE_CHECKING:
     from vahr.local.broker import Mosquitto
 
 COUNT = 25
+# At 50x, the default 10 simulated seconds without progress are 0.2 s of wall time: a busy
+# machine starves the simulator that long and a robot would report `stuck`. These tests
+# are about the swarm, not stuck detection, so they allow 2.4 s.
+PATIENT = ExecutorSettings(stuck_after_s=120)
 
 
 def test_swarm_fleet_names_robots_in_order_and_keeps_the_zones() -> None:
@@ -36,7 +41,9 @@ def test_a_swarm_that_cannot_be_built_leaves_no_thread_behind() -> None:
 def test_one_fleet_command_reaches_every_robot_of_the_swarm(
     mosquitto: Mosquitto, tap: WireTap, shadows: ShadowResponder
 ) -> None:
-    with SwarmThread(broker=str(mosquitto.plain_url), count=COUNT, speed_factor=50) as swarm:
+    with SwarmThread(
+        broker=str(mosquitto.plain_url), count=COUNT, speed_factor=50, settings=PATIENT
+    ) as swarm:
         assert swarm.things[0] == "swarm0001" and len(swarm.things) == COUNT
         for thing in swarm.things:
             tap.reported(thing, lambda r: r["connected"] is True)
@@ -71,7 +78,9 @@ def test_one_fleet_command_reaches_every_robot_of_the_swarm(
 def test_swarm_robots_coordinate_a_sequential_delivery(
     mosquitto: Mosquitto, tap: WireTap, shadows: ShadowResponder
 ) -> None:
-    with SwarmThread(broker=str(mosquitto.plain_url), count=2, speed_factor=50) as swarm:
+    with SwarmThread(
+        broker=str(mosquitto.plain_url), count=2, speed_factor=50, settings=PATIENT
+    ) as swarm:
         first, second = swarm.things
         tap.reported(second, lambda r: r["connected"] is True)
         tap.publish(

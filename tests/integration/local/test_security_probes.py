@@ -46,7 +46,7 @@ class Probe:
             CallbackAPIVersion.VERSION2, client_id=client_id, protocol=MQTTProtocolVersion.MQTTv5
         )
         self.client.tls_set_context(_context(credentials))
-        self.received: list[str] = []
+        self.received: list[tuple[str, bytes]] = []
         self.acks: dict[int, int] = {}
         self.disconnects: list[str] = []
         self._changed = threading.Condition()
@@ -71,7 +71,7 @@ class Probe:
 
     def _on_message(self, client: Any, userdata: Any, message: paho.MQTTMessage) -> None:
         with self._changed:
-            self.received.append(message.topic)
+            self.received.append((message.topic, bytes(message.payload)))
             self._changed.notify_all()
 
     def _on_publish(self, client: Any, userdata: Any, mid: int, reason: Any, props: Any) -> None:
@@ -92,10 +92,18 @@ class Probe:
         self.client.subscribe(topic_filter, qos=1)
         assert done.wait(10)
 
-    def wait_received(self, topic: str, timeout_s: float = 10.0) -> list[str]:
+    def received_until(self, marker: bytes, timeout_s: float = 10.0) -> list[str]:
+        """The topics received (retained ones too) up to the message carrying `marker`."""
         with self._changed:
-            assert self._changed.wait_for(lambda: topic in self.received, timeout_s), topic
-            return list(self.received)
+            assert self._changed.wait_for(
+                lambda: any(payload == marker for _, payload in self.received), timeout_s
+            ), marker
+            topics_seen = []
+            for topic, payload in self.received:
+                topics_seen.append(topic)
+                if payload == marker:
+                    return topics_seen
+        raise AssertionError("unreachable")
 
     def close(self) -> None:
         self.client.disconnect()
@@ -146,24 +154,29 @@ def test_a_robot_certificate_is_refused_every_other_identitys_topics(
 ) -> None:
     with MqttClient(local_stack.service_endpoint()) as watcher:
         seen: list[str] = []
-        arrived = threading.Event()
+        markers = threading.Semaphore(0)
 
         def record(topic: str, payload: bytes) -> None:
             seen.append(topic)
             if topic == topics.robot_events("placebot2"):
-                arrived.set()
+                markers.release()
 
         watcher.subscribe("#", record)
         watcher.subscribe("$aws/#", record)
+        # Given a first event of placebot2's own: what the watcher saw before it (retained
+        # messages of earlier tests) is not this test's business
+        assert intruder.publish(topics.robot_events("placebot2")) == 0
+        assert markers.acquire(timeout=10)
+        before = len(seen)
         # When placebot2's certificate publishes where only others may
         codes = {topic: intruder.publish(topic) for topic in FORBIDDEN_PUBLISH}
         # Then every publish is refused (MQTT 5 PUBACK 0x87, Not authorized)...
         assert codes == dict.fromkeys(FORBIDDEN_PUBLISH, NOT_AUTHORIZED)
         # ...while its own rights still work, and the refused messages never reached
-        # anyone: the broker keeps one publisher's order, so its own event comes last.
+        # anyone: the broker keeps one publisher's order, so its own event comes next.
         assert intruder.publish(topics.robot_events("placebot2")) == 0
-        assert arrived.wait(10)
-        assert seen == [topics.robot_events("placebot2")]
+        assert markers.acquire(timeout=10)
+        assert seen[before:] == [topics.robot_events("placebot2")]
         assert intruder.disconnects == []
 
 
@@ -180,11 +193,11 @@ def test_a_robot_certificate_hears_nothing_of_another_robot(
     with MqttClient(local_stack.service_endpoint()) as service:
         service.publish(topics.robot_cmd("placebot1"), b'{"secret":1}')
         service.publish(topics.shadow("placebot1", "update/delta"), b'{"secret":2}')
-        service.publish(topics.robot_events("placebot1"), b'{"event":"marker"}')
-    # Then it received only the event, which came after both secrets
-    assert intruder.wait_received(topics.robot_events("placebot1")) == [
-        topics.robot_events("placebot1")
-    ]
+        service.publish(topics.robot_events("placebot1"), b'{"event":"marker-1"}')
+    # Then of all it received (retained events of earlier tests included), nothing was
+    # placebot1's command or shadow, up to the event that came after both secrets
+    received = intruder.received_until(b'{"event":"marker-1"}')
+    assert set(received) == {topics.robot_events("placebot1")}
 
 
 def _handshake(port: int, context: ssl.SSLContext) -> str | None:
@@ -270,10 +283,9 @@ def test_a_client_id_that_is_not_the_thing_name_gets_nothing_of_that_thing(
         impostor.subscribe(topics.robot_events("placebot1"))
         with MqttClient(local_stack.service_endpoint()) as service:
             service.publish(topics.robot_cmd("placebot1"), b'{"secret":1}')
-            service.publish(topics.robot_events("placebot1"), b'{"event":"marker"}')
-        assert impostor.wait_received(topics.robot_events("placebot1")) == [
-            topics.robot_events("placebot1")
-        ]
+            service.publish(topics.robot_events("placebot1"), b'{"event":"marker-2"}')
+        received = impostor.received_until(b'{"event":"marker-2"}')
+        assert set(received) == {topics.robot_events("placebot1")}
         # And its publishes are judged by its certificate, not by the id it claimed
         assert impostor.publish(topics.robot_events("placebot1")) == NOT_AUTHORIZED
     finally:
@@ -348,8 +360,8 @@ def test_a_flood_of_connections_does_not_stop_the_broker_or_the_api(
         try:
             robot.subscribe(topics.robot_events("placebot2"))
             with MqttClient(local_stack.service_endpoint()) as service:
-                service.publish(topics.robot_events("placebot2"), b'{"event":"marker"}')
-            robot.wait_received(topics.robot_events("placebot2"))
+                service.publish(topics.robot_events("placebot2"), b'{"event":"marker-3"}')
+            robot.received_until(b'{"event":"marker-3"}')
         finally:
             robot.close()
         # And the data plane answers
