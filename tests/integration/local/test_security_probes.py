@@ -25,15 +25,15 @@ from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 from paho.mqtt.enums import CallbackAPIVersion, MQTTProtocolVersion
 
 from vahr.local.mqtt import MqttClient
-from vahr.local.pki import LocalCA
+from vahr.pki import LocalCA
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
 
-    from vahr.local.pki import ClientCredentials
     from vahr.local.stack import LocalStack
+    from vahr.pki import ClientCredentials
 
 NOT_AUTHORIZED = 0x87
 
