@@ -82,3 +82,11 @@ def test_a_shadow_update_nested_deeper_than_the_parser_goes_is_a_400() -> None:
         with pytest.raises(ShadowError) as rejected:
             store.update("placebot1", None, payload)
         assert (rejected.value.code, rejected.value.message) == (400, message)
+
+
+def test_a_room_message_nested_deeper_than_the_parser_goes_is_not_speech() -> None:
+    from vahr.speech.errors import SpeechError
+    from vahr.speech.room import Utterance
+
+    with pytest.raises(SpeechError, match="^room message is not an utterance: "):
+        Utterance.decode(b"[" * 4000 + b"]" * 4000)

@@ -79,7 +79,7 @@ class Utterance:
                 audio=Audio.from_wav(base64.b64decode(body["audio"], validate=True)),
                 in_reply_to=None if reply is None else str(reply),
             )
-        except (ValueError, KeyError, TypeError, binascii.Error) as err:
+        except (ValueError, KeyError, TypeError, binascii.Error, RecursionError) as err:
             raise SpeechError(f"room message is not an utterance: {err}") from err
 
 
