@@ -90,3 +90,15 @@ def test_a_room_message_nested_deeper_than_the_parser_goes_is_not_speech() -> No
 
     with pytest.raises(SpeechError, match="^room message is not an utterance: "):
         Utterance.decode(b"[" * 4000 + b"]" * 4000)
+
+
+def test_a_results_row_without_interaction_is_refused_in_one_line(tmp_path: Path) -> None:
+    # fan-out = task time / RAD, and RAD = 0 without any interaction (found by tests/fuzz/)
+    results = tmp_path / "results.csv"
+    header = "participant,method,trial,interaction_time_s,neglect_time_s,task_time_s,puzzle_parts,mental,physical,temporal,performance,effort,frustration,confidence,trust"
+    results.write_text(f"{header}\nP0,console,1,0,40,60,3,10,3,8,15,9,4,17,16\n")
+    with pytest.raises(VahrError) as refused:
+        read_csv(results)
+    assert str(refused.value) == (
+        "row 2: interaction_time_s is 0; fan-out (task time / RAD) is undefined"
+    )

@@ -52,6 +52,14 @@ class ResultRow:
     # (successes, total) of tasks, commands and communication, when measured from a log.
     tallies: dict[str, tuple[int, int]] | None = None
 
+    def __post_init__(self) -> None:
+        # RAD = IE / (IE + NT) and fan-out = task time / RAD: with no interaction at all
+        # neither is defined, and no report could be drawn from the row.
+        if self.interaction_time_s + self.neglect_time_s == 0:
+            raise VahrError("interaction and neglect time are both 0; RAD is undefined")
+        if self.interaction_time_s == 0:
+            raise VahrError("interaction_time_s is 0; fan-out (task time / RAD) is undefined")
+
     @property
     def rad(self) -> float:
         """RAD of this row: IE / (IE + NT)."""
@@ -122,19 +130,24 @@ def parse_row(line: int, raw: dict[str, str]) -> ResultRow:
             tlx = TlxAnswers.from_mapping({item: check_level(item, cell(item)) for item in ITEMS})
         except ValueError as err:
             raise VahrError(f"row {line}: {err}") from None
-    row = ResultRow(
-        participant=cell("participant"),
-        method=cell("method"),
-        trial=int(trial),
-        interaction_time_s=_number(line, "interaction_time_s", cell("interaction_time_s")),
-        neglect_time_s=_number(line, "neglect_time_s", cell("neglect_time_s")),
-        task_time_s=_number(line, "task_time_s", cell("task_time_s")),
-        puzzle_parts=int(_number(line, "puzzle_parts", cell("puzzle_parts"), whole=True)),
-        tlx=tlx,
-    )
-    if row.interaction_time_s + row.neglect_time_s == 0:
-        raise VahrError(f"row {line}: interaction and neglect time are both 0; RAD is undefined")
-    return row
+    interaction = _number(line, "interaction_time_s", cell("interaction_time_s"))
+    neglect = _number(line, "neglect_time_s", cell("neglect_time_s"))
+    task = _number(line, "task_time_s", cell("task_time_s"))
+    puzzle_parts = int(_number(line, "puzzle_parts", cell("puzzle_parts"), whole=True))
+    participant, method = cell("participant"), cell("method")
+    try:
+        return ResultRow(
+            participant=participant,
+            method=method,
+            trial=int(trial),
+            interaction_time_s=interaction,
+            neglect_time_s=neglect,
+            task_time_s=task,
+            puzzle_parts=puzzle_parts,
+            tlx=tlx,
+        )
+    except VahrError as err:  # the row's own rules (ResultRow.__post_init__)
+        raise VahrError(f"row {line}: {err}") from None
 
 
 def read_csv(path: Path) -> list[ResultRow]:
