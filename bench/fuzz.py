@@ -45,12 +45,13 @@ def main() -> None:
         f"| {'0' if done.returncode == 0 else 'see run'} |"
         for boundary, counts in tally.items()
     ]
+    only = f" Only the tests matching `-k {args.k}` ran." if args.k else ""
     body = f"""
 Every boundary that takes outside input, fed by hypothesis (`bench` profile, derandomized)
 through its real entry point; {elapsed / 60:.1f} minutes in one run. Accepted inputs did what
 they asked; rejected ones were refused with a reason naming the field (or AWS's code) and
 changed nothing; a crash, hang or wrong answer would fail the run. pytest exit code:
-{done.returncode}.
+{done.returncode}.{only}
 
 | boundary | inputs | accepted | rejected | crashes |
 | --- | --- | --- | --- | --- |
