@@ -253,33 +253,12 @@ class _Handler(QuietHandler):
         if self.command != "HEAD":
             self.wfile.write(payload)
 
-    def parse_request(self) -> bool:
-        if not super().parse_request():
-            return False
-        if self.request_version == "HTTP/0.9":
-            # A request line of two words (a path with a space or line break in it reads
-            # so): HTTP/0.9 answers carry no status line, which no AWS client can read.
-            self.send_error(400, "Bad request line: HTTP/1.1 is required")
-            return False
-        return True
+    def refuse(self, status: int, message: str) -> None:
+        self._answer(*_error(status, message))
 
-    def __getattr__(self, name: str) -> Any:
-        # Any method reaches the router, which answers 405 (or 404) in AWS's error shape;
-        # http.server would answer a method it has no `do_` for with an HTML 501.
-        if name.startswith("do_"):
-            return self._serve
-        raise AttributeError(name)
-
-    def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
-        """http.server's own rejections (a malformed request line, headers too long, ...)
-        in the same JSON shape as every other error."""
-        self.close_connection = True
-        # The request line may not have been parsed: answer as to a GET of nothing.
-        self.command, self.path = self.command or "GET", getattr(self, "path", "") or ""
-        # A mangled request line reads as HTTP/0.9, whose answers have no status line;
-        # every client this API serves speaks HTTP/1.1, so answer in it.
-        self.request_version = "HTTP/1.1"
-        self._answer(*_error(code, message or explain or "Bad request"))
+    def unknown_method(self) -> None:
+        # Any method reaches the router, which answers 405 (or 404) in AWS's error shape.
+        self._serve()
 
 
 class _Server(QuietServer):

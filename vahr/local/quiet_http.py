@@ -1,6 +1,6 @@
 """The HTTP plumbing the lab's servers share (the data plane, the operator station): a
-threaded server whose handlers keep connections alive and log at debug level only, served
-on a background thread.
+threaded server whose handlers keep connections alive, log at debug level only and answer
+every request, however mangled, in their own error shape; served on a background thread.
 """
 
 from __future__ import annotations
@@ -9,8 +9,12 @@ import logging
 import sys
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from typing import TYPE_CHECKING
 
 from vahr.errors import VahrError
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 log = logging.getLogger(__name__)
 
@@ -25,6 +29,41 @@ class QuietHandler(BaseHTTPRequestHandler):
 
     def log_message(self, format: str, *args: object) -> None:  # noqa: A002
         log.debug("%s " + format, self.address_string(), *args)
+
+    def refuse(self, status: int, message: str) -> None:
+        """Answer with an error in the server's own shape (JSON, never http.server's HTML)."""
+        raise NotImplementedError
+
+    def unknown_method(self) -> None:
+        """A method the handler has no `do_` for (http.server would answer an HTML 501)."""
+        self.close_connection = True
+        self.refuse(405, f"{self.command} is not used here")
+
+    def __getattr__(self, name: str) -> Callable[[], None]:
+        if name.startswith("do_"):
+            return self.unknown_method
+        raise AttributeError(name)
+
+    def parse_request(self) -> bool:
+        if not super().parse_request():
+            return False
+        if self.request_version == "HTTP/0.9":
+            # A request line of two words (a path with a space or line break in it reads
+            # so): HTTP/0.9 answers carry no status line, which no client here can read.
+            self.send_error(400, "Bad request line: HTTP/1.1 is required")
+            return False
+        return True
+
+    def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
+        """http.server's own rejections (a malformed request line, headers too long, ...)
+        in the same shape as every other error."""
+        self.close_connection = True
+        # The request line may not have been parsed: answer as to a GET of nothing.
+        self.command, self.path = self.command or "GET", getattr(self, "path", "") or ""
+        # A mangled request line reads as HTTP/0.9, whose answers have no status line;
+        # every client of these servers speaks HTTP/1.1, so answer in it.
+        self.request_version = "HTTP/1.1"
+        self.refuse(code, message or explain or "Bad request")
 
 
 class QuietServer(ThreadingHTTPServer):

@@ -83,7 +83,7 @@ class _Handler(QuietHandler):
         if self.command != "HEAD":
             self.wfile.write(reply.body)
 
-    def _refuse(self, status: int, message: str) -> None:
+    def refuse(self, status: int, message: str) -> None:
         # A refused request's body may not have been read: close rather than misread it.
         self.close_connection = True
         self._send(error_reply(status, message), {"Connection": "close"})
@@ -93,16 +93,16 @@ class _Handler(QuietHandler):
         station = self.server.station
         host = self.headers.get("Host", "")
         if not station.host_allowed(host):
-            self._refuse(421, f"this station does not answer to the host {host!r}")
+            self.refuse(421, f"this station does not answer to the host {host!r}")
             return None
         url = urlsplit(self.path)
         query = {k: v[-1] for k, v in parse_qs(url.query).items()}
         if station.token is not None and not self._authorized(query):
-            self._refuse(401, "this station needs its token: open the URL it printed")
+            self.refuse(401, "this station needs its token: open the URL it printed")
             return None
         origin = self.headers.get("Origin")
         if self.command == "POST" and origin is not None and origin != f"http://{host}":
-            self._refuse(403, f"requests from {origin} are not accepted")
+            self.refuse(403, f"requests from {origin} are not accepted")
             return None
         return url.path, query
 
@@ -123,15 +123,15 @@ class _Handler(QuietHandler):
 
     def _body(self, limit: int) -> bytes | None:
         if "chunked" in self.headers.get("Transfer-Encoding", "").lower():
-            self._refuse(411, "send the body with a Content-Length, not chunked")
+            self.refuse(411, "send the body with a Content-Length, not chunked")
             return None
         try:
             length = int(self.headers.get("Content-Length") or 0)
         except ValueError:
-            self._refuse(400, "Content-Length is not a number")
+            self.refuse(400, "Content-Length is not a number")
             return None
         if length < 0 or length > limit:
-            self._refuse(413, f"the body is {length} bytes; at most {limit} are accepted")
+            self.refuse(413, f"the body is {length} bytes; at most {limit} are accepted")
             return None
         return self.rfile.read(length) if length else b""
 
@@ -175,31 +175,26 @@ class _Handler(QuietHandler):
         kind = self.headers.get("Content-Type", "").split(";")[0].strip().lower()
         if path == "/api/voice":
             if kind not in ("audio/wav", "audio/x-wav", "audio/wave"):
-                self._refuse(415, "push-to-talk sends audio/wav")
+                self.refuse(415, "push-to-talk sends audio/wav")
                 return
             body = self._body(MAX_AUDIO_BYTES)
             if body is not None:
                 self._send(app.voice(body))
             return
         if not app.is_json_route("POST", path):
-            self._refuse(404, f"nothing to POST at {path}")
+            self.refuse(404, f"nothing to POST at {path}")
             return
         if kind != "application/json":
-            self._refuse(415, "send application/json")
+            self.refuse(415, "send application/json")
             return
         body = self._body(MAX_JSON_BYTES)
         if body is not None:
             self._send(app.handle_json("POST", path, body))
 
-    def do_PUT(self) -> None:  # noqa: N802
-        self._refuse(405, f"{self.command} is not used here")
-
-    do_DELETE = do_PATCH = do_OPTIONS = do_PUT
-
     def _stream(self) -> None:
         station = self.server.station
         if not station.open_stream():
-            self._refuse(503, f"at most {MAX_STREAMS} pages at once")
+            self.refuse(503, f"at most {MAX_STREAMS} pages at once")
             return
         feed = station.app.feed
         subscriber = feed.subscribe()

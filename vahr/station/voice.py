@@ -46,8 +46,11 @@ def read_clip(data: bytes) -> Audio:
             shape = (clip.getnchannels(), clip.getsampwidth(), clip.getframerate())
             frames = clip.getnframes()
             pcm = clip.readframes(frames)
-    except (wave.Error, EOFError) as err:
-        raise RequestError(400, f"the WAV file is not readable: {err}") from err
+    except (wave.Error, EOFError, RuntimeError) as err:
+        # The wave module raises a bare RuntimeError for a chunk whose size points past the
+        # end of the file (its chunk reader cannot seek there).
+        reason = err or "a chunk is cut short"
+        raise RequestError(400, f"the WAV file is not readable: {reason}") from err
     if shape != (1, SAMPLE_WIDTH, SAMPLE_RATE):
         channels, width, rate = shape
         raise RequestError(
