@@ -18,7 +18,7 @@ import msgspec
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tests.fuzz.strategies import json_values, scalars, text
+from tests.fuzz.strategies import json_values, paths_in, scalars, text
 from tests.fuzz.tally import TALLY, budget
 from vahr.errors import VahrError
 from vahr.experiment.report import build_report
@@ -32,17 +32,6 @@ ROOT = Path(__file__).resolve().parents[2]
 FLEET_DOCUMENT: dict[str, Any] = msgspec.yaml.decode((ROOT / "fleet.yaml").read_bytes())
 
 
-def _paths(value: Any, prefix: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
-    found = [prefix] if prefix else []
-    if isinstance(value, dict):
-        for key, inner in value.items():
-            found += _paths(inner, (*prefix, key))
-    elif isinstance(value, list):
-        for index, inner in enumerate(value):
-            found += _paths(inner, (*prefix, index))
-    return found
-
-
 @st.composite
 def fleet_texts(draw: st.DrawFn) -> bytes:
     kind = draw(st.sampled_from(["mutated", "mutated", "mutated", "json", "text", "bytes"]))
@@ -54,7 +43,7 @@ def fleet_texts(draw: st.DrawFn) -> bytes:
         return draw(st.binary(max_size=80))
     document = copy.deepcopy(FLEET_DOCUMENT)
     for _ in range(draw(st.integers(1, 3))):
-        path = draw(st.sampled_from(_paths(document)))
+        path = draw(st.sampled_from(paths_in(document)))
         parent: Any = document
         for step in path[:-1]:
             parent = parent[step]

@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 from skill.app import make_lambda_handler
 from skill.config import SkillConfig
 from skill.errors import GatewayError, ShadowConflict
-from tests.fuzz.strategies import json_values, text
+from tests.fuzz.strategies import json_values, paths_in, text
 from tests.fuzz.tally import TALLY, budget
 from tests.unit.skill.skill_testkit import check_response
 from vahr.local.shadow_store import ShadowError, ShadowStore
@@ -81,22 +81,11 @@ class StoreRobots:
             raise GatewayError(err.message) from err
 
 
-def _paths(value: Any, prefix: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
-    found = [prefix] if prefix else []
-    if isinstance(value, dict):
-        for key, inner in value.items():
-            found += _paths(inner, (*prefix, key))
-    elif isinstance(value, list):
-        for index, inner in enumerate(value):
-            found += _paths(inner, (*prefix, index))
-    return found
-
-
 @st.composite
 def envelopes(draw: st.DrawFn) -> dict[str, Any]:
     envelope = copy.deepcopy(ENVELOPES[draw(st.sampled_from(sorted(ENVELOPES)))])
     for _ in range(draw(st.integers(1, 3))):
-        paths = _paths(envelope)
+        paths = paths_in(envelope)
         if not paths:
             break
         path = draw(st.sampled_from(paths))

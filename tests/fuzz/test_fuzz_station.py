@@ -26,6 +26,7 @@ from hypothesis import strategies as st
 
 from tests.fuzz.strategies import THINGS, ZONES, encode, json_values, text
 from tests.fuzz.tally import TALLY, budget
+from tests.support.station import RecordingAssistant, Wire
 from vahr.local.ports import free_port
 from vahr.protocol import decode_command
 from vahr.speech.stt import NOTHING_HEARD
@@ -124,23 +125,6 @@ CLIPS = st.one_of(
 )
 
 
-class Wire:
-    def __init__(self) -> None:
-        self.sent: list[tuple[str, bytes]] = []
-
-    def publish(self, topic: str, payload: bytes) -> None:
-        self.sent.append((topic, payload))
-
-
-class Assistant:
-    def __init__(self) -> None:
-        self.asked: list[str] = []
-
-    def ask(self, utterance: str, *, origin: str, heard: dict[str, Any] | None = None) -> Any:
-        self.asked.append(utterance)
-        return {"speech": "Okay.", "intent": "StatusIntent", "commands": []}
-
-
 class HearsNothing:
     def recognize(self, audio: Audio) -> Recognition:
         return NOTHING_HEARD
@@ -148,7 +132,7 @@ class HearsNothing:
 
 class Station:
     def __init__(self, fleet: Fleet) -> None:
-        self.wire, self.assistant = Wire(), Assistant()
+        self.wire, self.assistant = Wire(), RecordingAssistant()
         self.feed = Feed(fleet)
         desk = Desk(self.feed, self.wire.publish)
         app = StationApp(

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
+from tests.support.station import RecordingAssistant, Wire
 from vahr.protocol import decode_command, topics
 from vahr.protocol.station import Interaction, PuzzleInput, decode_station_input
 from vahr.station.app import StationApp
@@ -18,25 +19,6 @@ from vahr.station.feed import Feed
 
 if TYPE_CHECKING:
     from vahr.protocol import Fleet
-
-
-class Wire:
-    def __init__(self) -> None:
-        self.sent: list[tuple[str, bytes]] = []
-
-    def publish(self, topic: str, payload: bytes) -> None:
-        self.sent.append((topic, payload))
-
-
-class Assistant:
-    def __init__(self) -> None:
-        self.asked: list[tuple[str, str]] = []
-
-    def ask(
-        self, utterance: str, *, origin: str, heard: dict[str, Any] | None = None
-    ) -> dict[str, Any]:
-        self.asked.append((utterance, origin))
-        return {"speech": "It is sunny.", "intent": "WeatherIntent", "commands": []}
 
 
 @pytest.fixture
@@ -56,7 +38,7 @@ def app(fleet: Fleet, feed: Feed, wire: Wire) -> StationApp:
         feed=feed,
         controls=Controls(fleet, desk, wire.publish),
         desk=desk,
-        assistant=Assistant(),
+        assistant=RecordingAssistant(),
         push_to_talk=None,
         synthesize=None,
     )
