@@ -65,14 +65,15 @@ lint: setup
 typecheck: setup
 	$(BIN)/mypy
 
+# Two workers, one per core: each test file runs whole on one worker (tests/conftest.py).
 pytest: setup
-	$(BIN)/pytest -q
+	$(BIN)/pytest -q -n 2 --dist loadgroup
 
 # The integration tests (processes, brokers, timing) five times in a row: a test that
 # passes only most of the time fails here (see docs/reliability.md).
 test-repeat: setup
 	for run in 1 2 3 4 5; do echo "integration run $$run of 5"; \
-		$(BIN)/pytest -q tests/integration || exit 1; done
+		$(BIN)/pytest -q -n 2 --dist loadgroup tests/integration || exit 1; done
 
 bench: setup
 	for script in bench/*.py; do case $$script in */_*) continue;; esac; $(BIN)/python $$script || exit 1; done

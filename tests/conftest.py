@@ -17,6 +17,16 @@ if TYPE_CHECKING:
     from collections.abc import Iterator
 
 EVENTS_DIR = Path(__file__).parent / "events"
+INFRA_DIR = Path(__file__).parent / "infra"
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """With pytest-xdist's `--dist loadgroup`, keep each file's tests on one worker (its
+    module fixtures, a stack or a robot, start once) and every infra test on one worker
+    (the CDK apps they share are synthesized once per session)."""
+    for item in items:
+        group = "infra" if INFRA_DIR in item.path.parents else str(item.path)
+        item.add_marker(pytest.mark.xdist_group(group))
 
 
 @pytest.fixture(scope="session")

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 from vahr.speech.audio import SAMPLE_RATE, SpeechDetector
 from vahr.speech.errors import SpeechError
 from vahr.speech.pronounce import guesses
-from vahr.speech.stt import NOTHING_HEARD, HeardWord, Recognition
+from vahr.speech.stt import NOTHING_HEARD, HeardWord, Recognition, utterance
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -96,9 +96,8 @@ class LanguageModelRecognizer:
             return NOTHING_HEARD
         with self._lock:
             decoder = self._decoder
-            decoder.start_utt()
-            decoder.process_raw(audio.pcm, full_utt=True)
-            decoder.end_utt()
+            with utterance(decoder):
+                decoder.process_raw(audio.pcm, full_utt=True)
             words = self._words() if decoder.hyp() is not None else ()
         if not words:
             return Recognition("", 0.0, False, reason="nothing recognizable")

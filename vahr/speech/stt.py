@@ -23,15 +23,16 @@ from __future__ import annotations
 
 import math
 import threading
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio, SpeechDetector
 from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
+    from collections.abc import Iterable, Iterator
 
 # Logistic mapping of the per-frame log-likelihood ratio (pocketsphinx log units, base
 # 1.0001) to a confidence. Measured on espeak-ng speech in two voices, clean and at 20 dB
@@ -190,15 +191,25 @@ class GrammarRecognizer:
     def _score_per_frame(self, search: str, audio: Audio) -> float | None:
         decoder = self._decoder
         decoder.activate_search(search)
-        decoder.start_utt()
-        decoder.process_raw(audio.pcm, full_utt=True)
-        decoder.end_utt()
+        with utterance(decoder):
+            decoder.process_raw(audio.pcm, full_utt=True)
         hypothesis = decoder.hyp()
         frames = decoder.n_frames()
         if hypothesis is None or hypothesis.score <= 0.0 or frames == 0:
             return None
         # The binding hands the score back exponentiated; take the log again.
         return float(self._logmath.log(hypothesis.score)) / frames
+
+
+@contextmanager
+def utterance(decoder: Any) -> Iterator[None]:
+    """One utterance on a pocketsphinx decoder, ended even when processing raises: a
+    decoder left mid-utterance refuses every later search ("Unable to set search")."""
+    decoder.start_utt()
+    try:
+        yield
+    finally:
+        decoder.end_utt()
 
 
 def _reason(decoy: bool) -> str:
