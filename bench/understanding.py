@@ -190,9 +190,7 @@ turn, not the endpoints (budget: at most 1 s added to the start).
 | --- | --- | --- | --- | --- |
 {chr(10).join(rows)}
 
-<!-- The hearing half of issue 13 (`robot-agent hear` on spoken weather answers) adds its
-per-clip timings here, beside the recognizer alone, from a function of its own in this
-script. -->
+The robot's hearing (per clip, beside the recognizer alone) is `bench/hearing.py`'s section.
 """
     write_section("understanding", "Understanding people: the simulator's NLU", body)
     return 0
