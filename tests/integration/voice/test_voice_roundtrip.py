@@ -108,3 +108,18 @@ def test_the_room_assistant_hears_questions_and_ignores_other_robot_talk(voice: 
     for talk in ("Thank you. It is rainy, so I am delivering to zone C.",
                  "The weather is sunny.", "Robot two is stuck."):  # fmt: skip
         assert not recognizer.recognize(tts.synthesize(talk)).accepted, talk
+
+
+def test_a_decode_that_fails_does_not_deafen_the_recognizer() -> None:
+    from vahr.speech.stt import GrammarRecognizer, utterance
+
+    # Given a recognizer whose decoder fails in the middle of an utterance (pocketsphinx
+    # raises on an empty buffer, and a decoder left mid-utterance refuses every later search)
+    recognizer = GrammarRecognizer(["it is sunny"], verify=False)
+    decoder = recognizer._decoder
+    decoder.activate_search("grammar")
+    with pytest.raises(IndexError), utterance(decoder):
+        decoder.process_raw(b"", full_utt=True)
+    # Then the next clip is still heard
+    heard = recognizer.recognize(EspeakSynthesizer("en-us+f2").synthesize("It is sunny."))
+    assert (heard.accepted, heard.text) == (True, "it is sunny")
