@@ -35,6 +35,7 @@ ENV_PREFIX = "VAHR_AGENT_"
 # meaningless, so such values are refused at start-up with the key's name.
 Positive = Annotated[float, msgspec.Meta(gt=0)]
 NonNegative = Annotated[float, msgspec.Meta(ge=0)]
+Fraction = Annotated[float, msgspec.Meta(ge=0, le=1)]
 NonNegativeInt = Annotated[int, msgspec.Meta(ge=0)]
 PositiveInt = Annotated[int, msgspec.Meta(gt=0)]
 
@@ -64,7 +65,14 @@ class ExecutorSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True,
     listen_timeout_s: Positive = 8.0
     # Wall-clock bound on speaking one sentence, so a hung audio device fails the task.
     speak_timeout_s: Positive = 30.0
-    progress_interval_s: NonNegative = 1.0
+    # How often a drive reports `progress`. On AWS every event is a billed message, so by
+    # default a robot reports at most once every 5 s and once per quarter of the way (both
+    # must hold; `arrived` closes the drive). The local stack asks for more (`vahr up`
+    # writes progress_interval_s 1, progress_step 0) because a screen is cheap.
+    # Simulated seconds between two reports at least (0: every backend step).
+    progress_interval_s: NonNegative = 5.0
+    # Fraction of the way covered between two reports at least (0: no bound).
+    progress_step: Fraction = 0.25
 
 
 class Ros1Settings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
@@ -194,6 +202,8 @@ _SCALARS = (
 # Every environment variable the agent reads, and the key it sets (later rows win).
 ENVIRONMENT: dict[str, tuple[str, ...]] = {
     **{ENV_PREFIX + name.upper(): (name,) for name in _SCALARS},
+    "VAHR_AGENT_PROGRESS_INTERVAL_S": ("executor", "progress_interval_s"),
+    "VAHR_AGENT_PROGRESS_STEP": ("executor", "progress_step"),
     "VAHR_AGENT_VOICE": ("voice", "factory"),
     "VAHR_VOICE": ("voice", "synthesizer"),
     "VAHR_PLAY_COMMAND": ("voice", "play_command"),

@@ -259,12 +259,14 @@ class Executor:
         """Drive with stuck detection: no progress for `stuck_after_s` ends the task."""
         last_advance = self.clock.monotonic()
         last_progress: Progress | None = None
-        last_report = float("-inf")
+        # The drive's start counts as a report: the shadow said `navigating` from here.
+        last_report, last_fraction = last_advance, 0.0
+        interval, step = self.settings.progress_interval_s, self.settings.progress_step
 
         active = True
 
         def on_progress(progress: Progress) -> None:
-            nonlocal last_advance, last_progress, last_report
+            nonlocal last_advance, last_progress, last_report, last_fraction
             if not active or self._current is not command:
                 # Feedback a backend queued before the goal ended (ROS threads) comes late;
                 # after `cancelled` or `arrived` the task has nothing more to say.
@@ -273,13 +275,21 @@ class Executor:
                 last_advance = self.clock.monotonic()
             last_progress = progress
             now = self.clock.monotonic()
-            if now - last_report >= self.settings.progress_interval_s or progress.fraction >= 1:
-                last_report = now
+            fraction = min(max(progress.fraction, 0.0), 1.0)
+            # Both bounds must hold (see ExecutorSettings); `step` is compared with a little
+            # slack so that float steps of exactly a quarter still count as a quarter. The
+            # end of the way is never reported: `arrived`, with the pose, follows at once.
+            if (
+                fraction < 1
+                and now - last_report >= interval
+                and fraction - last_fraction >= step - 1e-9
+            ):
+                last_report, last_fraction = now, fraction
                 self._emit(
                     "progress",
                     command,
                     zone=zone.id,
-                    progress=round(min(max(progress.fraction, 0.0), 1.0), 3),
+                    progress=round(fraction, 3),
                     pose=progress.pose,
                 )
 

@@ -71,6 +71,16 @@ def write_fleet(fleet: Fleet, path: Path) -> Path:
     return path
 
 
+# Every robot here runs on this machine's clock, so a sequential delivery needs no
+# tolerance for clocks that disagree (see robot-agent's `peer_clock_skew_s`). And messages
+# cost nothing here, so robots report their progress every simulated second, as often as
+# the station wants for smooth drawing; on AWS the agent's defaults report far less often
+# (docs/robot-agent.md, "Progress reports").
+LOCAL_AGENT_CONFIG = (
+    "executor:\n  peer_clock_skew_s: 0\n  progress_interval_s: 1\n  progress_step: 0\n"
+)
+
+
 class RobotProcesses:
     """Start, watch and stop one `robot-agent run` process per robot."""
 
@@ -103,9 +113,7 @@ class RobotProcesses:
     def command(self, thing: str) -> list[str]:
         credentials = self.ca.issue_client(thing, self.state_dir / thing / "certs")
         config = self.state_dir / thing / "agent.yaml"
-        # Every robot here runs on this machine's clock, so a sequential delivery needs no
-        # tolerance for clocks that disagree (see robot-agent's `peer_clock_skew_s`).
-        config.write_text("executor:\n  peer_clock_skew_s: 0\n")
+        config.write_text(LOCAL_AGENT_CONFIG)
         command = [
             sys.executable, "-m", "robot_agent.cli", "run",
             "--config", str(config),

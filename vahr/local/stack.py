@@ -199,6 +199,9 @@ class LocalStack:
         if self._server is not None:
             self._server.stop()
             self._server = None
+        if self.shadows is not None:
+            # Before the client: what it delivered so far is served and answered.
+            self.shadows.stop()
         if self._service_client is not None:
             self._service_client.stop()
             self._service_client = None

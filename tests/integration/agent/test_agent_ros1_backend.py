@@ -136,7 +136,7 @@ def ros_executor(fleet: Fleet, ros_master: str) -> tuple[Executor, Recorder]:
         clock=ScaledClock(1.0),
         publish_state=recorder.states.append,
         publish_event=recorder.events.append,
-        settings=ExecutorSettings(progress_interval_s=0.0, stuck_after_s=5),
+        settings=ExecutorSettings(progress_interval_s=0.0, progress_step=0.0, stuck_after_s=5),
     )
     return executor, recorder
 

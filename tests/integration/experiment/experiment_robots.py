@@ -17,6 +17,7 @@ import paho.mqtt.client as mqtt
 import pytest
 
 from vahr.local.lifetime import spawn
+from vahr.local.robots import LOCAL_AGENT_CONFIG
 from vahr.protocol import decode_presence, topics
 
 if TYPE_CHECKING:
@@ -28,9 +29,10 @@ if TYPE_CHECKING:
     from vahr.protocol import Fleet
 
 SPEED = 50.0
-# These robots run on this machine's clock: no tolerance for clocks that disagree, so task
-# II's delivery (moments earlier at this speed) never counts for task III's sequence.
-AGENT_CONFIG = "executor:\n  peer_clock_skew_s: 0\n"
+# These robots run as `vahr up` runs them (this machine's clock, so no tolerance for clocks
+# that disagree and task II's delivery never counts for task III's sequence; the local
+# progress rate).
+AGENT_CONFIG = LOCAL_AGENT_CONFIG
 
 
 class RobotAgents:

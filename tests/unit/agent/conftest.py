@@ -68,6 +68,15 @@ class Recorder:
                 await asyncio.sleep(0.002)
 
 
+async def until_moved(backend: SimBackend, timeout_s: float = 5.0) -> None:
+    """Wait until the robot has left where it stood: it is driving, whatever its reporting
+    rate (progress events may be seconds apart, or none on a short drive)."""
+    start = backend.pose
+    async with asyncio.timeout(timeout_s):
+        while backend.pose.distance_to(start) < 0.05:
+            await asyncio.sleep(0.002)
+
+
 def make_executor(
     fleet: Fleet,
     *,

@@ -55,9 +55,28 @@ def test_flags_beat_environment_beat_file_beat_defaults(
         "peer_clock_skew_s": 2.0,
         "listen_timeout_s": 8.0,
         "speak_timeout_s": 30.0,
-        "progress_interval_s": 1.0,
+        "progress_interval_s": 5.0,
+        "progress_step": 0.25,
     }
     assert shown["backend"] == "sim" and shown["port"] == 8883  # defaults
+
+
+def test_the_progress_rate_is_chosen_by_file_or_environment(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Given a deployment that wants a report every 2 s (file) on every tenth (environment)
+    config = tmp_path / "agent.yaml"
+    config.write_text(
+        "thing: placebot1\nbroker: mqtt://127.0.0.1:1999\n"
+        "executor:\n  progress_interval_s: 2\n  progress_step: 0.5\n"
+    )
+    monkeypatch.setenv("VAHR_AGENT_PROGRESS_STEP", "0.1")
+    # When the agent reads its configuration
+    shown = printed_config(capsys, "--config", str(config))
+    # Then both apply, the environment over the file
+    executor = shown["executor"]
+    assert isinstance(executor, dict)
+    assert (executor["progress_interval_s"], executor["progress_step"]) == (2.0, 0.1)
 
 
 def test_an_unknown_key_in_the_file_is_named(
@@ -77,6 +96,7 @@ def test_an_unknown_key_in_the_file_is_named(
         ("sim:\n  speed_mps: -1\n", "sim.speed_mps: expected `float` > 0.0"),
         ("executor:\n  stuck_after_s: 0\n", "executor.stuck_after_s: expected `float` > 0.0"),
         ("ros:\n  loader_delay_s: -3\n", "ros.loader_delay_s: expected `float` >= 0.0"),
+        ("executor:\n  progress_step: 1.5\n", "executor.progress_step: expected `float` <= 1.0"),
     ],
 )
 def test_a_number_out_of_range_in_the_file_is_named(

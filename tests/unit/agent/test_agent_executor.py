@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from robot_agent.backends.port import Progress
 from robot_agent.config import ExecutorSettings, SimSettings
-from tests.unit.agent.conftest import make_executor
+from tests.unit.agent.conftest import make_executor, until_moved
 from vahr.protocol import Event, Pose, new_command, utc_now
 
 if TYPE_CHECKING:
@@ -41,7 +41,11 @@ async def test_navigate_reports_navigating_then_arrives_idle_in_the_zone(fleet: 
 
 
 async def test_each_state_is_published_once_and_only_on_change(fleet: Fleet) -> None:
-    executor, rec, _ = make_executor(fleet)
+    # Given a robot reporting progress every simulated second (the local stack's rate)
+    executor, rec, _ = make_executor(
+        fleet,
+        settings=ExecutorSettings(stuck_after_s=120, progress_interval_s=1, progress_step=0),
+    )
     executor.execute(cmd("navigate", {"zone": "A"}, "n1"))
     await executor.wait_idle()
     for before, after in zip(rec.states, rec.states[1:], strict=False):
@@ -71,10 +75,60 @@ async def test_deliver_loads_at_loading_then_unloads_in_the_zone(fleet: Fleet) -
     assert final.last_command is not None and final.last_command.result == "done"
 
 
+async def test_by_default_a_drive_reports_progress_at_most_every_5_s_and_per_quarter(
+    fleet: Fleet,
+) -> None:
+    # Given a robot with the default (AWS) reporting rate, and a drive of 16.5 simulated
+    # seconds (placebot1's start to zone B, 8.25 m at 0.5 m/s)
+    executor, rec, _ = make_executor(fleet)
+    # When it drives there
+    executor.execute(cmd("navigate", {"zone": "B"}, "far"))
+    await executor.wait_idle()
+    # Then a few progress reports went out (16.5 s allow three 5-second gaps), each at
+    # least a quarter of the way after the one before, and the drive still ends arrived, done
+    progress = [e for e in rec.events if e.event == "progress"]
+    assert 1 <= len(progress) <= 3
+    fractions = [0.0] + [e.progress or 0.0 for e in progress]
+    assert all(b - a >= 0.25 - 1e-6 for a, b in zip(fractions, fractions[1:], strict=False))
+    assert rec.kinds("far")[-2:] == ["arrived", "done"]
+
+
+async def test_the_time_bound_alone_limits_progress_to_one_every_interval(fleet: Fleet) -> None:
+    # Given a robot reporting at most every 8 simulated seconds, whatever the way covered
+    executor, rec, _ = make_executor(
+        fleet, settings=ExecutorSettings(stuck_after_s=120, progress_interval_s=8, progress_step=0)
+    )
+    # When it drives 16.5 simulated seconds
+    executor.execute(cmd("navigate", {"zone": "B"}, "far"))
+    await executor.wait_idle()
+    # Then it reported twice at most, 8 s (4 m) of driving apart
+    progress = [e.progress or 0.0 for e in rec.events if e.event == "progress"]
+    assert 1 <= len(progress) <= 2
+    assert all(b - a >= 4.0 / 8.25 - 0.01 for a, b in zip(progress, progress[1:], strict=False))
+
+
+async def test_a_short_drive_reports_no_progress_by_default_but_does_locally(
+    fleet: Fleet,
+) -> None:
+    # Given the same short drive (1.1 m, 2.2 simulated seconds) at both reporting rates
+    aws, aws_rec, _ = make_executor(fleet, settings=ExecutorSettings(stuck_after_s=120))
+    local, local_rec, _ = make_executor(
+        fleet,
+        settings=ExecutorSettings(stuck_after_s=120, progress_interval_s=0.5, progress_step=0),
+    )
+    # When each drives to the loading zone
+    for executor in (aws, local):
+        executor.execute(cmd("navigate", {"zone": "LOADING"}, "near"))
+        await executor.wait_idle()
+    # Then on AWS's rate only what changed is said; locally the drive is reported as it goes
+    assert aws_rec.kinds("near") == ["accepted", "arrived", "loaded", "done"]
+    assert local_rec.kinds("near").count("progress") >= 2
+
+
 async def test_a_new_motion_command_preempts_and_the_old_task_ends_cancelled(fleet: Fleet) -> None:
-    executor, rec, _ = make_executor(fleet, speed=50)
+    executor, rec, backend = make_executor(fleet, speed=50)
     executor.execute(cmd("deliver", {"zone": "A"}, "old"))
-    await rec.until("progress", "old")
+    await until_moved(backend)
     executor.execute(cmd("navigate", {"zone": "D"}, "new"))
     await executor.wait_idle()
     assert rec.kinds("old")[-1] == "cancelled"
@@ -88,7 +142,7 @@ async def test_a_new_motion_command_preempts_and_the_old_task_ends_cancelled(fle
 async def test_stop_preempts_everything_and_halts_where_the_robot_is(fleet: Fleet) -> None:
     executor, rec, backend = make_executor(fleet, speed=50)
     executor.execute(cmd("navigate", {"zone": "A"}, "go"))
-    await rec.until("progress", "go")
+    await until_moved(backend)
     executor.execute(cmd("stop", None, "halt"))
     await executor.wait_idle()
     where = backend.pose
@@ -221,9 +275,9 @@ async def test_navigating_to_the_zone_it_is_in_arrives_at_once(fleet: Fleet) -> 
 
 
 async def test_close_cancels_the_running_task(fleet: Fleet) -> None:
-    executor, rec, _ = make_executor(fleet, speed=20)
+    executor, rec, backend = make_executor(fleet, speed=20)
     executor.execute(cmd("navigate", {"zone": "A"}, "going"))
-    await rec.until("progress", "going")
+    await until_moved(backend)
     await executor.close()
     assert rec.first("cancelled", "going").reason == "the agent is shutting down"
     final = rec.states[-1]
@@ -310,7 +364,7 @@ async def test_no_progress_is_reported_for_a_task_after_its_cancelled_event(flee
         clock=ScaledClock(1),
         publish_state=rec.states.append,
         publish_event=rec.events.append,
-        settings=ExecutorSettings(progress_interval_s=0),
+        settings=ExecutorSettings(progress_interval_s=0, progress_step=0),
     )
     executor.execute(cmd("navigate", {"zone": "A"}, "first"))
     await rec.until("progress", "first")
