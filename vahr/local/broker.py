@@ -51,8 +51,18 @@ class BrokerConfig:
             "log_type notice",
             "connection_messages true",
             "set_tcp_nodelay true",
-            # Persistent sessions must keep QoS 1 commands for robots that are away.
-            "max_queued_messages 10000",
+            # Persistent sessions must keep QoS 1 commands for robots that are away, and an
+            # online client's queue must hold a swarm's burst: one fleet command to 10,000
+            # swarm robots on one connection sends that connection about 60,000 answers and
+            # events, and the shadow service about 20,000 requests, faster than a Python
+            # client takes them. Past this bound mosquitto drops QoS 1 messages silently.
+            "max_queued_messages 1000000",
+            # QoS 1 messages in flight to one client before its PUBACKs come back: no bound
+            # but the client's own receive maximum (the default, 20, is also what mosquitto
+            # announces as its own receive maximum). A Python client under load answers in
+            # milliseconds, and a window of 20 held the shadow service near 500 requests a
+            # second.
+            "max_inflight_messages 0",
             "persistent_client_expiration 7d",
             # Save sessions and queued messages every second, not only on a clean stop:
             # after a crash (SIGKILL, power loss) a robot's persistent session is still
