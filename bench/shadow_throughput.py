@@ -153,8 +153,8 @@ Median **{median(rates):,.0f} accepted updates/s** (target at least {TARGET_PER_
 {"met" if median(rates) >= TARGET_PER_S else "NOT met"}); {total:,} updates were committed in
 {bursts:,} SQLite transactions. The stack's CPU per update (its MQTT client, the
 service, SQLite; mosquitto apart) bounds what one quiet core could do:
-{1e6 / median(service_cpu_us):,.0f} updates/s. Before (one commit and one publish call per answer on the
-MQTT network thread): {BEFORE}.
+{1e6 / median(service_cpu_us):,.0f} updates/s. Before (one commit and one publish call per
+answer on the MQTT network thread): {BEFORE}.
 """
     write_section("shadow_throughput", "Shadow service throughput", body)
     return 0

@@ -20,6 +20,11 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
 PRICES_AS_OF = "2026-11-22"
+# Where the prices come from (list prices, us-east-1, read on PRICES_AS_OF):
+# https://aws.amazon.com/iot-core/pricing/ (connectivity, messaging, Device Shadow and
+# registry, rules engine; metering in 5 KB message and 1 KB shadow units),
+# https://aws.amazon.com/lambda/pricing/, https://aws.amazon.com/lex/pricing/,
+# https://aws.amazon.com/cloudwatch/pricing/, https://aws.amazon.com/secrets-manager/pricing/.
 
 
 @dataclass(frozen=True)
@@ -134,6 +139,76 @@ def estimate(usage: LabUsage, prices: Prices, *, lex: bool, skill: bool) -> list
     if skill:
         lines.append(Line("Secrets Manager", 1, "secret-month", prices.secret_month))
     return lines
+
+
+# -- cost of measured operations (bench/billable_operations.py) ---------------------------
+
+
+def operation_cost(kind: str, units: int, usage: LabUsage, prices: Prices) -> float:
+    """USD for `units` billing units of one kind the local meter counts (vahr.local.meter),
+    with the metering rules `estimate` applies: a QoS 1 delivery counts twice (the PUBLISH
+    out and the PUBACK in), a shadow request over MQTT is a message in and its
+    `accepted` answer out besides the shadow operation."""
+    if kind == "http.publish":  # a command, to its robot(s) and the recorder
+        return units * (1 + 2 * usage.command_subscribers) * prices.message
+    if kind == "mqtt.robot.event":  # to the peer robot and the recorder
+        return units * (1 + 2 * usage.event_subscribers) * prices.message
+    if kind.startswith("mqtt.shadow."):
+        return units * (prices.shadow_operation + 3 * prices.message)
+    if kind.startswith("http.shadow."):
+        return units * prices.shadow_operation
+    return units * prices.message
+
+
+def poll_cost(usage: LabUsage, prices: Prices) -> float:
+    """USD for one shadow read by a polling robot over MQTT: the get request in, the
+    document out to the robot (QoS 1: twice) and the read itself."""
+    return 3 * prices.message + usage.shadow_units_per_read * prices.shadow_operation
+
+
+def idle_hour_cost(
+    robots: int, prices: Prices, *, poll_period_s: float | None = None, usage: LabUsage = LabUsage()
+) -> float:
+    """USD for an hour in which nobody commands anything: the robots stay connected
+    (keep-alive pings are free) and, with `poll_period_s`, read their shadows."""
+    connected = robots * 60 * prices.connection_minute
+    if poll_period_s is None:
+        return connected
+    return connected + robots * 3600 / poll_period_s * poll_cost(usage, prices)
+
+
+@dataclass(frozen=True)
+class Deployment:
+    """A fleet's month: how many robots, connected how long, given how many commands."""
+
+    name: str
+    robots: int
+    hours_per_month: float
+    commands_per_month: float
+
+
+# The paper's lab: 2 robots, 8 hours on 22 days, 100 sessions of 5 commands (LabUsage).
+LAB = Deployment("2-robot lab", robots=2, hours_per_month=22 * 8, commands_per_month=100 * 5)
+# A warehouse running around the clock: 1,000 robots, each sent a task every 15 minutes.
+WAREHOUSE = Deployment(
+    "1,000-robot warehouse",
+    robots=1000,
+    hours_per_month=30 * 24,
+    commands_per_month=1000 * 4 * 24 * 30,
+)
+
+
+def monthly_cost(
+    deployment: Deployment,
+    command_usd: float,
+    prices: Prices,
+    *,
+    poll_period_s: float | None = None,
+    usage: LabUsage = LabUsage(),
+) -> float:
+    """USD a month: connected hours (and polling) plus `command_usd` per command."""
+    idle = idle_hour_cost(deployment.robots, prices, poll_period_s=poll_period_s, usage=usage)
+    return deployment.hours_per_month * idle + deployment.commands_per_month * command_usd
 
 
 def markdown(lines: list[Line]) -> str:

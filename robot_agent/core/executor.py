@@ -114,9 +114,12 @@ class Executor:
             self.reject(command.id, command.action, "params.after: a robot cannot wait for itself")
             return
         if isinstance(command, Ping):
-            self._update(last_command=LastCommand(command.id, command.action, "accepted"))
+            # Accepted and done at the same instant: one shadow update says both (the skill
+            # waits for the id; on AWS each update is billed, and a fleet ping to 10,000
+            # robots is 10,000 updates rather than 20,000).
+            self._update(last_command=LastCommand(command.id, command.action, "done"))
             self._emit("accepted", command)
-            self._finish_ack(command)
+            self._emit("done", command)
             return
         previous = self._task
         if previous is not None and not previous.done() and self._current is not None:
@@ -124,11 +127,17 @@ class Executor:
             self._emit("cancelled", self._current, reason=reason)
             previous.cancel()
         self._current = command
-        self._update(
-            last_command=LastCommand(command.id, command.action, "accepted"),
-            task=command.action if command.is_motion else None,
-            destination=_destination(command),
-        )
+        accepted: dict[str, Any] = {
+            "last_command": LastCommand(command.id, command.action, "accepted"),
+            "task": command.action if command.is_motion else None,
+            "destination": _destination(command),
+        }
+        if isinstance(command, Stop):
+            # A stop is reported once, when the robot has halted (a moment later): one
+            # shadow update says accepted, stopped and done together.
+            self.state = msgspec.structs.replace(self.state, **accepted)
+        else:
+            self._update(**accepted)
         self._emit("accepted", command)
         self._task = asyncio.get_running_loop().create_task(
             self._run(command, previous), name=f"{self.thing}:{command.action}:{command.id}"
@@ -207,11 +216,13 @@ class Executor:
             if isinstance(command, Stop):
                 await self._stop(command)
                 return
+            final: Status | None = None
             if isinstance(command, Navigate):
                 zone = self.fleet.zone(command.params.zone)
                 await self._drive(command, zone)
                 await self._arm_on_arrival(command, zone)
-                self._update(status="idle")
+                # Idle and done in one shadow update, by `_close` below.
+                final = "idle"
             elif isinstance(command, Deliver):
                 await self._deliver(command, self.fleet.zone(command.params.zone))
             elif isinstance(command, SequentialDelivery):
@@ -232,7 +243,7 @@ class Executor:
             await self.backend.halt()
             self._close(command, "failed", f"internal error: {err}", status="error")
             return
-        self._close(command, "done", None, status=self.state.status)
+        self._close(command, "done", None, status=final or self.state.status)
 
     async def _stop(self, command: Stop) -> None:
         await self.backend.halt()
@@ -410,10 +421,6 @@ class Executor:
         await _bounded(self.voice.say(text), self.settings.speak_timeout_s, "speaking")
 
     # -- reporting ----------------------------------------------------------------------
-
-    def _finish_ack(self, command: Command) -> None:
-        self._update(last_command=LastCommand(command.id, command.action, "done"))
-        self._emit("done", command)
 
     def _close(
         self, command: Command, result: Result, reason: str | None, *, status: Status

@@ -10,7 +10,7 @@ import subprocess
 import sys
 import threading
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 import msgspec
 
@@ -72,13 +72,16 @@ def write_fleet(fleet: Fleet, path: Path) -> Path:
 
 
 # Every robot here runs on this machine's clock, so a sequential delivery needs no
-# tolerance for clocks that disagree (see robot-agent's `peer_clock_skew_s`). And messages
-# cost nothing here, so robots report their progress every simulated second, as often as
-# the station wants for smooth drawing; on AWS the agent's defaults report far less often
-# (docs/robot-agent.md, "Progress reports").
-LOCAL_AGENT_CONFIG = (
-    "executor:\n  peer_clock_skew_s: 0\n  progress_interval_s: 1\n  progress_step: 0\n"
-)
+# tolerance for clocks that disagree (see robot-agent's `peer_clock_skew_s`).
+SAME_CLOCK = "executor:\n  peer_clock_skew_s: 0\n"
+# Messages cost nothing here, so robots report their progress every simulated second, as
+# often as the station wants for smooth drawing; on AWS the agent's defaults report far
+# less often (docs/robot-agent.md, "Progress reports").
+LOCAL_PROGRESS = "  progress_interval_s: 1\n  progress_step: 0\n"
+LOCAL_AGENT_CONFIG = SAME_CLOCK + LOCAL_PROGRESS
+# Which progress rate the robots of `vahr up` use: the local one, or the agent's own
+# defaults (the rate a deployment on AWS gets; for measuring what it would bill).
+ProgressRate = Literal["local", "aws"]
 
 
 class RobotProcesses:
@@ -95,6 +98,7 @@ class RobotProcesses:
         sim_speed_factor: float = 1.0,
         voice: str | None = None,
         log_level: str = "INFO",
+        progress: ProgressRate = "local",
     ) -> None:
         self.fleet_file = fleet_file
         self.things = things
@@ -104,6 +108,7 @@ class RobotProcesses:
         self.sim_speed_factor = sim_speed_factor
         self.voice = voice
         self.log_level = log_level
+        self.progress = progress
         self.processes: dict[str, subprocess.Popen[bytes]] = {}
         self._lock = threading.Lock()
 
@@ -113,7 +118,7 @@ class RobotProcesses:
     def command(self, thing: str) -> list[str]:
         credentials = self.ca.issue_client(thing, self.state_dir / thing / "certs")
         config = self.state_dir / thing / "agent.yaml"
-        config.write_text(LOCAL_AGENT_CONFIG)
+        config.write_text(LOCAL_AGENT_CONFIG if self.progress == "local" else SAME_CLOCK)
         command = [
             sys.executable, "-m", "robot_agent.cli", "run",
             "--config", str(config),

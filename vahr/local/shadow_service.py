@@ -115,7 +115,8 @@ class ShadowService:
                 return
 
     def _serve_burst(self, burst: list[tuple[Callable[[str, bytes], None], str, bytes]]) -> None:
-        self._answers = answers = []
+        answers: list[tuple[str, bytes]] = []
+        self._answers = answers
         for handler, topic, payload in burst:
             try:
                 handler(topic, payload)

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 from vahr.errors import VahrError
 from vahr.local.mqtt import MqttClient
 from vahr.local.ports import ensure_free
-from vahr.local.robots import RobotProcesses, fleet_of, write_fleet
+from vahr.local.robots import ProgressRate, RobotProcesses, fleet_of, write_fleet
 from vahr.local.shadow_store import ShadowError
 from vahr.local.stack import LocalStack, StackConfig
 from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
@@ -50,6 +50,9 @@ class SystemConfig:
     log_level: str = "WARNING"
     # The operator station's port on 127.0.0.1 (0: any free port; None: no station).
     station_port: int | None = None
+    # How often the robots report progress: "local" (every simulated second) or "aws"
+    # (robot-agent's defaults, what a deployment on AWS gets).
+    progress: ProgressRate = "local"
 
 
 class LocalSystem:
@@ -127,6 +130,7 @@ class LocalSystem:
                 sim_speed_factor=cfg.sim_speed_factor,
                 voice=ROOM_VOICE if self.voice_enabled else None,
                 log_level="INFO" if cfg.log_level == "DEBUG" else "WARNING",
+                progress=cfg.progress,
             ).start()
         except BaseException:
             self.stop()
