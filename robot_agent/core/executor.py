@@ -132,6 +132,9 @@ class Executor:
             "task": command.action if command.is_motion else None,
             "destination": _destination(command),
         }
+        if isinstance(command, Navigate):
+            # What `_drive` would report a moment later: the same shadow update says it.
+            accepted.update(status="navigating", zone=None)
         if isinstance(command, Stop):
             # A stop is reported once, when the robot has halted (a moment later): one
             # shadow update says accepted, stopped and done together.
@@ -355,7 +358,9 @@ class Executor:
     async def _unload(self, command: Command, zone: Zone) -> None:
         self._update(status="unloading")
         await self.backend.operate_arm(zone)
-        self._update(status="idle", cargo=False)
+        # Unloading is the last step of every task that unloads: the same shadow update
+        # closes the task, before `delivered` and `done` are said.
+        self._update(status="idle", cargo=False, **self._closing(command, "done", None))
         self._emit("delivered", command, zone=zone.id, pose=self.backend.pose)
 
     async def _arm_on_arrival(self, command: Command, zone: Zone) -> None:
@@ -425,16 +430,20 @@ class Executor:
     def _close(
         self, command: Command, result: Result, reason: str | None, *, status: Status
     ) -> None:
-        changes: dict[str, Any] = {"status": status, "task": None, "destination": None}
+        self._update(status=status, **self._closing(command, result, reason))
+        self._emit("done" if result == "done" else "failed", command, reason=reason)
+        if self._current is command:
+            self._current = None
+
+    def _closing(self, command: Command, result: Result, reason: str | None) -> dict[str, Any]:
+        """The state changes that end `command` with `result`."""
+        changes: dict[str, Any] = {"task": None, "destination": None}
         changes["pose"] = _pose(self.backend.pose)
         # A ping may have become the last command meanwhile; only our own entry is closed.
         last = self.state.last_command
         if last is None or last.id == command.id or last.action == "ping":
             changes["last_command"] = LastCommand(command.id, command.action, result, reason)
-        self._update(**changes)
-        self._emit("done" if result == "done" else "failed", command, reason=reason)
-        if self._current is command:
-            self._current = None
+        return changes
 
     def _update(self, **changes: Any) -> None:
         new = msgspec.structs.replace(self.state, **changes)
