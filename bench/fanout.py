@@ -86,7 +86,7 @@ def swarm_process(broker: str, size: int, ready: Any, stop: Any) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     from tests.support.swarm import SwarmThread
 
-    with SwarmThread(broker=broker, count=size, speed_factor=50):
+    with SwarmThread(broker=broker, count=size, speed_factor=50, listen_to_peers=False):
         ready.set()
         stop.wait(600)
 

@@ -45,9 +45,10 @@ class ShadowSync:
         self._resend_after_get = False
         self.updates_sent = 0
         self.rejections = 0
+        # Not `update/accepted`: nothing in it is news to the robot, and on AWS every
+        # delivery is a billed message (two with its PUBACK) for each update it sends.
         for operation, handler in (
             ("update/rejected", self._on_update_rejected),
-            ("update/accepted", self._on_update_accepted),
             ("update/delta", self._on_delta),
             ("get/accepted", self._on_get_accepted),
             ("get/rejected", self._on_get_rejected),
@@ -56,6 +57,11 @@ class ShadowSync:
 
     def report(self, state: Reported) -> None:
         """Publish the full reported state (the caller publishes only on change)."""
+        # A new state starts a new allowance of conflict retries.
+        self._conflicts = 0
+        self._send(state)
+
+    def _send(self, state: Reported) -> None:
         self._latest = state
         self._token += 1
         self.updates_sent += 1
@@ -72,9 +78,6 @@ class ShadowSync:
         self._link.publish(topics.shadow(self.thing, "update"), b'{"state":{"desired":null}}')
 
     # -- responses ----------------------------------------------------------------------
-
-    def _on_update_accepted(self, topic: str, payload: bytes) -> None:
-        self._conflicts = 0
 
     def _on_update_rejected(self, topic: str, payload: bytes) -> None:
         self.rejections += 1
@@ -94,7 +97,7 @@ class ShadowSync:
             # No shadow yet: the first update creates it.
             if self._latest is not None and self._resend_after_get:
                 self._resend_after_get = False
-                self.report(self._latest)
+                self._send(self._latest)
             return
         log.warning("shadow get rejected: %s %s", error.get("code"), error.get("message"))
 
@@ -102,7 +105,7 @@ class ShadowSync:
         document = _json_object(payload)
         if self._resend_after_get and self._latest is not None:
             self._resend_after_get = False
-            self.report(self._latest)
+            self._send(self._latest)
         state = document.get("state")
         desired = state.get("desired") if isinstance(state, dict) else None
         if isinstance(desired, dict):

@@ -97,7 +97,7 @@ def test_everything_the_agent_subscribes_to_and_publishes_is_allowed(
     assert {
         topics.robot_cmd(THING),
         topics.FLEET_CMD,
-        topics.shadow(THING, "update/accepted"),
+        topics.shadow(THING, "update/rejected"),
     } <= set(link.routes)
     # And the policy allows every subscription and the delivery of messages on it
     for topic_filter in link.routes:

@@ -96,8 +96,13 @@ class Swarm:
         settings: ExecutorSettings | None = None,
         state_dir: Path | None = None,
         client_id: str | None = None,
+        listen_to_peers: bool = True,
     ) -> None:
+        """`listen_to_peers=False` leaves out the route on every robot's events, which only
+        sequential deliveries need (a fan-out benchmark would otherwise receive each of its
+        robots' events back)."""
         self.broker = broker
+        self._listen_to_peers = listen_to_peers
         self.fleet = swarm_fleet(count, prefix=prefix)
         self.things = list(self.fleet.robot_things)
         self.clock = ScaledClock(speed_factor)
@@ -145,7 +150,8 @@ class Swarm:
             )
             agent.attach()
             self.agents[thing] = agent
-        link.add_route(topics.ALL_EVENTS, self._on_peer_event)
+        if self._listen_to_peers:
+            link.add_route(topics.ALL_EVENTS, self._on_peer_event)
         await link.start(timeout_s)
 
     def _on_peer_event(self, topic: str, payload: bytes) -> None:
