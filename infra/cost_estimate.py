@@ -61,11 +61,12 @@ class LabUsage:
     skill_requests_per_voice_session: float = 10.0
     # The robot asks the weather once per session, sometimes twice.
     weather_questions_per_session: float = 1.25
-    # A delivery drives ~16 m at 0.5 m/s: a progress event each second plus accepted,
-    # arrived (x2), loaded, delivered and done; about ten shadow updates (status,
-    # destination, zone, cargo, last_command) as its state changes.
-    events_per_delivery: int = 40
-    shadow_updates_per_delivery: int = 10
+    # A delivery drives ~16 m at 0.5 m/s in two legs. At robot-agent's default progress
+    # rate (at most one report every 5 s and per quarter of the way) it sends about ten
+    # events (accepted, a few progress reports, arrived x2, loaded, delivered, done) and
+    # about nine shadow updates as its state changes (bench/billable_operations.py).
+    events_per_delivery: int = 10
+    shadow_updates_per_delivery: int = 9
     # Who receives a robot's event: its peer and the experiment recorder.
     event_subscribers: int = 2
     # A command reaches its robot and the recorder.
@@ -105,8 +106,9 @@ def estimate(usage: LabUsage, prices: Prices, *, lex: bool, skill: bool) -> list
     messages = (
         commands * (1 + 2 * usage.command_subscribers)
         + deliveries * usage.events_per_delivery * (1 + 2 * usage.event_subscribers)
-        # A shadow update over MQTT: the request in, update/accepted out and its PUBACK.
-        + deliveries * usage.shadow_updates_per_delivery * 3
+        # A shadow update over MQTT: the request in (robots do not subscribe to
+        # update/accepted, and nothing else does on AWS).
+        + deliveries * usage.shadow_updates_per_delivery
         + usage.robots * usage.lab_days * usage.session_messages_per_robot_day
     )
     presence_changes = usage.robots * usage.lab_days * 2  # online in the morning, offline
@@ -147,13 +149,15 @@ def estimate(usage: LabUsage, prices: Prices, *, lex: bool, skill: bool) -> list
 def operation_cost(kind: str, units: int, usage: LabUsage, prices: Prices) -> float:
     """USD for `units` billing units of one kind the local meter counts (vahr.local.meter),
     with the metering rules `estimate` applies: a QoS 1 delivery counts twice (the PUBLISH
-    out and the PUBACK in), a shadow request over MQTT is a message in and its
-    `accepted` answer out besides the shadow operation."""
+    out and the PUBACK in); a shadow request over MQTT is a message in besides the shadow
+    operation, and a get's answer a delivery to the robot."""
     if kind == "http.publish":  # a command, to its robot(s) and the recorder
         return units * (1 + 2 * usage.command_subscribers) * prices.message
     if kind == "mqtt.robot.event":  # to the peer robot and the recorder
         return units * (1 + 2 * usage.event_subscribers) * prices.message
-    if kind.startswith("mqtt.shadow."):
+    if kind == "mqtt.shadow.update":  # the request in; nobody takes update/accepted
+        return units * (prices.shadow_operation + prices.message)
+    if kind.startswith("mqtt.shadow."):  # the request in, the answer out to the robot
         return units * (prices.shadow_operation + 3 * prices.message)
     if kind.startswith("http.shadow."):
         return units * prices.shadow_operation

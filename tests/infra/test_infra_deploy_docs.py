@@ -30,14 +30,14 @@ def test_the_estimate_counts_what_a_delivery_and_a_voice_request_cost() -> None:
         skill_requests_per_voice_session=1, robots=1, session_messages_per_robot_day=0,
     )  # fmt: skip
     lines = {line.item: line for line in estimate(usage, Prices(), lex=True, skill=False)}
-    # Then: the command (1 in + 2 subscribers x 2) + 40 events x (1 + 2 x 2) + 10 updates x 3
-    assert lines["IoT messages"].quantity == 5 + 40 * 5 + 10 * 3
-    # And: 10 updates + 4 reads x 2 units + 2 presence changes + 1 experiment plan
-    assert lines["Device Shadow operations"].quantity == 10 + 8 + 2 + 1
+    # Then: the command (1 in + 2 subscribers x 2) + 10 events x (1 + 2 x 2) + 9 updates in
+    assert lines["IoT messages"].quantity == 5 + 10 * 5 + 9
+    # And: 9 updates + 4 reads x 2 units + 2 presence changes + 1 experiment plan
+    assert lines["Device Shadow operations"].quantity == 9 + 8 + 2 + 1
     assert lines["Lambda requests"].quantity == 1
     assert lines["Lex text requests"].quantity == 1.25
     assert lines["IoT connectivity"].quantity == 8 * 60 + 15
-    assert lines["IoT messages"].cost == pytest.approx(235 / 1e6)
+    assert lines["IoT messages"].cost == pytest.approx(64 / 1e6)
 
 
 def test_ask_deploy_deploys_the_generated_skill_package() -> None:
