@@ -42,6 +42,12 @@ PUBLISH_TIMEOUT_S = 5.0
 READ_CHUNK = 64 * 1024
 READ_BURST = 1000
 WRITE_CHUNK = 64 * 1024
+# QoS 1 publishes of one client awaiting PUBACK at most. paho keeps no window of its own
+# here (with one, it rescans every unacknowledged message on each PUBACK), and MQTT allows
+# 65,535 at most (packet ids are 16 bits; past the broker's receive maximum mosquitto
+# drops the client with "protocol error", as a swarm's start-up once made the shadow
+# service do). A publisher past this bound waits for acknowledgments.
+MAX_UNACKNOWLEDGED = 10_000
 # Topics whose handlers are remembered; past this the memory starts again (a client that
 # sees more distinct topics than this pays the matching again, nothing else).
 ROUTE_CACHE_SIZE = 100_000
@@ -64,6 +70,15 @@ class _BatchingPahoClient(paho.Client):
     def __init__(self, *args: object, **kwargs: object) -> None:
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
         self._inbound = bytearray()
+        # QoS 1 publishes sent and not yet acknowledged: `MqttClient.publish` takes a slot,
+        # each PUBACK gives one back (see MAX_UNACKNOWLEDGED).
+        self.window = threading.BoundedSemaphore(MAX_UNACKNOWLEDGED)
+
+    def _do_on_publish(self, mid: int, reason_code: Any, properties: Any) -> MQTTErrorCode:
+        # Called for each PUBACK of a QoS 1 publish (a QoS 0 one never takes a slot).
+        with contextlib.suppress(ValueError):  # released more often than taken: ignore
+            self.window.release()
+        return super()._do_on_publish(mid, reason_code, properties)  # type: ignore[no-any-return]
 
     def forget_buffered(self) -> None:
         """A new socket starts with nothing buffered from the old one."""
@@ -362,9 +377,18 @@ class MqttClient:
     def publish(
         self, topic: str, payload: bytes, *, qos: int = 1, retain: bool = False, wait: bool = True
     ) -> None:
-        """Publish; with `wait` and QoS 1, block until PUBACK and raise if it was refused."""
+        """Publish; with `wait` and QoS 1, block until PUBACK and raise if it was refused.
+
+        Without `wait` it still blocks while MAX_UNACKNOWLEDGED publishes await PUBACK."""
+        if qos > 0 and not self._client.window.acquire(timeout=PUBLISH_TIMEOUT_S):
+            raise VahrError(
+                f"the MQTT broker did not acknowledge {MAX_UNACKNOWLEDGED:,} publishes in "
+                f"{PUBLISH_TIMEOUT_S:g} s; not publishing to {topic}"
+            )
         info = self._client.publish(topic, payload, qos=qos, retain=retain)
         if info.rc != paho.MQTT_ERR_SUCCESS:
+            if qos > 0:
+                self._client.window.release()
             raise VahrError(f"cannot publish to {topic}: {paho.error_string(info.rc)}")
         if qos == 0 or not wait:
             self._ignore(info.mid)
