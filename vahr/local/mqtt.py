@@ -48,6 +48,9 @@ WRITE_CHUNK = 64 * 1024
 # drops the client with "protocol error", as a swarm's start-up once made the shadow
 # service do). A publisher past this bound waits for acknowledgments.
 MAX_UNACKNOWLEDGED = 10_000
+# How long a publisher waits for a slot: mosquitto busy with a swarm's burst acknowledges
+# seconds late, and an answer given up on is lost.
+WINDOW_TIMEOUT_S = 60.0
 # Topics whose handlers are remembered; past this the memory starts again (a client that
 # sees more distinct topics than this pays the matching again, nothing else).
 ROUTE_CACHE_SIZE = 100_000
@@ -380,10 +383,10 @@ class MqttClient:
         """Publish; with `wait` and QoS 1, block until PUBACK and raise if it was refused.
 
         Without `wait` it still blocks while MAX_UNACKNOWLEDGED publishes await PUBACK."""
-        if qos > 0 and not self._client.window.acquire(timeout=PUBLISH_TIMEOUT_S):
+        if qos > 0 and not self._client.window.acquire(timeout=WINDOW_TIMEOUT_S):
             raise VahrError(
-                f"the MQTT broker did not acknowledge {MAX_UNACKNOWLEDGED:,} publishes in "
-                f"{PUBLISH_TIMEOUT_S:g} s; not publishing to {topic}"
+                f"the MQTT broker acknowledged none of {MAX_UNACKNOWLEDGED:,} publishes in "
+                f"{WINDOW_TIMEOUT_S:g} s; not publishing to {topic}"
             )
         info = self._client.publish(topic, payload, qos=qos, retain=retain)
         if info.rc != paho.MQTT_ERR_SUCCESS:
