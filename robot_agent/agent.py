@@ -14,6 +14,7 @@ import logging
 from typing import TYPE_CHECKING, Any
 
 from robot_agent.core.executor import Executor
+from robot_agent.core.in_flight import INTERRUPTED_REASON, InFlight
 from robot_agent.link.shadow import ShadowSync
 from vahr.protocol import Presence, ProtocolError, decode_command, decode_event, encode, topics
 
@@ -47,6 +48,7 @@ class RobotAgent:
         voice: Voice | None = None,
         settings: ExecutorSettings | None = None,
         listen_to_peers: bool = True,
+        in_flight: InFlight | None = None,
     ) -> None:
         self.thing = thing
         self.fleet = fleet
@@ -68,6 +70,8 @@ class RobotAgent:
             settings=settings,
         )
         self._listen_to_peers = listen_to_peers
+        self.in_flight = in_flight or InFlight()
+        self._left_over = self.in_flight.left_over()
 
     def attach(self) -> None:
         """Add this robot's routes and connection callbacks to the link."""
@@ -112,6 +116,13 @@ class RobotAgent:
 
     def on_connected(self, session_present: bool) -> None:
         self.executor.set_connected(True)
+        if self._left_over is not None:
+            # Before anything a resumed session redelivers: the sender learns first that
+            # the command the robot died running did not finish (see `in_flight`).
+            command_id, action = self._left_over
+            self._left_over = None
+            self.in_flight.clear()
+            self.executor.report_interrupted(command_id, action, INTERRUPTED_REASON)
         self.link.publish(
             topics.robot_presence(self.thing),
             encode(Presence(online=True, at=self.clock.now())),
@@ -129,6 +140,11 @@ class RobotAgent:
         self.shadow.report(state)
 
     def _publish_event(self, event: Event) -> None:
+        if event.command_id is not None and event.action not in (None, "ping"):
+            if event.event == "accepted":
+                self.in_flight.start(event.command_id, event.action)
+            elif event.event in ("done", "failed", "cancelled"):
+                self.in_flight.end(event.command_id)
         self.link.publish(
             topics.robot_events(self.thing), encode(event), retain=event.event == "delivered"
         )

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 from robot_agent.agent import RobotAgent
 from robot_agent.backends.sim import SimBackend
+from robot_agent.core.in_flight import InFlight
 from robot_agent.core.recent_ids import RecentIds
 from vahr.errors import VahrError
 from vahr.protocol import Presence, encode, load_fleet, topics
@@ -145,4 +146,5 @@ def build_agent(
         recent_ids=RecentIds(state_dir / "recent-ids.json"),
         voice=voice,
         settings=config.executor,
+        in_flight=InFlight(state_dir / "in-flight.json"),
     )

@@ -164,6 +164,20 @@ class Executor:
             )
         )
 
+    def report_interrupted(self, command_id: str, action: str, reason: str) -> None:
+        """Report a command an earlier run of this robot died running: it ended `failed`."""
+        self._update(last_command=LastCommand(command_id, action, "failed", reason))
+        self._publish_event(
+            Event(
+                event="failed",
+                thing=self.thing,
+                at=self.clock.now(),
+                command_id=command_id,
+                action=action,
+                reason=reason,
+            )
+        )
+
     def peer_event(self, event: Event) -> None:
         """Take note of a peer's event (only `delivered` matters to the executor)."""
         if event.event == "delivered" and event.thing != self.thing:

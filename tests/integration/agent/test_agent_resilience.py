@@ -85,7 +85,11 @@ def test_a_command_sent_while_the_robot_was_away_arrives_when_it_returns(
     try:
         # And the robot comes back
         start_agent("placebot1")
-        # Then the command it missed runs
+        # Then the delivery it died running is reported failed, with the reason, not re-run
+        interrupted = tap2.event("placebot1", "failed", "cut-short", timeout_s=20)
+        assert interrupted["reason"].startswith("interrupted: the robot-agent stopped")
+        assert [e["event"] for e in tap2.events("placebot1", "cut-short")] == ["failed"]
+        # And the command it missed runs
         done = tap2.reported(
             "placebot1",
             lambda r: (

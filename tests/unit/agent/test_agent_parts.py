@@ -14,6 +14,7 @@ from robot_agent.backends.port import NavigationFailed, Progress
 from robot_agent.backends.sim import SimBackend
 from robot_agent.config import SimSettings
 from robot_agent.core.clock import ScaledClock
+from robot_agent.core.in_flight import InFlight
 from robot_agent.core.peers import PeerDeliveries
 from robot_agent.core.recent_ids import RecentIds
 from vahr.protocol import Pose, utc_now
@@ -53,6 +54,29 @@ def test_a_recent_id_file_that_cannot_be_written_does_not_lose_the_command(
     # When a command id arrives, then it is new (it runs), and a redelivery is a duplicate
     assert ids.add("a") is True
     assert ids.add("a") is False
+
+
+def test_the_running_command_survives_a_crash_on_disk_and_is_forgotten_when_it_ends(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "robots" / "placebot1" / "in-flight.json"
+    # Given a robot running d1 that dies (its InFlight is never told the task ended)
+    InFlight(path).start("d1", "deliver")
+    # Then the next run finds d1 left over
+    assert InFlight(path).left_over() == ("d1", "deliver")
+    # And a command that ends, or is taken over by a newer one, leaves nothing behind
+    running = InFlight(path)
+    running.start("n1", "navigate")
+    running.end("d1")  # an older id ending does not clear the newer one
+    assert InFlight(path).left_over() == ("n1", "navigate")
+    running.end("n1")
+    assert InFlight(path).left_over() is None and not path.exists()
+
+
+def test_a_torn_in_flight_file_does_not_stop_the_robot(tmp_path: Path) -> None:
+    path = tmp_path / "in-flight.json"
+    path.write_text('{"id": "d1"')
+    assert InFlight(path).left_over() is None
 
 
 def test_only_a_peer_delivery_after_the_command_was_issued_counts() -> None:
