@@ -45,11 +45,12 @@ from vahr.protocol import (
 )
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from pathlib import Path
     from types import TracebackType
 
     from robot_agent.link.mqtt5 import Mqtt5Link
-    from vahr.protocol import Reported
+    from vahr.protocol import Event, Reported
 
 CONNECT_TIMEOUT_S = 10.0
 STOP_TIMEOUT_S = 10.0
@@ -97,10 +98,15 @@ class Swarm:
         state_dir: Path | None = None,
         client_id: str | None = None,
         listen_to_peers: bool = True,
+        session_expiry_s: int = 0,
+        on_event: Callable[[Event], None] | None = None,
     ) -> None:
         """`listen_to_peers=False` leaves out the route on every robot's events, which only
         sequential deliveries need (a fan-out benchmark would otherwise receive each of its
-        robots' events back)."""
+        robots' events back). `session_expiry_s` > 0 makes the link's session persistent
+        (with a fixed `client_id`, the broker queues QoS 1 commands while the link is down);
+        `on_event` sees every event any robot publishes, as the robot publishes it (its
+        event log)."""
         self.broker = broker
         self._listen_to_peers = listen_to_peers
         self.fleet = swarm_fleet(count, prefix=prefix)
@@ -110,6 +116,8 @@ class Swarm:
         self._settings = settings or ExecutorSettings()
         self._state_dir = state_dir
         self._client_id = client_id or f"vahr-swarm-{uuid.uuid4().hex[:8]}"
+        self._session_expiry_s = session_expiry_s
+        self._on_event = on_event
         self.agents: dict[str, RobotAgent] = {}
         self.link: Mqtt5Link | None = None
 
@@ -126,7 +134,7 @@ class Swarm:
                 client_id=self._client_id,
                 host=host,
                 port=port,
-                session=MqttSettings(session_expiry_s=0),
+                session=MqttSettings(session_expiry_s=self._session_expiry_s),
             ),
             asyncio.get_running_loop(),
         )
@@ -137,7 +145,8 @@ class Swarm:
             recent = RecentIds(
                 self._state_dir / thing / "recent-ids.json" if self._state_dir else None
             )
-            agent = RobotAgent(
+            agent = _LoggedAgent(
+                self._on_event,
                 thing=thing,
                 fleet=self.fleet,
                 link=link,
@@ -191,6 +200,19 @@ class Swarm:
         tb: TracebackType | None,
     ) -> None:
         await self.stop()
+
+
+class _LoggedAgent(RobotAgent):
+    """A robot whose every published event is also handed to `on_event`."""
+
+    def __init__(self, on_event: Callable[[Event], None] | None, **arguments: Any) -> None:
+        super().__init__(**arguments)
+        self._on_event = on_event
+
+    def _publish_event(self, event: Event) -> None:
+        super()._publish_event(event)
+        if self._on_event is not None:
+            self._on_event(event)
 
 
 class SwarmThread:

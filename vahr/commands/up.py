@@ -94,10 +94,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             _emit(_banner(endpoints, list(system.fleet.robot_things), system.voice_enabled))
         while not stopping.wait(0.5):
-            exited = system.robots.exited() if system.robots else {}
-            if exited:
-                thing, code = next(iter(exited.items()))
-                raise VahrError(f"robot {thing} stopped unexpectedly (exit code {code})")
+            for line in system.supervise():
+                print(f"vahr up: {line}", file=sys.stderr, flush=True)
     finally:
         system.stop()
         for signum, handler in previous.items():

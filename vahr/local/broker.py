@@ -146,6 +146,15 @@ class Mosquitto:
     def is_running(self) -> bool:
         return self._process is not None and self._process.poll() is None
 
+    def exit_code(self) -> int | None:
+        """The exit code if the broker ended without being stopped (a crash), else None."""
+        return self._process.poll() if self._process is not None else None
+
+    def restart(self) -> None:
+        """Start again on the same ports and persistence, after a crash."""
+        self.kill()
+        self.start()
+
     def kill(self) -> None:
         """Stop abruptly (SIGKILL), as a crash would; for failure tests."""
         process, self._process = self._process, None

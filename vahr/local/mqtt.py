@@ -382,7 +382,15 @@ class MqttClient:
     ) -> None:
         """Publish; with `wait` and QoS 1, block until PUBACK and raise if it was refused.
 
-        Without `wait` it still blocks while MAX_UNACKNOWLEDGED publishes await PUBACK."""
+        Without `wait` it still blocks while MAX_UNACKNOWLEDGED publishes await PUBACK.
+
+        A publish this raises for is never sent later: paho keeps a QoS 1 message it could
+        not send (no connection) or that was not acknowledged, and sends it again after it
+        reconnects, so a command the caller was told had failed would still reach a robot
+        minutes later. Such a message is withdrawn from paho's queue before raising.
+        """
+        if wait and qos > 0 and not self._client.is_connected():
+            raise VahrError(f"cannot publish to {topic}: not connected to the MQTT broker")
         if qos > 0 and not self._client.window.acquire(timeout=WINDOW_TIMEOUT_S):
             raise VahrError(
                 f"the MQTT broker acknowledged none of {MAX_UNACKNOWLEDGED:,} publishes in "
@@ -390,15 +398,23 @@ class MqttClient:
             )
         info = self._client.publish(topic, payload, qos=qos, retain=retain)
         if info.rc != paho.MQTT_ERR_SUCCESS:
-            if qos > 0:
-                self._client.window.release()
+            # Without `wait`, paho sends it after reconnecting and its PUBACK frees the slot.
+            if wait:
+                self._withdraw(info.mid)
             raise VahrError(f"cannot publish to {topic}: {paho.error_string(info.rc)}")
         if qos == 0 or not wait:
             self._ignore(info.mid)
             return
         waiter, codes = self._expect(self._acks, info.mid)
         if not waiter.wait(PUBLISH_TIMEOUT_S):
-            raise VahrError(f"the MQTT broker did not acknowledge a publish to {topic}")
+            if self._withdraw(info.mid):
+                raise VahrError(
+                    f"the MQTT broker did not acknowledge a publish to {topic} within "
+                    f"{PUBLISH_TIMEOUT_S:g} s; it will not be sent again (the broker may "
+                    "still have received it)"
+                )
+            # Else it was acknowledged just now, between the timeout and the withdrawal.
+            waiter.wait(1.0)
         if codes and codes[0].is_failure:
             raise PublishDenied(f"the MQTT broker refused a publish to {topic}: {codes[0]}")
 
@@ -418,6 +434,26 @@ class MqttClient:
             entry[1].extend(early)
             entry[0].set()
         return entry
+
+    def _withdraw(self, mid: int) -> bool:
+        """Drop message `mid` from paho's outgoing queue; False if it was acknowledged.
+
+        paho 2.2 has no public way to cancel a publish; its queue and counter are guarded by
+        its own mutex, which is taken here exactly as paho takes it.
+        """
+        client = self._client
+        with client._out_message_mutex:
+            message = client._out_messages.pop(mid, None)
+            if message is not None and message.state == paho.mqtt_ms_wait_for_puback:
+                client._inflight_messages -= 1
+        if message is None:
+            return False
+        if message.qos > 0:
+            with contextlib.suppress(ValueError):  # its slot in the window is free again
+                client.window.release()
+        with self._acks_lock:
+            self._acks.pop(mid, None)
+        return True
 
     def _ignore(self, mid: int) -> None:
         with self._acks_lock:

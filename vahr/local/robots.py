@@ -138,31 +138,35 @@ class RobotProcesses:
         return command
 
     def start(self) -> RobotProcesses:
+        for thing in self.things:
+            self.restart(thing)
+        return self
+
+    def restart(self, thing: str) -> None:
+        """Start `thing`'s process (again, after it ended); its log file is appended to."""
         env = {
             **os.environ,
             "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
         }
-        for thing in self.things:
-            log_path = self.log_file(thing)
-            log_path.parent.mkdir(parents=True, exist_ok=True)
-            with log_path.open("ab") as log_stream:
-                # Tied to this process's life: a robot never outlives the `vahr up` that
-                # started it, even one killed with SIGKILL (see `lifetime`).
-                process = spawn(
-                    self.command(thing),
-                    started_for=self.state_dir,
-                    cwd=ROOT,
-                    env=env,
-                    stdin=subprocess.DEVNULL,
-                    stdout=log_stream,
-                    stderr=subprocess.STDOUT,
-                    # Their own process group: Ctrl-C reaches `vahr up`, which stops them
-                    # in order, rather than every process at once.
-                    start_new_session=True,
-                )
-            with self._lock:
-                self.processes[thing] = process
-        return self
+        log_path = self.log_file(thing)
+        log_path.parent.mkdir(parents=True, exist_ok=True)
+        with log_path.open("ab") as log_stream:
+            # Tied to this process's life: a robot never outlives the `vahr up` that
+            # started it, even one killed with SIGKILL (see `lifetime`).
+            process = spawn(
+                self.command(thing),
+                started_for=self.state_dir,
+                cwd=ROOT,
+                env=env,
+                stdin=subprocess.DEVNULL,
+                stdout=log_stream,
+                stderr=subprocess.STDOUT,
+                # Their own process group: Ctrl-C reaches `vahr up`, which stops them
+                # in order, rather than every process at once.
+                start_new_session=True,
+            )
+        with self._lock:
+            self.processes[thing] = process
 
     def exited(self) -> dict[str, int]:
         """Robots whose process has ended, with the exit code."""

@@ -13,6 +13,7 @@ import logging
 import shutil
 import threading
 import time
+from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -35,6 +36,9 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 ROOM_VOICE = "robot_agent.voice.factories:room"
+# A part that dies more often than this is not restarted again: `vahr up` stops and says why.
+RESTART_LIMIT = 5
+RESTART_WINDOW_S = 60.0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -81,6 +85,7 @@ class LocalSystem:
         self.station: Station | None = None
         self._online: dict[str, bool] = {}
         self._changed = threading.Condition()
+        self._restarts: dict[str, deque[float]] = {}
 
     @property
     def voice_enabled(self) -> bool:
@@ -202,6 +207,43 @@ class LocalSystem:
                         f"(logs in {self.config.state_dir / 'robots'})"
                     )
                 self._changed.wait(min(remaining, 0.5))
+
+    def supervise(self) -> list[str]:
+        """Restart the broker or a robot whose process died; one line for each restart.
+
+        A lab runs `vahr up` all day: a robot-agent killed by the OOM killer or a crashed
+        mosquitto comes back as a robot's service manager or a broker's would bring it back.
+        The broker restarts on the same persistence, so robots resume their sessions and
+        commands queued for them; a robot restarts on the same state directory, so a command
+        it died running is reported failed (robot_agent.core.in_flight). Raises VahrError
+        when one part keeps dying (RESTART_LIMIT times in RESTART_WINDOW_S).
+        """
+        lines: list[str] = []
+        broker = self.stack.broker
+        code = broker.exit_code() if broker is not None else None
+        if broker is not None and code is not None:
+            self._count_restart("the MQTT broker", code)
+            broker.restart()
+            lines.append(f"the MQTT broker stopped unexpectedly (exit code {code}); restarted it")
+        exited = self.robots.exited() if self.robots is not None else {}
+        for thing, code in exited.items():
+            assert self.robots is not None
+            self._count_restart(f"robot {thing}", code)
+            self.robots.restart(thing)
+            lines.append(f"robot {thing} stopped unexpectedly (exit code {code}); restarted it")
+        return lines
+
+    def _count_restart(self, part: str, code: int) -> None:
+        now = time.monotonic()
+        recent = self._restarts.setdefault(part, deque())
+        while recent and now - recent[0] > RESTART_WINDOW_S:
+            recent.popleft()
+        if len(recent) >= RESTART_LIMIT:
+            raise VahrError(
+                f"{part} stopped unexpectedly (exit code {code}) {len(recent) + 1} times within "
+                f"{RESTART_WINDOW_S:g} s; not restarting it (logs in {self.config.state_dir})"
+            )
+        recent.append(now)
 
     def _on_event(self, topic: str, payload: bytes) -> None:
         # A robot's event is a message AWS IoT would bill for, like any other publish.
