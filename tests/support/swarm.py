@@ -51,6 +51,7 @@ if TYPE_CHECKING:
 
     from robot_agent.link.mqtt5 import Mqtt5Link
     from vahr.protocol import Event, Reported
+    from vahr.protocol.broker import ClientCredentials
 
 CONNECT_TIMEOUT_S = 10.0
 STOP_TIMEOUT_S = 10.0
@@ -100,13 +101,15 @@ class Swarm:
         listen_to_peers: bool = True,
         session_expiry_s: int = 0,
         on_event: Callable[[Event], None] | None = None,
+        tls: ClientCredentials | None = None,
     ) -> None:
         """`listen_to_peers=False` leaves out the route on every robot's events, which only
         sequential deliveries need (a fan-out benchmark would otherwise receive each of its
         robots' events back). `session_expiry_s` > 0 makes the link's session persistent
         (with a fixed `client_id`, the broker queues QoS 1 commands while the link is down);
         `on_event` sees every event any robot publishes, as the robot publishes it (its
-        event log)."""
+        event log); with `tls`, `broker` is the local stack's `mqtts://` listener and the
+        link holds that identity (the service's, to speak for every robot)."""
         self.broker = broker
         self._listen_to_peers = listen_to_peers
         self.fleet = swarm_fleet(count, prefix=prefix)
@@ -118,6 +121,7 @@ class Swarm:
         self._client_id = client_id or f"vahr-swarm-{uuid.uuid4().hex[:8]}"
         self._session_expiry_s = session_expiry_s
         self._on_event = on_event
+        self._tls = tls
         self.agents: dict[str, RobotAgent] = {}
         self.link: Mqtt5Link | None = None
 
@@ -125,15 +129,19 @@ class Swarm:
         """Build every robot, connect once, and return when all of them are online."""
         from robot_agent.config import MqttSettings
         from robot_agent.link.mqtt5 import LinkSettings, Mqtt5Link
-        from vahr.protocol.broker import plaintext_loopback
+        from vahr.protocol.broker import parse_broker_url, plaintext_loopback
 
-        address = plaintext_loopback(self.broker)
+        if self._tls is None:
+            address = plaintext_loopback(self.broker)
+        else:
+            address = parse_broker_url(self.broker)
         host, port = address.host, address.port
         link = Mqtt5Link(
             LinkSettings(
                 client_id=self._client_id,
                 host=host,
                 port=port,
+                tls=self._tls,
                 session=MqttSettings(session_expiry_s=self._session_expiry_s),
             ),
             asyncio.get_running_loop(),

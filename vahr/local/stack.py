@@ -34,6 +34,9 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
+# How long the broker keeps shadow requests for a shadow service that is away.
+SHADOW_SESSION_EXPIRY_S = 24 * 3600
+
 
 @dataclass(frozen=True, kw_only=True)
 class StackConfig:
@@ -117,9 +120,15 @@ class LocalStack:
                 )
             )
             self.broker.start()
+            # A persistent session: robots' shadow updates sent while this client is away
+            # (a broker restart, a pause) are queued by the broker and applied when it is
+            # back, as AWS's shadow service never misses one. With a clean session they
+            # were dropped, and a robot that then stayed idle left its shadow stale.
             self._service_client = MqttClient(
-                self.service_endpoint(), client_id="vahr-shadow-service"
-            ).connect()
+                self.service_endpoint(),
+                client_id="vahr-shadow-service",
+                session_expiry_s=SHADOW_SESSION_EXPIRY_S,
+            )
             client = self._service_client
             self.store = ShadowStore(self.database)
 
@@ -129,7 +138,9 @@ class LocalStack:
                 client.publish(topic, payload, qos=1, wait=False)
 
             self.shadows = ShadowService(self.store, publish_answer, self.meter)
+            # Routes first: what a resumed session delivers at once finds its handler.
             self.shadows.attach(client)
+            client.connect()
 
             def publish(topic: str, payload: bytes, qos: int, retain: bool) -> None:
                 client.publish(topic, payload, qos=qos, retain=retain, wait=qos > 0)
