@@ -260,7 +260,9 @@ class Soak:
                 return
             thing = rng.choice(AGENTS) if rng.random() < 0.2 else rng.choice(swarm_things)
             action = rng.choices(["navigate", "deliver", "stop", "ping"], [5, 2, 1, 2])[0]
-            params = {"zone": rng.choice(ZONES[:4])} if action in ("navigate", "deliver") else None
+            params: dict[str, object] | None = (
+                {"zone": rng.choice(ZONES[:4])} if action in ("navigate", "deliver") else None
+            )
             command = new_command(action, params, source="console")
             error = None
             try:
