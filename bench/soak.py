@@ -42,8 +42,9 @@ def body(report: SoakReport) -> str:
     lines = [
         f"{report.elapsed_s / 60:.1f} minutes of load (seed {cfg.seed}); {cfg.swarm_size} swarm "
         f"robots and 2 robot-agent processes on `vahr up`; a console command every "
-        f"{cfg.console_interval_s:g} s, an utterance every {cfg.skill_interval_s:g} s, a fault "
-        f"every {cfg.fault_interval_s:g} s; simulated time {cfg.sim_speed_factor:g}x.",
+        f"{cfg.console_interval_s:g} s (one in ten as desired state), an utterance every "
+        f"{cfg.skill_interval_s:g} s, a fault every {cfg.fault_interval_s:g} s; simulated "
+        f"time {cfg.sim_speed_factor:g}x.",
         "",
         "| figure | value | target |",
         "| --- | --- | --- |",
@@ -51,6 +52,8 @@ def body(report: SoakReport) -> str:
         f"| executed once | {v.executed} | - |",
         f"| reported failed, cancelled or rejected, with a reason | {reported or 0} "
         f"({v.reported_without_reason} without a reason) | - |",
+        f"| written as desired state and replaced by a later one before the robot read it "
+        f"(last writer wins) | {v.replaced_in_desired} | - |",
         f"| lost | {len(v.lost)} | 0 |",
         f"| run twice | {len(v.run_twice)} | 0 |",
         f"| publishes refused at the source (the sender was told) | {v.refused_at_source} | - |",

@@ -7,7 +7,8 @@ on its broker, then for `duration_s`:
 - the skill path: utterances through `POST /vahr/say` (what `vahr say` sends), whose real
   ASK request envelopes run the skill handler; every answer is timed against Alexa's 8 s;
 - the console path: commands published on the robots' topics with `source: console`,
-  as the operator console does, through the relay below;
+  as the operator console does, through the relay below; one in ten written instead as
+  the robot's desired state through the data plane (`UpdateThingShadow`);
 - a fault injector, one fault at a time in a seeded order: mosquitto killed (SIGKILL; `vahr
   up` restarts it), a robot-agent killed (SIGKILL; `vahr up` restarts it), the process
   serving the shadows paused (SIGSTOP, then SIGCONT), and every connection through the
@@ -24,6 +25,7 @@ from __future__ import annotations
 
 import contextlib
 import itertools
+import json
 import os
 import random
 import re
@@ -253,7 +255,8 @@ class Soak:
 
     def _console_load(self) -> None:
         rng = random.Random(f"{self.config.seed}-console")
-        assert self.swarm is not None and self.console is not None
+        assert self.swarm is not None and self.console is not None and self.up is not None
+        api = self.up.endpoints["api"]
         swarm_things = self.swarm.things
         for tick in itertools.count():
             if not self._wait_tick(self.config.console_interval_s, tick):
@@ -264,14 +267,19 @@ class Soak:
                 {"zone": rng.choice(ZONES[:4])} if action in ("navigate", "deliver") else None
             )
             command = new_command(action, params, source="console")
+            # One in ten is written as the robot's desired state instead (DESIGN.md: for a
+            # robot that may be offline); the robot applies it from the shadow's delta.
+            path = "shadow" if rng.random() < 0.1 else "console"
             error = None
             try:
-                self.console.publish(topics.robot_cmd(thing), encode(command))
+                if path == "shadow":
+                    desired = {"state": {"desired": {"command": json.loads(encode(command))}}}
+                    call(api, "POST", f"/things/{thing}/shadow", desired)
+                else:
+                    self.console.publish(topics.robot_cmd(thing), encode(command))
             except VahrError as err:
                 error = str(err)
-            self.ledger.send(
-                Sent(command.id, action, (thing,), "console", self._now(), error=error)
-            )
+            self.ledger.send(Sent(command.id, action, (thing,), path, self._now(), error=error))
 
     def _skill_load(self) -> None:
         rng = random.Random(f"{self.config.seed}-skill")
@@ -582,6 +590,7 @@ def summary(report: SoakReport) -> dict[str, Any]:
         "commands owed": v.owed,
         "executed once": v.executed,
         "reported": dict(v.reported),
+        "replaced in desired state": v.replaced_in_desired,
         "lost": len(v.lost),
         "run twice": len(v.run_twice),
         "refused at source": v.refused_at_source,

@@ -40,7 +40,7 @@ class Sent:
     command_id: str
     action: str
     targets: tuple[str, ...]
-    path: str  # "skill" or "console"
+    path: str  # "skill", "console" or "shadow" (desired state)
     at: float
     error: str | None = None  # what the sender was told when the publish failed
 
@@ -69,6 +69,9 @@ class Verdict:
     reported_without_reason: int = 0
     lost: list[str] = field(default_factory=list)
     run_twice: list[str] = field(default_factory=list)
+    # Desired state holds one command: one written while the robot had not yet read an
+    # earlier one replaces it, as on AWS (last writer wins). Not lost: the shadow said so.
+    replaced_in_desired: int = 0
     refused_at_source: int = 0
     ran_after_refusal: list[str] = field(default_factory=list)
     unknown: list[str] = field(default_factory=list)
@@ -135,7 +138,9 @@ class Ledger:
                 ending = record.ending if record is not None else None
                 if record is not None and record.accepted > 1:
                     verdict.run_twice.append(label)
-                if ending is None:
+                if ending is None and _replaced(command, thing, sent, records):
+                    verdict.replaced_in_desired += 1
+                elif ending is None:
                     verdict.lost.append(label)
                 elif ending[0] == "done":
                     verdict.executed += 1
@@ -165,3 +170,20 @@ def read_agent_log(path: Path) -> tuple[dict[tuple[str, str], Record], tuple[str
         records[key].events.append((match["event"], match["reason"]))
         last = (match["id"], match["event"])
     return dict(records), last
+
+
+def _replaced(
+    command: Sent, thing: str, sent: list[Sent], records: dict[tuple[str, str], Record]
+) -> bool:
+    """True when `command`, written as `thing`'s desired state, was overwritten by a later
+    desired command that `thing` then ran."""
+    if command.path != "shadow":
+        return False
+    return any(
+        later.path == "shadow"
+        and later.error is None
+        and later.at > command.at
+        and thing in later.targets
+        and (thing, later.command_id) in records
+        for later in sent
+    )
