@@ -227,8 +227,34 @@ class Mqtt5Link:
         topic, payload = packet.topic, bytes(packet.payload or b"")
         handlers = list(self._exact.get(topic, ()))
         handlers += [h for f, h in self._wildcards if topic_matches(f, topic)]
-        if handlers:
-            self._loop.call_soon_threadsafe(_dispatch, handlers, topic, payload)
+        if not handlers:
+            return
+        # Acknowledge a QoS 1 message only after its handlers ran on the event loop (a
+        # command's id is then on disk among the recent ids). awscrt would acknowledge it
+        # when this callback returns, before the loop has seen it: a robot killed in
+        # between lost the command, since the broker had its PUBACK and never sent it
+        # again. Now the broker redelivers it when the robot is back, and it runs once.
+        acquire = getattr(data, "acquire_publish_acknowledgement_control", None)
+        handle = acquire() if acquire is not None else None  # None: awscrt before 0.36
+        self._loop.call_soon_threadsafe(
+            self._dispatch_and_acknowledge, handlers, topic, payload, handle
+        )
+
+    def _dispatch_and_acknowledge(
+        self,
+        handlers: list[Callable[[str, bytes], None]],
+        topic: str,
+        payload: bytes,
+        handle: mqtt5.PublishAcknowledgementControlHandle | None,
+    ) -> None:
+        _dispatch(handlers, topic, payload)
+        if handle is None:
+            return
+        try:
+            self._client.invoke_publish_acknowledgement(handle)
+        except Exception as err:  # noqa: BLE001 - the connection it came on is gone
+            # The broker sends it again on the next connection; its id makes it a duplicate.
+            log.debug("could not acknowledge a message on %s: %s", topic, err)
 
     def _on_lifecycle_connection_success(self, data: mqtt5.LifecycleConnectSuccessData) -> None:
         session_present = bool(data.connack_packet and data.connack_packet.session_present)
