@@ -19,6 +19,7 @@ RECOVERY_BOUND_S = 20.0
 
 
 @pytest.mark.slow
+@pytest.mark.soak
 @pytest.mark.timeout(420)
 def test_load_and_every_fault_lose_nothing_and_run_nothing_twice(
     tmp_path: Path,
