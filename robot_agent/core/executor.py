@@ -13,7 +13,7 @@ from __future__ import annotations
 import asyncio
 import inspect
 import logging
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 import msgspec
 
@@ -148,28 +148,26 @@ class Executor:
 
     def reject(self, command_id: str | None, action: str | None, reason: str) -> None:
         """Report a command that could not be decoded or is not allowed; nothing else changes."""
-        self._update(
-            last_command=LastCommand(
-                command_id or "unknown", action or "unknown", "rejected", reason
-            )
-        )
-        self._publish_event(
-            Event(
-                event="rejected",
-                thing=self.thing,
-                at=self.clock.now(),
-                command_id=command_id,
-                action=action,
-                reason=reason,
-            )
-        )
+        self._report_ended("rejected", command_id, action, reason)
 
     def report_interrupted(self, command_id: str, action: str, reason: str) -> None:
         """Report a command an earlier run of this robot died running: it ended `failed`."""
-        self._update(last_command=LastCommand(command_id, action, "failed", reason))
+        self._report_ended("failed", command_id, action, reason)
+
+    def _report_ended(
+        self,
+        outcome: Literal["rejected", "failed"],
+        command_id: str | None,
+        action: str | None,
+        reason: str,
+    ) -> None:
+        """`outcome` as the last command (named "unknown" where it could not be read) and
+        as an event, for a command that never ran here."""
+        last = LastCommand(command_id or "unknown", action or "unknown", outcome, reason)
+        self._update(last_command=last)
         self._publish_event(
             Event(
-                event="failed",
+                event=outcome,
                 thing=self.thing,
                 at=self.clock.now(),
                 command_id=command_id,
