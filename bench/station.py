@@ -40,6 +40,7 @@ from playwright.sync_api import sync_playwright  # noqa: E402
 
 from tests.support.browser import launch  # noqa: E402
 from tests.support.swarm import swarm_fleet  # noqa: E402
+from vahr.local.lifetime import spawn  # noqa: E402
 from vahr.local.mqtt import MqttClient, MqttEndpoint  # noqa: E402
 from vahr.local.ports import free_port  # noqa: E402
 from vahr.protocol import encode, new_command, topics  # noqa: E402
@@ -169,10 +170,10 @@ def main() -> int:
 
 def start_station(broker: str, api: str, fleet_file: Path) -> tuple[subprocess.Popen[str], str]:
     """`vahr station` against the stack, as a lab would run it; its page's URL."""
-    process = subprocess.Popen(
+    process = spawn(
         [sys.executable, "-m", "vahr.cli", "station", "--broker", broker, "--api", api,
          "--fleet", str(fleet_file), "--port", str(free_port()), "--json"],
-        stdout=subprocess.PIPE, text=True,
+        started_for=fleet_file.parent, stdout=subprocess.PIPE, text=True,
         cwd=Path(__file__).resolve().parents[1],
     )  # fmt: skip
     assert process.stdout is not None

@@ -23,6 +23,7 @@ from typing import IO, TYPE_CHECKING
 
 import pytest
 
+from vahr.local.lifetime import spawn
 from vahr.local.ports import free_port
 
 if TYPE_CHECKING:
@@ -135,10 +136,10 @@ def test_robot_agent_runs_from_an_empty_directory(
             lambda _t, p: online.set() if json.loads(p).get("online") else None,
         )
         # When the installed robot-agent runs with the bundled fleet, from an empty directory
-        agent = subprocess.Popen(
+        agent = spawn(
             [str(installed / "robot-agent"), "run", "--thing", "placebot1",
              "--broker", f"mqtt://127.0.0.1:{port}", "--backend", "sim"],
-            cwd=empty, env=clean_env(), stdout=subprocess.DEVNULL,
+            started_for=tmp_path, cwd=empty, env=clean_env(), stdout=subprocess.DEVNULL,
             stderr=(tmp_path / "agent.err").open("w"), text=True,
         )  # fmt: skip
         try:
@@ -154,11 +155,11 @@ def test_vahr_up_and_say_run_from_an_empty_directory(installed: Path, tmp_path: 
     empty = tmp_path / "empty"
     empty.mkdir()
     # When the installed `vahr up` starts the whole system from an empty directory
-    up = subprocess.Popen(
+    up = spawn(
         [str(installed / "vahr"), "up", "--json", "--no-voice", "--robots", "1",
          "--api-port", str(free_port()), "--mqtts-port", str(free_port()), "--mqtt-port", "0",
          "--station-port", str(free_port()), "--sim-speed-factor", "20"],
-        cwd=empty, env=clean_env(), stdout=subprocess.PIPE,
+        started_for=tmp_path, cwd=empty, env=clean_env(), stdout=subprocess.PIPE,
         stderr=(tmp_path / "up.err").open("w"), text=True,
     )  # fmt: skip
     try:

@@ -25,6 +25,7 @@ from playwright.sync_api import sync_playwright
 from tests.support.browser import Watch, launch
 from tests.support.vahr_up import ROOT, VAHR, Up, clean_env, say, start_up, stop_up
 from vahr.experiment.eventlog import Kind, read_log
+from vahr.local.lifetime import spawn
 from vahr.local.ports import free_port
 from vahr.speech.audio import Audio
 from vahr.speech.tts import EspeakSynthesizer
@@ -224,11 +225,12 @@ def test_a_click_on_a_robot_then_a_zone_sends_a_navigate_and_logs_the_clicks(
 ) -> None:
     at_rest(up, "placebot2")
     # Given a keyboard-and-mouse session of the experiment running against the system
-    experiment = subprocess.Popen(
+    experiment = spawn(
         [*VAHR, "experiment", "--participant", "P07", "--method", "keyboard", "--trial", "1",
          "--log-dir", str(tmp_path), "--broker", up.endpoints["mqtt"],
          "--api", up.endpoints["api"], "--task-timeout", "120"],
-        cwd=ROOT, env=clean_env(), stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+        started_for=tmp_path, cwd=ROOT, env=clean_env(), stdin=subprocess.PIPE,
+        stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
     try:

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from tests.support.vahr_up import ROOT, VAHR, clean_env
+from vahr.local.lifetime import spawn
 from vahr.local.ports import free_port
 
 if TYPE_CHECKING:
@@ -21,10 +22,11 @@ if TYPE_CHECKING:
 def test_vahr_station_serves_the_page_for_a_running_stack(stack: LocalStack) -> None:
     # Given a local stack (broker, shadows, data plane)
     assert stack.mqtt_url is not None
-    process = subprocess.Popen(
+    process = spawn(
         [*VAHR, "station", "--broker", stack.mqtt_url, "--api", stack.api_url,
          "--port", str(free_port()), "--no-voice", "--json"],
-        cwd=ROOT, env=clean_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        started_for=stack.config.state_dir, cwd=ROOT, env=clean_env(), stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
     try:
         assert process.stdout is not None
