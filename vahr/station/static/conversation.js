@@ -31,21 +31,36 @@ export class Conversation {
     this.names = names; // thing -> spoken name
     this.filter = null;
     this.refreshers = new Map(); // command id -> [functions that redraw what shows it]
+    this.stale = new Set(); // commands acknowledged since the last frame
+    this.frame = null;
     // The list follows the newest entry while the reader is at its end, and stays where
     // the reader scrolled to otherwise: entries never pull the text away from them.
     this.sticky = true;
     list.addEventListener("scroll", () => {
       this.sticky = list.scrollHeight - list.scrollTop - list.clientHeight < 40;
     });
-    new ResizeObserver(() => this.follow()).observe(list);
+    // Following happens when the list or an entry has been laid out anew (an entry
+    // appeared or grew), so it never makes the browser lay the page out an extra time:
+    // a fleet command's hundred acknowledgments cost one layout, not a hundred.
+    this.resized = new ResizeObserver(() => this.follow());
+    this.resized.observe(list);
   }
 
   follow() {
     if (this.sticky) this.list.scrollTop = this.list.scrollHeight;
   }
 
+  // Acknowledgments come in bursts: what shows them is redrawn once, in the next frame.
+  redrawStale() {
+    this.frame = null;
+    for (const commandId of this.stale) for (const redraw of this.refreshers.get(commandId) || []) redraw();
+    this.stale.clear();
+  }
+
   build(fleet, entries) {
     this.list.replaceChildren();
+    this.resized.disconnect();
+    this.resized.observe(this.list);
     this.refreshers.clear();
     this.filters.replaceChildren();
     const chips = [[null, "All"], ...fleet.robots.slice(0, 8).map((r) => [r.thing, r.name])];
@@ -97,15 +112,18 @@ export class Conversation {
     item.hidden = !this.visible(item);
     this.list.querySelector(".empty")?.remove();
     this.list.appendChild(item);
+    this.resized.observe(item);
     // The oldest entries go, so a long session does not grow the page without end.
-    while (this.list.children.length > ENTRIES_KEPT) this.list.firstElementChild.remove();
+    while (this.list.children.length > ENTRIES_KEPT) {
+      this.resized.unobserve(this.list.firstElementChild);
+      this.list.firstElementChild.remove();
+    }
     this.showEmpty();
-    this.follow();
   }
 
   acknowledged(commandId) {
-    for (const redraw of this.refreshers.get(commandId) || []) redraw();
-    this.follow();
+    this.stale.add(commandId);
+    if (this.frame === null) this.frame = requestAnimationFrame(() => this.redrawStale());
   }
 
   watch(commandId, redraw) {

@@ -23,6 +23,13 @@ function el(name, attributes = {}, parent = null) {
   return node;
 }
 
+// Write an attribute only when its value changes: every write, even of the same value,
+// makes the browser restyle and lay the map out again.
+function put(node, name, value) {
+  const text = String(value);
+  if (node.getAttribute(name) !== text) node.setAttribute(name, text);
+}
+
 const now = () => performance.now();
 const distance = (a, b) => Math.hypot(a.x - b.x, a.y - b.y);
 const smooth = (t) => 1 - Math.pow(1 - Math.min(Math.max(t, 0), 1), 3);
@@ -253,13 +260,11 @@ export class MapView {
       drawn.colour = colour;
       drawn.body.style.fill = drawn.path.style.stroke = drawn.destination.style.stroke = colour;
     }
-    const cargo = reported.cargo ? "visible" : "hidden";
-    if (drawn.cargo.getAttribute("visibility") !== cargo) drawn.cargo.setAttribute("visibility", cargo);
+    put(drawn.cargo, "visibility", reported.cargo ? "visible" : "hidden");
     if (drawn.detail) {
       const text = describe(drawn.state);
       if (drawn.detail.textContent !== text) drawn.detail.textContent = text;
     }
-    this.updateArms();
   }
 
   // A reported pose (from the shadow or an event): move the robot's motion.
@@ -281,6 +286,7 @@ export class MapView {
     this.svg.classList.toggle("map-armed", Boolean(thing));
   }
 
+  // The arms at work: call once after the robots of a frame were updated.
   updateArms() {
     const working = new Set();
     for (const drawn of this.robots.values()) {
@@ -319,20 +325,20 @@ export class MapView {
     const { motion } = drawn;
     const at = motion.position(t);
     const heading = motion.headingAt(t, dt);
-    drawn.group.setAttribute("transform", `translate(${at.x.toFixed(3)} ${(-at.y).toFixed(3)})`);
+    put(drawn.group, "transform", `translate(${at.x.toFixed(3)} ${(-at.y).toFixed(3)})`);
     if (drawn.label) this.placeLabel(drawn, at);
-    drawn.rotor.setAttribute("transform", `rotate(${((-heading * 180) / Math.PI).toFixed(1)})`);
+    put(drawn.rotor, "transform", `rotate(${((-heading * 180) / Math.PI).toFixed(1)})`);
     const target = motion.target;
     const show = target && distance(at, target) > 0.05 ? "visible" : "hidden";
-    drawn.path.setAttribute("visibility", show);
-    drawn.destination.setAttribute("visibility", show);
+    put(drawn.path, "visibility", show);
+    put(drawn.destination, "visibility", show);
     if (target) {
-      drawn.path.setAttribute("x1", at.x.toFixed(3));
-      drawn.path.setAttribute("y1", (-at.y).toFixed(3));
-      drawn.path.setAttribute("x2", target.x);
-      drawn.path.setAttribute("y2", -target.y);
-      drawn.destination.setAttribute("cx", target.x);
-      drawn.destination.setAttribute("cy", -target.y);
+      put(drawn.path, "x1", at.x.toFixed(3));
+      put(drawn.path, "y1", (-at.y).toFixed(3));
+      put(drawn.path, "x2", target.x);
+      put(drawn.path, "y2", -target.y);
+      put(drawn.destination, "cx", target.x);
+      put(drawn.destination, "cy", -target.y);
     }
     const turning = Math.abs(angleDelta(motion.heading, motion.target ? heading : motion.theta)) > 0.01;
     return motion.driving || motion.settling || turning;

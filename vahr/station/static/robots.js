@@ -8,6 +8,10 @@ import { clock, node } from "./dom.js";
 import { describe, statusColour, zoneText } from "./map.js";
 
 
+// Up to this many robots the list is as tall as its rows; beyond, it has the card's whole
+// height whatever its rows say, so a row that changes lays out the list alone, not the page.
+const ROWS_SIZED_BY_CONTENT = 4;
+
 // Set a property only when it changes (reading is cheap, writing makes the browser work).
 function put(target, key, value) {
   if (target[key] !== value) target[key] = value;
@@ -22,6 +26,7 @@ export class RobotsPanel {
 
   build(fleet) {
     this.list.replaceChildren();
+    this.list.classList.toggle("many", fleet.robots.length > ROWS_SIZED_BY_CONTENT);
     this.rows.clear();
     fleet.robots.forEach((robot, index) => {
       const row = node("li", "robot-row");

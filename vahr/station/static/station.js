@@ -72,15 +72,21 @@ function draw() {
     if (metrics) record(thing, status, robot.reported || {});
   }
   dirty.clear();
+  map.updateArms();
   if (metrics && painted.length) {
-    const done = painted.splice(0);
-    // After this frame is painted: the next task once rendering has happened.
-    setTimeout(() => {
-      const at = performance.timeOrigin + performance.now();
-      for (const marker of done) metrics.painted.push({ ...marker, at });
-    }, 0);
+    // After this frame is painted: the first task once its rendering has run. A posted
+    // message, not a timer: timers wait behind other queued work (a stream's next batch).
+    afterFrame.push(painted.splice(0));
+    frameDone.port2.postMessage(null);
   }
 }
+
+const afterFrame = [];
+const frameDone = new MessageChannel();
+frameDone.port1.onmessage = () => {
+  const at = performance.timeOrigin + performance.now();
+  for (const marker of afterFrame.shift()) metrics.painted.push({ ...marker, at });
+};
 
 // Each robot's status, cargo and zone as drawn, whenever one of them changes (`?metrics=1`).
 const lastShown = {};
