@@ -127,7 +127,7 @@ def main() -> int:
                         f"{service_cpu_us[-1]:.0f} us of the stack's CPU each",
                         file=sys.stderr,
                     )
-                cpu_before = time.process_time()
+                    cpu_before = time.process_time()  # each run's CPU is its own
             finally:
                 loader.join(30)
                 if loader.is_alive():
