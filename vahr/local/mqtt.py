@@ -382,7 +382,9 @@ class MqttClient:
     ) -> None:
         """Publish; with `wait` and QoS 1, block until PUBACK and raise if it was refused.
 
-        Without `wait` it still blocks while MAX_UNACKNOWLEDGED publishes await PUBACK.
+        Without `wait` it still blocks while MAX_UNACKNOWLEDGED publishes await PUBACK,
+        and a QoS 1 message published while disconnected is queued and sent after the
+        client reconnects (a fire-and-forget notification, a shadow service's answer).
 
         A publish this raises for is never sent later: paho keeps a QoS 1 message it could
         not send (no connection) or that was not acknowledged, and sends it again after it
@@ -397,8 +399,14 @@ class MqttClient:
                 f"{WINDOW_TIMEOUT_S:g} s; not publishing to {topic}"
             )
         info = self._client.publish(topic, payload, qos=qos, retain=retain)
+        if info.rc == paho.MQTT_ERR_NO_CONN and qos > 0 and not wait:
+            # Queued: paho sends it after reconnecting, and its PUBACK frees the slot. The
+            # caller asked not to wait, so this is not a failure; reported as one, the
+            # data plane answered 500 for a shadow update it had stored (its notifications
+            # go out here), and the robot ran a command its sender was told had failed.
+            self._ignore(info.mid)
+            return
         if info.rc != paho.MQTT_ERR_SUCCESS:
-            # Without `wait`, paho sends it after reconnecting and its PUBACK frees the slot.
             if wait:
                 self._withdraw(info.mid)
             raise VahrError(f"cannot publish to {topic}: {paho.error_string(info.rc)}")
