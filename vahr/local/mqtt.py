@@ -224,6 +224,11 @@ class PublishDenied(VahrError):
     """The broker refused a publish (MQTT 5 PUBACK reason code >= 0x80)."""
 
 
+class PublishUnconfirmed(VahrError):
+    """No PUBACK came in time: the message is not sent again, but the broker may have it
+    (the connection or the broker died after receiving it), so it may still be delivered."""
+
+
 class MqttClient:
     """One MQTT 5 connection. Handlers run on paho's network thread: keep them short."""
 
@@ -416,7 +421,7 @@ class MqttClient:
         waiter, codes = self._expect(self._acks, info.mid)
         if not waiter.wait(PUBLISH_TIMEOUT_S):
             if self._withdraw(info.mid):
-                raise VahrError(
+                raise PublishUnconfirmed(
                     f"the MQTT broker did not acknowledge a publish to {topic} within "
                     f"{PUBLISH_TIMEOUT_S:g} s; it will not be sent again (the broker may "
                     "still have received it)"
@@ -544,4 +549,4 @@ class MqttClient:
                 log.exception("handler for %s failed", topic_filter)
 
 
-__all__ = ["MqttClient", "MqttEndpoint", "PublishDenied"]
+__all__ = ["MqttClient", "MqttEndpoint", "PublishDenied", "PublishUnconfirmed"]
