@@ -31,6 +31,7 @@ log = logging.getLogger(__name__)
 
 # Events an operator should notice at the default log level and above.
 _TROUBLE = frozenset({"rejected", "failed", "stuck"})
+_ENDINGS = frozenset({"done", "failed", "cancelled", "rejected"})
 
 
 class RobotAgent:
@@ -94,10 +95,14 @@ class RobotAgent:
             command_id, action = _best_effort_identity(payload)
             self.executor.reject(command_id, action, str(err))
             return
-        if not self.recent_ids.add(command.id):
+        if command.id in self.recent_ids:
             self.duplicates += 1
             log.info("%s: ignored duplicate command %s", self.thing, command.id)
             return
+        # Written before the id is saved: a robot killed in between reports it when it is
+        # back, or runs its redelivery (see `in_flight`).
+        self.in_flight.start(command.id, command.action)
+        self.recent_ids.add(command.id)
         log.info(
             "%s: command %s %s from %s", self.thing, command.id, command.action, command.source
         )
@@ -116,13 +121,15 @@ class RobotAgent:
 
     def on_connected(self, session_present: bool) -> None:
         self.executor.set_connected(True)
-        if self._left_over is not None:
+        if self._left_over:
             # Before anything a resumed session redelivers: the sender learns first that
-            # the command the robot died running did not finish (see `in_flight`).
-            command_id, action = self._left_over
-            self._left_over = None
+            # the commands the robot died running did not finish. One whose id was never
+            # saved was not taken: its redelivery runs (see `in_flight`).
+            left_over, self._left_over = self._left_over, []
             self.in_flight.clear()
-            self.executor.report_interrupted(command_id, action, INTERRUPTED_REASON)
+            for command_id, action in left_over:
+                if command_id in self.recent_ids:
+                    self.executor.report_interrupted(command_id, action, INTERRUPTED_REASON)
         self.link.publish(
             topics.robot_presence(self.thing),
             encode(Presence(online=True, at=self.clock.now())),
@@ -140,16 +147,14 @@ class RobotAgent:
         self.shadow.report(state)
 
     def _publish_event(self, event: Event) -> None:
-        if event.command_id is not None and event.action not in (None, "ping"):
-            if event.event == "accepted":
-                self.in_flight.start(event.command_id, event.action)
-            elif event.event in ("done", "failed", "cancelled"):
-                self.in_flight.end(event.command_id)
         self.link.publish(
             topics.robot_events(self.thing), encode(event), retain=event.event == "delivered"
         )
         level = logging.WARNING if event.event in _TROUBLE else logging.INFO
         log.log(level, "%s: %s", self.thing, _describe(event))
+        # Forgotten only once its end is on record (logged, and queued on the link).
+        if event.command_id is not None and event.event in _ENDINGS:
+            self.in_flight.end(event.command_id)
 
     async def shut_down(self) -> None:
         """Cancel the running task, report the final state and presence offline."""

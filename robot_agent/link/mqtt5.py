@@ -14,6 +14,7 @@ import logging
 import os
 import socket
 import threading
+import time
 from concurrent import futures
 from dataclasses import dataclass
 from pathlib import Path
@@ -69,6 +70,8 @@ class Mqtt5Link:
         self._connected_callbacks: list[Callable[[bool], None]] = []
         self._disconnected_callbacks: list[Callable[[str], None]] = []
         self._connected = threading.Event()
+        # Set once the broker acknowledged every subscription of the current connection.
+        self._subscribed = threading.Event()
         self._stopped = threading.Event()
         self._lock = threading.Lock()
         self._pending: set[Future[mqtt5.PublishCompletionData]] = set()
@@ -111,16 +114,28 @@ class Mqtt5Link:
         return self._connected.is_set()
 
     async def start(self, timeout_s: float | None = None) -> None:
-        """Start connecting; with `timeout_s`, wait that long for the first connection."""
+        """Start connecting; with `timeout_s`, wait that long for the first connection and
+        the broker's acknowledgment of its subscriptions.
+
+        Connected is not yet listening: a message published between the CONNACK and the
+        SUBACK of a new session matches no subscription, and the broker drops it. A caller
+        told the link has started may send at once (the soak lost its first command so).
+        """
         self._client.start()
-        if timeout_s is not None:
-            connected = await asyncio.to_thread(self._connected.wait, timeout_s)
-            if not connected:
-                await self.stop()
-                raise VahrError(
-                    f"could not connect to {self.settings.host}:{self.settings.port} "
-                    f"within {timeout_s:g} s"
-                )
+        if timeout_s is None:
+            return
+        deadline = time.monotonic() + timeout_s
+        connected = await asyncio.to_thread(self._connected.wait, timeout_s)
+        subscribed = connected and await asyncio.to_thread(
+            self._subscribed.wait, max(0.0, deadline - time.monotonic())
+        )
+        if not subscribed:
+            await self.stop()
+            waited_for = "connect to" if not connected else "subscribe on"
+            raise VahrError(
+                f"could not {waited_for} {self.settings.host}:{self.settings.port} "
+                f"within {timeout_s:g} s"
+            )
 
     async def flush(self, timeout_s: float = 5.0) -> None:
         """Wait until every publish so far is acknowledged (or `timeout_s` passes)."""
@@ -186,17 +201,40 @@ class Mqtt5Link:
         )
         return mqtt5.Client(options)
 
-    def _subscribe(self, filters: list[str]) -> None:
+    def _subscribe(self, filters: list[str]) -> list[Future[mqtt5.SubackPacket]]:
         # Chunks keep each SUBSCRIBE packet small when a swarm subscribes thousands of topics.
+        sent = []
         for start in range(0, len(filters), SUBSCRIBE_CHUNK):
             subscriptions = [
                 mqtt5.Subscription(topic_filter=f, qos=mqtt5.QoS.AT_LEAST_ONCE)
                 for f in filters[start : start + SUBSCRIBE_CHUNK]
             ]
             future = self._client.subscribe(mqtt5.SubscribePacket(subscriptions=subscriptions))
-            future.add_done_callback(self._subscribed)
+            future.add_done_callback(self._on_suback)
+            sent.append(future)
+        return sent
 
-    def _subscribed(self, future: Future[mqtt5.SubackPacket]) -> None:
+    def _subscribe_all(self) -> None:
+        """Subscribe to every filter again; `_subscribed` is set once all are acknowledged
+        (or failed, which `_on_suback` logs)."""
+        self._subscribed.clear()
+        sent = self._subscribe(list(self._filters))
+        if not sent:
+            self._subscribed.set()
+            return
+        remaining = [len(sent)]
+
+        def one_done(_future: Future[mqtt5.SubackPacket]) -> None:
+            with self._lock:
+                remaining[0] -= 1
+                last = remaining[0] == 0
+            if last:
+                self._subscribed.set()
+
+        for future in sent:
+            future.add_done_callback(one_done)
+
+    def _on_suback(self, future: Future[mqtt5.SubackPacket]) -> None:
         try:
             suback = future.result()
         except Exception as err:  # noqa: BLE001 - reported, the next connection retries
@@ -269,8 +307,7 @@ class Mqtt5Link:
         )
         # Subscribing again is harmless when the session was resumed and required when
         # the broker lost it (a crash without persistence).
-        if self._filters:
-            self._subscribe(list(self._filters))
+        self._subscribe_all()
         for callback in self._connected_callbacks:
             self._loop.call_soon_threadsafe(callback, session_present)
 

@@ -18,12 +18,14 @@ Then it waits for every robot to finish, and reports from the robots' own record
 swarm's events as published, the agents' logs) and the shadows: commands executed once,
 reported failed or cancelled with a reason, lost, run twice; shadows that did not converge;
 the largest RSS of each process; the skill's slowest answer; the longest recovery after a
-broker restart (broker back to a ping answered by both agents and a swarm robot).
+broker restart (broker back to a ping answered by both agents and a swarm robot). The
+books of the run are left in `{work_dir}/ledger.json` beside the state directory.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import itertools
 import json
 import os
@@ -39,12 +41,12 @@ from typing import TYPE_CHECKING, Any
 
 from robot_agent.config import ExecutorSettings
 from tests.faults import TcpProxy, alive, kill_hard, processes_of, wait_until
-from tests.support.soak_ledger import Ledger, Sent, Verdict, read_agent_log
+from tests.support.soak_ledger import Ledger, Record, Sent, Verdict, read_agent_log
 from tests.support.swarm import SwarmThread
 from tests.support.vahr_up import start_up, stop_up
 from vahr.errors import VahrError
 from vahr.local.client import call, say
-from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.local.mqtt import MqttClient, MqttEndpoint, PublishUnconfirmed
 from vahr.local.ports import free_port
 from vahr.pki import LocalCA
 from vahr.protocol import encode, new_command, topics
@@ -173,6 +175,7 @@ class Soak:
             records = self._settle()
             unconverged, checked = self._check_shadows()
             verdict = self.ledger.verdict(records)
+            self._write_books(records)
             self._check_alive()
             return SoakReport(
                 config=cfg,
@@ -270,16 +273,28 @@ class Soak:
             # One in ten is written as the robot's desired state instead (DESIGN.md: for a
             # robot that may be offline); the robot applies it from the shadow's delta.
             path = "shadow" if rng.random() < 0.1 else "console"
-            error = None
+            error, unconfirmed = None, False
             try:
                 if path == "shadow":
                     desired = {"state": {"desired": {"command": json.loads(encode(command))}}}
                     call(api, "POST", f"/things/{thing}/shadow", desired)
                 else:
                     self.console.publish(topics.robot_cmd(thing), encode(command))
+            except PublishUnconfirmed as err:
+                error, unconfirmed = str(err), True
             except VahrError as err:
                 error = str(err)
-            self.ledger.send(Sent(command.id, action, (thing,), path, self._now(), error=error))
+            self.ledger.send(
+                Sent(
+                    command.id,
+                    action,
+                    (thing,),
+                    path,
+                    self._now(),
+                    error=error,
+                    unconfirmed=unconfirmed,
+                )
+            )
 
     def _skill_load(self) -> None:
         rng = random.Random(f"{self.config.seed}-skill")
@@ -466,6 +481,16 @@ class Soak:
             )
         return records()
 
+    def _write_books(self, records: dict[tuple[str, str], Record]) -> None:
+        """`{work_dir}/ledger.json`: every command sent, every fault and every robot's
+        record, so a lost command can be followed through the logs after the run."""
+        books = {
+            "sent": [dataclasses.asdict(s) for s in self.ledger.sent],
+            "faults": [dataclasses.asdict(f) for f in self.faults],
+            "records": {f"{thing} {i}": r.events for (thing, i), r in records.items()},
+        }
+        (self.config.work_dir / "ledger.json").write_text(json.dumps(books, indent=1))
+
     def _check_shadows(self) -> tuple[list[str], int]:
         """Robots whose shadow still differs from the robot's own final state after 30 s."""
         assert self.up is not None and self.swarm is not None
@@ -595,6 +620,7 @@ def summary(report: SoakReport) -> dict[str, Any]:
         "run twice": len(v.run_twice),
         "refused at source": v.refused_at_source,
         "ran after refusal": len(v.ran_after_refusal),
+        "unconfirmed at source (ran)": f"{v.unconfirmed} ({v.unconfirmed_ran})",
         "unknown ids": len(v.unknown),
         "faults": {k: sum(1 for f in report.faults if f.kind == k) for k in FAULTS},
         "faults survived": sum(1 for f in report.faults if f.survived),

@@ -43,6 +43,9 @@ class Sent:
     path: str  # "skill", "console" or "shadow" (desired state)
     at: float
     error: str | None = None  # what the sender was told when the publish failed
+    # The sender was told the outcome is unknown (no PUBACK in time; the broker may have
+    # it): not owed, and it may run, once at most.
+    unconfirmed: bool = False
 
 
 @dataclass
@@ -74,6 +77,10 @@ class Verdict:
     replaced_in_desired: int = 0
     refused_at_source: int = 0
     ran_after_refusal: list[str] = field(default_factory=list)
+    # Publishes the sender was told may or may not have reached the broker, and of those
+    # the ones a robot ran (allowed: the sender was not told they failed).
+    unconfirmed: int = 0
+    unconfirmed_ran: int = 0
     unknown: list[str] = field(default_factory=list)
 
 
@@ -118,7 +125,7 @@ class Ledger:
 
     def owed(self) -> list[Sent]:
         with self._lock:
-            return [s for s in self.sent if s.error is None]
+            return [s for s in self.sent if s.error is None and not s.unconfirmed]
 
     def verdict(self, records: dict[tuple[str, str], Record]) -> Verdict:
         verdict = Verdict()
@@ -126,9 +133,19 @@ class Ledger:
             sent = list(self.sent)
         known = {s.command_id for s in sent}
         for command in sent:
+            ran = [
+                records[(t, command.command_id)]
+                for t in command.targets
+                if (t, command.command_id) in records
+            ]
+            if command.unconfirmed:
+                verdict.unconfirmed += 1
+                verdict.unconfirmed_ran += bool(ran)
+                verdict.run_twice += [command.command_id for r in ran if r.accepted > 1]
+                continue
             if command.error is not None:
                 verdict.refused_at_source += 1
-                if any((t, command.command_id) in records for t in command.targets):
+                if ran:
                     verdict.ran_after_refusal.append(command.command_id)
                 continue
             for thing in command.targets:

@@ -72,6 +72,8 @@ class DataPlane:
         self.meter = meter
         # Called with (topic, payload) after each publish (the simulator's command log).
         self.publish_observers: list[Callable[[str, bytes], None]] = []
+        # Called with (topic, payload) before each publish is attempted.
+        self.publish_starters: list[Callable[[str, bytes], None]] = []
         self.local_routes: dict[tuple[str, str], Callable[[Json], tuple[int, Json]]] = {}
         # GET paths answered with a redirect (the old dashboard, now the operator station).
         self.redirects: dict[str, str] = {}
@@ -116,6 +118,8 @@ class DataPlane:
             raise ApiError(400, f"'{topic}' is not a topic one can publish to")
         if len(body) > MAX_PUBLISH_BYTES:
             raise ApiError(413, "The payload exceeds the maximum size allowed")
+        for starter in self.publish_starters:
+            starter(topic, body)
         try:
             self._publish(topic, body, qos, retain)
         except VahrError as err:

@@ -224,6 +224,11 @@ class PublishDenied(VahrError):
     """The broker refused a publish (MQTT 5 PUBACK reason code >= 0x80)."""
 
 
+class PublishUnconfirmed(VahrError):
+    """No PUBACK came in time: the message is not sent again, but the broker may have it
+    (the connection or the broker died after receiving it), so it may still be delivered."""
+
+
 class MqttClient:
     """One MQTT 5 connection. Handlers run on paho's network thread: keep them short."""
 
@@ -382,7 +387,9 @@ class MqttClient:
     ) -> None:
         """Publish; with `wait` and QoS 1, block until PUBACK and raise if it was refused.
 
-        Without `wait` it still blocks while MAX_UNACKNOWLEDGED publishes await PUBACK.
+        Without `wait` it still blocks while MAX_UNACKNOWLEDGED publishes await PUBACK,
+        and a QoS 1 message published while disconnected is queued and sent after the
+        client reconnects (a fire-and-forget notification, a shadow service's answer).
 
         A publish this raises for is never sent later: paho keeps a QoS 1 message it could
         not send (no connection) or that was not acknowledged, and sends it again after it
@@ -397,8 +404,14 @@ class MqttClient:
                 f"{WINDOW_TIMEOUT_S:g} s; not publishing to {topic}"
             )
         info = self._client.publish(topic, payload, qos=qos, retain=retain)
+        if info.rc == paho.MQTT_ERR_NO_CONN and qos > 0 and not wait:
+            # Queued: paho sends it after reconnecting, and its PUBACK frees the slot. The
+            # caller asked not to wait, so this is not a failure; reported as one, the
+            # data plane answered 500 for a shadow update it had stored (its notifications
+            # go out here), and the robot ran a command its sender was told had failed.
+            self._ignore(info.mid)
+            return
         if info.rc != paho.MQTT_ERR_SUCCESS:
-            # Without `wait`, paho sends it after reconnecting and its PUBACK frees the slot.
             if wait:
                 self._withdraw(info.mid)
             raise VahrError(f"cannot publish to {topic}: {paho.error_string(info.rc)}")
@@ -408,7 +421,7 @@ class MqttClient:
         waiter, codes = self._expect(self._acks, info.mid)
         if not waiter.wait(PUBLISH_TIMEOUT_S):
             if self._withdraw(info.mid):
-                raise VahrError(
+                raise PublishUnconfirmed(
                     f"the MQTT broker did not acknowledge a publish to {topic} within "
                     f"{PUBLISH_TIMEOUT_S:g} s; it will not be sent again (the broker may "
                     "still have received it)"
@@ -536,4 +549,4 @@ class MqttClient:
                 log.exception("handler for %s failed", topic_filter)
 
 
-__all__ = ["MqttClient", "MqttEndpoint", "PublishDenied"]
+__all__ = ["MqttClient", "MqttEndpoint", "PublishDenied", "PublishUnconfirmed"]

@@ -167,7 +167,8 @@ class LocalStack:
         from vahr.local.alexa.skill import load_skill_handler
 
         assert self.dataplane is not None, "start() first"
-        log = CommandLog()
+        log = CommandLog(starts_seen=True)
+        self.dataplane.publish_starters.append(log.begin)
         self.dataplane.publish_observers.append(log.observe)
         # The classifier loads (or trains, when its cache is cold) while the rest starts;
         # the first utterance waits for it.

@@ -63,20 +63,28 @@ def test_the_running_command_survives_a_crash_on_disk_and_is_forgotten_when_it_e
     # Given a robot running d1 that dies (its InFlight is never told the task ended)
     InFlight(path).start("d1", "deliver")
     # Then the next run finds d1 left over
-    assert InFlight(path).left_over() == ("d1", "deliver")
-    # And a command that ends, or is taken over by a newer one, leaves nothing behind
+    assert InFlight(path).left_over() == [("d1", "deliver")]
+    # And a command taken while another runs is kept beside it until each one ends
     running = InFlight(path)
+    running.start("d1", "deliver")
     running.start("n1", "navigate")
-    running.end("d1")  # an older id ending does not clear the newer one
-    assert InFlight(path).left_over() == ("n1", "navigate")
+    assert InFlight(path).left_over() == [("d1", "deliver"), ("n1", "navigate")]
+    running.end("d1")
+    assert InFlight(path).left_over() == [("n1", "navigate")]
     running.end("n1")
-    assert InFlight(path).left_over() is None and not path.exists()
+    assert InFlight(path).left_over() == [] and not path.exists()
+
+
+def test_the_one_command_file_of_earlier_versions_is_still_read(tmp_path: Path) -> None:
+    path = tmp_path / "in-flight.json"
+    path.write_text('{"id": "d1", "action": "deliver"}')
+    assert InFlight(path).left_over() == [("d1", "deliver")]
 
 
 def test_a_torn_in_flight_file_does_not_stop_the_robot(tmp_path: Path) -> None:
     path = tmp_path / "in-flight.json"
     path.write_text('{"id": "d1"')
-    assert InFlight(path).left_over() is None
+    assert InFlight(path).left_over() == []
 
 
 def test_only_a_peer_delivery_after_the_command_was_issued_counts() -> None:
