@@ -5,10 +5,12 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
-# Debian packages the project runs: the MQTT broker, speech, ROS 1 for the ros1 backend, and
-# chromium for the operator station's browser tests.
+# Debian packages the project runs: the MQTT broker, speech (sphinxtrain's tools remake the
+# hearing's acoustic adaptation), ROS 1 for the ros1 backend, and chromium for the operator
+# station's browser tests.
 DEB_PACKAGES := mosquitto espeak-ng sox chromium ros-core python3-rospy python3-actionlib \
-	python3-move-base-msgs python3-geometry-msgs python3-actionlib-msgs
+	python3-move-base-msgs python3-geometry-msgs python3-actionlib-msgs \
+	sphinxtrain pocketsphinx sphinxbase-utils
 # The pure-Python ROS packages the venv sees through a .pth file (see FIELD-NOTES: pointing
 # the venv at all of dist-packages would leak Debian's older packages into pip's view).
 ROS_PYTHON_PACKAGES := actionlib actionlib_msgs catkin genmsg genpy geometry_msgs \
@@ -17,7 +19,7 @@ ROS_SITE := $(VENV)/ros-site
 export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
 export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 
-.PHONY: demo test test-repeat soak-test lint typecheck pytest setup system-packages bench synth deploy skill-model clean
+.PHONY: hearing-adaptation demo test test-repeat soak-test lint typecheck pytest setup system-packages bench synth deploy skill-model clean
 
 demo: setup
 	$(BIN)/vahr demo
@@ -97,3 +99,7 @@ skill-model: setup
 
 clean:
 	rm -rf $(VENV) node_modules cdk.out .build .cache .state
+
+# Remake robot_agent/voice/data/espeak-ng.mllr, the hearing's adaptation to espeak-ng (docs/voice.md).
+hearing-adaptation: setup
+	$(BIN)/python -m robot_agent.voice.adaptation

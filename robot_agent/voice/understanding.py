@@ -21,6 +21,8 @@ the `heard` event. The reason says what happened.
 from __future__ import annotations
 
 import logging
+import os
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from robot_agent.voice.port import Heard
@@ -102,19 +104,33 @@ def _rejected(recognition: Recognition) -> Heard:
 
 def recognizers(answers: WeatherAnswers) -> tuple[Recognizer, Recognizer]:
     """The exact recognizer (a grammar of the answers, the not-answers as decoys) and the
-    open one (a language model of every sentence), both from `answers`."""
+    open one (a language model of every sentence), both from `answers`, both adapted to
+    the assistant's voice as `VAHR_HEARING_ADAPTATION` says."""
     from vahr.speech.lm_stt import LanguageModelRecognizer
     from vahr.speech.stt import DEFAULT_DECOYS, GrammarRecognizer
 
-    exact = GrammarRecognizer(answers.all_phrases(), decoys=(*answers.not_answers, *DEFAULT_DECOYS))
-    return exact, LanguageModelRecognizer(answers.corpus())
+    adaptation = hearing_adaptation()
+    decoys = (*answers.not_answers, *DEFAULT_DECOYS)
+    exact = GrammarRecognizer(answers.all_phrases(), decoys=decoys, adaptation=adaptation)
+    return exact, LanguageModelRecognizer(answers.corpus(), adaptation=adaptation)
+
+
+def hearing_adaptation(setting: str | None = None) -> Path | None:
+    """The acoustic adaptation to hear the assistant with (`robot_agent/voice/adaptation.py`):
+    `VAHR_HEARING_ADAPTATION` unset or `espeak-ng` is the bundled one, made for the local
+    stack's espeak-ng assistant; `none` hears with pocketsphinx's model as it is (a human
+    or an Alexa in the room); anything else is the path of a transform of one's own."""
+    value = os.environ.get("VAHR_HEARING_ADAPTATION", "") if setting is None else setting
+    if value in ("", "espeak-ng"):
+        from robot_agent.voice.adaptation import BUNDLED
+
+        return BUNDLED
+    return None if value == "none" else Path(value)
 
 
 def offline_understanding(answers_file: str | None = None) -> Understanding:
     """pocketsphinx (grammar, then language model) from `weather_answers.yaml`, and the
     local interpreter of its cues."""
-    from pathlib import Path
-
     from robot_agent.voice.answers import ANSWERS_FILE, WeatherAnswers
     from robot_agent.voice.interpreter import LocalInterpreter
 

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 from vahr.speech.audio import SAMPLE_RATE, SpeechDetector
 from vahr.speech.errors import SpeechError
 from vahr.speech.pronounce import guesses
-from vahr.speech.stt import NOTHING_HEARD, HeardWord, Recognition, utterance
+from vahr.speech.stt import NOTHING_HEARD, HeardWord, Recognition, adapted_to, utterance
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -61,7 +61,13 @@ def arpa_model(sentences: Iterable[str]) -> str:
 class LanguageModelRecognizer:
     """pocketsphinx with an n-gram model of example sentences, and word posteriors."""
 
-    def __init__(self, sentences: Iterable[str], *, detector: SpeechDetector | None = None) -> None:
+    def __init__(
+        self,
+        sentences: Iterable[str],
+        *,
+        detector: SpeechDetector | None = None,
+        adaptation: Path | None = None,
+    ) -> None:
         from pocketsphinx import Decoder, get_model_path
 
         self.sentences = tuple(dict.fromkeys(sentences))
@@ -87,6 +93,7 @@ class LanguageModelRecognizer:
                 loglevel="FATAL",
                 fwdflat=False,
                 samprate=float(SAMPLE_RATE),
+                **adapted_to(adaptation),
             )
         # One decoder, one utterance at a time.
         self._lock = threading.Lock()

@@ -109,6 +109,7 @@ class GrammarRecognizer:
         detector: SpeechDetector | None = None,
         decoys: Iterable[str] = DEFAULT_DECOYS,
         verify: bool = True,
+        adaptation: Path | None = None,
     ) -> None:
         from pocketsphinx import Decoder, get_model_path
 
@@ -123,7 +124,11 @@ class GrammarRecognizer:
         # compallsen: score every senone each frame, so the per-frame normalization (and
         # with it the ratio below) is the same for the grammar and the phone loop.
         self._decoder = Decoder(
-            lm=None, loglevel="FATAL", compallsen=verify, samprate=float(SAMPLE_RATE)
+            lm=None,
+            loglevel="FATAL",
+            compallsen=verify,
+            samprate=float(SAMPLE_RATE),
+            **adapted_to(adaptation),
         )
         missing = sorted(
             {w for p in self.phrases for w in p.split() if self._decoder.lookup_word(w) is None}
@@ -199,6 +204,16 @@ class GrammarRecognizer:
             return None
         # The binding hands the score back exponentiated; take the log again.
         return float(self._logmath.log(hypothesis.score)) / frames
+
+
+def adapted_to(adaptation: Path | None) -> dict[str, str]:
+    """The decoder options that apply a speaker adaptation (an MLLR transform of the
+    acoustic model's means, as sphinxtrain's `mllr_solve` writes it), or none."""
+    if adaptation is None:
+        return {}
+    if not adaptation.is_file():
+        raise SpeechError(f"no acoustic adaptation at {adaptation}")
+    return {"mllr": str(adaptation)}
 
 
 @contextmanager
