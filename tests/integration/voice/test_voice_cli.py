@@ -83,8 +83,9 @@ def test_hear_json_says_why_it_decided(tmp_path: Path, capsys: pytest.CaptureFix
     # When the robot hears it
     assert main(["hear", str(wav), "--json"]) == 0
     heard = json.loads(capsys.readouterr().out)
-    # Then it is rainy, and the word that decided is reported
-    assert (heard["intent"], heard["evidence"], heard["reason"]) == ("rainy", ["pouring"], "")
+    # Then it is rainy, and the words that decided are reported
+    assert (heard["intent"], heard["reason"]) == ("rainy", "")
+    assert "pouring" in heard["evidence"]
     assert "pouring" in heard["text"]
 
 
