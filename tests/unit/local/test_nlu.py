@@ -39,6 +39,8 @@ def model() -> InteractionModel:
         ("help", "AMAZON.HelpIntent", {}),
         ("stop", "AMAZON.StopIntent", {}),
         ("cancel", "AMAZON.CancelIntent", {}),
+        # Amazon lists "never mind" with cancel, not with stop.
+        ("never mind", "AMAZON.CancelIntent", {}),
         ("make me a sandwich", "AMAZON.FallbackIntent", {}),
     ],
 )  # fmt: skip
@@ -159,6 +161,50 @@ def test_both_robots_named_one_by_one_are_the_fleet(model: InteractionModel) -> 
     assert ids(understood) == {"robot": "all", "zone": "LOADING"}
 
 
+@pytest.mark.parametrize(
+    ("utterance", "robot"),
+    [
+        # Listed together, with the shared words left out or not: the fleet.
+        ("send robot one and two to the loading zone", "all"),
+        ("stop robot one and two", "all"),
+        # The robot turned down is not the one meant.
+        ("robot two not robot one to the loading area", "placebot2"),
+        # Named in separate phrases, or as a choice: asked about, never the fleet.
+        ("robot two arrived at zone b now send robot one to zone a", None),
+        ("send robot one or two to zone a", None),
+    ],
+)
+def test_several_robots_for_one_slot_are_the_fleet_only_when_listed(
+    model: InteractionModel, utterance: str, robot: str | None
+) -> None:
+    assert model.understand(utterance).slots["robot"].id == robot
+
+
+def test_names_that_overlap_and_disagree_are_asked_about(model: InteractionModel) -> None:
+    # "first placebot" is robot one and "placebot two" robot two: which was said is unknown.
+    _, matches = model.find_slots("placebot one delivers to d first placebot two waits")
+    robots = [(match.spoken, match.id) for match in matches if match.type == "ROBOT"]
+    assert robots == [("placebot one", "placebot1"), ("first placebot two", None)]
+
+
+@pytest.mark.parametrize(
+    "utterance",
+    [
+        # An intent without slots (here the weather question or cancel) for a named robot.
+        "robot one sunny means zone a and rainy means zone c",
+        "hold it robot one don't move",
+        # No sequential-delivery sample names one robot and one zone.
+        "go to zone b with robot two",
+    ],
+)
+def test_an_intent_the_values_named_do_not_fit_falls_back(
+    model: InteractionModel, utterance: str
+) -> None:
+    understood = model.understand(utterance)
+    assert (understood.intent, understood.slots) == (FALLBACK, {})
+    assert understood.best_guess is not None
+
+
 def test_of_two_zones_the_destination_is_the_one_after_to(model: InteractionModel) -> None:
     understood = model.understand("move robot one from the loading zone to zone c")
     assert ids(understood) == {"robot": "placebot1", "zone": "C"}
@@ -180,6 +226,10 @@ def test_two_zones_without_a_destination_are_asked_about(model: InteractionModel
           "secondZone": "D"}),
         ("robot one delivers to zone c then robot two",
          {"firstRobot": "placebot1", "firstZone": "C", "secondRobot": "placebot2"}),
+        # The fleet is not one of the two robots, and a robot cannot follow itself.
+        ("both robots to zone d robot one first", {"firstRobot": "placebot1", "firstZone": "D"}),
+        ("robot one delivers to zone a then robot one delivers to zone b",
+         {"firstRobot": "placebot1", "firstZone": "A", "secondRobot": None, "secondZone": "B"}),
     ],
 )  # fmt: skip
 def test_sequential_delivery_roles_follow_the_sentence(

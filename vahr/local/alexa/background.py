@@ -30,13 +30,14 @@ BUILT_IN_TEMPLATES: dict[str, tuple[str, ...]] = {
         "shut up",
         "be quiet",
         "(that's|that is) (all|it|enough)",
-        "never mind",
         "i'm done",
         "(we're|we are) done",
         "enough",
     ),
+    # Amazon lists "never mind" with cancel, not with stop (the built-in intents' reference).
     "AMAZON.CancelIntent": (
         "cancel [that|it|this|please]",
+        "never mind",
         "forget (it|that|about it)",
         "nothing",
         "no thanks",

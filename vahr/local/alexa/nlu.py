@@ -8,7 +8,10 @@ Understanding an utterance takes three steps, each from the same generated model
    utterances with the slots abstracted, plus the simulator's stand-ins for Alexa's own data
    (`background`: built-in intents and out-of-domain requests). Its confidence is calibrated;
    below `CONFIDENCE_THRESHOLD` the answer is AMAZON.FallbackIntent.
-3. The values found are given to the intent's slots by their type and order (`slot_roles`).
+3. The intent is held to the values found (`consistency`): an intent that takes no slot is
+   not chosen when a robot or zone was named, nor one whose samples never name as many
+   values of its types together; either way the answer is the fallback.
+4. The values found are given to the intent's slots by their type and order (`slot_roles`).
 
 Slot values resolve as Alexa's entity resolution does (ER_SUCCESS_MATCH with the value's id
 and name, or ER_SUCCESS_NO_MATCH). The trained classifier is cached on disk under a hash
@@ -28,6 +31,7 @@ from rapidfuzz import fuzz, process
 
 from vahr.errors import VahrError
 from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
+from vahr.local.alexa.consistency import SlotConsistency
 from vahr.local.alexa.intent_classifier import IntentClassifier, default_cache_dir, load_or_train
 from vahr.local.alexa.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize
 from vahr.local.alexa.slot_roles import assign_slots
@@ -124,6 +128,10 @@ class InteractionModel:
         except (KeyError, TypeError) as err:
             raise VahrError(f"the interaction model lacks {err}") from err
         self._samples: dict[str, list[tuple[str, str]]] = {}
+        self._consistency = SlotConsistency(
+            self.intent_slots,
+            [(name, sample) for name, phrases in samples.items() for sample in phrases],
+        )
         texts, labels = self._training_data(samples, sorted(answers))
         known = {word for text in texts for word in text.split()}
         self._finder = SlotFinder(
@@ -221,7 +229,11 @@ class InteractionModel:
         abstracted = _abstract(words, matches)
         # Outside a dialog there is no question to answer: the answer reading is set aside.
         intent, confidence = classifier.scores(abstracted).without(SLOT_ANSWER).best
-        if intent == FALLBACK or confidence < CONFIDENCE_THRESHOLD:
+        if (
+            intent == FALLBACK
+            or confidence < CONFIDENCE_THRESHOLD
+            or not self._consistency.agrees(intent, matches)
+        ):
             guess = None if intent == FALLBACK else intent
             return Understanding(FALLBACK, confidence=confidence, best_guess=guess)
         declared = self.intent_slots.get(intent, {})

@@ -4,14 +4,20 @@ Every name of every value of the custom slot types (ROBOT, ZONE) is looked for i
 words, the longest first. A word the model has never seen is first compared with the slot
 types' own words (rapidfuzz), so a misheard "plasebot" still finds "placebot"; words the
 model knows ("two", "robots") are never bent into another, since a changed number or letter
-would name another robot or zone. Two kinds of span need more than a name:
+would name another robot or zone. Some spans need more than a name:
 
 - a bare letter ("to b") is a zone only where the samples put a zone: after a word that
   comes before `{zone}` in some sample and before a word that follows one (or at an end),
   so the "a" of "deliver a package" stays a word;
 - a head word of a type followed by a number, a letter or an unknown word ("robot nine",
   "zone f") is a value of that type that does not resolve, so the skill asks for it
-  rather than acting on a guess.
+  rather than acting on a guess;
+- two names that overlap and name different values ("delivers first placebot two": "first
+  placebot" is robot one, "placebot two" robot two) are one value that does not resolve:
+  the words cannot say which was meant, so the skill asks rather than take the first;
+- a bare number or letter joined to a name by "and" or "or" names the value the name would
+  with that word last ("robot one and two", "zone a or b"), so the second value is not
+  lost: "stop robot one and two" stops both, not robot one alone.
 """
 
 from __future__ import annotations
@@ -38,6 +44,9 @@ _NOT_A_WORD = re.compile(r"[^a-z0-9' ]+")
 _DIGITS = re.compile(r"\d+")
 _LETTER_DIGIT = re.compile(r"(?<=[a-z])(?=\d)|(?<=\d)(?=[a-z])")
 _ARTICLES = frozenset({"the", "a", "an"})
+# Words that join a second value to a name with its shared words left out ("robot one and
+# two"); `slot_roles` reads "and" as a list and "or" as a choice to ask about.
+_JOINERS = frozenset({"and", "or", "plus"})
 
 
 def normalize(text: str) -> str:
@@ -152,9 +161,62 @@ class SlotFinder:
             if match is None:
                 index += 1
                 continue
-            found.append(match)
-            index = match.end
+            found.append(self._unless_overlapped(match, corrected, words, similarity))
+            found += self._elided_after(found[-1], corrected, words, similarity)
+            index = found[-1].end
         return found
+
+    def _elided_after(
+        self, match: SlotMatch, corrected: list[str], words: list[str], similarity: list[float]
+    ) -> list[SlotMatch]:
+        """The values named after `match` by their last word alone: "two" in "robot one
+        and two" (the name's other words left out, as people do in a list)."""
+        name = tuple(corrected[match.start : match.end])
+        if match.id is None or len(name) < 2:
+            return []
+        found: list[SlotMatch] = []
+        index = match.end
+        while index + 1 < len(corrected) and corrected[index] in _JOINERS:
+            word = corrected[index + 1]
+            owners = self._names.get((*name[:-1], word), [])
+            value = next(((i, c) for t, i, c in owners if t == match.type), None)
+            if value is None:
+                break
+            found.append(
+                SlotMatch(
+                    type=match.type,
+                    start=index + 1,
+                    end=index + 2,
+                    spoken=words[index + 1],
+                    id=value[0],
+                    canonical=value[1],
+                    similarity=similarity[index + 1],
+                )
+            )
+            index += 2
+        return found
+
+    def _unless_overlapped(
+        self, match: SlotMatch, corrected: list[str], words: list[str], similarity: list[float]
+    ) -> SlotMatch:
+        """`match`, or an unresolved value over both when a name starting inside it runs on
+        past its end and names another value ("first placebot two")."""
+        for start in range(match.start + 1, match.end):
+            other = self._name_at(corrected, words, similarity, start)
+            if other is None or other.end <= match.end or other.type != match.type:
+                continue
+            if other.id == match.id:
+                continue
+            return SlotMatch(
+                type=match.type,
+                start=match.start,
+                end=other.end,
+                spoken=" ".join(words[match.start : other.end]),
+                id=None,
+                canonical=None,
+                similarity=100.0,
+            )
+        return match
 
     def _name_at(
         self, corrected: list[str], words: list[str], similarity: list[float], start: int

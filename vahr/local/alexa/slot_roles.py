@@ -1,19 +1,24 @@
 """Giving the slot values found in an utterance to the chosen intent's slots.
 
 An intent with one slot of a type takes the one value of that type. Several values for one
-slot are never guessed between: the robots that together make the whole fleet are the fleet
-("robot one and robot two" -> `all`); of several zones the destination is the one not
-named as an origin ("from the loading zone to zone b", "to zone c instead of zone a");
-anything else ("to zone a or zone b", "to zone a, no, zone b") stays unresolved, so the
-skill asks. The sequential delivery has two robots and two zones: robots in the order spoken
-unless "after", "once" or "until" puts the later-named robot first ("robot two goes after
-robot one"); a zone belongs to the robot named before it, and a single zone said before
-both robots or after both applies to both ("robot one and then robot two deliver to zone d").
+slot are never guessed between: robots listed together ("robot one and robot two", "robot
+one, robot two") that make the whole fleet are the fleet (`all`), but robots named in
+separate phrases ("robot two arrived, now send robot one") or as alternatives ("robot one
+or robot two") are not; of several values the one meant is the only one not turned down,
+as an origin or a rejected alternative ("from the loading zone to zone b", "to zone c
+instead of zone a", "robot two, not robot one"); anything else ("to zone a or zone b", "to
+zone a, no, zone b") stays unresolved, so the skill asks. The sequential delivery has two
+robots and two zones: robots in the order spoken unless "after", "once" or "until" puts the
+later-named robot first ("robot two goes after robot one"); a zone belongs to the robot
+named before it, and a single zone said before both robots or after both applies to both
+("robot one and then robot two deliver to zone d"). The fleet is not one of its two robots,
+and one robot cannot follow itself: such a robot slot is left for the skill to ask about.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
+from itertools import pairwise
 from typing import TYPE_CHECKING
 
 from vahr.protocol import FLEET_GROUP
@@ -26,8 +31,13 @@ if TYPE_CHECKING:
 
 # Words before a robot that make it the one to go first although it is named second.
 _AFTER = frozenset({"after", "once", "until", "till", "for", "behind"})
-# Words before a zone that mark it as where a robot comes from, not where it goes.
-_ORIGIN = frozenset({"from", "of"})
+# Words right before a value that turn it down: where a robot comes from ("from zone a",
+# "instead of zone a"), or the value the speaker corrects ("not robot one").
+_TURNED_DOWN = frozenset({"from", "of", "not"})
+# The only words that may stand between robots listed together as one group ("robot one and
+# robot two", "robot one plus robot two", "robot one as well as robot two"); none at all is a
+# list too ("robot one, robot two": punctuation is gone by now).
+_LISTED = frozenset({"and", "plus", "also", "as", "well"})
 
 
 def assign_slots(
@@ -77,14 +87,22 @@ def _merge(
     ids = {value.id for value in values}
     spoken = " and ".join(value.spoken for value in values)
     first = values[0]
-    if first.type == ROBOT_TYPE and (ids == set(robots) or ids == {*robots, FLEET_GROUP}):
+    fleet = ids == set(robots) or ids == {*robots, FLEET_GROUP}
+    if first.type == ROBOT_TYPE and fleet and _listed(values, words):
         # Robots named one by one where one robot is expected are all of them only when
-        # together they are the fleet.
+        # together they are the fleet, and only when said as one group.
         return replace(first, spoken=spoken, id=FLEET_GROUP, canonical=fleet_name)
-    destinations = [v for v in values if v.start == 0 or words[v.start - 1] not in _ORIGIN]
-    if len(destinations) == 1:
-        return destinations[0]
+    meant = [v for v in values if v.start == 0 or words[v.start - 1] not in _TURNED_DOWN]
+    if len(meant) == 1:
+        return meant[0]
     return replace(first, spoken=spoken, id=None, canonical=None)
+
+
+def _listed(values: list[SlotMatch], words: list[str]) -> bool:
+    """Whether the values are said as one list: nothing but "and" (or the like) between."""
+    return all(
+        set(words[before.end : after.start]) <= _LISTED for before, after in pairwise(values)
+    )
 
 
 def _sequence(
@@ -93,7 +111,8 @@ def _sequence(
     (robot_type, robot_slots), (zone_type, zone_slots) = sorted(
         by_type.items(), key=lambda item: item[0] != ROBOT_TYPE
     )
-    robots = [m for m in matches if m.type == robot_type]
+    # The fleet is not one robot of two: "both robots to zone d" says nothing of the order.
+    robots = [m for m in matches if m.type == robot_type and m.id != FLEET_GROUP]
     zones = [m for m in matches if m.type == zone_type]
     # "robot two goes after robot one": the robot named second goes first, and the sentence
     # is about the one named first.
@@ -101,6 +120,9 @@ def _sequence(
     if swapped:
         robots = [robots[1], robots[0], *robots[2:]]
     filled: dict[str, SlotMatch] = dict(zip(robot_slots, robots, strict=False))
+    if len(robots) >= 2 and robots[0].id is not None and robots[0].id == robots[1].id:
+        # One robot cannot follow itself: the second is asked for, not guessed.
+        filled[robot_slots[1]] = replace(robots[1], id=None, canonical=None)
     order = {id(robot): rank for rank, robot in enumerate(robots[:2])}
     owned: dict[int, SlotMatch] = {}
     unowned: list[SlotMatch] = []
