@@ -100,6 +100,6 @@ skill-model: setup
 clean:
 	rm -rf $(VENV) node_modules cdk.out .build .cache .state
 
-# Remake robot_agent/voice/data/espeak-ng.mllr, the hearing's adaptation to espeak-ng (docs/voice.md).
+# Remake robot_agent/voice/data/espeak-ng/, the hearing's adaptation to espeak-ng (docs/voice.md).
 hearing-adaptation: setup
 	$(BIN)/python -m robot_agent.voice.adaptation

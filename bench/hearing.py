@@ -1,10 +1,10 @@
 """The robot's hearing on the spoken evaluation set: accuracy per condition and intent, and
-time per clip (the whole understanding beside each recognizer alone).
+time per clip (the whole understanding beside the recognizer alone).
 
 Renders `robot_agent/voice/data/hearing-eval.yaml` (three espeak-ng voices, clean, 20 dB
 and 10 dB SNR, answers and unrelated speech) into a temporary directory, hears every clip
-as `robot-agent hear --eval` does, and times the grammar recognizer and the language-model
-recognizer alone on the same clips. Also the start-up: building both recognizers.
+as `robot-agent hear --eval` does, and times the recognizer alone on the same clips. Also
+the start-up: building the recognizer (its language model, vocabulary and adapted model).
 Run: `.venv/bin/python bench/hearing.py [--phrasings FILE]`.
 """
 
@@ -29,7 +29,7 @@ from robot_agent.voice.evaluation import (  # noqa: E402
     score,
 )
 from robot_agent.voice.interpreter import LocalInterpreter  # noqa: E402
-from robot_agent.voice.understanding import Understanding, recognizers  # noqa: E402
+from robot_agent.voice.understanding import Understanding, weather_recognizer  # noqa: E402
 from vahr.speech.audio import Audio  # noqa: E402
 from vahr.speech.tts import EspeakSynthesizer  # noqa: E402
 
@@ -45,20 +45,19 @@ def main() -> None:
     phrasings = Phrasings.load(args.phrasings)
     started = time.perf_counter()
     answers = WeatherAnswers.load()
-    exact, wider = recognizers(answers)
+    recognizer = weather_recognizer(answers)
     build_s = time.perf_counter() - started
-    understanding = Understanding(exact, LocalInterpreter(answers), open_recognizer=wider)
+    understanding = Understanding(recognizer, LocalInterpreter(answers))
     with tempfile.TemporaryDirectory() as folder:
         directory = Path(folder)
         manifest = render(phrasings, directory, EspeakSynthesizer, source=args.phrasings.name)
         report = score(directory, understanding.hear, time.perf_counter)
-        alone: dict[str, list[float]] = {"grammar": [], "language model": []}
+        alone: list[float] = []
         for clip in load_manifest(directory).clips:
             audio = Audio.from_wav((directory / clip.file).read_bytes())
-            for name, recognizer in (("grammar", exact), ("language model", wider)):
-                begun = time.perf_counter()
-                recognizer.recognize(audio)
-                alone[name].append(time.perf_counter() - begun)
+            begun = time.perf_counter()
+            recognizer.recognize(audio)
+            alone.append(time.perf_counter() - begun)
     accepted = report.unrelated()
     body = f"""Set: `{args.phrasings.name}`, {len(manifest.clips)} clips (voices
 {", ".join(phrasings.voices)}; clean, {" and ".join(f"{s:g} dB" for s in phrasings.snr_db)} SNR),
@@ -73,11 +72,11 @@ Unrelated speech accepted as an answer: {accepted.counts["wrong"]} of {accepted.
 
 | per clip | p50 | p99 |
 | --- | --- | --- |
-| hearing (grammar, then the language model when the grammar recognizes nothing) | {ms(report.seconds)} |
-| grammar recognizer alone (with its phone-loop check) | {ms(alone["grammar"])} |
-| language-model recognizer alone | {ms(alone["language model"])} |
+| hearing (recognize, interpret, check the deciding words' posteriors) | {ms(report.seconds)} |
+| recognizer alone | {ms(alone)} |
 
-Building both recognizers at start-up: {build_s * 1000:.0f} ms."""  # noqa: E501
+Building the recognizer at start-up (language model, vocabulary, adapted model):
+{build_s * 1000:.0f} ms."""
     write_section("hearing", "The robot's hearing (spoken evaluation set)", body)
 
 

@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from robot_agent.voice.answers import WeatherAnswers  # noqa: E402
 from robot_agent.voice.interpreter import LocalInterpreter  # noqa: E402
-from robot_agent.voice.understanding import offline_understanding, recognizers  # noqa: E402
+from robot_agent.voice.understanding import offline_understanding, weather_recognizer  # noqa: E402
 from vahr.local.room import QUESTIONS  # noqa: E402
 from vahr.speech.audio import add_white_noise  # noqa: E402
 from vahr.speech.stt import GrammarRecognizer  # noqa: E402
@@ -58,7 +58,7 @@ def timed(fn, *args):  # type: ignore[no-untyped-def]
 def stages(runs: int) -> dict[str, list[float]]:
     robot_tts, assistant_tts = EspeakSynthesizer("en-us+f2"), EspeakSynthesizer("en-us+f4")
     answers = WeatherAnswers.load()
-    robot_stt, _ = recognizers(answers)  # an answer the grammar knows never needs the other
+    robot_stt = weather_recognizer(answers)
     assistant_stt = GrammarRecognizer(QUESTIONS, verify=False)
     interpreter = LocalInterpreter(answers)
     times: dict[str, list[float]] = {k: [] for k in

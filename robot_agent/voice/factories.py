@@ -37,7 +37,7 @@ def understanding_for(thing: str, config: AgentConfig) -> Understanding:
     from robot_agent.voice.understanding import (
         Understanding,
         offline_understanding,
-        recognizers,
+        weather_recognizer,
     )
 
     if config.voice.interpreter == "local":
@@ -75,8 +75,7 @@ def understanding_for(thing: str, config: AgentConfig) -> Understanding:
         credentials=provider.get,
         endpoint_url=lex.endpoint_url,
     )
-    exact, wider = recognizers(WeatherAnswers.load())
-    return Understanding(exact, interpreter, open_recognizer=wider)
+    return Understanding(weather_recognizer(WeatherAnswers.load()), interpreter)
 
 
 def room(*, thing: str, config: AgentConfig, link: Link) -> RoomVoice:

@@ -11,6 +11,11 @@ posterior probability in the decoder's word lattice: a word the audio hardly sup
 over its rivals ("will rain" against "no rain") has a low one, and the caller decides
 what to trust from the words that matter to it.
 
+Speech about something else is heard as the nearest words the model knows, so the model
+also knows the most frequent words of everyday English (`background_words`, taken from
+pocketsphinx's general language model at start-up): "play the radio" is then heard as
+that, not as "play the rainy".
+
 Words the pronunciation dictionary lacks (made-up robot names such as "placebot") get the
 pronunciations `vahr.speech.pronounce` guesses; only a word with no guess at all is an
 error.
@@ -67,13 +72,16 @@ class LanguageModelRecognizer:
         *,
         detector: SpeechDetector | None = None,
         adaptation: Path | None = None,
+        background_words: int = 0,
     ) -> None:
         from pocketsphinx import Decoder, get_model_path
 
         self.sentences = tuple(dict.fromkeys(sentences))
         self.detector = detector or SpeechDetector()
         model = Path(get_model_path()) / "en-us"
-        self.vocabulary = frozenset(w for s in self.sentences for w in s.split())
+        # Each background word is a sentence of its own: known, but in no example's context.
+        background = common_words(background_words) if background_words else []
+        self.vocabulary = frozenset(w for s in (*self.sentences, *background) for w in s.split())
         # Only the model's words from the 130,000 of the dictionary: the search is built
         # in milliseconds instead of seconds.
         pronunciations = _pronunciations(model / "cmudict-en-us.dict", self.vocabulary)
@@ -84,7 +92,7 @@ class LanguageModelRecognizer:
             dictionary = Path(folder) / "words.dict"
             dictionary.write_text("".join(pronunciations), encoding="utf-8")
             arpa = Path(folder) / "sentences.arpa"
-            arpa.write_text(arpa_model(self.sentences), encoding="utf-8")
+            arpa.write_text(arpa_model([*self.sentences, *background]), encoding="utf-8")
             # No second (flat) pass: it doubled the time and changed no result on the
             # tuning set.
             self._decoder = Decoder(
@@ -120,6 +128,19 @@ class LanguageModelRecognizer:
             # An alternative pronunciation is reported as `word(2)`.
             found.append(HeardWord(segment.word.split("(")[0], round(float(segment.prob), 3)))
         return tuple(found)
+
+
+def common_words(count: int) -> list[str]:
+    """The `count` most frequent words of pocketsphinx's general US English language model
+    (by their unigram probability), most frequent first."""
+    from pocketsphinx import Config, LogMath, NGramModel, get_model_path
+
+    model = Path(get_model_path()) / "en-us"
+    general = NGramModel(Config(), LogMath(), str(model / "en-us.lm.bin"))
+    with (model / "cmudict-en-us.dict").open(encoding="utf-8") as lines:
+        words = {entry for line in lines if "(" not in (entry := line.split(" ", 1)[0])}
+    # Sorted by word first so that ties come out the same on every run.
+    return sorted(sorted(words), key=lambda word: -general.prob([word]))[:count]
 
 
 def _pronunciations(dictionary: Path, words: frozenset[str]) -> list[str]:

@@ -207,13 +207,36 @@ class GrammarRecognizer:
 
 
 def adapted_to(adaptation: Path | None) -> dict[str, str]:
-    """The decoder options that apply a speaker adaptation (an MLLR transform of the
-    acoustic model's means, as sphinxtrain's `mllr_solve` writes it), or none."""
+    """The decoder options that apply an adaptation of the acoustic model: a file is an
+    MLLR transform of its means (as sphinxtrain's `mllr_solve` writes it); a folder holds
+    re-estimated parameters (`means`, `variances`, `sendump`, `transition_matrices`, as
+    sphinxtrain's `map_adapt` and `mk_s2sendump` write them) that replace the model's own,
+    each one present, and optionally an `mllr` transform as well."""
     if adaptation is None:
         return {}
-    if not adaptation.is_file():
+    if adaptation.is_file():
+        return {"mllr": str(adaptation)}
+    if not adaptation.is_dir():
         raise SpeechError(f"no acoustic adaptation at {adaptation}")
-    return {"mllr": str(adaptation)}
+    found = {
+        option: str(adaptation / name)
+        for option, name in _ADAPTED_PARAMETERS.items()
+        if (adaptation / name).is_file()
+    }
+    if not found:
+        names = ", ".join(_ADAPTED_PARAMETERS.values())
+        raise SpeechError(f"{adaptation}: no adapted parameters (any of {names})")
+    return found
+
+
+# Decoder option -> file name, for an adaptation that is a folder.
+_ADAPTED_PARAMETERS = {
+    "mean": "means",
+    "var": "variances",
+    "sendump": "sendump",
+    "tmat": "transition_matrices",
+    "mllr": "mllr",
+}
 
 
 @contextmanager

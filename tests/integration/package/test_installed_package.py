@@ -111,12 +111,14 @@ def test_the_installed_package_is_not_the_checkout(installed: Path, tmp_path: Pa
     where = subprocess.run(
         [str(installed / "python"), "-c",
          "import vahr, robot_agent, skill, vahr.protocol.fleet as f; "
-         "print(vahr.__file__, robot_agent.__file__, skill.__file__, f.DEFAULT_FLEET_FILE)"],
+         "from robot_agent.voice.adaptation import BUNDLED; "
+         "print(vahr.__file__, robot_agent.__file__, skill.__file__, f.DEFAULT_FLEET_FILE, "
+         "BUNDLED / 'sendump')"],
         cwd=tmp_path, env=clean_env(), capture_output=True, text=True, timeout=60, check=True,
     ).stdout.split()  # fmt: skip
-    # Then every one is inside the venv, the bundled fleet included
+    # Then every one is inside the venv, the bundled fleet and hearing adaptation included
     assert all(str(installed.parent) in path for path in where), where
-    assert Path(where[-1]).is_file()
+    assert Path(where[-2]).is_file() and Path(where[-1]).is_file()
 
 
 @pytest.mark.slow

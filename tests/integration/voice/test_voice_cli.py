@@ -97,8 +97,8 @@ def test_hear_json_gives_the_reason_for_unknown(
     capsys.readouterr()
     assert main(["hear", str(wav), "--json"]) == 0
     heard = json.loads(capsys.readouterr().out)
-    assert heard["intent"] == "unknown"
-    assert heard["reason"].startswith("recognized as no answer")
+    assert (heard["text"], heard["intent"]) == ("robot two is stuck", "unknown")
+    assert heard["reason"] == "robot talk (robot)"
 
 
 SMALL_SET = """
