@@ -1,5 +1,5 @@
-"""From the assistant's audio to a `Heard`: recognize, interpret, and check that the
-recognizer was sure of the words the decision rests on.
+"""From the assistant's audio to a `Heard`: recognize, interpret, and weigh how sure the
+recognizer was of the words the decision rests on.
 
 The offline hearing is one open recognizer: pocketsphinx with a language model of every
 sentence in `weather_answers.yaml` (the answers, and what is no answer) and of the most
