@@ -100,6 +100,7 @@ skill-model: setup
 clean:
 	rm -rf $(VENV) node_modules cdk.out .build .cache .state
 
-# Remake robot_agent/voice/data/espeak-ng/, the hearing's adaptation to espeak-ng (docs/voice.md).
+# Remake robot_agent/voice/data/espeak-ng/, the hearing's adaptation to espeak-ng (docs/voice.md;
+# about 17 minutes on 2 cores, and some 2.5 GB of temporary disk for the clips).
 hearing-adaptation: setup
 	$(BIN)/python -m robot_agent.voice.adaptation
