@@ -122,7 +122,7 @@ def _count(
     """Align `clips` on the model with `bw`: its counts land in `work/counts`."""
     dictionary = model / "cmudict-en-us.dict"
     acoustic = model / "en-us"
-    known = {line.split(" ", 1)[0] for line in dictionary.read_text(encoding="utf-8").splitlines()}
+    known = _dictionary_words()
     (work / "wav").mkdir()
     ids, lines = [], []
     for number, (audio, text) in enumerate(clips):
@@ -200,6 +200,14 @@ def synthesized_clips(
                 yield add_white_noise(clean, snr, noise), sentence
 
 
+def _dictionary_words() -> set[str]:
+    """Every entry of pocketsphinx's pronunciation dictionary (`word(2)` as it stands)."""
+    from pocketsphinx import get_model_path
+
+    dictionary = Path(get_model_path()) / "en-us" / "cmudict-en-us.dict"
+    return {line.split(" ", 1)[0] for line in dictionary.read_text(encoding="utf-8").splitlines()}
+
+
 def _tools() -> dict[str, Path]:
     found = {
         "sphinx_fe": shutil.which("sphinx_fe"),
@@ -226,12 +234,9 @@ def adaptation_sentences(held_out: Iterable[str] = ()) -> list[str]:
     `weather_answers.yaml` and of `everyday-sentences.txt`, and the licence texts' plain
     sentences of 4 to 16 words (no digits or symbols); only sentences whose every word the
     dictionary knows, none of `held_out` (normalized, sorted, no duplicates)."""
-    from pocketsphinx import get_model_path
-
     from robot_agent.voice.answers import WeatherAnswers
 
-    dictionary = Path(get_model_path()) / "en-us" / "cmudict-en-us.dict"
-    known = {line.split(" ", 1)[0] for line in dictionary.read_text(encoding="utf-8").splitlines()}
+    known = _dictionary_words()
     everyday = EVERYDAY.read_text(encoding="utf-8").splitlines()
     found = {normalize(s) for s in WeatherAnswers.load().corpus()}
     found |= {
@@ -255,7 +260,7 @@ def adaptation_sentences(held_out: Iterable[str] = ()) -> list[str]:
 def main(argv: Sequence[str] | None = None) -> int:
     """Remake the bundled adaptation (the weather answers and plain English, spoken by
     espeak-ng voices that no hearing set uses)."""
-    from robot_agent.voice.evaluation import Phrasings
+    from robot_agent.voice.evaluation import EVALUATION_SET, TUNING_SET, Phrasings
 
     parser = argparse.ArgumentParser(description=main.__doc__)
     parser.add_argument("--out", type=Path, default=BUNDLED, help=f"default: {BUNDLED}")
@@ -263,12 +268,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--method", choices=("map", "mllr"), default="map", help="map (a folder) or mllr (a file)"
     )
     args = parser.parse_args(argv)
-    data = Path(__file__).with_name("data")
-    held_out = [
-        sentence
-        for name in ("hearing-eval.yaml", "hearing-tuning.yaml")
-        for sentence in Phrasings.load(data / name).normalized()
-    ]
+    held_out = Phrasings.load(EVALUATION_SET).normalized() | Phrasings.load(TUNING_SET).normalized()
     try:
         sentences = adaptation_sentences(held_out)
         used = adapt(synthesized_clips(sentences), args.out, method=args.method)

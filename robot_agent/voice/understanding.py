@@ -17,9 +17,7 @@ posterior of the least sure deciding word is still the confidence reported.
 A grammar of the listed answers used to be tried first, the language model only when the
 grammar recognized nothing; with the adapted model, on the tuning set, the grammar's
 confident matches of the wrong answer ("it's wet outside" as "it's sunny outside") cost
-more than it gained, so the chain now starts with the language model (`Understanding`
-still takes an exact recognizer and an open one, for a setup that wants both;
-docs/voice.md has the figures).
+more than it gained, so the language model hears alone (docs/voice.md has the figures).
 
 Speech the recognizer does not trust (silence, noise) is `unknown` with empty text: a guess
 would only mislead whoever reads the `heard` event. The reason says what happened.
@@ -33,7 +31,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from robot_agent.voice.port import Heard
-from vahr.speech.stt import NOT_AN_ANSWER, NOTHING_HEARD
 
 if TYPE_CHECKING:
     from robot_agent.voice.answers import WeatherAnswers
@@ -55,33 +52,22 @@ BACKGROUND_WORDS = 3000
 
 
 class Understanding:
-    """A recognizer and an interpreter used together, with an open recognizer to fall
-    back on when the first one recognizes nothing."""
+    """A recognizer and an interpreter used together."""
 
     def __init__(
         self,
         recognizer: Recognizer,
         interpreter: Interpreter,
         *,
-        open_recognizer: Recognizer | None = None,
         min_posterior: float = DEFAULT_MIN_POSTERIOR,
     ) -> None:
         self.recognizer = recognizer
         self.interpreter = interpreter
-        self.open_recognizer = open_recognizer
         self.min_posterior = min_posterior
 
     def hear(self, audio: Audio) -> Heard:
         recognition = self.recognizer.recognize(audio)
-        if recognition.accepted:
-            return self._decide(recognition)
-        if self.open_recognizer is None or recognition.reason in (
-            NOT_AN_ANSWER,
-            NOTHING_HEARD.reason,
-        ):
-            return _rejected(recognition)
-        wider = self.open_recognizer.recognize(audio)
-        return self._decide(wider) if wider.accepted else _rejected(wider)
+        return self._decide(recognition) if recognition.accepted else _rejected(recognition)
 
     def _decide(self, recognition: Recognition) -> Heard:
         meaning = self.interpreter.interpret(recognition.text)

@@ -79,15 +79,26 @@ class LanguageModelRecognizer:
         self.sentences = tuple(dict.fromkeys(sentences))
         self.detector = detector or SpeechDetector()
         model = Path(get_model_path()) / "en-us"
+        # The 130,000 words of the dictionary, read once: (entry, phones), `word(2)` entries
+        # being a word's alternative pronunciations.
+        entries = [
+            (entry, phones)
+            for line in (model / "cmudict-en-us.dict").read_text(encoding="utf-8").splitlines()
+            for entry, _, phones in [line.partition(" ")]
+        ]
         # Each background word is a sentence of its own: known, but in no example's context.
-        background = common_words(background_words) if background_words else []
+        background = (
+            common_words(background_words, (e for e, _ in entries if "(" not in e))
+            if background_words
+            else []
+        )
         self.vocabulary = frozenset(w for s in (*self.sentences, *background) for w in s.split())
-        # Only the model's words from the 130,000 of the dictionary: the search is built
-        # in milliseconds instead of seconds.
-        pronunciations = _pronunciations(model / "cmudict-en-us.dict", self.vocabulary)
+        # Only the model's words from the dictionary: the search is built in milliseconds
+        # instead of seconds.
+        pronunciations = _pronunciations(entries, self.vocabulary)
         missing = sorted(self.vocabulary - {line.split(" ", 1)[0] for line in pronunciations})
         if missing:
-            pronunciations += _guessed(model / "cmudict-en-us.dict", missing)
+            pronunciations += _guessed(entries, missing)
         with tempfile.TemporaryDirectory() as folder:
             dictionary = Path(folder) / "words.dict"
             dictionary.write_text("".join(pronunciations), encoding="utf-8")
@@ -130,34 +141,29 @@ class LanguageModelRecognizer:
         return tuple(found)
 
 
-def common_words(count: int) -> list[str]:
-    """The `count` most frequent words of pocketsphinx's general US English language model
-    (by their unigram probability), most frequent first."""
+def common_words(count: int, candidates: Iterable[str]) -> list[str]:
+    """The `count` of `candidates` most frequent in pocketsphinx's general US English
+    language model (by their unigram probability), most frequent first."""
     from pocketsphinx import Config, LogMath, NGramModel, get_model_path
 
-    model = Path(get_model_path()) / "en-us"
-    general = NGramModel(Config(), LogMath(), str(model / "en-us.lm.bin"))
-    with (model / "cmudict-en-us.dict").open(encoding="utf-8") as lines:
-        words = {entry for line in lines if "(" not in (entry := line.split(" ", 1)[0])}
+    model = Path(get_model_path()) / "en-us" / "en-us.lm.bin"
+    general = NGramModel(Config(), LogMath(), str(model))
     # Sorted by word first so that ties come out the same on every run.
-    return sorted(sorted(words), key=lambda word: -general.prob([word]))[:count]
+    return sorted(sorted(set(candidates)), key=lambda word: -general.prob([word]))[:count]
 
 
-def _pronunciations(dictionary: Path, words: frozenset[str]) -> list[str]:
-    """The lines of `dictionary` for `words`, alternative pronunciations (`word(2)`) too."""
-    with dictionary.open(encoding="utf-8") as lines:
-        return [line for line in lines if line.split(" ", 1)[0].split("(")[0] in words]
+def _pronunciations(entries: list[tuple[str, str]], words: frozenset[str]) -> list[str]:
+    """The dictionary lines for `words`, alternative pronunciations (`word(2)`) too."""
+    return [f"{entry} {phones}\n" for entry, phones in entries if entry.split("(")[0] in words]
 
 
-def _guessed(dictionary: Path, words: list[str]) -> list[str]:
+def _guessed(entries: list[tuple[str, str]], words: list[str]) -> list[str]:
     """Dictionary lines for words the dictionary lacks, from `pronounce.guesses` (a made-up
     word may be two dictionary words run together, so the whole dictionary is looked in)."""
     first: dict[str, str] = {}
-    with dictionary.open(encoding="utf-8") as lines:
-        for line in lines:
-            entry, _, phones = line.strip().partition(" ")
-            if "(" not in entry:
-                first.setdefault(entry, phones)
+    for entry, phones in entries:
+        if "(" not in entry:
+            first.setdefault(entry, phones.strip())
     found = []
     for word in words:
         readings = guesses(word, first.get)

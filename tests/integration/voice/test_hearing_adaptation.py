@@ -72,8 +72,9 @@ def test_an_adaptation_estimated_from_speech_is_heard_with(tmp_path: Path) -> No
     answer = EspeakSynthesizer(voice="en-us+f2").synthesize("The weather is sunny.")
     for adaptation in (parameters, transform):
         exact = GrammarRecognizer(answers.all_phrases(), adaptation=adaptation)
+        assert exact.recognize(answer).text == "the weather is sunny"
         wider = LanguageModelRecognizer(answers.corpus(), adaptation=adaptation)
-        hearing = Understanding(exact, LocalInterpreter(answers), open_recognizer=wider)
+        hearing = Understanding(wider, LocalInterpreter(answers))
         assert hearing.hear(answer).intent == "sunny"
 
 
