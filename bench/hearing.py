@@ -4,7 +4,8 @@ time per clip (the whole understanding beside the recognizer alone).
 Renders `robot_agent/voice/data/hearing-eval.yaml` (three espeak-ng voices, clean, 20 dB
 and 10 dB SNR, answers and unrelated speech) into a temporary directory, hears every clip
 as `robot-agent hear --eval` does, and times the recognizer alone on the same clips. Also
-the start-up: building the recognizer (its language model, vocabulary and adapted model).
+the start-up: building the recognizer (its language model, vocabulary and adapted model),
+and the sense check trained (a cold cache, scikit-learn imported) or loaded from the cache.
 Run: `.venv/bin/python bench/hearing.py [--phrasings FILE]`.
 """
 
@@ -29,6 +30,7 @@ from robot_agent.voice.evaluation import (  # noqa: E402
     score,
 )
 from robot_agent.voice.interpreter import LocalInterpreter  # noqa: E402
+from robot_agent.voice.sense import SenseCheck  # noqa: E402
 from robot_agent.voice.understanding import Understanding, weather_recognizer  # noqa: E402
 from vahr.speech.audio import Audio  # noqa: E402
 from vahr.speech.tts import EspeakSynthesizer  # noqa: E402
@@ -47,7 +49,14 @@ def main() -> None:
     answers = WeatherAnswers.load()
     recognizer = weather_recognizer(answers)
     build_s = time.perf_counter() - started
-    understanding = Understanding(recognizer, LocalInterpreter(answers))
+    with tempfile.TemporaryDirectory() as cache:
+        begun = time.perf_counter()
+        SenseCheck.train(answers, cache_dir=Path(cache))
+        sense_cold_s = time.perf_counter() - begun
+        begun = time.perf_counter()
+        sense = SenseCheck.train(answers, cache_dir=Path(cache))
+        sense_warm_s = time.perf_counter() - begun
+    understanding = Understanding(recognizer, LocalInterpreter(answers), sense=sense)
     with tempfile.TemporaryDirectory() as folder:
         directory = Path(folder)
         manifest = render(phrasings, directory, EspeakSynthesizer, source=args.phrasings.name)
@@ -72,11 +81,12 @@ Unrelated speech accepted as an answer: {accepted.counts["wrong"]} of {accepted.
 
 | per clip | p50 | p99 |
 | --- | --- | --- |
-| hearing (recognize, interpret, check the deciding words' posteriors) | {ms(report.seconds)} |
+| hearing (recognize, interpret, sense check) | {ms(report.seconds)} |
 | recognizer alone | {ms(alone)} |
 
 Building the recognizer at start-up (language model, vocabulary, adapted model):
-{build_s * 1000:.0f} ms."""
+{build_s * 1000:.0f} ms. The sense check: {sense_cold_s * 1000:.0f} ms trained (cold cache, with
+scikit-learn's import), {sense_warm_s * 1000:.0f} ms from the cache."""
     write_section("hearing", "The robot's hearing (spoken evaluation set)", body)
 
 

@@ -19,6 +19,10 @@ grammar recognized nothing; with the adapted model, on the tuning set, the gramm
 confident matches of the wrong answer ("it's wet outside" as "it's sunny outside") cost
 more than it gained, so the language model hears alone (docs/voice.md has the figures).
 
+The interpreter reads cues, which say nothing of a word's sense ("a sunny personality"); so
+offline, the sense check (`sense.py`) reads the whole sentence and may veto: what it finds
+more likely other speech than an answer is `unknown`, whatever the cues.
+
 Speech the recognizer does not trust (silence, noise) is `unknown` with empty text: a guess
 would only mislead whoever reads the `heard` event. The reason says what happened.
 """
@@ -35,6 +39,7 @@ from robot_agent.voice.port import Heard
 if TYPE_CHECKING:
     from robot_agent.voice.answers import WeatherAnswers
     from robot_agent.voice.interpreter import Interpretation, Interpreter
+    from robot_agent.voice.sense import SenseCheck
     from vahr.speech.audio import Audio
     from vahr.speech.stt import Recognition, Recognizer
 
@@ -52,7 +57,7 @@ BACKGROUND_WORDS = 3000
 
 
 class Understanding:
-    """A recognizer and an interpreter used together."""
+    """A recognizer and an interpreter used together, and optionally the sense check."""
 
     def __init__(
         self,
@@ -60,10 +65,12 @@ class Understanding:
         interpreter: Interpreter,
         *,
         min_posterior: float = DEFAULT_MIN_POSTERIOR,
+        sense: SenseCheck | None = None,
     ) -> None:
         self.recognizer = recognizer
         self.interpreter = interpreter
         self.min_posterior = min_posterior
+        self.sense = sense
 
     def hear(self, audio: Audio) -> Heard:
         recognition = self.recognizer.recognize(audio)
@@ -73,6 +80,9 @@ class Understanding:
         meaning = self.interpreter.interpret(recognition.text)
         if meaning.intent == "unknown":
             return Heard(recognition.text, "unknown", 0.0, meaning.evidence, meaning.reason)
+        if self.sense is not None and not (sense := self.sense.read(recognition.text)).is_answer:
+            reason = f"reads as no answer ({sense.answer:.2f} an answer)"
+            return Heard(recognition.text, "unknown", 0.0, meaning.evidence, reason)
         sureness = self._sureness(recognition, meaning)
         if sureness < self.min_posterior:
             doubt = f"unsure of the words that decide ({sureness:.2f})"
@@ -125,10 +135,13 @@ def hearing_adaptation(setting: str | None = None) -> Path | None:
 
 
 def offline_understanding(answers_file: str | None = None) -> Understanding:
-    """pocketsphinx with a language model of `weather_answers.yaml`, and the local
-    interpreter of its cues."""
+    """pocketsphinx with a language model of `weather_answers.yaml`, the local interpreter
+    of its cues, and the sense check."""
     from robot_agent.voice.answers import ANSWERS_FILE, WeatherAnswers
     from robot_agent.voice.interpreter import LocalInterpreter
+    from robot_agent.voice.sense import SenseCheck
 
     answers = WeatherAnswers.load(Path(answers_file) if answers_file else ANSWERS_FILE)
-    return Understanding(weather_recognizer(answers), LocalInterpreter(answers))
+    return Understanding(
+        weather_recognizer(answers), LocalInterpreter(answers), sense=SenseCheck.train(answers)
+    )

@@ -109,6 +109,18 @@ NAVIGATE = IntentSpec(
         "<ask> (bring|get|send) {robot} <way> (here|over) to {zone}",
         "<ask> (get|set|start) {robot} (moving|going|driving|heading|rolling) <way> <to> {zone}",
         "<ask> (go|drive|head|move) <way> <to> {zone} (with|using|on) {robot} <end>",
+        "(next|then|and then|and now|now|after that) {robot} <goes> <way> <to> {zone} <end>",
+        "{robot} (is loaded|has its package|got its package|is ready|you are loaded|you're "
+        "loaded|you have your package) [so|now|so now] <go> <way> <to> {zone} <end>",
+        "{robot} (is loaded|has its package|got its package|is ready) [so|now|so now] (send|move|"
+        "take|get) it <way> <to> {zone}",
+        "[<ask>] (for|with) {robot} the zone is {zone} [so] (send it|go|move it) there",
+        "{robot} your zone is {zone} [so] (go|head|drive) there <end>",
+        "it's (sunny|raining|rainy) [so] {robot} <go> <way> <to> {zone}",
+        "(since|because) it's (sunny|raining|rainy) (send|move|take) {robot} <to> {zone}",
+        "<ask> (take|bring|walk|drive) {robot} <way> <to> {zone} <end>",
+        "<to> {zone} (with|for) {robot} <end>",
+        "{zone} for {robot} <end>",
     ),
 )
 
@@ -262,6 +274,12 @@ STATUS = IntentSpec(
         "[<ask>] (status|progress) report [please]",
         "(what's|what is) (happening|going on) with {robot}",
         "(did|has) {robot} (arrive|make it|deliver|get there) [yet]",
+        "(is|are) {robot} still (moving|driving|going|working|busy|on (its|the|their) way)",
+        "{robot} where are you [now|right now|at the moment]",
+        "(which|what) zone is {robot} (in|at) [now|right now]",
+        "how far (along|away) is {robot}",
+        "(any|is there any) (news|update|word) (on|about|from) {robot}",
+        "is (anyone|anybody|any robot|a robot) still (moving|driving|working|out)",
     ),
 )
 
@@ -284,6 +302,8 @@ EMERGENCY_STOP = IntentSpec(
         "(abort|cancel) (the|that) (command|move|delivery|task) for {robot}",
         "(emergency|urgent) (halt|freeze|shutdown) [now]",
         "{robot} (abort|cancel) (that|the task|the delivery|the move)",
+        "(hold it|hold on|wait) {robot} (don't move|stop|stay there|freeze|stay put)",
+        "(stop|halt|freeze) {robot} (please|thanks|for me)",
     ),
 )
 
@@ -306,6 +326,11 @@ WEATHER = IntentSpec(
         "(is the weather|is it) (good|bad|nice) [today|outside]",
         "(what's|what is) it like outside",
         "[<ask>] (check|look up) the weather [for me]",
+        "do (i|we) need (an umbrella|sunglasses|a jacket|a coat|a raincoat) [today|now|outside]",
+        "[<ask>] (tell me|let me know) if it's (raining|sunny|rainy|going to rain)",
+        "(do we have|is there|will there be|are we getting) (rain|sun|sunshine) [or (sun|rain)] "
+        "[today|now]",
+        "(how's|how is|what's) the weather for the (task|experiment|delivery|run)",
     ),
 )
 

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from vahr.local.alexa.intent_classifier import IntentClassifier, export, features, fit
+from vahr.local.alexa.intent_classifier import IntentClassifier, features, fit
 from vahr.local.alexa.nlu import InteractionModel
+from vahr.speech.text_classifier import export
 
 
 @pytest.fixture(scope="module")

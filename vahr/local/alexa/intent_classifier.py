@@ -1,38 +1,29 @@
 """Choosing the intent: a linear classifier over words with the slot values abstracted.
 
-Training (scikit-learn): TF-IDF over word unigrams, word bigrams, the character n-grams
-inside words and the number of slot values of each type; a logistic regression with
-balanced class weights (the built-in intents have far fewer phrases than the skill's); and
-temperature scaling fitted on held-out predictions (`CalibratedClassifierCV(method=
-"temperature", ensemble=False)`: 5-fold out-of-fold decisions calibrate one temperature; the
-final regression is fitted on every sample). The training sentences are the generated samples,
-with each `{slot}` replaced by its type's marker (`ROBOT`, `ZONE`), so "send ROBOT to ZONE"
-is learnt once for every robot and zone.
-
-scikit-learn takes 2-3 s to import on the lab machine, more than `vahr up` may add to its
-start. So the fitted model is exported as plain numbers (vocabulary, idf, weights,
-intercepts, inverse temperature) and cached on disk as JSON under a hash of the training
-data; answering an utterance needs only this module, and scikit-learn is imported only when
-the cache is cold. `tests/unit/local/test_intent_classifier.py` holds the exported model to
-scikit-learn's own probabilities.
+The classifier is `vahr.speech.text_classifier`'s (TF-IDF, a logistic regression with
+balanced class weights, temperature scaling, exported and cached so that `vahr up` need not
+import scikit-learn). What is particular to intents is the features: word unigrams, word
+bigrams, the character n-grams inside words and the number of slot values of each type.
+The training sentences are the generated samples, with each `{slot}` replaced by its type's
+marker (`ROBOT`, `ZONE`), so "send ROBOT to ZONE" is learnt once for every robot and zone.
+`tests/unit/local/test_intent_classifier.py` holds the features.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
-import math
-import os
-from collections import Counter
-from dataclasses import dataclass
-from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-# What the cached model depends on besides its data; change it with `features`, `fit` or the
-# export, and every cache is invalidated.
-TRAINING = "4: tfidf(counts, words, bigrams, chars 3-5), logreg(balanced, newton-cg), T(5 folds)"
+from vahr.speech.text_classifier import TextClassifier
+from vahr.speech.text_classifier import fit as fit_pipeline
+from vahr.speech.text_classifier import load_or_train as load_or_train_classifier
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+# What the cached model depends on besides its data; change it with `features`, and every
+# cache is invalidated.
+TRAINING = "4: counts, words, bigrams, chars 3-5"
 MARKERS = frozenset({"ROBOT", "ZONE"})
-CALIBRATION_FOLDS = 5
 
 
 def features(text: str) -> list[str]:
@@ -54,136 +45,22 @@ def features(text: str) -> list[str]:
     return found
 
 
-@dataclass(frozen=True)
-class IntentScores:
-    """Calibrated probabilities per intent, best first."""
-
-    ranked: list[tuple[str, float]]
-
-    @property
-    def best(self) -> tuple[str, float]:
-        return self.ranked[0]
-
-    def without(self, label: str) -> IntentScores:
-        """The scores with `label` set aside and the others renormalized."""
-        kept = [(name, p) for name, p in self.ranked if name != label]
-        total = sum(p for _, p in kept) or 1.0
-        return IntentScores([(name, p / total) for name, p in kept])
-
-
-class IntentClassifier:
-    """The exported linear model: TF-IDF weights, one row of weights per feature."""
+class IntentClassifier(TextClassifier):
+    """The exported model over intent features."""
 
     def __init__(self, exported: dict[str, Any]) -> None:
-        self.classes: list[str] = exported["classes"]
-        self._index: dict[str, int] = exported["vocabulary"]
-        self._idf: list[float] = exported["idf"]
-        self._weights: list[list[float]] = exported["weights"]
-        self._intercept: list[float] = exported["intercept"]
-        self._beta: float = exported["beta"]
-
-    def vector(self, text: str) -> dict[int, float]:
-        """The TF-IDF vector of `text` (sublinear tf, l2-normalized), as sklearn computes it."""
-        counts = Counter(index for f in features(text) if (index := self._index.get(f)) is not None)
-        weighted = {i: (1.0 + math.log(n)) * self._idf[i] for i, n in counts.items()}
-        norm = math.sqrt(sum(value * value for value in weighted.values()))
-        return {i: value / norm for i, value in weighted.items()} if norm else {}
-
-    def scores(self, text: str) -> IntentScores:
-        decision = list(self._intercept)
-        for index, value in self.vector(text).items():
-            for k, weight in enumerate(self._weights[index]):
-                decision[k] += value * weight
-        top = max(decision)
-        exps = [math.exp(self._beta * (d - top)) for d in decision]
-        total = sum(exps)
-        ranked = sorted(
-            ((name, e / total) for name, e in zip(self.classes, exps, strict=True)),
-            key=lambda pair: pair[1],
-            reverse=True,
-        )
-        return IntentScores(ranked)
-
-
-def training_key(texts: list[str], labels: list[str]) -> str:
-    """A hash of everything a trained model depends on."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        learner = version("scikit-learn")
-    except PackageNotFoundError:
-        learner = "absent"
-    digest = hashlib.sha256(json.dumps([TRAINING, learner, texts, labels]).encode())
-    return digest.hexdigest()
-
-
-def default_cache_dir() -> Path:
-    """$XDG_CACHE_HOME/vahr (or ~/.cache/vahr): trained models, keyed by their data."""
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "vahr"
+        super().__init__(exported, features)
 
 
 def load_or_train(
     texts: list[str], labels: list[str], cache_dir: Path | None
-) -> tuple[IntentClassifier, bool]:
-    """The classifier for this training data, from the cache when it has it (True) or
-    trained now and cached (False). A cache that cannot be read or written is skipped."""
-    key = training_key(texts, labels)
-    file = (cache_dir / f"intent-model-{key[:24]}.json") if cache_dir else None
-    if file is not None:
-        try:
-            exported = json.loads(file.read_text(encoding="utf-8"))
-            if exported.get("key") == key:
-                return IntentClassifier(exported), True
-        except (OSError, ValueError):
-            pass
-    exported = train(texts, labels)
-    exported["key"] = key
-    if file is not None:
-        try:
-            file.parent.mkdir(parents=True, exist_ok=True)
-            partial = file.with_suffix(f".{os.getpid()}.tmp")
-            partial.write_text(json.dumps(exported), encoding="utf-8")
-            partial.replace(file)
-        except OSError:
-            pass
-    return IntentClassifier(exported), False
+) -> tuple[TextClassifier, bool]:
+    """The intent classifier for this training data, cached (True) or trained now (False)."""
+    return load_or_train_classifier(
+        texts, labels, features, name="intent-model", recipe=TRAINING, cache_dir=cache_dir
+    )
 
 
 def fit(texts: list[str], labels: list[str]) -> Any:
-    """The scikit-learn pipeline, fitted and calibrated (tests compare the export with it)."""
-    from sklearn.calibration import CalibratedClassifierCV
-    from sklearn.feature_extraction.text import TfidfVectorizer
-    from sklearn.linear_model import LogisticRegression
-    from sklearn.model_selection import StratifiedKFold
-    from sklearn.pipeline import make_pipeline
-
-    vectorizer = TfidfVectorizer(analyzer=features, sublinear_tf=True)
-    # newton-cg reaches the same optimum as the default lbfgs here ten times faster.
-    regression = LogisticRegression(class_weight="balanced", solver="newton-cg", max_iter=1000)
-    folds = StratifiedKFold(n_splits=CALIBRATION_FOLDS, shuffle=True, random_state=0)
-    calibrated = CalibratedClassifierCV(regression, method="temperature", cv=folds, ensemble=False)
-    return make_pipeline(vectorizer, calibrated).fit(texts, labels)
-
-
-def train(texts: list[str], labels: list[str]) -> dict[str, Any]:
-    """Fit the pipeline and export it as plain numbers."""
-    return export(fit(texts, labels))
-
-
-def export(pipeline: Any) -> dict[str, Any]:
-    """The fitted pipeline as plain numbers (what `IntentClassifier` reads)."""
-    vectorizer, calibrated = pipeline[0], pipeline[1]
-    [member] = calibrated.calibrated_classifiers_
-    regression = member.estimator
-    [temperature] = member.calibrators
-    return {
-        "training": TRAINING,
-        # The calibrated wrapper encodes the labels; the regression's classes are their codes.
-        "classes": [str(calibrated.classes_[code]) for code in regression.classes_],
-        "vocabulary": {name: int(index) for name, index in vectorizer.vocabulary_.items()},
-        "idf": vectorizer.idf_.tolist(),
-        "weights": regression.coef_.T.tolist(),
-        "intercept": regression.intercept_.tolist(),
-        "beta": float(temperature.beta_),
-    }
+    """The scikit-learn pipeline over intent features (tests compare the export with it)."""
+    return fit_pipeline(texts, labels, features)

@@ -1,0 +1,110 @@
+"""The sense check: is what the robot heard an answer about the weather at all?
+
+The interpreter reads cues, and a cue says nothing of its sense: "she has such a sunny
+personality", "a baby shower", "the rainy day fund" hold cues and are no answer. So a
+second opinion reads the whole sentence: a text classifier
+(`vahr.speech.text_classifier`: TF-IDF of words, word pairs and character n-grams, a
+logistic regression) trained on weather answers (the intents' phrasings of
+`weather_answers.yaml` and the answers of `data/answer-sense.yaml`) against other speech
+(its `not_answers` and the other sentences of `data/answer-sense.yaml`: weather words in
+other senses, questions about the weather, other weather). It may only veto: a sentence the
+cues make sunny or rainy is unknown when the classifier finds it more likely other speech
+than an answer. Which answer it is stays the cues' to say, so the reason is always a cue.
+
+Chosen on the tuning set (docs/voice.md): the classifier's own decision (other more likely
+than answer), with scikit-learn's default regularization, no threshold of ours. The model is
+exported and cached like the NLU's, so a robot starts without importing scikit-learn once
+the cache is warm.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import yaml
+
+from vahr.speech.errors import SpeechError
+from vahr.speech.text import normalize
+from vahr.speech.text_classifier import default_cache_dir, load_or_train
+
+if TYPE_CHECKING:
+    from robot_agent.voice.answers import WeatherAnswers
+    from vahr.speech.text_classifier import TextClassifier
+
+SENSE_FILE = Path(__file__).with_name("data") / "answer-sense.yaml"
+ANSWER, OTHER = "answer", "other"
+# What the cached model depends on besides its data; change it with `features`.
+RECIPE = "sense 1: words, bigrams, chars 3-5"
+
+
+def features(text: str) -> list[str]:
+    """Words, word pairs (with the sentence's ends) and the character n-grams of words."""
+    words = text.split()
+    found = [f"w:{word}" for word in words]
+    padded = ["<s>", *words, "</s>"]
+    found += [f"b:{first} {second}" for first, second in zip(padded, padded[1:], strict=False)]
+    for word in words:
+        wrapped = f" {word} "
+        for size in (3, 4, 5):
+            found += [f"c:{wrapped[i : i + size]}" for i in range(len(wrapped) - size + 1)]
+    return found
+
+
+@dataclass(frozen=True)
+class Sense:
+    """How likely the text is an answer (0..1), and whether that is more likely than not."""
+
+    answer: float
+
+    @property
+    def is_answer(self) -> bool:
+        return self.answer >= 0.5
+
+
+class SenseCheck:
+    """The trained classifier of answers against other speech."""
+
+    def __init__(self, classifier: TextClassifier) -> None:
+        self.classifier = classifier
+
+    @classmethod
+    def train(
+        cls,
+        answers: WeatherAnswers,
+        sense_file: Path = SENSE_FILE,
+        *,
+        cache_dir: Path | None = None,
+        use_cache: bool = True,
+    ) -> SenseCheck:
+        """Trained on `answers` and `sense_file`, or loaded from the cache."""
+        said, other = training_sentences(answers, sense_file)
+        texts = [*said, *other]
+        labels = [ANSWER] * len(said) + [OTHER] * len(other)
+        cache = (cache_dir or default_cache_dir()) if use_cache else None
+        classifier, _ = load_or_train(
+            texts, labels, features, name="answer-sense", recipe=RECIPE, cache_dir=cache
+        )
+        return cls(classifier)
+
+    def read(self, text: str) -> Sense:
+        return Sense(round(self.classifier.scores(normalize(text)).of(ANSWER), 3))
+
+
+def training_sentences(answers: WeatherAnswers, sense_file: Path) -> tuple[list[str], list[str]]:
+    """(answers, other speech), normalized, without duplicates."""
+    try:
+        document = yaml.safe_load(sense_file.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise SpeechError(f"cannot read {sense_file}: {err.strerror}") from err
+    except yaml.YAMLError as err:
+        raise SpeechError(f"{sense_file} is not valid YAML: {err}") from err
+    if not isinstance(document, dict) or not all(
+        isinstance(document.get(key), list) for key in ("answers", "other")
+    ):
+        raise SpeechError(f"{sense_file}: expected lists 'answers' and 'other'")
+    said = [p for phrases in answers.phrases.values() for p in phrases]
+    said += [normalize(str(s)) for s in document["answers"]]
+    other = [*answers.not_answers, *(normalize(str(s)) for s in document["other"])]
+    return list(dict.fromkeys(said)), list(dict.fromkeys(other))
