@@ -33,13 +33,16 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class Interpretation:
     """The intent, how sure the interpreter is (0..1), the phrases that decided it, why it
-    is unknown when it is, and the positions of the words it rests on."""
+    is unknown when it is, the positions of the words it rests on, and the sentence the
+    answer was said in (the words up to a question that follows the cues, such as the
+    assistant's "is there anything else I can help with")."""
 
     intent: WeatherIntent
     confidence: float
     evidence: tuple[str, ...] = ()
     reason: str = ""
     decisive: tuple[int, ...] = field(default=(), compare=False)
+    sentence: str = field(default="", compare=False)
 
 
 class Interpreter(Protocol):
@@ -101,7 +104,10 @@ class LocalInterpreter:
         intent, chosen = next(iter(affirmed.items()))
         decisive = sorted({i for cue in chosen for i in self._span(words, cue)})
         evidence = tuple(dict.fromkeys(c.phrase(words) for c in chosen))
-        return Interpretation(intent, 1.0, evidence, decisive=tuple(decisive))
+        last = max(cue.end for cue in chosen)
+        end = next((i for i in range(last, len(words)) if words[i] in cues.question_openers), None)
+        sentence = " ".join(words[:end])
+        return Interpretation(intent, 1.0, evidence, decisive=tuple(decisive), sentence=sentence)
 
     def _find(self, words: list[str]) -> list[_Cue]:
         """Every cue in `words`, longest first where two overlap."""

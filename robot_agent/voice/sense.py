@@ -9,7 +9,9 @@ logistic regression) trained on weather answers (the intents' phrasings of
 (its `not_answers` and the other sentences of `data/answer-sense.yaml`: weather words in
 other senses, questions about the weather, other weather). It may only veto: a sentence the
 cues make sunny or rainy is unknown when the classifier finds it more likely other speech
-than an answer. Which answer it is stays the cues' to say, so the reason is always a cue.
+than an answer, both as a whole and as the sentence the cues were said in (the words up
+to a question that follows them). Which answer it is stays the cues' to say, so the reason
+is always a cue.
 
 Chosen on the tuning set (docs/voice.md): the classifier's own decision (other more likely
 than answer), with scikit-learn's default regularization, no threshold of ours. The model is
@@ -88,8 +90,13 @@ class SenseCheck:
         )
         return cls(classifier)
 
-    def read(self, text: str) -> Sense:
-        return Sense(round(self.classifier.scores(normalize(text)).of(ANSWER), 3))
+    def read(self, *readings: str) -> Sense:
+        """The most answer-like of `readings` of what was heard: the whole text, and the
+        sentence the cues were said in (an answer stays one when the assistant goes on
+        "is there anything else I can help with")."""
+        texts = {normalize(text) for text in readings if text.strip()}
+        best = max((self.classifier.scores(text).of(ANSWER) for text in texts), default=0.0)
+        return Sense(round(best, 3))
 
 
 def training_sentences(answers: WeatherAnswers, sense_file: Path) -> tuple[list[str], list[str]]:

@@ -80,7 +80,8 @@ class Understanding:
         meaning = self.interpreter.interpret(recognition.text)
         if meaning.intent == "unknown":
             return Heard(recognition.text, "unknown", 0.0, meaning.evidence, meaning.reason)
-        if self.sense is not None and not (sense := self.sense.read(recognition.text)).is_answer:
+        sense = self.sense.read(recognition.text, meaning.sentence) if self.sense else None
+        if sense is not None and not sense.is_answer:
             reason = f"reads as no answer ({sense.answer:.2f} an answer)"
             return Heard(recognition.text, "unknown", 0.0, meaning.evidence, reason)
         sureness = self._sureness(recognition, meaning)

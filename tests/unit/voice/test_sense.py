@@ -113,3 +113,14 @@ def test_a_broken_sense_file_is_one_clear_error(answers: WeatherAnswers, tmp_pat
         training_sentences(answers, broken)
     with pytest.raises(SpeechError, match="cannot read"):
         training_sentences(answers, tmp_path / "missing.yaml")
+
+
+def test_an_answer_followed_by_the_assistants_question_is_still_an_answer(
+    answers: WeatherAnswers, sense: SenseCheck
+) -> None:
+    # Given the skill's answer and the question it goes on with, heard as one text
+    heard = _Heard("the weather is rainy is there anything else i can help with")
+    understanding = Understanding(heard, LocalInterpreter(answers), sense=sense)
+    # Then the answer is read in the sentence its cue was said in
+    assert LocalInterpreter(answers).interpret(heard.text).sentence == "the weather is rainy"
+    assert understanding.hear(None).intent == "rainy"  # type: ignore[arg-type]
