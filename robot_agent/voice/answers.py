@@ -119,13 +119,17 @@ class WeatherAnswers:
 
     @classmethod
     def load(cls, path: Path = ANSWERS_FILE) -> WeatherAnswers:
-        try:
-            document = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except OSError as err:
-            raise SpeechError(f"{path}: cannot read the weather answers: {err.strerror}") from err
-        except yaml.YAMLError as err:
-            raise SpeechError(f"{path}: not valid YAML: {err}") from err
-        return cls.parse(document, str(path))
+        return cls.parse(read_yaml(path, "the weather answers"), str(path))
+
+
+def read_yaml(path: Path, what: str) -> object:
+    """The YAML document at `path`, or one `SpeechError` line saying what went wrong."""
+    try:
+        return yaml.safe_load(path.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise SpeechError(f"{path}: cannot read {what}: {err.strerror}") from err
+    except yaml.YAMLError as err:
+        raise SpeechError(f"{path}: not valid YAML: {err}") from err
 
 
 def _sentences(value: object, key: str, source: str) -> tuple[str, ...]:

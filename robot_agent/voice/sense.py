@@ -25,8 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import yaml
-
+from robot_agent.voice.answers import read_yaml
 from vahr.speech.errors import SpeechError
 from vahr.speech.text import normalize
 from vahr.speech.text_classifier import default_cache_dir, load_or_train
@@ -101,12 +100,7 @@ class SenseCheck:
 
 def training_sentences(answers: WeatherAnswers, sense_file: Path) -> tuple[list[str], list[str]]:
     """(answers, other speech), normalized, without duplicates."""
-    try:
-        document = yaml.safe_load(sense_file.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise SpeechError(f"cannot read {sense_file}: {err.strerror}") from err
-    except yaml.YAMLError as err:
-        raise SpeechError(f"{sense_file} is not valid YAML: {err}") from err
+    document = read_yaml(sense_file, "the sense check's sentences")
     if not isinstance(document, dict) or not all(
         isinstance(document.get(key), list) for key in ("answers", "other")
     ):
