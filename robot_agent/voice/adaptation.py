@@ -33,6 +33,7 @@ from __future__ import annotations
 import argparse
 import re
 import shutil
+import signal
 import struct
 import subprocess
 import sys
@@ -42,6 +43,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from vahr.lifeline import lifeline_command
 from vahr.speech.audio import SAMPLE_RATE, add_white_noise
 from vahr.speech.errors import SpeechError
 from vahr.speech.text import normalize
@@ -223,7 +225,9 @@ def _tools() -> dict[str, Path]:
 
 
 def _run(*command: object) -> None:
-    done = subprocess.run([str(part) for part in command], capture_output=True, text=True)
+    # Through the lifeline, so that a killed `make hearing-adaptation` leaves no `bw` behind.
+    line = lifeline_command([str(part) for part in command], signal.SIGKILL)
+    done = subprocess.run(line, capture_output=True, text=True)
     if done.returncode != 0:
         last = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["no output"]
         raise SpeechError(f"{Path(str(command[0])).name} failed: {last[0]}")

@@ -21,17 +21,17 @@ import os
 import queue
 import signal
 import subprocess
-import sys
 import threading
 from concurrent.futures import Future
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from vahr.lifeline import lifeline_command
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
+    from pathlib import Path
 
 STARTED_FOR = "VAHR_STARTED_FOR"
-LIFELINE = Path(__file__).with_name("lifeline.py")
 SPAWN_TIMEOUT_S = 30.0
 
 _Request = tuple["Callable[[], subprocess.Popen[Any]]", "Future[subprocess.Popen[Any]]"]
@@ -82,14 +82,6 @@ class _Spawner:
 _spawner = _Spawner()
 
 
-def lifeline_command(command: Sequence[str], death_signal: int) -> list[str]:
-    """`command` prefixed with the wrapper that ties it to this process's life."""
-    return [
-        sys.executable, "-I", "-S", str(LIFELINE),
-        str(os.getpid()), str(int(death_signal)), "--", *command,
-    ]  # fmt: skip
-
-
 def spawn(
     command: Sequence[str],
     *,
@@ -105,7 +97,7 @@ def spawn(
     something worth saving, like mosquitto's persistence; SIGKILL otherwise).
     """
     child_env = {**(os.environ if env is None else env), STARTED_FOR: str(started_for)}
-    wrapped = lifeline_command(command, death_signal)
+    wrapped = lifeline_command(list(command), death_signal)
 
     def start() -> subprocess.Popen[Any]:
         return subprocess.Popen(wrapped, env=child_env, **popen_kwargs)

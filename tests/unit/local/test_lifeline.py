@@ -1,4 +1,4 @@
-"""The exec wrapper that ties a child to its parent's life (vahr/local/lifeline.py)."""
+"""The exec wrapper that ties a child to its parent's life (vahr/lifeline.py)."""
 
 from __future__ import annotations
 
@@ -6,12 +6,11 @@ import os
 import signal
 import subprocess
 import sys
-from typing import TYPE_CHECKING
+from pathlib import Path
 
-from vahr.local.lifetime import LIFELINE, lifeline_command
+from vahr.lifeline import lifeline_command
 
-if TYPE_CHECKING:
-    from pathlib import Path
+LIFELINE = Path(lifeline_command([], 0)[3])  # the wrapper script itself
 
 
 def test_the_command_runs_with_the_parent_death_signal_armed(tmp_path: Path) -> None:

@@ -1,7 +1,10 @@
 """Exec a command that dies with the process that started it (Linux `PR_SET_PDEATHSIG`).
 
-Run as a script, never imported by the product: `python -I -S lifeline.py PARENT_PID SIGNAL
--- COMMAND [ARG...]`. It arms the parent-death signal, checks that the parent is still the
+Run as a script: `python -I -S lifeline.py PARENT_PID SIGNAL -- COMMAND [ARG...]`, the
+command line `lifeline_command` writes. The lab side's children start through it
+(`vahr.local.lifetime`), and so do the robot's long batch tools (sphinxtrain, in
+`robot_agent.voice.adaptation`); it sits at the top of the `vahr` package so that both may
+use it. It arms the parent-death signal, checks that the parent is still the
 process that asked (it may have died between fork and `prctl`, and then nothing would ever
 send the signal), and replaces itself with COMMAND. The signal survives `exec`, so COMMAND
 gets SIGNAL the moment its parent dies, SIGKILL of the parent included.
@@ -24,6 +27,16 @@ USAGE = 64
 ORPHANED = 65
 CANNOT_ARM = 66
 CANNOT_EXEC = 127
+
+
+def lifeline_command(command: list[str], death_signal: int) -> list[str]:
+    """`command` prefixed with this wrapper, tied to the calling process's life (to the
+    thread that forks it, strictly: see `vahr.local.lifetime`)."""
+    # os.path, not pathlib: the wrapper imports as little as it can, it starts every child.
+    return [
+        sys.executable, "-I", "-S", os.path.abspath(__file__),  # noqa: PTH100
+        str(os.getpid()), str(int(death_signal)), "--", *command,
+    ]  # fmt: skip
 
 
 def main(argv: list[str]) -> int:
