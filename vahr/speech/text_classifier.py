@@ -13,8 +13,8 @@ temperature) and cached on disk as JSON under a hash of the training data and th
 answering needs only this module, and scikit-learn is imported only when the cache is cold.
 The Alexa simulator's intent classifier (`vahr.local.alexa.intent_classifier`) and the
 robot's sense check of what it heard (`robot_agent.voice.sense`) are both this.
-`tests/unit/speech/test_text_classifier.py` holds the export to scikit-learn's own
-probabilities.
+`tests/unit/local/test_intent_classifier.py` (many classes) and `tests/unit/voice/
+test_sense.py` (two) hold the export to scikit-learn's own probabilities.
 """
 
 from __future__ import annotations
