@@ -121,6 +121,9 @@ NAVIGATE = IntentSpec(
         "<ask> (take|bring|walk|drive) {robot} <way> <to> {zone} <end>",
         "<to> {zone} (with|for) {robot} <end>",
         "{zone} for {robot} <end>",
+        "{robot} <go> <way> <to> {zone} (to|and) (pick up|get|collect|grab|fetch) (the|a|its|your) "
+        "(package|box|parcel|load)",
+        "(and|and then|then) {robot} <to> {zone} [as well|too|please]",
     ),
 )
 
@@ -280,6 +283,9 @@ STATUS = IntentSpec(
         "how far (along|away) is {robot}",
         "(any|is there any) (news|update|word) (on|about|from) {robot}",
         "is (anyone|anybody|any robot|a robot) still (moving|driving|working|out)",
+        "(did|has) {robot} [already] (deliver|delivered|drop off|dropped off) (its|the|a|his|her) "
+        "(package|parcel|box|load) [yet|already]",
+        "where (have|has) {robot} (got|gotten|ended up) [to]",
     ),
 )
 
@@ -331,6 +337,9 @@ WEATHER = IntentSpec(
         "(do we have|is there|will there be|are we getting) (rain|sun|sunshine) [or (sun|rain)] "
         "[today|now]",
         "(how's|how is|what's) the weather for the (task|experiment|delivery|run)",
+        "[the|today's] weather [please|now|today|report please]",
+        "[<ask>] (give me|get me|i want|i'd like|i need) the weather [please|now|today]",
+        "(ask|check) (for|about|on) the weather [please|now|today]",
     ),
 )
 

@@ -12,7 +12,8 @@ RULES: dict[str, str] = {
     # How a request opens: bare, polite, indirect, or with a filler first.
     "ask": (
         "[please|could you|can you|would you|will you|could you please|can you please"
-        "|would you please|i want you to|i'd like you to|i need you to|go ahead and"
+        "|would you please|could you kindly|would you kindly|kindly|i want you to|i'd like you to"
+        "|i need you to|go ahead and"
         "|okay|ok|so|um|uh|hey|now|alright]"
     ),
     # How it ends.
