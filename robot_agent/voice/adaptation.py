@@ -204,10 +204,9 @@ def synthesized_clips(
 
 def _dictionary_words() -> set[str]:
     """Every entry of pocketsphinx's pronunciation dictionary (`word(2)` as it stands)."""
-    from pocketsphinx import get_model_path
+    from vahr.speech.lm_stt import dictionary_entries
 
-    dictionary = Path(get_model_path()) / "en-us" / "cmudict-en-us.dict"
-    return {line.split(" ", 1)[0] for line in dictionary.read_text(encoding="utf-8").splitlines()}
+    return {entry for entry, _ in dictionary_entries()}
 
 
 def _tools() -> dict[str, Path]:

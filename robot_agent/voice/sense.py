@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 from robot_agent.voice.answers import read_yaml
 from vahr.speech.errors import SpeechError
 from vahr.speech.text import normalize
-from vahr.speech.text_classifier import default_cache_dir, load_or_train
+from vahr.speech.text_classifier import default_cache_dir, load_or_train, ngram_features
 
 if TYPE_CHECKING:
     from robot_agent.voice.answers import WeatherAnswers
@@ -42,15 +42,7 @@ RECIPE = "sense 1: words, bigrams, chars 3-5"
 
 def features(text: str) -> list[str]:
     """Words, word pairs (with the sentence's ends) and the character n-grams of words."""
-    words = text.split()
-    found = [f"w:{word}" for word in words]
-    padded = ["<s>", *words, "</s>"]
-    found += [f"b:{first} {second}" for first, second in zip(padded, padded[1:], strict=False)]
-    for word in words:
-        wrapped = f" {word} "
-        for size in (3, 4, 5):
-            found += [f"c:{wrapped[i : i + size]}" for i in range(len(wrapped) - size + 1)]
-    return found
+    return ngram_features(text.split())
 
 
 @dataclass(frozen=True)
@@ -77,15 +69,19 @@ class SenseCheck:
         sense_file: Path = SENSE_FILE,
         *,
         cache_dir: Path | None = None,
-        use_cache: bool = True,
     ) -> SenseCheck:
-        """Trained on `answers` and `sense_file`, or loaded from the cache."""
+        """Trained on `answers` and `sense_file`, or loaded from the cache (`cache_dir`, by
+        default the user's)."""
         said, other = training_sentences(answers, sense_file)
         texts = [*said, *other]
         labels = [ANSWER] * len(said) + [OTHER] * len(other)
-        cache = (cache_dir or default_cache_dir()) if use_cache else None
         classifier, _ = load_or_train(
-            texts, labels, features, name="answer-sense", recipe=RECIPE, cache_dir=cache
+            texts,
+            labels,
+            features,
+            name="answer-sense",
+            recipe=RECIPE,
+            cache_dir=cache_dir or default_cache_dir(),
         )
         return cls(classifier)
 

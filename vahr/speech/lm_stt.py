@@ -74,18 +74,11 @@ class LanguageModelRecognizer:
         adaptation: Path | None = None,
         background_words: int = 0,
     ) -> None:
-        from pocketsphinx import Decoder, get_model_path
+        from pocketsphinx import Decoder
 
         self.sentences = tuple(dict.fromkeys(sentences))
         self.detector = detector or SpeechDetector()
-        model = Path(get_model_path()) / "en-us"
-        # The 130,000 words of the dictionary, read once: (entry, phones), `word(2)` entries
-        # being a word's alternative pronunciations.
-        entries = [
-            (entry, phones)
-            for line in (model / "cmudict-en-us.dict").read_text(encoding="utf-8").splitlines()
-            for entry, _, phones in [line.partition(" ")]
-        ]
+        entries = dictionary_entries()
         # Each background word is a sentence of its own: known, but in no example's context.
         background = (
             common_words(background_words, (e for e, _ in entries if "(" not in e))
@@ -139,6 +132,19 @@ class LanguageModelRecognizer:
             # An alternative pronunciation is reported as `word(2)`.
             found.append(HeardWord(segment.word.split("(")[0], round(float(segment.prob), 3)))
         return tuple(found)
+
+
+def dictionary_entries() -> list[tuple[str, str]]:
+    """The 130,000 entries of pocketsphinx's US English pronunciation dictionary, read once
+    per call: (entry, phones), `word(2)` entries being a word's other pronunciations."""
+    from pocketsphinx import get_model_path
+
+    dictionary = Path(get_model_path()) / "en-us" / "cmudict-en-us.dict"
+    return [
+        (entry, phones)
+        for line in dictionary.read_text(encoding="utf-8").splitlines()
+        for entry, _, phones in [line.partition(" ")]
+    ]
 
 
 def common_words(count: int, candidates: Iterable[str]) -> list[str]:

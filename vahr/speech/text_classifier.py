@@ -39,6 +39,21 @@ CALIBRATION_FOLDS = 5
 LEARNER = "tfidf(sublinear), logreg(balanced, newton-cg), T(5 folds)"
 
 
+def ngram_features(words: list[str], *, opaque: frozenset[str] = frozenset()) -> list[str]:
+    """Words, word pairs (with the sentence's ends) and the character 3- to 5-grams of each
+    word but the `opaque` ones (placeholders whose spelling means nothing)."""
+    found = [f"w:{word}" for word in words]
+    padded = ["<s>", *words, "</s>"]
+    found += [f"b:{first} {second}" for first, second in zip(padded, padded[1:], strict=False)]
+    for word in words:
+        if word in opaque:
+            continue
+        wrapped = f" {word} "
+        for size in (3, 4, 5):
+            found += [f"c:{wrapped[i : i + size]}" for i in range(len(wrapped) - size + 1)]
+    return found
+
+
 @dataclass(frozen=True)
 class Scores:
     """Calibrated probabilities per class, best first."""

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from vahr.local.alexa.intent_classifier import IntentClassifier, features, fit
+from vahr.local.alexa.intent_classifier import features, fit
 from vahr.local.alexa.nlu import InteractionModel
-from vahr.speech.text_classifier import export
+from vahr.speech.text_classifier import TextClassifier, export
 
 
 @pytest.fixture(scope="module")
@@ -20,7 +20,7 @@ def test_the_export_gives_sklearns_probabilities(training: tuple[list[str], list
     # Given the pipeline fitted on the generated samples and its plain-number export
     texts, labels = training
     pipeline = fit(texts, labels)
-    exported = IntentClassifier(export(pipeline))
+    exported = TextClassifier(export(pipeline), features)
     # When both score utterances seen and unseen in training
     probes = [*texts[::40], "ROBOT please trundle over to ZONE", "play a song", "qwerty"]
     expected = pipeline.predict_proba(probes)

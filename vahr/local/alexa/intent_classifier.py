@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from vahr.speech.text_classifier import TextClassifier
+from vahr.speech.text_classifier import TextClassifier, ngram_features
 from vahr.speech.text_classifier import fit as fit_pipeline
 from vahr.speech.text_classifier import load_or_train as load_or_train_classifier
 
@@ -27,29 +27,13 @@ MARKERS = frozenset({"ROBOT", "ZONE"})
 
 
 def features(text: str) -> list[str]:
-    """The features of one abstracted utterance: words, bigrams, character n-grams, and how
-    many values of each slot type it names (none, one, two or more), which n-grams cannot
-    count: one robot named is rarely a sequential delivery, a question naming none is rarely
-    about one robot."""
+    """The features of one abstracted utterance: how many values of each slot type it names
+    (none, one, two or more), which n-grams cannot count (one robot named is rarely a
+    sequential delivery, a question naming none is rarely about one robot), then words,
+    bigrams and the character n-grams of words other than the markers."""
     words = text.split()
-    found = [f"k:{marker}={min(words.count(marker), 2)}" for marker in sorted(MARKERS)]
-    found += [f"w:{word}" for word in words]
-    padded = ["<s>", *words, "</s>"]
-    found += [f"b:{first} {second}" for first, second in zip(padded, padded[1:], strict=False)]
-    for word in words:
-        if word in MARKERS:
-            continue
-        wrapped = f" {word} "
-        for size in (3, 4, 5):
-            found += [f"c:{wrapped[i : i + size]}" for i in range(len(wrapped) - size + 1)]
-    return found
-
-
-class IntentClassifier(TextClassifier):
-    """The exported model over intent features."""
-
-    def __init__(self, exported: dict[str, Any]) -> None:
-        super().__init__(exported, features)
+    counts = [f"k:{marker}={min(words.count(marker), 2)}" for marker in sorted(MARKERS)]
+    return counts + ngram_features(words, opaque=MARKERS)
 
 
 def load_or_train(
