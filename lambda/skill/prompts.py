@@ -45,6 +45,10 @@ UNKNOWN_ROBOT = "I don't know a robot called {heard}. "
 UNKNOWN_ZONE = "I don't know a zone called {heard}. "
 NEEDS_ONE_ROBOT = "A sequential delivery needs one robot at a time. "
 SAME_ROBOT = "{robot} already delivers first. "
+OTHER_WEATHER_RULE = (
+    "Weather deliveries always go to {sunny} when it is sunny and {rainy} when it is rainy, "
+    "so I sent no robot. For that rule, say: have {robot} deliver based on the weather."
+)
 GIVE_UP = (
     "Sorry, I still did not get that, so I sent nothing. Try, for example: send {robot} to {zone}."
 )

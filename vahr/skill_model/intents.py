@@ -116,8 +116,11 @@ NAVIGATE = IntentSpec(
         "take|get) it <way> <to> {zone}",
         "[<ask>] (for|with) {robot} the zone is {zone} [so] (send it|go|move it) there",
         "{robot} your zone is {zone} [so] (go|head|drive) there <end>",
-        "it's (sunny|raining|rainy) [so] {robot} <go> <way> <to> {zone}",
-        "(since|because) it's (sunny|raining|rainy) (send|move|take) {robot} <to> {zone}",
+        "(it's|it is|the weather is) (sunny|raining|rainy) [so|and] {robot} <go> <way> <to> {zone}",
+        "(since|because|as) (it's|it is) (sunny|raining|rainy) (send|move|take) {robot} <to> {zone}",
+        "(it's|it is|the weather is) (sunny|raining|rainy) [today|now] [so] (send|move|take|get) "
+        "{robot} <way> <to> {zone} <end>",
+        "(sunny|rainy|raining|it's sunny|it's raining) [today|then] [so] {robot} <to> {zone} <end>",
         "<ask> (take|bring|walk|drive) {robot} <way> <to> {zone} <end>",
         "<to> {zone} (with|for) {robot} <end>",
         "{zone} for {robot} <end>",
@@ -169,9 +172,14 @@ DELIVER = IntentSpec(
     ),
 )
 
+# A person may say the weather delivery's rule aloud ("deliver to zone a if it's sunny and
+# zone c if it's raining"); the skill holds what was said to the rule robots follow.
+SUNNY_ZONE = SlotSpec("sunnyZone", ZONE_TYPE)
+RAINY_ZONE = SlotSpec("rainyZone", ZONE_TYPE)
+
 WEATHER_DELIVERY = IntentSpec(
     name="WeatherDeliveryIntent",
-    slots=(ROBOT,),
+    slots=(ROBOT, SUNNY_ZONE, RAINY_ZONE),
     commands_robots=True,
     essentials=(
         "have {robot} deliver based on the weather",
@@ -200,6 +208,28 @@ WEATHER_DELIVERY = IntentSpec(
         "<ask> (start|run|begin|do) <weather_job> <end>",
         "<ask> (start|run|begin|do) a weather (delivery|navigation|task|run) <end>",
         "<ask> (deliver|navigate) <weather_basis> <end>",
+        # The rule said aloud, either weather first.
+        "<ask> (have|let|tell) {robot} [to] (deliver|go) to {sunnyZone} <if_sunny> (and|or|but) "
+        "[to] {rainyZone} <if_rainy>",
+        "<ask> (have|let|tell) {robot} [to] (deliver|go) to {rainyZone} <if_rainy> (and|or|but) "
+        "[to] {sunnyZone} <if_sunny>",
+        "{robot} (deliver|go|drive) to {sunnyZone} <if_sunny> (and|or|otherwise|or else) [to] "
+        "{rainyZone} [<if_rainy>]",
+        "{robot} (deliver|go|drive) to {rainyZone} <if_rainy> (and|or|otherwise|or else) [to] "
+        "{sunnyZone} [<if_sunny>]",
+        "{robot} <if_sunny> (go|deliver|drive) to {sunnyZone} [and|but] <if_rainy> (go|deliver|"
+        "drive) to {rainyZone}",
+        "{robot} <if_rainy> (go|deliver|drive) to {rainyZone} [and|but] <if_sunny> (go|deliver|"
+        "drive) to {sunnyZone}",
+        "<ask> <if_sunny> (send|take) {robot} to {sunnyZone} (and|but|otherwise|or else) "
+        "[<if_rainy>] to {rainyZone}",
+        "{robot} (sunny|sunshine) (means|is) {sunnyZone} (and|but) (rainy|rain) (means|is) "
+        "{rainyZone} [so] [go|deliver|go deliver]",
+        "{robot} (check|find out|ask about) the weather (and|then) (deliver|go) to {sunnyZone} "
+        "<if_sunny> (or|and) {rainyZone} <if_rainy>",
+        "<ask> (have|let) {robot} (deliver|go) to [either] {sunnyZone} or {rainyZone} "
+        "<weather_basis>",
+        "{robot} (deliver|go) to [either] {sunnyZone} or {rainyZone} <weather_basis>",
     ),
 )
 
@@ -257,7 +287,13 @@ SEQUENTIAL_DELIVERY = IntentSpec(
 STATUS = IntentSpec(
     name="StatusIntent",
     slots=(ROBOT,),
-    essentials=("where is {robot}", "where are the robots", "what are the robots doing"),
+    essentials=(
+        "where is {robot}",
+        "where are the robots",
+        "what are the robots doing",
+        "is {robot} done delivering",
+        "has {robot} finished delivering",
+    ),
     templates=(
         "[so|um|okay|hey] (where is|where's) {robot} [right now|now|at the moment|at]",
         "[so|um|okay|hey] (what is|what's) {robot} (doing|up to) [right now|now|at the moment]",
@@ -286,6 +322,10 @@ STATUS = IntentSpec(
         "(did|has) {robot} [already] (deliver|delivered|drop off|dropped off) (its|the|a|his|her) "
         "(package|parcel|box|load) [yet|already]",
         "where (have|has) {robot} (got|gotten|ended up) [to]",
+        "(is|has) {robot} (done|finished) (delivering|with the delivery|with its delivery|with its "
+        "job|with the package) [yet]",
+        "(has|did) {robot} (finish|finished|complete|completed) (delivering|the delivery|its "
+        "delivery|its job|its task) [yet]",
     ),
 )
 

@@ -36,4 +36,7 @@ RULES: dict[str, str] = {
         "|in line with) the weather"
     ),
     "weather_job": "the weather (delivery|task|navigation|run|job|mission|errand)",
+    # A condition of the weather delivery's rule.
+    "if_sunny": "(if|when|in case) [it's|it is|the weather is] (sunny|nice|clear|dry)",
+    "if_rainy": "(if|when|in case) [it's|it is|the weather is] (rainy|raining|wet|pouring)",
 }

@@ -188,8 +188,8 @@ def test_names_that_overlap_and_disagree_are_asked_about(model: InteractionModel
 
 
 def test_an_intent_the_values_named_do_not_fit_falls_back(model: InteractionModel) -> None:
-    # The classifier reads the weather question; the words name a robot and two zones
-    understood = model.understand("robot one sunny means zone a and rainy means zone c")
+    # The classifier reads the weather question; the words name a robot
+    understood = model.understand("robot one what is the weather")
     assert (understood.intent, understood.slots) == (FALLBACK, {})
     assert understood.best_guess is not None
 
@@ -243,6 +243,30 @@ def test_sequential_delivery_roles_follow_the_sentence(
 ) -> None:
     understood = model.understand(utterance)
     assert understood.intent == "SequentialDeliveryIntent"
+    assert ids(understood) == slots
+
+
+@pytest.mark.parametrize(
+    ("utterance", "slots"),
+    [
+        ("robot one deliver to zone a if it's sunny and zone c if it's raining",
+         {"robot": "placebot1", "sunnyZone": "A", "rainyZone": "C"}),
+        ("robot two if it's raining go to zone c and if it's sunny go to zone a",
+         {"robot": "placebot2", "sunnyZone": "A", "rainyZone": "C"}),
+        ("robot one deliver to zone c if it rains otherwise zone a",
+         {"robot": "placebot1", "sunnyZone": "A", "rainyZone": "C"}),
+        ("robot one if it's not sunny go to zone b otherwise zone d",
+         {"robot": "placebot1", "sunnyZone": "D", "rainyZone": "B"}),
+        # One weather given two zones is heard, not guessed between.
+        ("robot one deliver to zone a if it's sunny and zone b if it's sunny",
+         {"robot": "placebot1", "sunnyZone": "A", "rainyZone": None}),
+    ],
+)  # fmt: skip
+def test_the_weather_rule_pairs_each_zone_with_its_weather(
+    model: InteractionModel, utterance: str, slots: dict[str, str | None]
+) -> None:
+    understood = model.understand(utterance)
+    assert understood.intent == "WeatherDeliveryIntent"
     assert ids(understood) == slots
 
 

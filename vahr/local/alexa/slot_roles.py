@@ -13,6 +13,10 @@ later-named robot first ("robot two goes after robot one"); a zone belongs to th
 named before it, and a single zone said before both robots or after both applies to both
 ("robot one and then robot two deliver to zone d"). The fleet is not one of its two robots,
 and one robot cannot follow itself: such a robot slot is left for the skill to ask about.
+The weather delivery's rule, said aloud, pairs each zone with the weather said beside it:
+after the zone when the zone comes first ("to zone a if it's sunny"), before it when the
+weather does ("if it's raining go to zone c"); "otherwise zone c" is the other weather; with
+no weather beside any zone, the first is the sunny one.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ from itertools import pairwise
 from typing import TYPE_CHECKING
 
 from vahr.protocol import FLEET_GROUP
-from vahr.skill_model.intents import ROBOT_TYPE
+from vahr.skill_model.intents import RAINY_ZONE, ROBOT_TYPE, SUNNY_ZONE
 
 if TYPE_CHECKING:
     from collections.abc import Mapping, Set
@@ -38,6 +42,17 @@ _TURNED_DOWN = frozenset({"from", "of", "not"})
 # robot two", "robot one plus robot two", "robot one as well as robot two"); none at all is a
 # list too ("robot one, robot two": punctuation is gone by now).
 _LISTED = frozenset({"and", "plus", "also", "as", "well"})
+# The words that say which weather a zone of the weather delivery's rule is for.
+_WEATHER_WORDS = {
+    **dict.fromkeys(("sunny", "sunshine", "sun", "nice", "clear", "dry", "fine", "bright"), "sunny"),
+    **dict.fromkeys(
+        ("rainy", "rain", "raining", "rains", "wet", "pouring", "showers", "drizzle", "stormy"),
+        "rainy",
+    ),
+}
+_OTHER_WEATHER = frozenset({"otherwise", "else"})
+_NOT = frozenset({"not", "isn't", "no"})
+_RULE_SLOTS = {"sunny": SUNNY_ZONE.name, "rainy": RAINY_ZONE.name}
 
 
 def assign_slots(
@@ -57,6 +72,11 @@ def assign_slots(
     if _is_sequence(by_type):
         return _sequence(by_type, matches, words)
     filled: dict[str, SlotMatch] = {}
+    rule = set(_RULE_SLOTS.values())
+    if rule <= declared.keys():
+        zone_type = declared[SUNNY_ZONE.name]
+        filled.update(_weather_rule([m for m in matches if m.type == zone_type], words))
+        by_type = {t: [n for n in names if n not in rule] for t, names in by_type.items()}
     for slot_type, names in by_type.items():
         values = [match for match in matches if match.type == slot_type]
         chosen = _one_each(values, len(names), words, robots, fleet_name)
@@ -147,3 +167,48 @@ def _sequence(
             owned[rank] = unowned.pop(0)
     filled.update({zone_slots[rank]: zone for rank, zone in owned.items()})
     return filled
+
+
+def _weather_rule(zones: list[SlotMatch], words: list[str]) -> dict[str, SlotMatch]:
+    """The rule's zones by the weather said beside each; a weather given two zones, or a
+    zone with no weather, is heard but left unresolved for the skill to turn down."""
+    said = [(at, _weather(words, at)) for at, word in enumerate(words) if word in _WEATHER_WORDS]
+    if not zones:
+        return {}
+    weather_first = bool(said) and said[0][0] < zones[0].start
+    kinds: list[str | None] = []
+    for rank, zone in enumerate(zones):
+        before = range(zones[rank - 1].end if rank else 0, zone.start)
+        after = range(zone.end, zones[rank + 1].start if rank + 1 < len(zones) else len(words))
+        near = [kind for at, kind in said if at in (before if weather_first else after)]
+        if near:
+            kinds.append(near[-1] if weather_first else near[0])
+        else:
+            other = any(words[at] in _OTHER_WEATHER for at in [*before, *after])
+            kinds.append("other" if rank and other else None)
+    named = {kind for kind in kinds if kind in _RULE_SLOTS}
+    if not any(kinds):
+        # No weather said beside any zone ("to zone a or zone c depending on the weather"):
+        # the zones fill the rule in the order Alexa's samples give them, sunny first.
+        kinds = list(_RULE_SLOTS)[: len(zones)]
+    elif len(named) == 1:
+        (rest,) = _RULE_SLOTS.keys() - named
+        kinds = [rest if kind == "other" else kind for kind in kinds]
+    filled: dict[str, SlotMatch] = {}
+    for zone, kind in zip(zones, kinds, strict=True):
+        slot = _RULE_SLOTS.get(kind or "")
+        if slot is None or slot in filled:
+            slot = next((s for s in _RULE_SLOTS.values() if s not in filled), None)
+            if slot is None:
+                continue
+            zone = replace(zone, id=None, canonical=None)
+        filled[slot] = zone
+    return filled
+
+
+def _weather(words: list[str], at: int) -> str:
+    """The weather `words[at]` says, turned round by a "not" before it ("if it's not sunny")."""
+    kind = _WEATHER_WORDS[words[at]]
+    if _NOT & set(words[max(0, at - 2) : at]):
+        return next(k for k in _RULE_SLOTS if k != kind)
+    return kind
