@@ -85,7 +85,12 @@ NAVIGATE = IntentSpec(
     name="NavigateIntent",
     slots=(ROBOT, ZONE),
     commands_robots=True,
-    essentials=("send {robot} to {zone}", "move {robot} to {zone}", "{robot} go to {zone}"),
+    essentials=(
+        "send {robot} to {zone}",
+        "move {robot} to {zone}",
+        "{robot} go to {zone}",
+        "bring {robot} to {zone}",
+    ),
     templates=(
         "<ask> <send> {robot} <way> <to> {zone} <end>",
         "<ask> (tell|ask|get) {robot} to <go> <way> <to> {zone} <end>",
@@ -293,6 +298,8 @@ STATUS = IntentSpec(
         "what are the robots doing",
         "is {robot} done delivering",
         "has {robot} finished delivering",
+        "is {robot} done",
+        "did {robot} deliver the package",
     ),
     templates=(
         "[so|um|okay|hey] (where is|where's) {robot} [right now|now|at the moment|at]",

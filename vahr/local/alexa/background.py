@@ -131,6 +131,16 @@ OUT_OF_DOMAIN_TEMPLATES: tuple[str, ...] = (
     "(what's up|what's new|what's happening)",
     "(here|off) we go",
     "(is|are) (it|we|they) (time|ready|late) [yet]",
+    # Talk about weather and deliveries in general, not the weather now or a robot's job.
+    "(do|don't) you (like|love|hate|enjoy|prefer) (rain|rainy weather|sunny weather|the sun"
+    "|sunshine|storms|summer|winter)",
+    "(what's|what is) your (favorite|favourite|least favorite) (season|weather|kind of weather"
+    "|time of year)",
+    "(how|why) (do|does) (weather forecasts|the weather|rain|clouds|rainbows|thunder) (work"
+    "|happen|form)",
+    "(why is|what makes) the sky (blue|grey|gray)",
+    "(who|which company|what company) (delivers|ships|makes) the most (packages|parcels)",
+    "(how|why) (do|does) (package delivery|the post office|shipping|couriers) work",
 )
 
 

@@ -176,16 +176,7 @@ def _weather_rule(zones: list[SlotMatch], words: list[str]) -> dict[str, SlotMat
     if not zones:
         return {}
     weather_first = bool(said) and said[0][0] < zones[0].start
-    kinds: list[str | None] = []
-    for rank, zone in enumerate(zones):
-        before = range(zones[rank - 1].end if rank else 0, zone.start)
-        after = range(zone.end, zones[rank + 1].start if rank + 1 < len(zones) else len(words))
-        near = [kind for at, kind in said if at in (before if weather_first else after)]
-        if near:
-            kinds.append(near[-1] if weather_first else near[0])
-        else:
-            other = any(words[at] in _OTHER_WEATHER for at in [*before, *after])
-            kinds.append("other" if rank and other else None)
+    kinds = [_zone_weather(zones, rank, said, words, weather_first) for rank in range(len(zones))]
     named = {kind for kind in kinds if kind in _RULE_SLOTS}
     if not any(kinds):
         # No weather said beside any zone ("to zone a or zone c depending on the weather"):
@@ -212,3 +203,26 @@ def _weather(words: list[str], at: int) -> str:
     if _NOT & set(words[max(0, at - 2) : at]):
         return next(k for k in _RULE_SLOTS if k != kind)
     return kind
+
+
+def _zone_weather(
+    zones: list[SlotMatch],
+    rank: int,
+    said: list[tuple[int, str]],
+    words: list[str],
+    weather_first: bool,
+) -> str | None:
+    """The weather zone `rank` is for: said on the sentence's side of it, "other" after
+    "otherwise", else said on its other side ("zone a if it's sunny" after "if it's
+    raining, zone c"); None when nothing says."""
+    zone = zones[rank]
+    before = range(zones[rank - 1].end if rank else 0, zone.start)
+    after = range(zone.end, zones[rank + 1].start if rank + 1 < len(zones) else len(words))
+    first, second = ((before, -1), (after, 0)) if weather_first else ((after, 0), (before, -1))
+    near = [kind for at, kind in said if at in first[0]]
+    if near:
+        return near[first[1]]
+    if rank and any(words[at] in _OTHER_WEATHER for at in [*before, *after]):
+        return "other"
+    near = [kind for at, kind in said if at in second[0]]
+    return near[second[1]] if near else None
