@@ -122,7 +122,8 @@ NAVIGATE = IntentSpec(
         "[<ask>] (for|with) {robot} the zone is {zone} [so] (send it|go|move it) there",
         "{robot} your zone is {zone} [so] (go|head|drive) there <end>",
         "(it's|it is|the weather is) (sunny|raining|rainy) [so|and] {robot} <go> <way> <to> {zone}",
-        "(since|because|as) (it's|it is) (sunny|raining|rainy) (send|move|take) {robot} <to> {zone}",
+        "(since|because|as) (it's|it is) (sunny|raining|rainy) (send|move|take) {robot} <to> "
+        "{zone}",
         "(it's|it is|the weather is) (sunny|raining|rainy) [today|now] [so] (send|move|take|get) "
         "{robot} <way> <to> {zone} <end>",
         "(sunny|rainy|raining|it's sunny|it's raining) [today|then] [so] {robot} <to> {zone} <end>",

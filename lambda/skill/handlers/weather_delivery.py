@@ -10,7 +10,7 @@ from ask_sdk_core.utils import is_intent_name
 from skill import dialog, prompts
 from skill.handlers.send import send_and_report
 from skill.responses import answer
-from vahr.protocol.weather import WEATHER_ZONES
+from vahr.protocol.weather import WEATHER_ZONES, Weather
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 
 # The zones a person may say with the request ("deliver to zone a if it's sunny and zone c
 # if it's rainy"), by the weather each is for.
-RULE_SLOTS = {"sunny": "sunnyZone", "rainy": "rainyZone"}
+RULE_SLOTS: dict[Weather, str] = {"sunny": "sunnyZone", "rainy": "rainyZone"}
 
 
 class WeatherDeliveryIntentHandler(AbstractRequestHandler):
@@ -38,8 +38,9 @@ class WeatherDeliveryIntentHandler(AbstractRequestHandler):
             # the person did not mean.
             vocabulary = self.runtime.vocabulary
             zones = {weather: vocabulary.zone(zone) for weather, zone in WEATHER_ZONES.items()}
-            robot = vocabulary.examples()["robot"]
-            return answer(handler_input, prompts.OTHER_WEATHER_RULE.format(robot=robot, **zones))
+            example = vocabulary.examples()["robot"]
+            speech = prompts.OTHER_WEATHER_RULE.format(robot=example, **zones)
+            return answer(handler_input, speech)
         robot = dialog.robot(handler_input, self.runtime, "robot")
         if robot.id is None:
             return dialog.ask_robot(handler_input, self.runtime, robot)

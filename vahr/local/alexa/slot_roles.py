@@ -44,7 +44,9 @@ _TURNED_DOWN = frozenset({"from", "of", "not"})
 _LISTED = frozenset({"and", "plus", "also", "as", "well"})
 # The words that say which weather a zone of the weather delivery's rule is for.
 _WEATHER_WORDS = {
-    **dict.fromkeys(("sunny", "sunshine", "sun", "nice", "clear", "dry", "fine", "bright"), "sunny"),
+    **dict.fromkeys(
+        ("sunny", "sunshine", "sun", "nice", "clear", "dry", "fine", "bright"), "sunny"
+    ),
     **dict.fromkeys(
         ("rainy", "rain", "raining", "rains", "wet", "pouring", "showers", "drizzle", "stormy"),
         "rainy",
@@ -176,12 +178,14 @@ def _weather_rule(zones: list[SlotMatch], words: list[str]) -> dict[str, SlotMat
     if not zones:
         return {}
     weather_first = bool(said) and said[0][0] < zones[0].start
-    kinds = [_zone_weather(zones, rank, said, words, weather_first) for rank in range(len(zones))]
+    kinds: list[str | None] = [
+        _zone_weather(zones, rank, said, words, weather_first) for rank in range(len(zones))
+    ]
     named = {kind for kind in kinds if kind in _RULE_SLOTS}
     if not any(kinds):
         # No weather said beside any zone ("to zone a or zone c depending on the weather"):
         # the zones fill the rule in the order Alexa's samples give them, sunny first.
-        kinds = list(_RULE_SLOTS)[: len(zones)]
+        kinds = [kind for kind, _ in zip(_RULE_SLOTS, zones, strict=False)]
     elif len(named) == 1:
         (rest,) = _RULE_SLOTS.keys() - named
         kinds = [rest if kind == "other" else kind for kind in kinds]
