@@ -232,8 +232,26 @@ def test_two_zones_without_a_destination_are_asked_about(model: InteractionModel
           "secondZone": "D"}),
         ("robot one delivers to zone c then robot two",
          {"firstRobot": "placebot1", "firstZone": "C", "secondRobot": "placebot2"}),
-        # The fleet is not one of the two robots, and a robot cannot follow itself.
-        ("both robots to zone d robot one first", {"firstRobot": "placebot1", "firstZone": "D"}),
+        # The fleet of two and one robot's turn give both robots, and the zone is both's.
+        ("both robots to zone d robot one first",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "D"}),
+        ("both robots deliver to zone d placebot two goes second",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "D"}),
+        # "the other robot" after one robot of two is the other one.
+        ("placebot one delivers to zone d and then the other robot delivers to zone c",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "C"}),
+        # A robot said to go second, named first, goes second.
+        ("placebot two second and placebot one first deliver to zone d",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "D"}),
+        # "there" after the robot without a zone sends it where the other goes.
+        ("placebot two deliver to zone d after placebot one delivers there",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "D"}),
+        # A robot cannot follow itself.
         ("robot one delivers to zone a then robot one delivers to zone b",
          {"firstRobot": "placebot1", "firstZone": "A", "secondRobot": None, "secondZone": "B"}),
     ],

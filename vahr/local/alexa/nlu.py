@@ -150,7 +150,7 @@ class InteractionModel:
         robot_values = [
             value for t in self._slot_types if t.name == ROBOT_TYPE for value in t.names.values()
         ]
-        self._robots = frozenset(v for v, _ in robot_values if v != FLEET_GROUP)
+        self._robots = {v: name for v, name in robot_values if v != FLEET_GROUP}
         self._fleet_name = next((n for v, n in robot_values if v == FLEET_GROUP), "all robots")
         self.training = (texts, labels)
         self.cached: bool | None = None

@@ -17,7 +17,10 @@ would name another robot or zone. Some spans need more than a name:
   the words cannot say which was meant, so the skill asks rather than take the first;
 - a bare number or letter joined to a name by "and" or "or" names the value the name would
   with that word last ("robot one and two", "zone a or b"), so the second value is not
-  lost: "stop robot one and two" stops both, not robot one alone.
+  lost: "stop robot one and two" stops both, not robot one alone;
+- "the other robot" (or "the other one") is a robot that does not resolve by its words:
+  which one it is depends on the robot named before it, which `slot_roles` settles where
+  it can (a sequential delivery in a fleet of two).
 """
 
 from __future__ import annotations
@@ -28,6 +31,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from rapidfuzz import fuzz, process
+
+from vahr.skill_model.intents import ROBOT_TYPE
 
 if TYPE_CHECKING:
     from collections.abc import Iterable, Mapping
@@ -47,6 +52,9 @@ _ARTICLES = frozenset({"the", "a", "an"})
 # Words that join a second value to a name with its shared words left out ("robot one and
 # two"); `slot_roles` reads "and" as a list and "or" as a choice to ask about.
 _JOINERS = frozenset({"and", "or", "plus"})
+# "the other robot": a robot named by the one named before it.
+OTHER_ROBOT = ("the", "other")
+_OTHER_HEADS = frozenset({"robot", "one", "placebot", "bot"})
 
 
 def normalize(text: str) -> str:
@@ -155,8 +163,10 @@ class SlotFinder:
         found: list[SlotMatch] = []
         index = 0
         while index < len(corrected):
-            match = self._name_at(corrected, words, similarity, index) or self._unknown_at(
-                corrected, words, index
+            match = (
+                self._name_at(corrected, words, similarity, index)
+                or self._unknown_at(corrected, words, index)
+                or _other_robot_at(words, index)
             )
             if match is None:
                 index += 1
@@ -262,3 +272,14 @@ class SlotFinder:
             canonical=None,
             similarity=100.0,
         )
+
+
+def _other_robot_at(words: list[str], start: int) -> SlotMatch | None:
+    """ "the other robot" at `start`, as a robot that does not resolve by its words."""
+    end = start + len(OTHER_ROBOT) + 1
+    if tuple(words[start : end - 1]) != OTHER_ROBOT or words[end - 1 : end] == []:
+        return None
+    if words[end - 1] not in _OTHER_HEADS:
+        return None
+    spoken = " ".join(words[start:end])
+    return SlotMatch(ROBOT_TYPE, start, end, spoken, id=None, canonical=None, similarity=100.0)

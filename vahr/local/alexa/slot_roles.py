@@ -42,6 +42,11 @@ _TURNED_DOWN = frozenset({"from", "of", "not"})
 # robot two", "robot one plus robot two", "robot one as well as robot two"); none at all is a
 # list too ("robot one, robot two": punctuation is gone by now).
 _LISTED = frozenset({"and", "plus", "also", "as", "well"})
+# Words after a robot that give its turn in a sequence ("placebot one first").
+_TURNS = {"first": 0, "second": 1, "last": 1}
+_GOES = frozenset({"goes", "go", "comes", "delivers", "is", "will", "should"})
+# Words that send the second robot where the first went ("delivers there too").
+_SAME_PLACE = frozenset({"there", "too", "also", "same", "well"})
 # The words that say which weather a zone of the weather delivery's rule is for.
 _WEATHER_WORDS = {
     **dict.fromkeys(
@@ -61,18 +66,19 @@ def assign_slots(
     declared: Mapping[str, str],
     matches: list[SlotMatch],
     words: list[str],
-    robots: Set[str],
+    robots: Mapping[str, str],
     fleet_name: str,
 ) -> dict[str, SlotMatch]:
     """Slot name -> the value it takes, for the slots of `declared` (name -> type).
 
-    `robots` are the ids of the fleet's robots (not the fleet's own id), `fleet_name` the
-    fleet value's name."""
+    `robots` are the fleet's robots (id -> name, without the fleet's own id), `fleet_name`
+    the fleet value's name."""
     by_type: dict[str, list[str]] = {}
     for name, slot_type in declared.items():
         by_type.setdefault(slot_type, []).append(name)
     if _is_sequence(by_type):
-        return _sequence(by_type, matches, words)
+        return _sequence(by_type, matches, words, robots)
+    fleet_robots = robots.keys()
     filled: dict[str, SlotMatch] = {}
     rule = set(_RULE_SLOTS.values())
     if rule <= declared.keys():
@@ -81,7 +87,7 @@ def assign_slots(
         by_type = {t: [n for n in names if n not in rule] for t, names in by_type.items()}
     for slot_type, names in by_type.items():
         values = [match for match in matches if match.type == slot_type]
-        chosen = _one_each(values, len(names), words, robots, fleet_name)
+        chosen = _one_each(values, len(names), words, fleet_robots, fleet_name)
         for name, value in zip(names, chosen, strict=False):
             if value is not None:
                 filled[name] = value
@@ -128,18 +134,33 @@ def _listed(values: list[SlotMatch], words: list[str]) -> bool:
 
 
 def _sequence(
-    by_type: Mapping[str, list[str]], matches: list[SlotMatch], words: list[str]
+    by_type: Mapping[str, list[str]],
+    matches: list[SlotMatch],
+    words: list[str],
+    fleet: Mapping[str, str],
 ) -> dict[str, SlotMatch]:
     (robot_type, robot_slots), (zone_type, zone_slots) = sorted(
         by_type.items(), key=lambda item: item[0] != ROBOT_TYPE
     )
     # The fleet is not one robot of two: "both robots to zone d" says nothing of the order.
     robots = [m for m in matches if m.type == robot_type and m.id != FLEET_GROUP]
+    robots = _the_other_robot(robots, fleet)
     zones = [m for m in matches if m.type == zone_type]
+    group = next((m for m in matches if m.type == robot_type and m.id == FLEET_GROUP), None)
+    if group is not None and len(robots) == 1 and len(zones) <= 1:
+        pair = _pair_from_the_fleet(robots[0], group, words, fleet)
+        if pair is not None:
+            # "both robots to zone d, placebot one first": the fleet's other robot is the
+            # other one, and the zone is both robots'.
+            return {
+                **dict(zip(robot_slots, pair, strict=True)),
+                **{slot: zone for slot in zone_slots for zone in zones},
+            }
     # "robot two goes after robot one": the robot named second goes first, and the sentence
-    # is about the one named first.
+    # is about the one named first. A robot said to go "second" before the other goes
+    # second too, but says nothing of whose a zone is.
     swapped = len(robots) >= 2 and robots[1].start > 0 and words[robots[1].start - 1] in _AFTER
-    if swapped:
+    if swapped or (len(robots) >= 2 and _turn(robots[0], words) == 1):
         robots = [robots[1], robots[0], *robots[2:]]
     filled: dict[str, SlotMatch] = dict(zip(robot_slots, robots, strict=False))
     if len(robots) >= 2 and robots[0].id is not None and robots[0].id == robots[1].id:
@@ -164,6 +185,13 @@ def _sequence(
     if len(zones) == 1 and unowned and len(robots) != 1:
         # One zone before or after both robots: both deliver there.
         return {**filled, zone_slots[0]: unowned[0], zone_slots[1]: unowned[0]}
+    if len(zones) == 1 and len(owned) == 1 and len(robots) >= 2:
+        # "... and then robot two delivers there too": the robot without a zone goes where
+        # the other does, when the words after it say so.
+        [(rank, zone)] = owned.items()
+        missing = 1 - rank
+        if set(words[robots[missing].end :]) & _SAME_PLACE:
+            owned[missing] = zone
     for rank in range(2):
         if rank not in owned and unowned:
             owned[rank] = unowned.pop(0)
@@ -230,3 +258,41 @@ def _zone_weather(
         return "other"
     near = [kind for at, kind in said if at in second[0]]
     return near[second[1]] if near else None
+
+
+def _the_other_robot(robots: list[SlotMatch], fleet: Mapping[str, str]) -> list[SlotMatch]:
+    """ "the other robot" after one robot of a fleet of two is the fleet's other robot."""
+    named = {robot.id for robot in robots if robot.id is not None}
+    if len(fleet) != 2 or len(named) != 1:
+        return robots
+    (other,) = fleet.keys() - named
+    return [
+        replace(robot, id=other, canonical=fleet[other])
+        if robot.id is None
+        and robot.spoken.startswith("the other")
+        and robot.start > min(r.start for r in robots if r.id is not None)
+        else robot
+        for robot in robots
+    ]
+
+
+def _turn(robot: SlotMatch, words: list[str]) -> int | None:
+    """The robot's turn when said right after it ("placebot one first", "placebot two goes
+    second")."""
+    after = words[robot.end : robot.end + 2]
+    if after[:1] and after[0] in _GOES:
+        after = after[1:]
+    return _TURNS.get(after[0]) if after else None
+
+
+def _pair_from_the_fleet(
+    named: SlotMatch, group: SlotMatch, words: list[str], fleet: Mapping[str, str]
+) -> tuple[SlotMatch, SlotMatch] | None:
+    """The two robots when the fleet of two and one robot's turn are said ("both robots,
+    placebot one first"); None when no turn is said."""
+    turn = _turn(named, words)
+    if len(fleet) != 2 or named.id not in fleet or turn is None:
+        return None
+    (other_id,) = fleet.keys() - {named.id}
+    other = replace(group, id=other_id, canonical=fleet[other_id])
+    return (named, other) if turn == 0 else (other, named)
