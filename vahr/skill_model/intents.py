@@ -236,6 +236,11 @@ WEATHER_DELIVERY = IntentSpec(
         "<ask> (have|let) {robot} (deliver|go) to [either] {sunnyZone} or {rainyZone} "
         "<weather_basis>",
         "{robot} (deliver|go) to [either] {sunnyZone} or {rainyZone} <weather_basis>",
+        # One side of the rule said ("deliver to zone c if it's raining").
+        "[<ask>] {robot} (deliver|go|take the package) to {sunnyZone} <if_sunny>",
+        "[<ask>] {robot} (deliver|go|take the package) to {rainyZone} <if_rainy>",
+        "{robot} <if_sunny> (deliver|go|take the package) to {sunnyZone}",
+        "{robot} <if_rainy> (deliver|go|take the package) to {rainyZone}",
     ),
 )
 

@@ -68,6 +68,14 @@ def test_the_invocation_is_removed_from_one_shot_requests(model: InteractionMode
         "where is robot two"
     )
     assert strip_invocation(name, "where is robot two") == "where is robot two"
+    # Alexa's other phrasings for a request with an invocation name
+    for said in (
+        "tell robot fleet that placebot two should go to zone d",
+        "open robot fleet and placebot two should go to zone d",
+        "use robot fleet to placebot two should go to zone d",
+        "placebot two should go to zone d using robot fleet",
+    ):
+        assert strip_invocation(name, said) == "placebot two should go to zone d", said
 
 
 def test_the_envelope_carries_alexa_resolutions(model: InteractionModel) -> None:
@@ -264,6 +272,12 @@ def test_sequential_delivery_roles_follow_the_sentence(
     assert ids(understood) == slots
 
 
+def test_a_weather_report_before_a_zone_is_no_weather_rule(model: InteractionModel) -> None:
+    # "it's raining, go to zone c" says where to go, and why: no rule for the robot to follow
+    understood = model.understand("it is raining robot two go to zone c")
+    assert understood.intent != "WeatherDeliveryIntent"
+
+
 @pytest.mark.parametrize(
     ("utterance", "slots"),
     [
@@ -275,6 +289,8 @@ def test_sequential_delivery_roles_follow_the_sentence(
          {"robot": "placebot1", "sunnyZone": "A", "rainyZone": "C"}),
         ("robot one if it's not sunny go to zone b otherwise zone d",
          {"robot": "placebot1", "sunnyZone": "D", "rainyZone": "B"}),
+        # One side of the rule.
+        ("robot two deliver to zone c if it's raining", {"robot": "placebot2", "rainyZone": "C"}),
         # One weather given two zones is heard, not guessed between.
         ("robot one deliver to zone a if it's sunny and zone b if it's sunny",
          {"robot": "placebot1", "sunnyZone": "A", "rainyZone": None}),

@@ -91,18 +91,21 @@ def speech_text(output: dict[str, Any] | None) -> str:
 
 
 def strip_invocation(invocation_name: str, utterance: str) -> str:
-    """What is said to the skill once the wake word and invocation are removed:
-    "Alexa, ask robot fleet to send robot one to zone b" -> "send robot one to zone b"."""
-    text = normalize(utterance)
+    """What is said to the skill once the wake word and invocation are removed, in the
+    phrasings Alexa supports for a request with an invocation name: "Alexa, ask robot fleet
+    to send robot one to zone b", "tell robot fleet that ...", "open robot fleet and ...",
+    "... using robot fleet" -> "send robot one to zone b"."""
+    text = normalize(utterance).removeprefix("alexa ")
     invocation = re.escape(normalize(invocation_name))
-    found = re.match(
-        rf"^(?:alexa\s+)?(?:ask|tell)\s+{invocation}(?:\s+(?:to|for|about|if|whether))?"
-        rf"(?:\s+(?P<rest>.*))?$",
-        text,
-    )
-    if found:
-        return found["rest"] or ""
-    return text.removeprefix("alexa ")
+    for pattern in (
+        rf"(?:ask|tell|have)\s+{invocation}(?:\s+(?:to|for|about|if|whether|that))?",
+        rf"(?:open|launch|start|use|talk\s+to)\s+{invocation}\s+(?:and|to)",
+    ):
+        found = re.match(rf"^{pattern}(?:\s+(?P<rest>.*))?$", text)
+        if found:
+            return found["rest"] or ""
+    found = re.match(rf"^(?P<rest>.+?)\s+(?:using|with|from|on|in)\s+{invocation}$", text)
+    return found["rest"] if found else text
 
 
 class AlexaSimulator:

@@ -58,6 +58,11 @@ _WEATHER_WORDS = {
     ),
 }
 _OTHER_WEATHER = frozenset({"otherwise", "else"})
+# Words that make a weather a condition ("if it's sunny", "in case of rain", "a for sunny",
+# "depending on the weather"), as a rule says it and a report ("it's raining, go to c")
+# does not.
+_CONDITIONS = frozenset({"if", "when", "case", "for", "unless", "depending", "according", "based"})
+_RULE_VERBS = frozenset({"means", "goes", "go"})
 _NOT = frozenset({"not", "isn't", "no"})
 _RULE_SLOTS = {"sunny": SUNNY_ZONE.name, "rainy": RAINY_ZONE.name}
 
@@ -296,3 +301,16 @@ def _pair_from_the_fleet(
     (other_id,) = fleet.keys() - {named.id}
     other = replace(group, id=other_id, canonical=fleet[other_id])
     return (named, other) if turn == 0 else (other, named)
+
+
+def states_a_weather_rule(words: list[str]) -> bool:
+    """Whether the words make the weather a condition: a weather word with "if", "when",
+    "for" or the like up to three words before it, or "means" or "goes" right after it;
+    or "depending on the weather" and the like."""
+    for at, word in enumerate(words):
+        if word in _WEATHER_WORDS or word == "weather":
+            if _CONDITIONS & set(words[max(0, at - 3) : at]):
+                return True
+            if words[at + 1 : at + 2] and words[at + 1] in _RULE_VERBS and word != "weather":
+                return True
+    return False
