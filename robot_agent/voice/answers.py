@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 ANSWERS_FILE = Path(__file__).with_name("weather_answers.yaml")
 INTENTS: tuple[WeatherIntent, ...] = WEATHERS
-_WORD_LISTS = ("negations", "clause_breaks", "question_openers", "robot_talk")
+_WORD_LISTS = ("negations", "clause_breaks", "question_openers", "robot_talk", "weak_cues")
 
 
 @dataclass(frozen=True)
@@ -38,6 +38,8 @@ class Cues:
     clause_breaks: frozenset[str]
     question_openers: frozenset[str]
     robot_talk: frozenset[str]
+    # Cues that decide only when the other weather has none.
+    weak: frozenset[str] = frozenset()
 
     def words(self) -> set[str]:
         phrases = [*self.said.values(), *self.denied.values()]
@@ -170,6 +172,7 @@ def _cues(document: dict[str, Any], source: str) -> Cues:
         clause_breaks=lists["clause_breaks"],
         question_openers=lists["question_openers"],
         robot_talk=lists["robot_talk"],
+        weak=lists["weak_cues"],
     )
 
 

@@ -10,7 +10,8 @@ answer is one-sided:
 
 - cues of one intent and none of the other: that intent;
 - cues of both ("sunny now, rain later"), none, or only denied ones ("no rain today"):
-  unknown, with the reason;
+  unknown, with the reason; but a side whose cues are all weak ("bright", often "right"
+  misheard) gives way to the other's strong ones;
 - a question ("will it rain today") or robot talk ("it is sunny, so I am delivering to
   zone A": an answer never mentions the robots' work): unknown, whatever the cues.
 
@@ -94,6 +95,8 @@ class LocalInterpreter:
             elif cue.denied_by is not None:
                 denied.append(cue)
         if len(affirmed) > 1:
+            affirmed = self._without_weak_cues(affirmed, words)
+        if len(affirmed) > 1:
             phrases = tuple(c.phrase(words) for group in affirmed.values() for c in group)
             return Interpretation("unknown", 0.0, phrases, "both sunny and rainy")
         if not affirmed:
@@ -108,6 +111,18 @@ class LocalInterpreter:
         end = next((i for i in range(last, len(words)) if words[i] in cues.question_openers), None)
         sentence = " ".join(words[:end])
         return Interpretation(intent, 1.0, evidence, decisive=tuple(decisive), sentence=sentence)
+
+    def _without_weak_cues(
+        self, affirmed: dict[WeatherIntent, list[_Cue]], words: list[str]
+    ) -> dict[WeatherIntent, list[_Cue]]:
+        """Both weathers said: the side whose cues are all weak ("bright", "warm") drops out
+        when the other has a cue that is not; if both are weak or both strong, neither."""
+        strong = {
+            intent: [c for c in cues if " ".join(words[c.start : c.end]) not in self.cues.weak]
+            for intent, cues in affirmed.items()
+        }
+        standing = {intent: cues for intent, cues in strong.items() if cues}
+        return {intent: affirmed[intent] for intent in standing} if len(standing) == 1 else affirmed
 
     def _find(self, words: list[str]) -> list[_Cue]:
         """Every cue in `words`, longest first where two overlap."""

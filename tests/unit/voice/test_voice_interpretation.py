@@ -86,6 +86,10 @@ def test_the_evaluation_and_tuning_sets_share_no_sentence_and_no_voice() -> None
         ("no sun today only rain", "rainy", ("rain",)),
         # The skill may add a sentence after its answer.
         ("the weather is rainy is there anything else", "rainy", ("rainy",)),
+        # A weak cue gives way to the other weather's strong one ("right now" misheard).
+        ("it is raining bright now", "rainy", ("raining",)),
+        ("warm with heavy rain", "rainy", ("rain",)),
+        ("bright and warm", "sunny", ("bright", "warm")),
     ],
 )
 def test_cues_decide_and_are_reported(
@@ -105,6 +109,8 @@ def test_cues_decide_and_are_reported(
         ("it won't rain", "the weather only denied"),
         ("it is cloudy", "no weather word"),
         ("it is sunny now but it will rain later", "both sunny and rainy"),
+        # Two weak cues, or two strong ones, still say both.
+        ("bright but raining and sunny", "both sunny and rainy"),
         ("thank you it is sunny so i am delivering to zone a", "robot talk (delivering, zone)"),
     ],
 )
