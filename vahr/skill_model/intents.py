@@ -236,6 +236,10 @@ WEATHER_DELIVERY = IntentSpec(
         "<ask> (have|let) {robot} (deliver|go) to [either] {sunnyZone} or {rainyZone} "
         "<weather_basis>",
         "{robot} (deliver|go) to [either] {sunnyZone} or {rainyZone} <weather_basis>",
+        "{robot} [(check|look up) the weather and deliver] (sunny|if sunny|sunshine) "
+        "{sunnyZone} (rainy|if rainy|rain) {rainyZone}",
+        "{robot} (deliver|go) to {sunnyZone} (on|in|for) (sunny|a sunny day|sunny weather) and "
+        "[to] {rainyZone} (on|in|for) (rainy|a rainy day|rainy weather)",
         # One side of the rule said ("deliver to zone c if it's raining").
         "[<ask>] {robot} (deliver|go|take the package) to {sunnyZone} <if_sunny>",
         "[<ask>] {robot} (deliver|go|take the package) to {rainyZone} <if_rainy>",

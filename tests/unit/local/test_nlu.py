@@ -251,6 +251,12 @@ def test_two_zones_without_a_destination_are_asked_about(model: InteractionModel
         ("placebot one delivers to zone d and then the other robot delivers to zone c",
          {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
           "secondZone": "C"}),
+        # An ordinal after a robot's name is its turn, not the start of the next name.
+        ("start the sequential delivery placebot one first placebot two second",
+         {"firstRobot": "placebot1", "secondRobot": "placebot2"}),
+        ("first placebot one second placebot two deliver to zone d",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "D"}),
         # A robot said to go second, named first, goes second.
         ("placebot two second and placebot one first deliver to zone d",
          {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",

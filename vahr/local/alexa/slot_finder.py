@@ -15,6 +15,8 @@ would name another robot or zone. Some spans need more than a name:
 - two names that overlap and name different values ("delivers first placebot two": "first
   placebot" is robot one, "placebot two" robot two) are one value that does not resolve:
   the words cannot say which was meant, so the skill asks rather than take the first;
+  but an ordinal right after a robot's name is that robot's turn ("placebot one first,
+  placebot two second"), not the start of the next name;
 - a bare number or letter joined to a name by "and" or "or" names the value the name would
   with that word last ("robot one and two", "zone a or b"), so the second value is not
   lost: "stop robot one and two" stops both, not robot one alone;
@@ -52,6 +54,8 @@ _ARTICLES = frozenset({"the", "a", "an"})
 # Words that join a second value to a name with its shared words left out ("robot one and
 # two"); `slot_roles` reads "and" as a list and "or" as a choice to ask about.
 _JOINERS = frozenset({"and", "or", "plus"})
+# Ordinals that say a robot's turn when they follow its name ("placebot one first").
+_TURN_WORDS = frozenset({"first", "second"})
 # "the other robot": a robot named by the one named before it.
 OTHER_ROBOT = ("the", "other")
 _OTHER_HEADS = frozenset({"robot", "one", "placebot", "bot"})
@@ -171,6 +175,13 @@ class SlotFinder:
             if match is None:
                 index += 1
                 continue
+            if found and found[-1].end == match.start and words[match.start] in _TURN_WORDS:
+                # "placebot one first placebot two": the ordinal is the first robot's turn,
+                # not the start of "first placebot" (which names another robot than the
+                # name it runs into; "second placebot two" is one name).
+                after = self._name_at(corrected, words, similarity, match.start + 1)
+                if after is not None and after.end > match.end and after.id != match.id:
+                    match = after
             found.append(self._unless_overlapped(match, corrected, words, similarity))
             found += self._elided_after(found[-1], corrected, words, similarity)
             index = found[-1].end

@@ -62,7 +62,7 @@ _OTHER_WEATHER = frozenset({"otherwise", "else"})
 # "depending on the weather"), as a rule says it and a report ("it's raining, go to c")
 # does not.
 _CONDITIONS = frozenset({"if", "when", "case", "for", "unless", "depending", "according", "based"})
-_RULE_VERBS = frozenset({"means", "goes", "go"})
+_RULE_VERBS = frozenset({"means", "goes", "go", "zone", "is"})
 _NOT = frozenset({"not", "isn't", "no"})
 _RULE_SLOTS = {"sunny": SUNNY_ZONE.name, "rainy": RAINY_ZONE.name}
 
@@ -165,7 +165,7 @@ def _sequence(
     # is about the one named first. A robot said to go "second" before the other goes
     # second too, but says nothing of whose a zone is.
     swapped = len(robots) >= 2 and robots[1].start > 0 and words[robots[1].start - 1] in _AFTER
-    if swapped or (len(robots) >= 2 and _turn(robots[0], words) == 1):
+    if swapped or (len(robots) >= 2 and _turn(robots[0], words, robots[1].start) == 1):
         robots = [robots[1], robots[0], *robots[2:]]
     filled: dict[str, SlotMatch] = dict(zip(robot_slots, robots, strict=False))
     if len(robots) >= 2 and robots[0].id is not None and robots[0].id == robots[1].id:
@@ -281,10 +281,10 @@ def _the_other_robot(robots: list[SlotMatch], fleet: Mapping[str, str]) -> list[
     ]
 
 
-def _turn(robot: SlotMatch, words: list[str]) -> int | None:
-    """The robot's turn when said right after it ("placebot one first", "placebot two goes
-    second")."""
-    after = words[robot.end : robot.end + 2]
+def _turn(robot: SlotMatch, words: list[str], until: int | None = None) -> int | None:
+    """The robot's turn when said right after it, before `until` ("placebot one first",
+    "placebot two goes second")."""
+    after = words[robot.end : min(robot.end + 2, len(words) if until is None else until)]
     if after[:1] and after[0] in _GOES:
         after = after[1:]
     return _TURNS.get(after[0]) if after else None
@@ -305,8 +305,8 @@ def _pair_from_the_fleet(
 
 def states_a_weather_rule(words: list[str]) -> bool:
     """Whether the words make the weather a condition: a weather word with "if", "when",
-    "for" or the like up to three words before it, or "means" or "goes" right after it;
-    or "depending on the weather" and the like."""
+    "for" or the like up to three words before it, or "means", "goes" or a zone right
+    after it ("sunny zone a"); or "depending on the weather" and the like."""
     for at, word in enumerate(words):
         if word in _WEATHER_WORDS or word == "weather":
             if _CONDITIONS & set(words[max(0, at - 3) : at]):
