@@ -146,6 +146,7 @@ DELIVER = IntentSpec(
         "have {robot} deliver",
         "let {robot} deliver",
         "tell {robot} to deliver a package to {zone}",
+        "deliver to {zone}",
     ),
     templates=(
         "<ask> (have|let|make) {robot} <carry> <cargo> <way> to {zone} <end>",

@@ -74,6 +74,8 @@ def test_the_invocation_is_removed_from_one_shot_requests(model: InteractionMode
         "open robot fleet and placebot two should go to zone d",
         "use robot fleet to placebot two should go to zone d",
         "placebot two should go to zone d using robot fleet",
+        # and the skill addressed by its name alone, inside a session
+        "alexa, robot fleet, placebot two should go to zone d",
     ):
         assert strip_invocation(name, said) == "placebot two should go to zone d", said
 
@@ -255,6 +257,9 @@ def test_two_zones_without_a_destination_are_asked_about(model: InteractionModel
         ("start the sequential delivery placebot one first placebot two second",
          {"firstRobot": "placebot1", "secondRobot": "placebot2"}),
         ("first placebot one second placebot two deliver to zone d",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "D"}),
+        ("placebot two goes second placebot one goes first both deliver to zone d",
          {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
           "secondZone": "D"}),
         # A robot said to go second, named first, goes second.

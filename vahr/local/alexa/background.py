@@ -141,6 +141,16 @@ OUT_OF_DOMAIN_TEMPLATES: tuple[str, ...] = (
     "(why is|what makes) the sky (blue|grey|gray)",
     "(who|which company|what company) (delivers|ships|makes) the most (packages|parcels)",
     "(how|why) (do|does) (package delivery|the post office|shipping|couriers) work",
+    # Questions about what the robots are, which name them but ask nothing of them.
+    "(what|which) (programming language|software|operating system|sensors|motors|batteries)"
+    " (do|does) (the robots|these robots|the placebots|placebot one) (use|run on|have)",
+    "(are|is) (the robots|these robots|the placebots|placebot two) (running on|built with|made"
+    " of|powered by) (ros|linux|batteries|python|plastic)",
+    "(what|who) (is|are) (a placebot|the placebots|placebot one) [anyway|exactly|really]",
+    "(how|why) (do|does|did) (meteorologists|forecasters|weather stations|satellites) "
+    "(predict|forecast|measure|track) the weather",
+    "(what's|what is) the difference between (weather and climate|rain and drizzle|a shower and"
+    " a storm)",
 )
 
 

@@ -96,6 +96,9 @@ def strip_invocation(invocation_name: str, utterance: str) -> str:
     to send robot one to zone b", "tell robot fleet that ...", "open robot fleet and ...",
     "... using robot fleet" -> "send robot one to zone b"."""
     text = normalize(utterance).removeprefix("alexa ")
+    # The skill addressed by its name alone, as people do inside a session ("robot fleet,
+    # placebot one go to zone b"): the name is no part of the request.
+    text = text.removeprefix(normalize(invocation_name) + " ")
     invocation = re.escape(normalize(invocation_name))
     for pattern in (
         rf"(?:ask|tell|have)\s+{invocation}(?:\s+(?:to|for|about|if|whether|that))?",

@@ -54,8 +54,11 @@ _ARTICLES = frozenset({"the", "a", "an"})
 # Words that join a second value to a name with its shared words left out ("robot one and
 # two"); `slot_roles` reads "and" as a list and "or" as a choice to ask about.
 _JOINERS = frozenset({"and", "or", "plus"})
-# Ordinals that say a robot's turn when they follow its name ("placebot one first").
+# Ordinals that say a robot's turn when they follow its name ("placebot one first",
+# "placebot two goes second").
 _TURN_WORDS = frozenset({"first", "second"})
+# The verbs that may stand between a robot and its turn; `slot_roles` reads turns by them too.
+GOING_VERBS = frozenset({"goes", "go", "comes", "delivers", "is", "will", "should"})
 # "the other robot": a robot named by the one named before it.
 OTHER_ROBOT = ("the", "other")
 _OTHER_HEADS = frozenset({"robot", "one", "placebot", "bot"})
@@ -175,7 +178,11 @@ class SlotFinder:
             if match is None:
                 index += 1
                 continue
-            if found and found[-1].end == match.start and words[match.start] in _TURN_WORDS:
+            if (
+                found
+                and _right_after(found[-1], match.start, words)
+                and (words[match.start] in _TURN_WORDS)
+            ):
                 # "placebot one first placebot two": the ordinal is the first robot's turn,
                 # not the start of "first placebot" (which names another robot than the
                 # name it runs into; "second placebot two" is one name).
@@ -294,3 +301,9 @@ def _other_robot_at(words: list[str], start: int) -> SlotMatch | None:
         return None
     spoken = " ".join(words[start:end])
     return SlotMatch(ROBOT_TYPE, start, end, spoken, id=None, canonical=None, similarity=100.0)
+
+
+def _right_after(previous: SlotMatch, start: int, words: list[str]) -> bool:
+    """Whether `start` follows `previous` at once, or after a verb of going ("goes")."""
+    between = words[previous.end : start]
+    return not between or (len(between) == 1 and between[0] in GOING_VERBS)

@@ -25,6 +25,7 @@ from dataclasses import replace
 from itertools import pairwise
 from typing import TYPE_CHECKING
 
+from vahr.local.alexa.slot_finder import GOING_VERBS
 from vahr.protocol import FLEET_GROUP
 from vahr.skill_model.intents import RAINY_ZONE, ROBOT_TYPE, SUNNY_ZONE
 
@@ -44,7 +45,6 @@ _TURNED_DOWN = frozenset({"from", "of", "not"})
 _LISTED = frozenset({"and", "plus", "also", "as", "well"})
 # Words after a robot that give its turn in a sequence ("placebot one first").
 _TURNS = {"first": 0, "second": 1, "last": 1}
-_GOES = frozenset({"goes", "go", "comes", "delivers", "is", "will", "should"})
 # Words that send the second robot where the first went ("delivers there too").
 _SAME_PLACE = frozenset({"there", "too", "also", "same", "well"})
 # The words that say which weather a zone of the weather delivery's rule is for.
@@ -285,7 +285,7 @@ def _turn(robot: SlotMatch, words: list[str], until: int | None = None) -> int |
     """The robot's turn when said right after it, before `until` ("placebot one first",
     "placebot two goes second")."""
     after = words[robot.end : min(robot.end + 2, len(words) if until is None else until)]
-    if after[:1] and after[0] in _GOES:
+    if after[:1] and after[0] in GOING_VERBS:
         after = after[1:]
     return _TURNS.get(after[0]) if after else None
 
