@@ -1,6 +1,6 @@
 """Acceptance of the robot's hearing (issue 13) on the whole spoken evaluation set,
-`robot_agent/voice/data/hearing-eval.yaml`: 65 answers and 70 unrelated sentences in three
-espeak-ng voices, clean, at 20 dB and at 10 dB SNR (1,215 clips, rendered with the set's
+`robot_agent/voice/data/hearing-eval.yaml`: 66 answers and 70 unrelated sentences in three
+espeak-ng voices, clean, at 20 dB and at 10 dB SNR (1,224 clips, rendered with the set's
 seed, so the same on every run; about two minutes here). `bench/hearing.py` scores the same set
 and times it.
 
@@ -21,7 +21,7 @@ from vahr.speech.tts import EspeakSynthesizer
 if TYPE_CHECKING:
     from robot_agent.voice.understanding import Understanding
 
-# Rendering and hearing 1,215 clips takes two to three minutes on two cores.
+# Rendering and hearing 1,224 clips takes two to three minutes on two cores.
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(420)]
 
 
@@ -42,17 +42,15 @@ def _answers_right(report: Report) -> dict[str, float]:
 
 
 def test_heard_answers_stay_at_the_measured_figures(report: Report) -> None:
-    # Then answers are right as measured (184, 189 and 178 of 195: 94.4% clean, 96.9% at
-    # 20 dB, 91.3% at 10 dB; the 20 dB and 10 dB targets of 95% and 85% are met), and never
-    # taken for the other weather
+    # Then answers are right as measured (181, 187 and 177 of 198: 91.4% clean, 94.4% at
+    # 20 dB, 89.4% at 10 dB; the 10 dB target of 85% is met), and never taken for the other
+    # weather
     right = {c: report.answers(c).counts["right"] for c in CONDITIONS}
-    assert right["clean"] >= 184 and right["snr20"] >= 189 and right["snr10"] >= 178, right
+    assert right["clean"] >= 181 and right["snr20"] >= 187 and right["snr10"] >= 177, right
     assert all(report.answers(c).counts["wrong"] == 0 for c in CONDITIONS)
 
 
-@pytest.mark.xfail(
-    strict=True, reason="issue 13: at least 95% clean; measured 94.4%"
-)
+@pytest.mark.xfail(strict=True, reason="issue 13: at least 95% clean and at 20 dB; measured 91.4% and 94.4%")
 def test_heard_answers_meet_the_targets(report: Report) -> None:
     # Then answers are right >= 95% clean and at 20 dB, >= 85% at 10 dB
     rates = _answers_right(report)
@@ -60,11 +58,11 @@ def test_heard_answers_meet_the_targets(report: Report) -> None:
 
 
 def test_unrelated_speech_stays_at_the_measured_figure(report: Report) -> None:
-    # Then unrelated speech is taken for an answer no more often than measured (40 of 630)
-    assert report.unrelated().counts["wrong"] <= 40, report.unrelated().to_json()
+    # Then unrelated speech is taken for an answer no more often than measured (23 of 630)
+    assert report.unrelated().counts["wrong"] <= 23, report.unrelated().to_json()
 
 
-@pytest.mark.xfail(strict=True, reason="issue 13: at most 2% unrelated accepted; measured 6.3%")
+@pytest.mark.xfail(strict=True, reason="issue 13: at most 2% unrelated accepted; measured 3.7%")
 def test_unrelated_speech_is_rarely_taken_for_an_answer(report: Report) -> None:
     # Then unrelated speech is taken for an answer at most 2% of the time
     assert report.unrelated().rate("wrong") <= 0.02
