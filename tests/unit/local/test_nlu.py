@@ -16,6 +16,15 @@ if TYPE_CHECKING:
     from pathlib import Path
 
 
+# Task III as the paper has it: placebot one delivers to zone D, then placebot two.
+TASK_III = {
+    "firstRobot": "placebot1",
+    "firstZone": "D",
+    "secondRobot": "placebot2",
+    "secondZone": "D",
+}
+
+
 @pytest.fixture(scope="module")
 def model() -> InteractionModel:
     return InteractionModel.load()
@@ -238,17 +247,14 @@ def test_two_zones_without_a_destination_are_asked_about(model: InteractionModel
          {"firstRobot": "placebot1", "firstZone": "A", "secondRobot": "placebot2",
           "secondZone": "D"}),
         ("robot one and then robot two deliver to zone d",
-         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
-          "secondZone": "D"}),
+         TASK_III),
         ("robot one delivers to zone c then robot two",
          {"firstRobot": "placebot1", "firstZone": "C", "secondRobot": "placebot2"}),
         # The fleet of two and one robot's turn give both robots, and the zone is both's.
         ("both robots to zone d robot one first",
-         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
-          "secondZone": "D"}),
+         TASK_III),
         ("both robots deliver to zone d placebot two goes second",
-         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
-          "secondZone": "D"}),
+         TASK_III),
         # "the other robot" after one robot of two is the other one.
         ("placebot one delivers to zone d and then the other robot delivers to zone c",
          {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
@@ -257,19 +263,15 @@ def test_two_zones_without_a_destination_are_asked_about(model: InteractionModel
         ("start the sequential delivery placebot one first placebot two second",
          {"firstRobot": "placebot1", "secondRobot": "placebot2"}),
         ("first placebot one second placebot two deliver to zone d",
-         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
-          "secondZone": "D"}),
+         TASK_III),
         ("placebot two goes second placebot one goes first both deliver to zone d",
-         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
-          "secondZone": "D"}),
+         TASK_III),
         # A robot said to go second, named first, goes second.
         ("placebot two second and placebot one first deliver to zone d",
-         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
-          "secondZone": "D"}),
+         TASK_III),
         # "there" after the robot without a zone sends it where the other goes.
         ("placebot two deliver to zone d after placebot one delivers there",
-         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
-          "secondZone": "D"}),
+         TASK_III),
         # A robot cannot follow itself.
         ("robot one delivers to zone a then robot one delivers to zone b",
          {"firstRobot": "placebot1", "firstZone": "A", "secondRobot": None, "secondZone": "B"}),
