@@ -34,7 +34,8 @@ from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
 from vahr.local.alexa.consistency import SlotConsistency
 from vahr.local.alexa.intent_classifier import load_or_train
 from vahr.local.alexa.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize
-from vahr.local.alexa.slot_roles import assign_slots, states_a_weather_rule
+from vahr.local.alexa.slot_roles import assign_slots
+from vahr.local.alexa.weather_rule import states_a_weather_rule
 from vahr.protocol import FLEET_GROUP
 from vahr.skill_model.intents import RAINY_ZONE, ROBOT_TYPE, SUNNY_ZONE
 from vahr.speech.text_classifier import TextClassifier, default_cache_dir

@@ -13,10 +13,11 @@ later-named robot first ("robot two goes after robot one"); a zone belongs to th
 named before it, and a single zone said before both robots or after both applies to both
 ("robot one and then robot two deliver to zone d"). The fleet is not one of its two robots,
 and one robot cannot follow itself: such a robot slot is left for the skill to ask about.
-The weather delivery's rule, said aloud, pairs each zone with the weather said beside it:
-after the zone when the zone comes first ("to zone a if it's sunny"), before it when the
-weather does ("if it's raining go to zone c"); "otherwise zone c" is the other weather; with
-no weather beside any zone, the first is the sunny one.
+In a fleet of two, "the other robot" after one robot is the other one, and the fleet with
+one robot's turn ("both robots to zone d, placebot one first") is both robots in that
+order; a robot said to go "second" right after its name goes second; and "there" or "too"
+after the robot without a zone sends it where the other goes. The weather delivery's rule
+said aloud is `weather_rule`'s.
 """
 
 from __future__ import annotations
@@ -26,8 +27,9 @@ from itertools import pairwise
 from typing import TYPE_CHECKING
 
 from vahr.local.alexa.slot_finder import GOING_VERBS
+from vahr.local.alexa.weather_rule import RULE_SLOTS, rule_zones
 from vahr.protocol import FLEET_GROUP
-from vahr.skill_model.intents import RAINY_ZONE, ROBOT_TYPE, SUNNY_ZONE
+from vahr.skill_model.intents import ROBOT_TYPE, SUNNY_ZONE
 
 if TYPE_CHECKING:
     from collections.abc import Mapping, Set
@@ -47,24 +49,6 @@ _LISTED = frozenset({"and", "plus", "also", "as", "well"})
 _TURNS = {"first": 0, "second": 1, "last": 1}
 # Words that send the second robot where the first went ("delivers there too").
 _SAME_PLACE = frozenset({"there", "too", "also", "same", "well"})
-# The words that say which weather a zone of the weather delivery's rule is for.
-_WEATHER_WORDS = {
-    **dict.fromkeys(
-        ("sunny", "sunshine", "sun", "nice", "clear", "dry", "fine", "bright"), "sunny"
-    ),
-    **dict.fromkeys(
-        ("rainy", "rain", "raining", "rains", "wet", "pouring", "showers", "drizzle", "stormy"),
-        "rainy",
-    ),
-}
-_OTHER_WEATHER = frozenset({"otherwise", "else"})
-# Words that make a weather a condition ("if it's sunny", "in case of rain", "a for sunny",
-# "depending on the weather"), as a rule says it and a report ("it's raining, go to c")
-# does not.
-_CONDITIONS = frozenset({"if", "when", "case", "for", "unless", "depending", "according", "based"})
-_RULE_VERBS = frozenset({"means", "goes", "go", "zone", "is"})
-_NOT = frozenset({"not", "isn't", "no"})
-_RULE_SLOTS = {"sunny": SUNNY_ZONE.name, "rainy": RAINY_ZONE.name}
 
 
 def assign_slots(
@@ -85,10 +69,10 @@ def assign_slots(
         return _sequence(by_type, matches, words, robots)
     fleet_robots = robots.keys()
     filled: dict[str, SlotMatch] = {}
-    rule = set(_RULE_SLOTS.values())
+    rule = set(RULE_SLOTS.values())
     if rule <= declared.keys():
         zone_type = declared[SUNNY_ZONE.name]
-        filled.update(_weather_rule([m for m in matches if m.type == zone_type], words))
+        filled.update(rule_zones([m for m in matches if m.type == zone_type], words))
         by_type = {t: [n for n in names if n not in rule] for t, names in by_type.items()}
     for slot_type, names in by_type.items():
         values = [match for match in matches if match.type == slot_type]
@@ -204,67 +188,6 @@ def _sequence(
     return filled
 
 
-def _weather_rule(zones: list[SlotMatch], words: list[str]) -> dict[str, SlotMatch]:
-    """The rule's zones by the weather said beside each; a weather given two zones, or a
-    zone with no weather, is heard but left unresolved for the skill to turn down."""
-    said = [(at, _weather(words, at)) for at, word in enumerate(words) if word in _WEATHER_WORDS]
-    if not zones:
-        return {}
-    weather_first = bool(said) and said[0][0] < zones[0].start
-    kinds: list[str | None] = [
-        _zone_weather(zones, rank, said, words, weather_first) for rank in range(len(zones))
-    ]
-    named = {kind for kind in kinds if kind in _RULE_SLOTS}
-    if not any(kinds):
-        # No weather said beside any zone ("to zone a or zone c depending on the weather"):
-        # the zones fill the rule in the order Alexa's samples give them, sunny first.
-        kinds = [kind for kind, _ in zip(_RULE_SLOTS, zones, strict=False)]
-    elif len(named) == 1:
-        (rest,) = _RULE_SLOTS.keys() - named
-        kinds = [rest if kind == "other" else kind for kind in kinds]
-    filled: dict[str, SlotMatch] = {}
-    for zone, kind in zip(zones, kinds, strict=True):
-        slot = _RULE_SLOTS.get(kind or "")
-        if slot is None or slot in filled:
-            slot = next((s for s in _RULE_SLOTS.values() if s not in filled), None)
-            if slot is None:
-                continue
-            zone = replace(zone, id=None, canonical=None)
-        filled[slot] = zone
-    return filled
-
-
-def _weather(words: list[str], at: int) -> str:
-    """The weather `words[at]` says, turned round by a "not" before it ("if it's not sunny")."""
-    kind = _WEATHER_WORDS[words[at]]
-    if _NOT & set(words[max(0, at - 2) : at]):
-        return next(k for k in _RULE_SLOTS if k != kind)
-    return kind
-
-
-def _zone_weather(
-    zones: list[SlotMatch],
-    rank: int,
-    said: list[tuple[int, str]],
-    words: list[str],
-    weather_first: bool,
-) -> str | None:
-    """The weather zone `rank` is for: said on the sentence's side of it, "other" after
-    "otherwise", else said on its other side ("zone a if it's sunny" after "if it's
-    raining, zone c"); None when nothing says."""
-    zone = zones[rank]
-    before = range(zones[rank - 1].end if rank else 0, zone.start)
-    after = range(zone.end, zones[rank + 1].start if rank + 1 < len(zones) else len(words))
-    first, second = ((before, -1), (after, 0)) if weather_first else ((after, 0), (before, -1))
-    near = [kind for at, kind in said if at in first[0]]
-    if near:
-        return near[first[1]]
-    if rank and any(words[at] in _OTHER_WEATHER for at in [*before, *after]):
-        return "other"
-    near = [kind for at, kind in said if at in second[0]]
-    return near[second[1]] if near else None
-
-
 def _the_other_robot(robots: list[SlotMatch], fleet: Mapping[str, str]) -> list[SlotMatch]:
     """ "the other robot" after one robot of a fleet of two is the fleet's other robot."""
     named = {robot.id for robot in robots if robot.id is not None}
@@ -301,16 +224,3 @@ def _pair_from_the_fleet(
     (other_id,) = fleet.keys() - {named.id}
     other = replace(group, id=other_id, canonical=fleet[other_id])
     return (named, other) if turn == 0 else (other, named)
-
-
-def states_a_weather_rule(words: list[str]) -> bool:
-    """Whether the words make the weather a condition: a weather word with "if", "when",
-    "for" or the like up to three words before it, or "means", "goes" or a zone right
-    after it ("sunny zone a"); or "depending on the weather" and the like."""
-    for at, word in enumerate(words):
-        if word in _WEATHER_WORDS or word == "weather":
-            if _CONDITIONS & set(words[max(0, at - 3) : at]):
-                return True
-            if words[at + 1 : at + 2] and words[at + 1] in _RULE_VERBS and word != "weather":
-                return True
-    return False
