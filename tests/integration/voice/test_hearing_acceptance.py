@@ -50,7 +50,9 @@ def test_heard_answers_stay_at_the_measured_figures(report: Report) -> None:
     assert all(report.answers(c).counts["wrong"] == 0 for c in CONDITIONS)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 13: at least 95% clean and at 20 dB; measured 91.4% and 94.4%")
+@pytest.mark.xfail(
+    strict=True, reason="issue 13: at least 95% clean and at 20 dB; measured 91.4% and 94.4%"
+)
 def test_heard_answers_meet_the_targets(report: Report) -> None:
     # Then answers are right >= 95% clean and at 20 dB, >= 85% at 10 dB
     rates = _answers_right(report)
