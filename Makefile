@@ -19,7 +19,7 @@ ROS_SITE := $(VENV)/ros-site
 export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
 export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 
-.PHONY: hearing-adaptation demo test test-repeat soak-test lint typecheck pytest setup system-packages bench synth deploy skill-model clean
+.PHONY: hearing-adaptation sense-heard demo test test-repeat soak-test lint typecheck pytest setup system-packages bench synth deploy skill-model clean
 
 demo: setup
 	$(BIN)/vahr demo
@@ -104,3 +104,8 @@ clean:
 # about 17 minutes on 2 cores, and some 2.5 GB of temporary disk for the clips).
 hearing-adaptation: setup
 	$(BIN)/python -m robot_agent.voice.adaptation
+
+# Remake robot_agent/voice/data/answer-sense-heard.yaml, the sense check's training sentences as
+# the robot hears them (docs/voice.md, "The ninth round"; about ten minutes on 2 cores).
+sense-heard: setup
+	$(BIN)/python -m robot_agent.voice.sense_heard

@@ -7,7 +7,9 @@ second opinion reads the whole sentence: a text classifier
 logistic regression) trained on weather answers (the intents' phrasings of
 `weather_answers.yaml` and the answers of `data/answer-sense.yaml`) against other speech
 (its `not_answers` and the other sentences of `data/answer-sense.yaml`: weather words in
-other senses, questions about the weather, other weather). It may only veto: a sentence the
+other senses, questions about the weather, other weather), each also as the robot's
+recognizer heard it spoken, clean and in noise (`data/answer-sense-heard.yaml`, written by
+`sense_heard`), since what it reads at run time is heard, not written. It may only veto: a sentence the
 cues make sunny or rainy is unknown when the classifier finds it more likely other speech
 than an answer, both as a whole and as the sentence the cues were said in (the words up
 to a question that follows them). Which answer it is stays the cues' to say, so the reason
@@ -35,6 +37,8 @@ if TYPE_CHECKING:
     from vahr.speech.text_classifier import TextClassifier
 
 SENSE_FILE = Path(__file__).with_name("data") / "answer-sense.yaml"
+# The same sentences as the robot's recognizer heard them (`make sense-heard`); optional.
+HEARD_FILE = SENSE_FILE.with_name("answer-sense-heard.yaml")
 ANSWER, OTHER = "answer", "other"
 # What the cached model depends on besides its data; change it with `features`.
 RECIPE = "sense 1: words, bigrams, chars 3-5"
@@ -68,11 +72,12 @@ class SenseCheck:
         answers: WeatherAnswers,
         sense_file: Path = SENSE_FILE,
         *,
+        heard_file: Path | None = HEARD_FILE,
         cache_dir: Path | None = None,
     ) -> SenseCheck:
         """Trained on `answers` and `sense_file`, or loaded from the cache (`cache_dir`, by
         default the user's)."""
-        said, other = training_sentences(answers, sense_file)
+        said, other = training_sentences(answers, sense_file, heard_file=heard_file)
         texts = [*said, *other]
         labels = [ANSWER] * len(said) + [OTHER] * len(other)
         classifier, _ = load_or_train(
@@ -94,14 +99,22 @@ class SenseCheck:
         return Sense(round(best, 3))
 
 
-def training_sentences(answers: WeatherAnswers, sense_file: Path) -> tuple[list[str], list[str]]:
-    """(answers, other speech), normalized, without duplicates."""
-    document = read_yaml(sense_file, "the sense check's sentences")
-    if not isinstance(document, dict) or not all(
-        isinstance(document.get(key), list) for key in ("answers", "other")
-    ):
-        raise SpeechError(f"{sense_file}: expected lists 'answers' and 'other'")
+def training_sentences(
+    answers: WeatherAnswers, sense_file: Path, *, heard_file: Path | None = HEARD_FILE
+) -> tuple[list[str], list[str]]:
+    """(answers, other speech), normalized, without duplicates: the written sentences and,
+    when `heard_file` exists, the same as the recognizer heard them."""
     said = [p for phrases in answers.phrases.values() for p in phrases]
-    said += [normalize(str(s)) for s in document["answers"]]
-    other = [*answers.not_answers, *(normalize(str(s)) for s in document["other"])]
+    other = list(answers.not_answers)
+    files = (
+        [sense_file] if heard_file is None or not heard_file.exists() else [sense_file, heard_file]
+    )
+    for path in files:
+        document = read_yaml(path, "the sense check's sentences")
+        if not isinstance(document, dict) or not all(
+            isinstance(document.get(key), list) for key in ("answers", "other")
+        ):
+            raise SpeechError(f"{path}: expected lists 'answers' and 'other'")
+        said += [normalize(str(s)) for s in document["answers"]]
+        other += [normalize(str(s)) for s in document["other"]]
     return list(dict.fromkeys(said)), list(dict.fromkeys(other))
