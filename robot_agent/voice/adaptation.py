@@ -263,7 +263,7 @@ def adaptation_sentences(held_out: Iterable[str] = ()) -> list[str]:
 def main(argv: Sequence[str] | None = None) -> int:
     """Remake the bundled adaptation (the weather answers and plain English, spoken by
     espeak-ng voices that no hearing set uses)."""
-    from robot_agent.voice.evaluation import EVALUATION_SET, TUNING_SET, Phrasings
+    from robot_agent.voice.evaluation import held_out_sentences
 
     parser = argparse.ArgumentParser(description=main.__doc__)
     parser.add_argument("--out", type=Path, default=BUNDLED, help=f"default: {BUNDLED}")
@@ -271,7 +271,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--method", choices=("map", "mllr"), default="map", help="map (a folder) or mllr (a file)"
     )
     args = parser.parse_args(argv)
-    held_out = Phrasings.load(EVALUATION_SET).normalized() | Phrasings.load(TUNING_SET).normalized()
+    held_out = held_out_sentences()
     try:
         sentences = adaptation_sentences(held_out)
         used = adapt(synthesized_clips(sentences), args.out, method=args.method)

@@ -139,6 +139,12 @@ def _noise(phrasings: Phrasings, voice: str, name: str, condition: str) -> np.ra
     return np.random.default_rng([phrasings.seed, clip])
 
 
+def held_out_sentences() -> set[str]:
+    """Every sentence of the evaluation and tuning sets, normalized: what nothing the hearing
+    is built from may hold."""
+    return Phrasings.load(EVALUATION_SET).normalized() | Phrasings.load(TUNING_SET).normalized()
+
+
 def load_manifest(directory: Path) -> Manifest:
     path = directory / MANIFEST
     try:

@@ -9,11 +9,11 @@ logistic regression) trained on weather answers (the intents' phrasings of
 (its `not_answers` and the other sentences of `data/answer-sense.yaml`: weather words in
 other senses, questions about the weather, other weather), each also as the robot's
 recognizer heard it spoken, clean and in noise (`data/answer-sense-heard.yaml`, written by
-`sense_heard`), since what it reads at run time is heard, not written. It may only veto: a sentence the
-cues make sunny or rainy is unknown when the classifier finds it more likely other speech
-than an answer, both as a whole and as the sentence the cues were said in (the words up
-to a question that follows them). Which answer it is stays the cues' to say, so the reason
-is always a cue.
+`sense_heard`), since what it reads at run time is heard, not written. It may only veto:
+a sentence the cues make sunny or rainy is unknown when the classifier finds it more likely
+other speech than an answer, both as a whole and as the sentence the cues were said in
+(the words up to a question that follows them). Which answer it is stays the cues' to say,
+so the reason is always a cue.
 
 Chosen on the tuning set (docs/voice.md): the classifier's own decision (other more likely
 than answer), with scikit-learn's default regularization, no threshold of ours. The model is

@@ -82,7 +82,7 @@ def write_heard(
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Remake data/answer-sense-heard.yaml from the sense check's training sentences."""
-    from robot_agent.voice.evaluation import EVALUATION_SET, TUNING_SET, Phrasings
+    from robot_agent.voice.evaluation import held_out_sentences
     from robot_agent.voice.understanding import weather_recognizer
     from vahr.speech.tts import EspeakSynthesizer
 
@@ -90,7 +90,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=HEARD_FILE, help=f"default: {HEARD_FILE}")
     args = parser.parse_args(argv)
     answers = WeatherAnswers.load()
-    held_out = Phrasings.load(EVALUATION_SET).normalized() | Phrasings.load(TUNING_SET).normalized()
+    held_out = held_out_sentences()
     synthesizers = {voice: EspeakSynthesizer(voice) for voice in HEARD_VOICES}
     recognizer = weather_recognizer(answers)
     try:
