@@ -1,7 +1,8 @@
 """What push-to-talk listens for: sentences made from the skill's interaction model.
 
-Every sample utterance of every intent is written out with its slots filled, each slot
-going through all of its type's values and synonyms across the copies of the sample (so
+Every sample utterance of every intent (but the weather rule's, below) is written out with
+its slots filled, each slot going through all of its type's values and synonyms across the
+copies of the sample (so
 every value appears in every sample's context once, without multiplying out samples with
 several slots), plus the built-in intents' phrases (those the simulator knows them by,
 `vahr.local.alexa.background`) and the invocation forms ("ask robot fleet to ..."). The
@@ -27,6 +28,11 @@ if TYPE_CHECKING:
 _SLOT = re.compile(r"\{([A-Za-z0-9_.]+)\}")
 _ONES = "zero one two three four five six seven eight nine ten eleven twelve thirteen fourteen fifteen sixteen seventeen eighteen nineteen".split()  # noqa: E501
 _TENS = "_ _ twenty thirty forty fifty sixty seventy eighty ninety".split()
+# The weather delivery's rule said aloud ("deliver to zone a if it's sunny and zone c if it's
+# raining") is left out: its zone-and-weather sentences, filled with every name, crowded the
+# model until "send placebot two to zone c" was heard "send placebots to that zone c" (the
+# whole fleet) in the browser test. The weather delivery itself is still heard.
+_RULE_SLOTS = frozenset({"sunnyZone", "rainyZone"})
 # Ways of leaving a session, which the simulator answers like Alexa does.
 EXITS = ("exit", "goodbye", "stop", "cancel")
 
@@ -69,6 +75,8 @@ def sentences(document: dict[str, Any]) -> list[str]:
             types = {slot["name"]: slot["type"] for slot in intent.get("slots", [])}
             samples = intent.get("samples") or built_in.get(intent["name"], [])
             for sample in samples:
+                if _RULE_SLOTS & set(_SLOT.findall(sample)):
+                    continue
                 filled = _filled(sample, types, values)
                 found += filled
                 found.append(f"ask {invocation} to {filled[0]}")
