@@ -124,10 +124,15 @@ class WeatherAnswers:
         return cls.parse(read_yaml(path, "the weather answers"), str(path))
 
 
+# libyaml's parser where PyYAML was built with it: the sense check's data (thousands of
+# sentences) is read at every robot start, and the pure-Python parser takes most of it.
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
 def read_yaml(path: Path, what: str) -> object:
     """The YAML document at `path`, or one `SpeechError` line saying what went wrong."""
     try:
-        return yaml.safe_load(path.read_text(encoding="utf-8"))
+        return yaml.load(path.read_text(encoding="utf-8"), Loader=_LOADER)
     except OSError as err:
         raise SpeechError(f"{path}: cannot read {what}: {err.strerror}") from err
     except yaml.YAMLError as err:
