@@ -54,9 +54,9 @@ _ARTICLES = frozenset({"the", "a", "an"})
 # Words that join a second value to a name with its shared words left out ("robot one and
 # two"); `slot_roles` reads "and" as a list and "or" as a choice to ask about.
 _JOINERS = frozenset({"and", "or", "plus"})
-# Ordinals that say a robot's turn when they follow its name ("placebot one first",
-# "placebot two goes second").
-_TURN_WORDS = frozenset({"first", "second"})
+# Words that say a robot's turn in a sequence when they follow its name ("placebot one
+# first", "placebot two goes second"); `slot_roles` orders the robots by them.
+TURNS = {"first": 0, "second": 1, "last": 1}
 # The verbs that may stand between a robot and its turn; `slot_roles` reads turns by them too.
 GOING_VERBS = frozenset({"goes", "go", "comes", "delivers", "is", "will", "should"})
 # "the other robot": a robot named by the one named before it.
@@ -181,7 +181,7 @@ class SlotFinder:
             if (
                 found
                 and _right_after(found[-1], match.start, words)
-                and (words[match.start] in _TURN_WORDS)
+                and (words[match.start] in TURNS)
             ):
                 # "placebot one first placebot two": the ordinal is the first robot's turn,
                 # not the start of "first placebot" (which names another robot than the

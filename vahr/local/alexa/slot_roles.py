@@ -26,7 +26,7 @@ from dataclasses import replace
 from itertools import pairwise
 from typing import TYPE_CHECKING
 
-from vahr.local.alexa.slot_finder import GOING_VERBS
+from vahr.local.alexa.slot_finder import GOING_VERBS, OTHER_ROBOT, TURNS
 from vahr.local.alexa.weather_rule import RULE_SLOTS, rule_zones
 from vahr.protocol import FLEET_GROUP
 from vahr.skill_model.intents import ROBOT_TYPE, SUNNY_ZONE
@@ -45,8 +45,6 @@ _TURNED_DOWN = frozenset({"from", "of", "not"})
 # robot two", "robot one plus robot two", "robot one as well as robot two"); none at all is a
 # list too ("robot one, robot two": punctuation is gone by now).
 _LISTED = frozenset({"and", "plus", "also", "as", "well"})
-# Words after a robot that give its turn in a sequence ("placebot one first").
-_TURNS = {"first": 0, "second": 1, "last": 1}
 # Words that send the second robot where the first went ("delivers there too").
 _SAME_PLACE = frozenset({"there", "too", "also", "same", "well"})
 
@@ -197,7 +195,7 @@ def _the_other_robot(robots: list[SlotMatch], fleet: Mapping[str, str]) -> list[
     return [
         replace(robot, id=other, canonical=fleet[other])
         if robot.id is None
-        and robot.spoken.startswith("the other")
+        and tuple(robot.spoken.split()[: len(OTHER_ROBOT)]) == OTHER_ROBOT
         and robot.start > min(r.start for r in robots if r.id is not None)
         else robot
         for robot in robots
@@ -210,7 +208,7 @@ def _turn(robot: SlotMatch, words: list[str], until: int | None = None) -> int |
     after = words[robot.end : min(robot.end + 2, len(words) if until is None else until)]
     if after[:1] and after[0] in GOING_VERBS:
         after = after[1:]
-    return _TURNS.get(after[0]) if after else None
+    return TURNS.get(after[0]) if after else None
 
 
 def _pair_from_the_fleet(
