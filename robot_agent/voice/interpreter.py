@@ -11,7 +11,8 @@ answer is one-sided:
 - cues of one intent and none of the other: that intent;
 - cues of both ("sunny now, rain later"), none, or only denied ones ("no rain today"):
   unknown, with the reason; but a side whose cues are all weak ("bright", often "right"
-  misheard) gives way to the other's strong ones;
+  misheard) or count only denied ("no clouds", said of a rainy day too) gives way to the
+  other's strong ones;
 - a question ("will it rain today") or robot talk ("it is sunny, so I am delivering to
   zone A": an answer never mentions the robots' work): unknown, whatever the cues.
 
@@ -115,10 +116,15 @@ class LocalInterpreter:
     def _without_weak_cues(
         self, affirmed: dict[WeatherIntent, list[_Cue]], words: list[str]
     ) -> dict[WeatherIntent, list[_Cue]]:
-        """Both weathers said: the side whose cues are all weak ("bright", "warm") drops out
-        when the other has a cue that is not; if both are weak or both strong, neither."""
+        """Both weathers said: the side whose cues are all weak ("bright", "warm") or only
+        denied ("no clouds") drops out when the other has a strong cue; if both are weak or
+        both strong, neither."""
         strong = {
-            intent: [c for c in cues if " ".join(words[c.start : c.end]) not in self.cues.weak]
+            intent: [
+                c
+                for c in cues
+                if not c.only_denied and " ".join(words[c.start : c.end]) not in self.cues.weak
+            ]
             for intent, cues in affirmed.items()
         }
         standing = {intent: cues for intent, cues in strong.items() if cues}

@@ -103,18 +103,29 @@ def training_sentences(
     answers: WeatherAnswers, sense_file: Path, *, heard_file: Path | None = HEARD_FILE
 ) -> tuple[list[str], list[str]]:
     """(answers, other speech), normalized, without duplicates: the written sentences and,
-    when `heard_file` exists, the same as the recognizer heard them."""
+    when `heard_file` exists, the same as the recognizer heard them. A heard text that is
+    also on the other side, written or heard, is left out: "is it raining" heard as "it is
+    raining" teaches nothing but noise."""
     said = [p for phrases in answers.phrases.values() for p in phrases]
     other = list(answers.not_answers)
-    files = (
-        [sense_file] if heard_file is None or not heard_file.exists() else [sense_file, heard_file]
-    )
-    for path in files:
-        document = read_yaml(path, "the sense check's sentences")
-        if not isinstance(document, dict) or not all(
-            isinstance(document.get(key), list) for key in ("answers", "other")
-        ):
-            raise SpeechError(f"{path}: expected lists 'answers' and 'other'")
-        said += [normalize(str(s)) for s in document["answers"]]
-        other += [normalize(str(s)) for s in document["other"]]
+    written_said, written_other = _sentences(sense_file)
+    said, other = [*said, *written_said], [*other, *written_other]
+    if heard_file is not None and heard_file.exists():
+        heard_said, heard_other = _sentences(heard_file)
+        said_all, other_all = {*said, *heard_said}, {*other, *heard_other}
+        said += [text for text in heard_said if text not in other_all]
+        other += [text for text in heard_other if text not in said_all]
     return list(dict.fromkeys(said)), list(dict.fromkeys(other))
+
+
+def _sentences(path: Path) -> tuple[list[str], list[str]]:
+    """The normalized `answers` and `other` lists of a sense-check file."""
+    document = read_yaml(path, "the sense check's sentences")
+    if not isinstance(document, dict) or not all(
+        isinstance(document.get(key), list) for key in ("answers", "other")
+    ):
+        raise SpeechError(f"{path}: expected lists 'answers' and 'other'")
+    return (
+        [normalize(str(s)) for s in document["answers"]],
+        [normalize(str(s)) for s in document["other"]],
+    )

@@ -90,6 +90,8 @@ def test_the_evaluation_and_tuning_sets_share_no_sentence_and_no_voice() -> None
         ("it is raining bright now", "rainy", ("raining",)),
         ("warm with heavy rain", "rainy", ("rain",)),
         ("bright and warm", "sunny", ("bright", "warm")),
+        # So does a cue that counts only denied ("low clouds" heard as "no clouds").
+        ("rainy and cool with no clouds", "rainy", ("rainy",)),
         # Leaving the umbrella at home denies the rain.
         ("leave the umbrella at home it is sunny", "sunny", ("sunny",)),
     ],
