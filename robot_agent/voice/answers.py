@@ -23,7 +23,16 @@ if TYPE_CHECKING:
 
 ANSWERS_FILE = Path(__file__).with_name("weather_answers.yaml")
 INTENTS: tuple[WeatherIntent, ...] = WEATHERS
-_WORD_LISTS = ("negations", "clause_breaks", "question_openers", "robot_talk", "weak_cues")
+_WORD_LISTS = (
+    "negations",
+    "clause_breaks",
+    "question_openers",
+    "question_verbs",
+    "question_subjects",
+    "robot_talk",
+    "weak_cues",
+    "other_times",
+)
 
 
 @dataclass(frozen=True)
@@ -40,6 +49,12 @@ class Cues:
     robot_talk: frozenset[str]
     # Cues that decide only when the other weather has none.
     weak: frozenset[str] = frozenset()
+    # Verbs that open a question only with a subject after them ("is it raining", but not
+    # "is raining right now", an answer whose "it" was not heard).
+    question_verbs: frozenset[str] = frozenset()
+    question_subjects: frozenset[str] = frozenset()
+    # Words that put the weather said in their clause at another time ("next tuesday").
+    other_times: frozenset[str] = frozenset()
 
     def words(self) -> set[str]:
         phrases = [*self.said.values(), *self.denied.values()]
@@ -178,6 +193,9 @@ def _cues(document: dict[str, Any], source: str) -> Cues:
         question_openers=lists["question_openers"],
         robot_talk=lists["robot_talk"],
         weak=lists["weak_cues"],
+        question_verbs=lists["question_verbs"],
+        question_subjects=lists["question_subjects"],
+        other_times=lists["other_times"],
     )
 
 

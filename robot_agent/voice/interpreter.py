@@ -13,8 +13,12 @@ answer is one-sided:
   unknown, with the reason; but a side whose cues are all weak ("bright", often "right"
   misheard) or count only denied ("no clouds", said of a rainy day too) gives way to the
   other's strong ones;
-- a question ("will it rain today") or robot talk ("it is sunny, so I am delivering to
-  zone A": an answer never mentions the robots' work): unknown, whatever the cues.
+- a cue in a clause of another time ("the forecast says it will be sunny next tuesday")
+  says nothing of now;
+- a question ("will it rain today"; a verb opens one only with its subject after it, as
+  "is raining right now" is an answer whose "it" was not heard) or robot talk ("it is
+  sunny, so I am delivering to zone A": an answer never mentions the robots' work):
+  unknown, whatever the cues.
 
 The words that decided (each cue and the words before it that could have denied it) are
 returned as positions, so the caller can ask how sure the recognizer was of exactly those.
@@ -85,13 +89,17 @@ class LocalInterpreter:
         talk = sorted({w for w in words if w in cues.robot_talk})
         if talk:
             return Interpretation("unknown", 0.0, reason=f"robot talk ({', '.join(talk)})")
-        if words[0] in cues.question_openers and words[1:2] != ["not"]:
+        if self._asks(words, 0) and words[1:2] != ["not"]:
             return Interpretation("unknown", 0.0, reason=f"a question ({words[0]} ...)")
         found = self._find(words)
         affirmed: dict[WeatherIntent, list[_Cue]] = {}
         denied: list[_Cue] = []
+        elsewhen: list[tuple[_Cue, str]] = []
         for cue in found:
-            if cue.only_denied == (cue.denied_by is not None):
+            when = self._other_time(words, cue)
+            if when and cue.only_denied == (cue.denied_by is not None):
+                elsewhen.append((cue, when))
+            elif cue.only_denied == (cue.denied_by is not None):
                 affirmed.setdefault(cue.intent, []).append(cue)
             elif cue.denied_by is not None:
                 denied.append(cue)
@@ -101,6 +109,9 @@ class LocalInterpreter:
             phrases = tuple(c.phrase(words) for group in affirmed.values() for c in group)
             return Interpretation("unknown", 0.0, phrases, "both sunny and rainy")
         if not affirmed:
+            if elsewhen:
+                phrases = tuple(f"{c.phrase(words)} ... {when}" for c, when in elsewhen)
+                return Interpretation("unknown", 0.0, phrases, "the weather of another time")
             if denied:
                 phrases = tuple(c.phrase(words) for c in denied)
                 return Interpretation("unknown", 0.0, phrases, "the weather only denied")
@@ -109,9 +120,34 @@ class LocalInterpreter:
         decisive = sorted({i for cue in chosen for i in self._span(words, cue)})
         evidence = tuple(dict.fromkeys(c.phrase(words) for c in chosen))
         last = max(cue.end for cue in chosen)
-        end = next((i for i in range(last, len(words)) if words[i] in cues.question_openers), None)
+        end = next((i for i in range(last, len(words)) if self._asks(words, i)), None)
         sentence = " ".join(words[:end])
         return Interpretation(intent, 1.0, evidence, decisive=tuple(decisive), sentence=sentence)
+
+    def _asks(self, words: list[str], at: int) -> bool:
+        """Whether a question opens at `at`: a question word ("where", "what"), or a verb
+        ("is", "will") with its subject after it ("is it raining", not "is raining right
+        now", an answer whose "it" was not heard)."""
+        word, after = words[at], words[at + 1 : at + 2]
+        if word in self.cues.question_verbs:
+            return bool(after) and after[0] in self.cues.question_subjects
+        return word in self.cues.question_openers
+
+    def _other_time(self, words: list[str], cue: _Cue) -> str:
+        """The word that puts the cue's clause at another time ("sunny next tuesday", "it
+        rained a lot last spring"), or "": the clause runs between clause breaks and up to
+        a question that follows."""
+        first = cue.start
+        while first > 0 and words[first - 1] not in self.cues.clause_breaks:
+            first -= 1
+        last = cue.end
+        while (
+            last < len(words)
+            and words[last] not in self.cues.clause_breaks
+            and not self._asks(words, last)
+        ):
+            last += 1
+        return next((w for w in words[first:last] if w in self.cues.other_times), "")
 
     def _without_weak_cues(
         self, affirmed: dict[WeatherIntent, list[_Cue]], words: list[str]

@@ -94,6 +94,10 @@ def test_the_evaluation_and_tuning_sets_share_no_sentence_and_no_voice() -> None
         ("rainy and cool with no clouds", "rainy", ("rainy",)),
         # Leaving the umbrella at home denies the rain.
         ("leave the umbrella at home it is sunny", "sunny", ("sunny",)),
+        # A verb without its subject opens no question: "it" was not heard.
+        ("is raining right now", "rainy", ("raining",)),
+        # Weather of another time says nothing of now.
+        ("it is sunny now but it will rain next week", "sunny", ("sunny",)),
     ],
 )
 def test_cues_decide_and_are_reported(
@@ -109,6 +113,9 @@ def test_cues_decide_and_are_reported(
         ("", "nothing said"),
         ("what time is it", "a question (what ...)"),
         ("will it rain today", "a question (will ...)"),
+        ("is it raining", "a question (is ...)"),
+        ("the forecast says it will be sunny next tuesday", "the weather of another time"),
+        ("it rained a lot last spring", "the weather of another time"),
         ("no rain today", "the weather only denied"),
         ("it won't rain", "the weather only denied"),
         ("it is cloudy", "no weather word"),
