@@ -21,7 +21,7 @@ more than it gained, so the language model hears alone (docs/voice.md has the fi
 
 The interpreter reads cues, which say nothing of a word's sense ("a sunny personality"); so
 offline, the sense check (`sense.py`) reads the whole sentence and may veto: what it finds
-more likely other speech than an answer is `unknown`, whatever the cues.
+too unlikely an answer is `unknown`, whatever the cues.
 
 Speech the recognizer does not trust (silence, noise) is `unknown` with empty text: a guess
 would only mislead whoever reads the `heard` event. The reason says what happened.
