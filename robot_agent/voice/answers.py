@@ -55,6 +55,8 @@ class Cues:
     question_subjects: frozenset[str] = frozenset()
     # Words that put the weather said in their clause at another time ("next tuesday").
     other_times: frozenset[str] = frozenset()
+    # Phrases that undo the cue before them, in its clause ("the sun will not be out").
+    undone_after: tuple[tuple[str, ...], ...] = ()
 
     def words(self) -> set[str]:
         phrases = [*self.said.values(), *self.denied.values()]
@@ -196,6 +198,10 @@ def _cues(document: dict[str, Any], source: str) -> Cues:
         question_verbs=lists["question_verbs"],
         question_subjects=lists["question_subjects"],
         other_times=lists["other_times"],
+        undone_after=tuple(
+            tuple(p.split())
+            for p in _sentences(document.get("undone_after", []), "undone_after", source)
+        ),
     )
 
 

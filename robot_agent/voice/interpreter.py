@@ -14,7 +14,8 @@ answer is one-sided:
   misheard) or count only denied ("no clouds", said of a rainy day too) gives way to the
   other's strong ones;
 - a cue in a clause of another time ("the forecast says it will be sunny next tuesday")
-  says nothing of now;
+  says nothing of now, nor does one taken back after it in its clause ("the sun will not
+  be out", "the rain has stayed away") or the sun that is no weather ("the sun sets");
 - a question ("will it rain today"; a verb opens one only with its subject after it, as
   "is raining right now" is an answer whose "it" was not heard) or robot talk ("it is
   sunny, so I am delivering to zone A": an answer never mentions the robots' work):
@@ -69,6 +70,8 @@ class _Cue:
     only_denied: bool  # a cue that counts only when denied
 
     def phrase(self, words: list[str]) -> str:
+        if self.denied_by is not None and self.denied_by > self.start:  # undone after it
+            return " ".join(words[self.start : self.denied_by + 1])
         first = self.denied_by if self.denied_by is not None else self.start
         return " ".join(words[first : self.end])
 
@@ -183,6 +186,8 @@ class LocalInterpreter:
             if start < taken:
                 continue
             denied_by = self._negation(words, start, since=taken)
+            if denied_by is None:
+                denied_by = self._undoing(words, end)
             cues.append(_Cue(intent, start, end, denied_by, only_denied))
             taken = end
         return cues
@@ -197,6 +202,18 @@ class LocalInterpreter:
                 return position
             if words[position] in self.cues.clause_breaks:
                 return None
+        return None
+
+    def _undoing(self, words: list[str], end: int) -> int | None:
+        """The position of words after a cue, in its clause, that undo it ("the sun will
+        not be out", "the rain has stayed away", "the sun sets at seven"), if any."""
+        last = min(len(words), end + self.cues.negation_reach + 2)
+        for position in range(end, last):
+            if words[position] in self.cues.clause_breaks:
+                return None
+            for phrase in self.cues.undone_after:
+                if tuple(words[position : position + len(phrase)]) == phrase:
+                    return position + len(phrase) - 1
         return None
 
     def _span(self, words: list[str], cue: _Cue) -> range:

@@ -98,6 +98,9 @@ def test_the_evaluation_and_tuning_sets_share_no_sentence_and_no_voice() -> None
         ("is raining right now", "rainy", ("raining",)),
         # Weather of another time says nothing of now.
         ("it is sunny now but it will rain next week", "sunny", ("sunny",)),
+        # A weather named and taken back after it says nothing.
+        ("it is raining so the sun will not be out today", "rainy", ("raining",)),
+        ("good news it is sunny and the rain has stayed away", "sunny", ("sunny",)),
     ],
 )
 def test_cues_decide_and_are_reported(
@@ -116,6 +119,7 @@ def test_cues_decide_and_are_reported(
         ("is it raining", "a question (is ...)"),
         ("the forecast says it will be sunny next tuesday", "the weather of another time"),
         ("it rained a lot last spring", "the weather of another time"),
+        ("the sun sets at seven this evening", "the weather only denied"),
         ("no rain today", "the weather only denied"),
         ("it won't rain", "the weather only denied"),
         ("it is cloudy", "no weather word"),
