@@ -99,11 +99,12 @@ class LocalInterpreter:
         denied: list[_Cue] = []
         elsewhen: list[tuple[_Cue, str]] = []
         for cue in found:
-            when = self._other_time(words, cue)
-            if when and cue.only_denied == (cue.denied_by is not None):
-                elsewhen.append((cue, when))
-            elif cue.only_denied == (cue.denied_by is not None):
-                affirmed.setdefault(cue.intent, []).append(cue)
+            if cue.only_denied == (cue.denied_by is not None):  # the cue says its weather
+                when = self._other_time(words, cue)
+                if when:
+                    elsewhen.append((cue, when))
+                else:
+                    affirmed.setdefault(cue.intent, []).append(cue)
             elif cue.denied_by is not None:
                 denied.append(cue)
         if len(affirmed) > 1:
