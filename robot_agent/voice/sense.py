@@ -110,10 +110,9 @@ def training_sentences(
     when `heard_file` exists, the same as the recognizer heard them. A heard text that is
     also on the other side, written or heard, is left out: "is it raining" heard as "it is
     raining" teaches nothing but noise."""
-    said = [p for phrases in answers.phrases.values() for p in phrases]
-    other = list(answers.not_answers)
     written_said, written_other = _sentences(sense_file)
-    said, other = [*said, *written_said], [*other, *written_other]
+    said = [*answers.all_phrases(), *written_said]
+    other = [*answers.not_answers, *written_other]
     if heard_file is not None and heard_file.exists():
         heard_said, heard_other = _sentences(heard_file)
         said_all, other_all = {*said, *heard_said}, {*other, *heard_other}

@@ -89,11 +89,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=main.__doc__)
     parser.add_argument("--out", type=Path, default=HEARD_FILE, help=f"default: {HEARD_FILE}")
     args = parser.parse_args(argv)
-    answers = WeatherAnswers.load()
-    held_out = held_out_sentences()
     synthesizers = {voice: EspeakSynthesizer(voice) for voice in HEARD_VOICES}
-    recognizer = weather_recognizer(answers)
     try:
+        answers = WeatherAnswers.load()
+        recognizer = weather_recognizer(answers)
         said, other = training_sentences(answers, SENSE_FILE, heard_file=None)
 
         def speak(voice: str, text: str) -> Audio:
@@ -103,7 +102,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return recognizer.recognize(audio).text
 
         counts = write_heard(
-            args.out, heard_texts(said, speak, hear), heard_texts(other, speak, hear), held_out
+            args.out,
+            heard_texts(said, speak, hear),
+            heard_texts(other, speak, hear),
+            held_out_sentences(),
         )
     except SpeechError as error:
         print(f"error: {error}", file=sys.stderr)

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from vahr.errors import VahrError
 from vahr.local.alexa.background import built_in_phrases
 from vahr.local.alexa.nlu import DEFAULT_MODEL
+from vahr.local.alexa.weather_rule import RULE_SLOTS
 from vahr.speech.text import normalize
 
 if TYPE_CHECKING:
@@ -32,7 +33,7 @@ _TENS = "_ _ twenty thirty forty fifty sixty seventy eighty ninety".split()
 # raining") is left out: its zone-and-weather sentences, filled with every name, crowded the
 # model until "send placebot two to zone c" was heard "send placebots to that zone c" (the
 # whole fleet) in the browser test. The weather delivery itself is still heard.
-_RULE_SLOTS = frozenset({"sunnyZone", "rainyZone"})
+_RULE_SLOTS = frozenset(RULE_SLOTS.values())
 # Ways of leaving a session, which the simulator answers like Alexa does.
 EXITS = ("exit", "goodbye", "stop", "cancel")
 

@@ -181,7 +181,7 @@ class SlotFinder:
             if (
                 found
                 and _right_after(found[-1], match.start, words)
-                and (words[match.start] in TURNS)
+                and words[match.start] in TURNS
             ):
                 # "placebot one first placebot two": the ordinal is the first robot's turn,
                 # not the start of "first placebot" (which names another robot than the
