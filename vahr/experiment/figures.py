@@ -19,8 +19,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from vahr.experiment import stats
-from vahr.experiment.report import ITEM_LABELS, OBJECTIVE
-from vahr.experiment.tlx import ITEMS, SUBSCALES
+from vahr.experiment.results import OBJECTIVE
+from vahr.experiment.tlx import ITEM_LABELS, ITEMS, SUBSCALES
 
 if TYPE_CHECKING:
     from pathlib import Path

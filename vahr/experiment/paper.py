@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from vahr.experiment.report import OBJECTIVE
+from vahr.experiment.results import OBJECTIVE
 
 
 @dataclass(frozen=True)

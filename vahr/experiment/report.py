@@ -25,33 +25,16 @@ import statistics
 from typing import TYPE_CHECKING, Any
 
 from vahr.experiment import stats
+from vahr.experiment.figures import draw_figures, figure_names
 from vahr.experiment.metrics import rate
-from vahr.experiment.results import ResultRow, write_csv
+from vahr.experiment.results import OBJECTIVE, ResultRow, write_csv
 from vahr.experiment.tasks import METHODS
-from vahr.experiment.tlx import ITEMS, SUBSCALES
+from vahr.experiment.tlx import ITEM_LABELS, ITEMS, SUBSCALES
 
 if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-OBJECTIVE: dict[str, tuple[str, str, Callable[[ResultRow], float]]] = {
-    "interaction_time": ("Interaction time (IE)", "s", lambda r: r.interaction_time_s),
-    "neglect_time": ("Neglect time (NT)", "s", lambda r: r.neglect_time_s),
-    "rad": ("RAD = IE / (IE + NT)", "", lambda r: r.rad),
-    "fan_out": ("Fan-out = time / RAD", "s", lambda r: r.fan_out),
-    "puzzle_parts": ("Solved puzzle parts", "", lambda r: float(r.puzzle_parts)),
-    "time_taken": ("Time taken", "s", lambda r: r.task_time_s),
-}
-ITEM_LABELS = {
-    "mental": "Mental demand",
-    "physical": "Physical demand",
-    "temporal": "Temporal demand",
-    "performance": "Performance",
-    "effort": "Effort",
-    "frustration": "Frustration",
-    "confidence": "Confidence",
-    "trust": "Trust",
-}
 TEST_NAMES = {"paired_t": "paired t", "wilcoxon": "Wilcoxon", "rm_anova": "RM ANOVA"}
 
 
@@ -230,8 +213,6 @@ def _table(
 
 def render_markdown(report: dict[str, Any]) -> str:
     """report.md: the paper's Table II with the within-subjects analysis beside it."""
-    from vahr.experiment.figures import figure_names
-
     methods: list[str] = report["methods"]
     difference = " - ".join(methods[:2]) + " [95% CI]" if len(methods) == 2 else "difference"
     lines = ["# Experiment report", ""]
@@ -330,8 +311,6 @@ def write_report(
     rows: list[ResultRow], out_dir: Path, *, source: str = "", simulated: bool = False
 ) -> dict[str, Any]:
     """Write report.json, report.md, results.csv and the figures into `out_dir`."""
-    from vahr.experiment.figures import draw_figures
-
     out_dir.mkdir(parents=True, exist_ok=True)
     report = build_report(rows, source=source, simulated=simulated)
     (out_dir / "report.json").write_text(json.dumps(report, indent=2, sort_keys=False) + "\n")

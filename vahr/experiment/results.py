@@ -23,6 +23,7 @@ from vahr.experiment.tasks import Plan
 from vahr.experiment.tlx import ITEMS, TlxAnswers, check_level
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from pathlib import Path
 
     from vahr.experiment.eventlog import LogEntry
@@ -92,6 +93,18 @@ class ResultRow:
         for item in ITEMS:
             row[item] = levels.get(item, "")
         return row
+
+
+# The objective metrics the report compares and draws: each one's label, unit and value in
+# a row.
+OBJECTIVE: dict[str, tuple[str, str, Callable[[ResultRow], float]]] = {
+    "interaction_time": ("Interaction time (IE)", "s", lambda r: r.interaction_time_s),
+    "neglect_time": ("Neglect time (NT)", "s", lambda r: r.neglect_time_s),
+    "rad": ("RAD = IE / (IE + NT)", "", lambda r: r.rad),
+    "fan_out": ("Fan-out = time / RAD", "s", lambda r: r.fan_out),
+    "puzzle_parts": ("Solved puzzle parts", "", lambda r: float(r.puzzle_parts)),
+    "time_taken": ("Time taken", "s", lambda r: r.task_time_s),
+}
 
 
 def _number(line: int, column: str, text: str, *, whole: bool = False) -> float:

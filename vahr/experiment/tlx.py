@@ -26,6 +26,18 @@ QUESTIONS = {
     "trust": "How much did you trust the robots to complete the tasks without you?",
 }
 
+# Each item's name in the report's tables and figures.
+ITEM_LABELS = {
+    "mental": "Mental demand",
+    "physical": "Physical demand",
+    "temporal": "Temporal demand",
+    "performance": "Performance",
+    "effort": "Effort",
+    "frustration": "Frustration",
+    "confidence": "Confidence",
+    "trust": "Trust",
+}
+
 
 def check_level(item: str, level: object) -> int:
     """Return `level` as an int if it is a whole level 1..21, else raise ValueError."""
