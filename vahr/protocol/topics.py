@@ -136,6 +136,9 @@ def parse_room_topic(topic: str) -> tuple[str, str] | None:
 # Every exchange with the local Alexa simulator (`vahr up`'s), one message per turn; AWS's
 # Alexa publishes nothing here.
 ASSISTANT_TURNS = "vahr/assistant/turns"
+# What the assistant told the person without being asked: a robot stuck, failed, offline
+# (vahr.announce; the local announcer and the cloud's announcer function publish it).
+ASSISTANT_ANNOUNCEMENTS = "vahr/assistant/announcements"
 # The running experiment session as the station shows it (retained; `vahr experiment`).
 EXPERIMENT_STATUS = "vahr/experiment/status"
 # What the participant did on the station (interactions, puzzle pieces), for the session's log.
