@@ -152,11 +152,11 @@ def run(args: argparse.Namespace) -> int:
 
 def _experiment(system: Any, log_dir: Path, args: argparse.Namespace) -> list[str]:
     """The paper's tasks I-III, performed by the simulated participant with both methods."""
-    from vahr.experiment.assistant import HttpAssistant
     from vahr.experiment.eventlog import read_log
     from vahr.experiment.metrics import fan_out, rad
     from vahr.experiment.rehearsal import rehearse
     from vahr.experiment.results import row_from_log
+    from vahr.local.client import HttpAssistant
 
     if not args.json:
         print("The paper's experiment, tasks I-III (simulated participant):\n")

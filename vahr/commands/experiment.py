@@ -159,7 +159,7 @@ def _run_session(args: argparse.Namespace, fleet: Any, session: Any) -> Any:
 
     performer_for: Any
     if args.simulate:
-        from vahr.experiment.assistant import HttpAssistant, SayCommandAssistant
+        from vahr.local.client import HttpAssistant, SayCommandAssistant
 
         assistant = HttpAssistant(args.api) if args.api else SayCommandAssistant(None)
         performer_for = simulated_performer(session, fleet, assistant)

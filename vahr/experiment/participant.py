@@ -32,6 +32,7 @@ import random
 import time
 from typing import TYPE_CHECKING, Any
 
+from vahr.errors import VahrError
 from vahr.experiment import timing
 from vahr.experiment.eventlog import Kind
 from vahr.experiment.procedures import Observation, check_action, heard_weather, procedure_for
@@ -40,10 +41,10 @@ from vahr.protocol import Pose, encode, new_command, topics
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.experiment.assistant import Assistant
     from vahr.experiment.eventlog import EventLog, LogEntry
     from vahr.experiment.procedures import Procedure, Step
     from vahr.experiment.tasks import Plan
+    from vahr.local.client import Assistant
     from vahr.protocol import Fleet
 
 # A question the assistant does not answer with a weather is asked again, up to this often.
@@ -304,9 +305,14 @@ class SimulatedParticipant:
             prepare = self.person.mental_s()
         self._sleep(prepare + self.person.speaking_s(text))
         started = time.monotonic()
-        reply = self.assistant.ask(text)
+        try:
+            turn, error = self.assistant.ask(text), None
+        except VahrError as err:
+            # A failed exchange is logged as one and the task goes on, as a person would.
+            turn, error = {}, str(err)
         latency = time.monotonic() - started
-        listen = timing.listening_s(reply.speech)
+        speech = str(turn.get("speech") or "")
+        listen = timing.listening_s(speech)
         # The call took `latency` of wall time; at the speed factor only latency / F of it
         # belongs to the rehearsal's clock. Take the rest out of the listening.
         excess = latency - latency / self.speed_factor
@@ -315,18 +321,19 @@ class SimulatedParticipant:
         if listen_wall > 0:
             time.sleep(listen_wall)
         self._block, self._last_listen_s = "voice", listen
+        commands = turn.get("commands")
         body: dict[str, Any] = {
-            "speech": reply.speech,
-            "intent": reply.intent,
-            "commands": reply.commands,
+            "speech": speech,
+            "intent": str(turn["intent"]) if turn.get("intent") else None,
+            "commands": [str(c) for c in commands] if isinstance(commands, list) else [],
             "latency_ms": round(latency * 1000, 1),
             "overrun_s": round(overrun, 3),
             **extra,
         }
-        if reply.error:
-            body["error"] = reply.error
+        if error:
+            body["error"] = error
         if step.is_question:
-            weather = heard_weather(reply.speech)
+            weather = heard_weather(speech)
             if weather is not None:
                 self._answered(step.thing, weather)
             body["commands"] = []

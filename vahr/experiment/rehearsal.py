@@ -28,9 +28,9 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-    from vahr.experiment.assistant import Assistant
     from vahr.experiment.judge import SessionVerdict
     from vahr.experiment.session import OpenSession, Performer
+    from vahr.local.client import Assistant
     from vahr.protocol import Fleet
     from vahr.protocol.broker import ClientCredentials
 

@@ -162,7 +162,7 @@ class LocalSystem:
     def _start_station(self, port: int) -> None:
         """The operator station on this stack: the simulator in-process, shadows read from
         the store, every turn seen on the broker."""
-        from vahr.station.assistant import SimulatorAssistant
+        from vahr.local.client import SimulatorAssistant
         from vahr.station.station import Station, StationConfig
 
         assert self.alexa is not None and self.stack.dataplane is not None

@@ -31,7 +31,7 @@ from vahr.speech.errors import SpeechError
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.station.assistant import Assistant
+    from vahr.local.client import Assistant
     from vahr.station.controls import Controls
     from vahr.station.desk import Desk
     from vahr.station.feed import Feed

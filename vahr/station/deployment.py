@@ -23,10 +23,10 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from vahr.errors import VahrError
+from vahr.local.client import HttpAssistant, SimulatorAssistant
 from vahr.local.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
 from vahr.protocol.broker import parse_broker_url
-from vahr.station.assistant import HttpAssistant, SimulatorAssistant
 from vahr.station.feed import Feed
 from vahr.station.station import Station
 
@@ -34,9 +34,9 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
+    from vahr.local.client import Assistant
     from vahr.protocol import Fleet
     from vahr.protocol.broker import ClientCredentials
-    from vahr.station.assistant import Assistant
     from vahr.station.station import StationConfig
 
 log = logging.getLogger(__name__)

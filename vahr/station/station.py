@@ -27,9 +27,9 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
+    from vahr.local.client import Assistant
     from vahr.local.mqtt import MqttClient
     from vahr.protocol import Fleet
-    from vahr.station.assistant import Assistant
     from vahr.station.voice import PushToTalk
 
 log = logging.getLogger(__name__)

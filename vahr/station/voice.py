@@ -23,8 +23,8 @@ from vahr.station.app import RequestError
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from vahr.local.client import Assistant
     from vahr.speech.stt import Recognizer
-    from vahr.station.assistant import Assistant
 
 SORRY = "Sorry, I didn't catch that."
 MAX_CLIP_S = 20.0

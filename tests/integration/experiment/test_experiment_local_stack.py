@@ -8,6 +8,7 @@ import json
 from typing import TYPE_CHECKING
 
 import boto3
+import pytest
 
 from tests.integration.experiment.experiment_robots import SPEED, RobotAgents
 from vahr.cli import main
@@ -16,8 +17,6 @@ from vahr.protocol import experiment_state_from_payload, robot_shadow_from_paylo
 
 if TYPE_CHECKING:
     from pathlib import Path
-
-    import pytest
 
     from vahr.local.stack import LocalStack
     from vahr.protocol import Fleet
@@ -94,15 +93,17 @@ def test_a_keyboard_session_through_the_local_stack(
     assert (tmp_path / "out" / "objective.png").stat().st_size > 1000
 
 
-def test_the_assistant_adapter_reports_a_missing_or_unreachable_assistant(
+def test_the_assistant_client_reports_a_missing_or_unreachable_assistant(
     stack: LocalStack,
 ) -> None:
-    from vahr.experiment.assistant import HttpAssistant
+    from vahr.errors import VahrError
+    from vahr.local.client import HttpAssistant
 
     # Given a data plane without the Alexa simulator attached, and a port nothing listens on
-    missing = HttpAssistant(stack.api_url).ask("tell placebot one to deliver a package to zone B")
-    unreachable = HttpAssistant(f"http://127.0.0.1:{free_port()}", timeout_s=2).ask("hello")
-    # Then each utterance comes back as a failed exchange naming the reason
-    assert missing.commands == [] and missing.error is not None
-    assert missing.error.startswith("the assistant answered HTTP 404")
-    assert unreachable.error is not None and "is unreachable" in unreachable.error
+    missing = HttpAssistant(stack.api_url)
+    unreachable = HttpAssistant(f"http://127.0.0.1:{free_port()}", timeout_s=2)
+    # Then each utterance fails with one line naming the reason
+    with pytest.raises(VahrError, match=r"answered 404"):
+        missing.ask("tell placebot one to deliver a package to zone B")
+    with pytest.raises(VahrError, match=r"^nothing answers at"):
+        unreachable.ask("hello")

@@ -6,12 +6,12 @@ import io
 import os
 import threading
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
+from vahr.errors import VahrError
 from vahr.experiment import timing
-from vahr.experiment.assistant import AssistantReply
 from vahr.experiment.eventlog import EventLog, Kind
 from vahr.experiment.observer import ObserverConsole
 from vahr.experiment.participant import Console, SimulatedParticipant
@@ -34,13 +34,16 @@ class ScriptedAssistant:
         self.heard: list[str] = []
         self.weather = weather
 
-    def ask(self, utterance: str) -> AssistantReply:
+    def ask(
+        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+    ) -> dict[str, Any]:
         self.heard.append(utterance)
         if "what is the weather" in utterance:
-            return AssistantReply(f"The weather is {self.weather}.", intent="WeatherIntent")
-        return AssistantReply(
-            "Okay, it is on its way.", intent="NavigateIntent", commands=[f"c{len(self.heard)}"]
-        )
+            speech, intent, commands = f"The weather is {self.weather}.", "WeatherIntent", []
+        else:
+            speech, intent = "Okay, it is on its way.", "NavigateIntent"
+            commands = [f"c{len(self.heard)}"]
+        return {"utterance": utterance, "speech": speech, "intent": intent, "commands": commands}
 
 
 def robot_event(log: EventLog, thing: str, event: str, **data: object) -> None:
@@ -109,6 +112,55 @@ def test_the_voice_participant_looks_for_the_robot_loaded_before_sending_it_on(
     assert ended[first.data["id"]].data["commands"] == ["c1"]
     # and it solved puzzle parts while it waited
     assert any(e.kind == Kind.OBSERVER and e.data["what"] == "puzzle_piece" for e in entries)
+
+
+class UnreachableAssistant:
+    """An assistant nothing answers for: every utterance fails as `HttpAssistant` fails."""
+
+    def __init__(self) -> None:
+        self.heard: list[str] = []
+
+    def ask(
+        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+    ) -> dict[str, Any]:
+        self.heard.append(utterance)
+        raise VahrError("nothing answers at http://127.0.0.1:1 (refused)")
+
+
+def test_the_voice_participant_logs_an_exchange_the_assistant_failed_and_goes_on(
+    fleet: Fleet, tmp_path: Path
+) -> None:
+    # Given a voice participant in task I whose assistant cannot be reached
+    assistant = UnreachableAssistant()
+    with EventLog.open(tmp_path / "log.sqlite") as log:
+        log.append(Kind.TASK_STARTED, {"task": "I"}, task="I")
+        participant = SimulatedParticipant(
+            method="vahr",
+            fleet=fleet,
+            plan=draw_plan(fleet, 3),
+            log=log,
+            person=timing.Person(),
+            seed=3,
+            speed_factor=SPEED,
+            assistant=assistant,
+        )
+        # When it says its first orders
+        participant.perform("I")
+        decided = participant.wait(lambda: len(assistant.heard) == 2, timeout_s=600)
+        spoken = [
+            e.data
+            for e in log.entries()
+            if e.kind == Kind.INTERACTION_ENDED and e.data["channel"] == "voice"
+        ]
+    # Then each exchange is logged with the reason, no reply and no command, and it went on
+    assert decided and spoken
+    assert all(
+        data["error"].startswith("nothing answers at")
+        and data["speech"] == ""
+        and data["intent"] is None
+        and data["commands"] == []
+        for data in spoken
+    )
 
 
 def test_the_keyboard_participant_asks_the_weather_per_robot_and_clicks_navigations(
