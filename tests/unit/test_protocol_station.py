@@ -1,20 +1,30 @@
-"""The messages of the station's topics: validation in one place, the page's clock mapped."""
+"""The messages of the station's topics and its pages: validation in one place, the page's
+clock mapped, the page messages told apart by their type."""
 
 from __future__ import annotations
 
 import json
+import typing
 from datetime import UTC, datetime, timedelta
 
+import msgspec
 import pytest
 
-from vahr.protocol import ProtocolError
+from vahr.protocol import EventKind, ProtocolError
 from vahr.protocol.station import (
+    DRIVE_ENDS,
+    EXCHANGE_EVENTS,
+    AckMessage,
+    EventMessage,
     ExperimentStatus,
     Interaction,
+    PageMessage,
     decode_experiment_status,
     decode_station_input,
     decode_turn,
+    encode_page_message,
     on_clock,
+    turn_from_message,
 )
 
 NOW = datetime(2026, 11, 23, 10, 0, 0, tzinfo=UTC)
@@ -88,3 +98,31 @@ def test_the_pages_clock_is_moved_onto_the_receivers() -> None:
     assert at == NOW - timedelta(seconds=2)
     # A sent time before the event (a clock stepping back) is no lead at all
     assert on_clock(NOW, NOW - timedelta(seconds=1), received=NOW) == NOW
+
+
+def test_a_drive_ends_only_on_events_that_end_it() -> None:
+    # Every drive ends with one of these; the rest are events a robot may send mid-drive
+    assert {"arrived", "stopped", "stuck", "failed", "cancelled"} <= DRIVE_ENDS
+    assert not {"rejected", "done", "accepted", "progress"} & DRIVE_ENDS
+    assert (DRIVE_ENDS | EXCHANGE_EVENTS) <= set(typing.get_args(EventKind))
+
+
+def test_page_messages_are_told_apart_by_their_type() -> None:
+    decoder = msgspec.json.Decoder(PageMessage)
+    ack = decoder.decode(b'{"type": "ack", "id": "c1", "thing": "placebot1", '
+                         b'"event": "accepted", "latency_ms": 12.0}')  # fmt: skip
+    assert ack == AckMessage(id="c1", thing="placebot1", event="accepted", latency_ms=12.0)
+    message = EventMessage(event="said", thing="placebot1", at=NOW, text="hi", last_seen=5.0)
+    body = json.loads(encode_page_message(message))
+    # An event is sent as the robot sent it, with its type and when it was last seen
+    assert body == {"type": "event", "event": "said", "thing": "placebot1",
+                    "at": "2026-11-23T10:00:00Z", "text": "hi", "last_seen": 5.0}  # fmt: skip
+
+
+def test_a_turn_handed_over_in_process_is_checked_like_one_from_the_broker() -> None:
+    turn = turn_from_message({"utterance": "hi", "speech": "Hello.", "origin": "station",
+                              "at": "2026-11-23T10:00:00+00:00"})  # fmt: skip
+    assert turn.at == NOW and turn.origin == "station"
+    with pytest.raises(ProtocolError) as raised:
+        turn_from_message({"utterance": "hi", "speech": "Hello.", "origin": "Not An Origin"})
+    assert raised.value.field == "origin"

@@ -11,17 +11,28 @@
   current task and the judge's live verdict per task.
 
 Each decoder is the one place its payload is validated; errors are `ProtocolError`s.
+
+The station's page contract follows: `PageMessage`, the messages the station's feed pushes
+to its pages (server-sent events), a union tagged on `type`. `python -m vahr.station.contract`
+writes them as JSDoc typedefs, with `DRIVE_ENDS` and `EXCHANGE_EVENTS`, into the page's
+`static/contract.js`, and `make lint` fails when that file and these structs differ.
 """
 
 from __future__ import annotations
 
 from datetime import datetime, timedelta
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import msgspec
 
 from vahr.protocol.errors import ProtocolError, from_validation_error
-from vahr.protocol.messages import MAX_PAYLOAD_BYTES, Timestamp, check_payload
+
+# The page's structs name these in annotations, which msgspec reads at run time.
+from vahr.protocol.fleet import Floor, Pose  # noqa: TC001
+from vahr.protocol.messages import MAX_PAYLOAD_BYTES, Event, EventKind, Timestamp, check_payload
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
 
 Text = Annotated[str, msgspec.Meta(max_length=1_000)]
 ShortText = Annotated[str, msgspec.Meta(max_length=200)]
@@ -165,9 +176,193 @@ def decode_experiment_status(payload: bytes | bytearray | memoryview) -> Experim
     return result
 
 
+def turn_from_message(message: Mapping[str, Any]) -> AssistantTurn:
+    """A turn from its JSON object (as the in-process simulator hands it over), validated as
+    `decode_turn` validates one from the broker."""
+    try:
+        return msgspec.convert(message, AssistantTurn)
+    except msgspec.ValidationError as err:
+        raise from_validation_error(err) from err
+
+
 def on_clock(at: datetime, sent: datetime, received: datetime) -> datetime:
     """`at` (the page's clock) on the receiver's clock: the page's clock may be off by
     minutes (a tablet), so the time from `at` to `sent` is kept and the whole moved to end
     at `received`. The few milliseconds the message travelled are counted as part of it."""
     lead: timedelta = max(sent - at, timedelta(0))
     return received - lead
+
+
+# -- the page contract: what the station's feed pushes to its pages ---------------------------
+
+# Events after which a robot is no longer driving (the page stops moving it; its progress is
+# over). Not `rejected`: a rejected command never ran and the robot carries on with what it
+# was doing. Not `done`: a drive ends with one of these first, and a ping answered mid-drive
+# says `done` while the robot drives on.
+DRIVE_ENDS: frozenset[EventKind] = frozenset(
+    {"arrived", "delivered", "stopped", "stuck", "failed", "cancelled"}
+)
+# The robots' own exchanges with the assistant, which the conversation shows.
+EXCHANGE_EVENTS: frozenset[EventKind] = frozenset({"said", "heard", "interpreted"})
+
+# A robot's reported shadow state as the robot sent it, passed on whole: a `Reported` (the
+# page shows the raw document too, so fields beyond the contract are kept).
+ReportedState = Annotated[
+    dict[str, Any], msgspec.Meta(extra_json_schema={"$ref": "#/$defs/Reported"})
+]
+
+
+class RobotEntry(msgspec.Struct, frozen=True, kw_only=True):
+    """A robot as the page draws it: its spoken name, its key (1-9, None past nine robots)
+    and where it starts."""
+
+    thing: str
+    name: str
+    key: str | None
+    start: Pose
+
+
+class ZoneEntry(msgspec.Struct, frozen=True, kw_only=True):
+    """A zone as the page draws it, with its key (its first letter, None if another zone
+    took it)."""
+
+    id: str
+    name: str
+    pose: Pose
+    radius: float
+    arm: Literal["loader", "unloader"] | None
+    key: str | None
+
+
+class FleetView(msgspec.Struct, frozen=True, kw_only=True):
+    """The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`)."""
+
+    robots: list[RobotEntry]
+    zones: list[ZoneEntry]
+    floor: Floor
+    experiment_thing: str
+
+
+class RobotView(msgspec.Struct, kw_only=True):
+    """What a page knows of one robot: its reported shadow and version, presence, when it
+    was last seen (ms since the epoch), its last event and the progress of the drive under
+    way. None until known."""
+
+    reported: ReportedState | None
+    version: int | None
+    online: bool | None
+    last_seen: float | None
+    last_event: Event | None
+    progress: Event | None
+
+
+class Acknowledgment(msgspec.Struct, frozen=True):
+    """A robot's first answer to a command (an event, or its shadow's `last_command`
+    result) and the time from the command being seen to it."""
+
+    event: str
+    latency_ms: float
+
+
+class CommandParams(msgspec.Struct, frozen=True, omit_defaults=True):
+    """A command's params as seen: only those of its action are present."""
+
+    zone: str | msgspec.UnsetType = msgspec.UNSET
+    after: str | None | msgspec.UnsetType = msgspec.UNSET
+
+
+class SnapshotMessage(msgspec.Struct, kw_only=True, tag="snapshot", tag_field="type"):
+    """What a page starts from: the fleet, every robot, the conversation so far, the
+    commands seen with their acknowledgments, the session, and the station's clock (ms
+    since the epoch) for the page to correct its own."""
+
+    fleet: FleetView
+    robots: dict[str, RobotView]
+    conversation: list[ConversationEntry]
+    commands: dict[str, CommandMessage]
+    experiment: ExperimentStatus | None
+    server_time: float
+
+
+class ShadowMessage(msgspec.Struct, frozen=True, kw_only=True, tag="shadow", tag_field="type"):
+    """A robot's whole reported state after an accepted update, with its version."""
+
+    thing: str
+    reported: ReportedState
+    version: int
+    last_seen: float | None
+
+
+class PresenceMessage(msgspec.Struct, frozen=True, kw_only=True, tag="presence", tag_field="type"):
+    """A robot came online or went offline."""
+
+    thing: str
+    online: bool
+    last_seen: float | None
+
+
+class EventMessage(Event, frozen=True, tag="event", tag_field="type"):
+    """Anything a robot did (progress, arrived, said, heard, interpreted...), with when the
+    station last heard from it; in the conversation, with the robots it concerns."""
+
+    last_seen: float
+    robots: list[str] = []
+
+
+class CommandMessage(msgspec.Struct, kw_only=True, tag="command", tag_field="type"):
+    """A command seen on a command topic (from the assistant, the console, a robot), to
+    `target` (a thing, or "fleet" for every robot in `robots`); `acks` grows as robots
+    answer. `seen` is when the station saw it (ms since the epoch)."""
+
+    id: str
+    target: str
+    robots: list[str]
+    action: str
+    params: CommandParams
+    source: str
+    seen: float
+    acks: dict[str, Acknowledgment]
+
+
+class AckMessage(msgspec.Struct, frozen=True, kw_only=True, tag="ack", tag_field="type"):
+    """A robot's first answer to a command, with the time it took from the command being
+    seen (the acknowledgment latency the conversation shows)."""
+
+    id: str
+    thing: str
+    event: str
+    latency_ms: float
+
+
+class TurnMessage(AssistantTurn, frozen=True, tag="turn", tag_field="type"):
+    """One exchange with the assistant, with the robots it concerns."""
+
+    robots: list[str]
+
+
+class ExperimentMessage(
+    msgspec.Struct, frozen=True, kw_only=True, tag="experiment", tag_field="type"
+):
+    """The running session, or None when none runs."""
+
+    status: ExperimentStatus | None
+
+
+ConversationEntry = TurnMessage | CommandMessage | EventMessage
+PageMessage = (
+    SnapshotMessage
+    | ShadowMessage
+    | PresenceMessage
+    | EventMessage
+    | CommandMessage
+    | AckMessage
+    | TurnMessage
+    | ExperimentMessage
+)
+
+_page_encoder = msgspec.json.Encoder()
+
+
+def encode_page_message(message: PageMessage) -> bytes:
+    """The JSON of one message to the pages."""
+    return _page_encoder.encode(message)

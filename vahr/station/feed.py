@@ -3,7 +3,8 @@
 `Feed` is transport-free: an MQTT client routes messages to its `on_*` handlers (`routes`),
 and each page holds a `Subscriber` that receives first a snapshot of everything, then one
 message per change, in the order the feed saw them. Messages are JSON objects with a
-`type`:
+`type`, each a struct of `vahr.protocol.station` (`PageMessage`), which the page knows as
+the typedefs of `static/contract.js`:
 
 - `snapshot`: the fleet and its floor, every robot (reported shadow, presence, the last
   event, the progress of the drive under way), the conversation so far, the commands seen
@@ -40,10 +41,35 @@ from vahr.protocol import (
     decode_presence,
     topics,
 )
-from vahr.protocol.station import decode_experiment_status, decode_turn
+from vahr.protocol.station import (
+    DRIVE_ENDS,
+    EXCHANGE_EVENTS,
+    AckMessage,
+    Acknowledgment,
+    AssistantTurn,
+    CommandMessage,
+    CommandParams,
+    ConversationEntry,
+    EventMessage,
+    ExperimentMessage,
+    ExperimentStatus,
+    FleetView,
+    PageMessage,
+    PresenceMessage,
+    RobotEntry,
+    RobotView,
+    ShadowMessage,
+    SnapshotMessage,
+    TurnMessage,
+    ZoneEntry,
+    decode_experiment_status,
+    decode_turn,
+    encode_page_message,
+    turn_from_message,
+)
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Mapping
 
     from vahr.protocol import Fleet
 
@@ -55,12 +81,6 @@ SUBSCRIBER_LIMIT = 20_000
 CONVERSATION_LIMIT = 400
 # Commands whose acknowledgments are followed; older ones are forgotten.
 COMMANDS_LIMIT = 1_000
-# The robots' exchanges with the assistant, shown in the conversation.
-EXCHANGE_EVENTS = frozenset({"said", "heard", "interpreted"})
-# Events after which a robot is no longer driving (its progress is over).
-DRIVE_ENDS = frozenset(
-    {"arrived", "done", "failed", "cancelled", "stopped", "stuck", "rejected", "delivered"}
-)
 Json = dict[str, Any]
 
 
@@ -118,38 +138,37 @@ class Subscriber:
             self._ready.notify()
 
 
-def fleet_view(fleet: Fleet) -> Json:
+def fleet_view(fleet: Fleet) -> FleetView:
     """The fleet as the page draws it: robots with their keys, zones with theirs, the floor."""
     zone_keys: dict[str, str] = {}
     for zone in fleet.zones:
         key = zone.id[0]
         if key not in zone_keys.values():
             zone_keys[zone.id] = key
-    floor = msgspec.to_builtins(fleet.layout())
-    return {
-        "robots": [
-            {
-                "thing": robot.thing,
-                "name": robot.spoken[0],
-                "key": str(index + 1) if index < 9 else None,
-                "start": msgspec.to_builtins(robot.start),
-            }
+    return FleetView(
+        robots=[
+            RobotEntry(
+                thing=robot.thing,
+                name=robot.spoken[0],
+                key=str(index + 1) if index < 9 else None,
+                start=robot.start,
+            )
             for index, robot in enumerate(fleet.robots)
         ],
-        "zones": [
-            {
-                "id": zone.id,
-                "name": zone.spoken[0],
-                "pose": msgspec.to_builtins(zone.pose),
-                "radius": zone.radius,
-                "arm": zone.arm,
-                "key": zone_keys.get(zone.id),
-            }
+        zones=[
+            ZoneEntry(
+                id=zone.id,
+                name=zone.spoken[0],
+                pose=zone.pose,
+                radius=zone.radius,
+                arm=zone.arm,
+                key=zone_keys.get(zone.id),
+            )
             for zone in fleet.zones
         ],
-        "floor": floor,
-        "experiment_thing": fleet.experiment_thing,
-    }
+        floor=fleet.layout(),
+        experiment_thing=fleet.experiment_thing,
+    )
 
 
 class Feed:
@@ -162,20 +181,20 @@ class Feed:
         self._things = frozenset(fleet.robot_things)
         self._lock = threading.Lock()
         self._subscribers: list[Subscriber] = []
-        self._robots: dict[str, Json] = {
-            thing: {
-                "reported": None,
-                "version": None,
-                "online": None,
-                "last_seen": None,
-                "last_event": None,
-                "progress": None,
-            }
+        self._robots: dict[str, RobotView] = {
+            thing: RobotView(
+                reported=None,
+                version=None,
+                online=None,
+                last_seen=None,
+                last_event=None,
+                progress=None,
+            )
             for thing in fleet.robot_things
         }
-        self._conversation: deque[Json] = deque(maxlen=CONVERSATION_LIMIT)
-        self._commands: OrderedDict[str, Json] = OrderedDict()
-        self._experiment: Json | None = None
+        self._conversation: deque[ConversationEntry] = deque(maxlen=CONVERSATION_LIMIT)
+        self._commands: OrderedDict[str, CommandMessage] = OrderedDict()
+        self._experiment: ExperimentStatus | None = None
         self.closed = False
 
     # -- pages ----------------------------------------------------------------------------
@@ -184,7 +203,7 @@ class Feed:
         """A new page's queue, starting with a snapshot; nothing is missed in between."""
         subscriber = Subscriber(limit)
         with self._lock:
-            subscriber.push(_encode({"type": "snapshot", **self._snapshot()}))
+            subscriber.push(encode_page_message(self._snapshot()))
             if self.closed:
                 subscriber.close()
             else:
@@ -203,18 +222,22 @@ class Feed:
             return len(self._subscribers)
 
     def snapshot(self) -> Json:
+        """What a new page starts from (`SnapshotMessage`), as JSON-ready builtins: a copy."""
         with self._lock:
-            return self._snapshot()
+            snapshot: Json = msgspec.to_builtins(self._snapshot())
+            return snapshot
 
-    def _snapshot(self) -> Json:
-        return {
-            "fleet": self.view,
-            "robots": {thing: dict(state) for thing, state in self._robots.items()},
-            "conversation": list(self._conversation),
-            "commands": {key: dict(value) for key, value in self._commands.items()},
-            "experiment": self._experiment,
-            "server_time": self._clock(),
-        }
+    def _snapshot(self) -> SnapshotMessage:
+        """Call with the lock held, and encode before letting go of it: the robots and the
+        commands in it are the feed's own, which change as messages come."""
+        return SnapshotMessage(
+            fleet=self.view,
+            robots=self._robots,
+            conversation=list(self._conversation),
+            commands=self._commands,
+            experiment=self._experiment,
+            server_time=self._clock(),
+        )
 
     def close(self) -> None:
         """End every page's stream (the server is stopping)."""
@@ -224,9 +247,9 @@ class Feed:
         for subscriber in subscribers:
             subscriber.close()
 
-    def _broadcast(self, message: Json, key: str | None = None) -> None:
+    def _broadcast(self, message: PageMessage, key: str | None = None) -> None:
         """Send `message` to every page; call with the lock held, so order is kept."""
-        encoded = _encode(message)
+        encoded = encode_page_message(message)
         dropped = []
         for subscriber in self._subscribers:
             subscriber.push(encoded, key)
@@ -283,22 +306,18 @@ class Feed:
     def _shadow(self, thing: str, reported: Json, version: int, seen: float | None) -> None:
         with self._lock:
             robot = self._robots[thing]
-            if robot["version"] is not None and version <= robot["version"]:
+            if robot.version is not None and version <= robot.version:
                 return  # an older document than one already shown (start-up read raced)
-            robot.update(reported=reported, version=version)
+            robot.reported, robot.version = reported, version
             if seen is not None:
-                robot["last_seen"] = max(robot["last_seen"] or 0, seen)
+                robot.last_seen = max(robot.last_seen or 0, seen)
             if reported.get("status") != "navigating":
-                robot["progress"] = None
+                robot.progress = None
             self._acknowledged_by_shadow(thing, reported)
             self._broadcast(
-                {
-                    "type": "shadow",
-                    "thing": thing,
-                    "reported": reported,
-                    "version": version,
-                    "last_seen": robot["last_seen"],
-                }
+                ShadowMessage(
+                    thing=thing, reported=reported, version=version, last_seen=robot.last_seen
+                )
             )
 
     def on_presence(self, topic: str, payload: bytes) -> None:
@@ -313,16 +332,11 @@ class Feed:
         thing = parsed[0]
         with self._lock:
             robot = self._robots[thing]
-            robot["online"] = presence.online
+            robot.online = presence.online
             if presence.online:
-                robot["last_seen"] = max(robot["last_seen"] or 0, self._clock())
+                robot.last_seen = max(robot.last_seen or 0, self._clock())
             self._broadcast(
-                {
-                    "type": "presence",
-                    "thing": thing,
-                    "online": presence.online,
-                    "last_seen": robot["last_seen"],
-                }
+                PresenceMessage(thing=thing, online=presence.online, last_seen=robot.last_seen)
             )
 
     def on_event(self, topic: str, payload: bytes) -> None:
@@ -336,23 +350,24 @@ class Feed:
             return
         if event.thing != parsed[0]:
             return  # a robot speaking for another is not believed
-        body: Json = msgspec.to_builtins(event)
         now = self._clock()
         with self._lock:
             robot = self._robots[event.thing]
-            robot["last_seen"] = now
-            robot["last_event"] = body
+            robot.last_seen = now
+            robot.last_event = event
             if event.event == "progress":
-                robot["progress"] = body
+                robot.progress = event
             elif event.event in DRIVE_ENDS:
-                robot["progress"] = None
+                robot.progress = None
             if event.command_id is not None:
                 self._acknowledged(event.command_id, event.thing, event.event, now)
-            message = {"type": "event", **body, "last_seen": now}
+            fields = msgspec.structs.asdict(event)
             if event.event in EXCHANGE_EVENTS:
-                self._conversation.append({**message, "robots": [event.thing]})
+                self._conversation.append(
+                    EventMessage(**fields, last_seen=now, robots=[event.thing])
+                )
             progress = f"progress:{event.thing}" if event.event == "progress" else None
-            self._broadcast(message, progress)
+            self._broadcast(EventMessage(**fields, last_seen=now), progress)
 
     def on_command(self, topic: str, payload: bytes) -> None:
         parsed = topics.parse_robot_topic(topic)
@@ -364,17 +379,16 @@ class Feed:
             return  # the robot rejects it and says why; its event shows that
         target = parsed[0] if parsed is not None else "fleet"
         things = sorted(self._things) if target == "fleet" else [target]
-        body: Json = {
-            "type": "command",
-            "id": command.id,
-            "target": target,
-            "robots": things,
-            "action": command.action,
-            "params": msgspec.to_builtins(command.params),
-            "source": command.source,
-            "seen": self._clock(),
-            "acks": {},
-        }
+        body = CommandMessage(
+            id=command.id,
+            target=target,
+            robots=things,
+            action=command.action,
+            params=msgspec.convert(msgspec.to_builtins(command.params), CommandParams),
+            source=command.source,
+            seen=self._clock(),
+            acks={},
+        )
         with self._lock:
             if command.id in self._commands:
                 return  # the same command twice (a retry) is one command
@@ -388,13 +402,11 @@ class Feed:
 
     def _acknowledged(self, command_id: str, thing: str, how: str, at: float) -> None:
         command = self._commands.get(command_id)
-        if command is None or thing in command["acks"] or thing not in command["robots"]:
+        if command is None or thing in command.acks or thing not in command.robots:
             return
-        latency = round(max(0.0, at - command["seen"]), 1)
-        command["acks"][thing] = {"event": how, "latency_ms": latency}
-        self._broadcast(
-            {"type": "ack", "id": command_id, "thing": thing, "event": how, "latency_ms": latency}
-        )
+        latency = round(max(0.0, at - command.seen), 1)
+        command.acks[thing] = Acknowledgment(how, latency)
+        self._broadcast(AckMessage(id=command_id, thing=thing, event=how, latency_ms=latency))
 
     def _acknowledged_by_shadow(self, thing: str, reported: Json) -> None:
         last = reported.get("last_command")
@@ -403,25 +415,34 @@ class Feed:
 
     def on_turn(self, topic: str, payload: bytes) -> None:
         try:
-            turn = msgspec.to_builtins(decode_turn(payload))
+            turn = decode_turn(payload)
         except ProtocolError as err:
             log.warning("ignoring a turn: %s", err)
             return
         self.add_turn(turn)
 
-    def add_turn(self, turn: Json) -> None:
-        """One exchange with the assistant (from the broker, or the station's own)."""
+    def add_turn(self, turn: AssistantTurn | Mapping[str, Any]) -> None:
+        """One exchange with the assistant: from the broker, or the station's own (the
+        in-process simulator's turn message, validated here as a decoded one is)."""
+        if not isinstance(turn, AssistantTurn):
+            try:
+                turn = turn_from_message(turn)
+            except ProtocolError as err:
+                log.warning("ignoring a turn: %s", err)
+                return
         with self._lock:
-            robots = set()
-            for command_id in turn.get("commands") or []:
-                robots.update(self._commands.get(command_id, {}).get("robots", []))
-            for slot in (turn.get("slots") or {}).values():
-                value = slot.get("id") if isinstance(slot, dict) else None
+            robots: set[str] = set()
+            for command_id in turn.commands:
+                seen = self._commands.get(command_id)
+                if seen is not None:
+                    robots.update(seen.robots)
+            for slot in turn.slots.values():
+                value = slot.get("id")
                 if value in self._things:
                     robots.add(value)
                 elif value == FLEET_GROUP:
                     robots.update(self._things)
-            message = {"type": "turn", **turn, "robots": sorted(robots)}
+            message = TurnMessage(**msgspec.structs.asdict(turn), robots=sorted(robots))
             self._conversation.append(message)
             self._broadcast(message)
 
@@ -434,21 +455,21 @@ class Feed:
         except ProtocolError as err:
             log.warning("ignoring the experiment status: %s", err)
             return
-        self.set_experiment(msgspec.to_builtins(status))
+        self.set_experiment(status)
 
-    def set_experiment(self, status: Json | None) -> None:
+    def set_experiment(self, status: ExperimentStatus | None) -> None:
         with self._lock:
             self._experiment = status
-            self._broadcast({"type": "experiment", "status": status})
+            self._broadcast(ExperimentMessage(status=status))
 
     @property
     def experiment(self) -> Json | None:
+        """The running session's status as JSON-ready builtins (what the desk reads), or None."""
         with self._lock:
-            return self._experiment
-
-
-def _encode(message: Json) -> bytes:
-    return msgspec.json.encode(message)
+            if self._experiment is None:
+                return None
+            status: Json = msgspec.to_builtins(self._experiment)
+            return status
 
 
 def _timestamps(metadata: object) -> list[float]:

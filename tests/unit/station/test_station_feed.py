@@ -3,15 +3,21 @@
 from __future__ import annotations
 
 import json
+from datetime import UTC, datetime
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 import pytest
 
 from vahr.protocol import Event, EventPose, Presence, encode, new_command, topics, utc_now
+from vahr.protocol.station import PageMessage, ShadowMessage, SnapshotMessage, TurnMessage
 from vahr.station.feed import Feed, Subscriber, fleet_view
 
 if TYPE_CHECKING:
     from vahr.protocol import Fleet
+
+
+PAGE = msgspec.json.Decoder(PageMessage)
 
 
 class Clock:
@@ -217,8 +223,74 @@ def test_an_experiment_status_and_its_clearing_reach_pages(feed: Feed) -> None:
 
 
 def test_a_fleet_without_a_floor_gets_keys_and_one(fleet: Fleet) -> None:
-    import msgspec
-
     bare = msgspec.structs.replace(fleet, floor=None)
     view = fleet_view(bare)
-    assert view["floor"]["width"] > 0 and len(view["floor"]["walls"]) == 4
+    assert view.floor.width > 0 and len(view.floor.walls) == 4
+
+
+def test_every_message_a_page_is_sent_is_a_page_message_of_the_contract(
+    feed: Feed, clock: Clock
+) -> None:
+    page = feed.subscribe()
+    command = new_command("navigate", {"zone": "B"}, source="console")
+    # When every kind of broker message reaches the feed
+    feed.on_command(topics.robot_cmd("placebot1"), encode(command))
+    feed.on_event(topics.robot_events("placebot1"), event("accepted", command_id=command.id))
+    feed.on_shadow_documents(
+        topics.shadow("placebot1", "update/documents"),
+        documents({"status": "navigating", "destination": "B", "extra": [1]}, 3),
+    )
+    feed.on_presence(
+        topics.robot_presence("placebot2"), encode(Presence(online=True, at=utc_now()))
+    )
+    feed.on_turn(topics.ASSISTANT_TURNS, b'{"utterance": "hi", "speech": "Hello."}')
+    feed.on_experiment_status(
+        topics.EXPERIMENT_STATUS,
+        b'{"session": "P01-vahr-trial1", "participant": "P01", "method": "vahr", "trial": 1}',
+    )
+    # Then each message the page gets decodes as the contract's struct of its type
+    told = [PAGE.decode(message) for message in page.take(0) or []]
+    assert [m.__struct_config__.tag for m in told] == [
+        "snapshot", "command", "ack", "event", "shadow", "presence", "turn", "experiment"
+    ]  # fmt: skip
+    # And what the robot reported is passed on whole, fields beyond the contract too
+    shadow = told[4]
+    assert isinstance(shadow, ShadowMessage) and shadow.reported["extra"] == [1]
+    # And a new page's snapshot holds the same, as a page message too
+    (snapshot,) = [PAGE.decode(m) for m in feed.subscribe().take(0) or []]
+    assert isinstance(snapshot, SnapshotMessage)
+    assert snapshot.commands[command.id].acks["placebot1"].event == "accepted"
+
+
+def test_a_rejected_command_or_a_ping_answered_mid_drive_does_not_end_the_drive(
+    feed: Feed,
+) -> None:
+    events = topics.robot_events("placebot1")
+    feed.on_event(events, event("progress", progress=0.4, pose=EventPose(2.0, 3.0)))
+    # When the robot rejects a bad command and answers a ping while it drives
+    feed.on_event(events, event("rejected", reason="params.zone: 'Q' is not a zone"))
+    feed.on_event(events, event("done", action="ping"))
+    # Then the drive's progress is still shown
+    assert feed.snapshot()["robots"]["placebot1"]["progress"]["progress"] == 0.4
+    # And arriving ends it
+    feed.on_event(events, event("arrived", zone="B"))
+    assert feed.snapshot()["robots"]["placebot1"]["progress"] is None
+
+
+def test_the_stations_own_turns_reach_pages_as_the_brokers_do(feed: Feed) -> None:
+    page = feed.subscribe()
+    messages(page)
+    # The in-process simulator's turn message keeps its defaults and its time as text
+    simulated = {
+        "speech": "Hello.", "intent": None, "slots": {}, "commands": [], "latency_ms": 3.0,
+        "session_open": False, "request_type": "IntentRequest", "reprompt": None,
+        "origin": "station", "utterance": "hi", "at": "2026-11-23T10:00:00+00:00",
+    }  # fmt: skip
+    feed.add_turn(simulated)
+    feed.on_turn(topics.ASSISTANT_TURNS, json.dumps(simulated).encode())
+    feed.add_turn({**simulated, "origin": "Not An Origin"})  # not a turn: ignored
+    first, second = (PAGE.decode(message) for message in page.take(0) or [])
+    # Then the page sees one turn, whichever way it came (defaults may be left out)
+    assert first == second
+    assert isinstance(first, TurnMessage) and first.robots == [] and first.origin == "station"
+    assert first.at == datetime(2026, 11, 23, 10, 0, tzinfo=UTC)

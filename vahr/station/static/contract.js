@@ -1,0 +1,363 @@
+// @ts-check
+// The station's page contract: the messages the page is sent and sends, and the constants
+// it shares with the station. Generated from vahr/protocol/station.py by
+// `python -m vahr.station.contract`: do not edit; change the structs and run it again.
+
+/**
+ * A robot's first answer to a command, with the time it took from the command being seen (the
+ * acknowledgment latency the conversation shows).
+ * @typedef {object} AckMessage
+ * @property {"ack"} type
+ * @property {string} id
+ * @property {string} thing
+ * @property {string} event
+ * @property {number} latency_ms
+ */
+
+/**
+ * A robot's first answer to a command (an event, or its shadow's `last_command` result) and the
+ * time from the command being seen to it.
+ * @typedef {object} Acknowledgment
+ * @property {string} event
+ * @property {number} latency_ms
+ */
+
+/**
+ * A command seen on a command topic (from the assistant, the console, a robot), to `target` (a
+ * thing, or "fleet" for every robot in `robots`); `acks` grows as robots answer. `seen` is when
+ * the station saw it (ms since the epoch).
+ * @typedef {object} CommandMessage
+ * @property {"command"} type
+ * @property {string} id
+ * @property {string} target
+ * @property {Array<string>} robots
+ * @property {string} action
+ * @property {CommandParams} params
+ * @property {string} source
+ * @property {number} seen
+ * @property {Record<string, Acknowledgment>} acks
+ */
+
+/**
+ * A command's params as seen: only those of its action are present.
+ * @typedef {object} CommandParams
+ * @property {string} [zone]
+ * @property {string|null} [after]
+ */
+
+/**
+ * The belt that brings packages to the loading arm: its centre line and width.
+ * @typedef {object} Conveyor
+ * @property {Point} start
+ * @property {Point} end
+ * @property {number} width
+ */
+
+/**
+ * What a robot did, published on `vahr/robots/{thing}/events`.
+ *
+ * Only the fields that apply are sent: `zone` for arrived/loaded/delivered, `reason` for
+ * rejected/failed/stuck/cancelled, `progress` (0..1) for progress, `text` for what was said or
+ * heard, `intent` and `confidence` for interpreted.
+ * @typedef {object} Event
+ * @property {"accepted"|"arrived"|"cancelled"|"delivered"|"done"|"failed"|"heard"|"interpreted"|"loaded"|"progress"|"rejected"|"said"|"stopped"|"stuck"|"waiting"} event
+ * @property {string} thing
+ * @property {string} at
+ * @property {string|null} [command_id]
+ * @property {string|null} [action]
+ * @property {string|null} [zone]
+ * @property {string|null} [reason]
+ * @property {number|null} [progress]
+ * @property {EventPose|null} [pose]
+ * @property {string|null} [text]
+ * @property {string|null} [intent]
+ * @property {number|null} [confidence]
+ */
+
+/**
+ * Anything a robot did (progress, arrived, said, heard, interpreted...), with when the station
+ * last heard from it; in the conversation, with the robots it concerns.
+ * @typedef {object} EventMessage
+ * @property {"event"} type
+ * @property {number} last_seen
+ * @property {Array<string>} [robots]
+ * @property {"accepted"|"arrived"|"cancelled"|"delivered"|"done"|"failed"|"heard"|"interpreted"|"loaded"|"progress"|"rejected"|"said"|"stopped"|"stuck"|"waiting"} event
+ * @property {string} thing
+ * @property {string} at
+ * @property {string|null} [command_id]
+ * @property {string|null} [action]
+ * @property {string|null} [zone]
+ * @property {string|null} [reason]
+ * @property {number|null} [progress]
+ * @property {EventPose|null} [pose]
+ * @property {string|null} [text]
+ * @property {string|null} [intent]
+ * @property {number|null} [confidence]
+ */
+
+/**
+ * @typedef {object} EventPose
+ * @property {number} x
+ * @property {number} y
+ * @property {number} theta
+ */
+
+/**
+ * The running session, or None when none runs.
+ * @typedef {object} ExperimentMessage
+ * @property {"experiment"} type
+ * @property {ExperimentStatus|null} status
+ */
+
+/**
+ * The running session for the station (retained on `topics.EXPERIMENT_STATUS`).
+ *
+ * The weather is left out on purpose: a keyboard-and-mouse participant learns it by asking the
+ * assistant, and the station shows only what was answered.
+ * @typedef {object} ExperimentStatus
+ * @property {string} session
+ * @property {string} participant
+ * @property {"keyboard"|"vahr"} method
+ * @property {number} trial
+ * @property {boolean} [simulated]
+ * @property {Record<string, string>} [assignments]
+ * @property {"I"|"II"|"III"|null} [task]
+ * @property {Record<string, TaskStatus>} [tasks]
+ * @property {Array<string>} [allowed]
+ * @property {number} [puzzle]
+ * @property {boolean} [led_on]
+ * @property {string|null} [started_at]
+ * @property {boolean} [ended]
+ * @property {string|null} [at]
+ */
+
+/**
+ * The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`).
+ * @typedef {object} FleetView
+ * @property {Array<RobotEntry>} robots
+ * @property {Array<ZoneEntry>} zones
+ * @property {Floor} floor
+ * @property {string} experiment_thing
+ */
+
+/**
+ * The floor as drawn: the rectangle from `origin` of `width` by `height` metres, its walls, the
+ * conveyor, where each zone's arm stands (by zone id) and the task III LED.
+ * @typedef {object} Floor
+ * @property {number} width
+ * @property {number} height
+ * @property {Point} origin
+ * @property {Array<Segment>} walls
+ * @property {Conveyor|null} conveyor
+ * @property {Record<string, Point>} arms
+ * @property {Point|null} led
+ */
+
+/**
+ * What the recognizer made of a spoken clip.
+ * @typedef {object} Heard
+ * @property {string} transcript
+ * @property {number} confidence
+ * @property {boolean} accepted
+ * @property {number} [seconds]
+ */
+
+/**
+ * A click, key press or push-to-talk on the station, sent when it starts and when it ends (same
+ * `id`). The end says what came of it: the commands it sent, or for a question to the assistant
+ * (`asks`) the reply; `counts` is False for input that sends nothing by design (selecting a
+ * robot), which is interaction time but not communication.
+ * @typedef {object} Interaction
+ * @property {"interaction"} kind
+ * @property {string} session
+ * @property {string} id
+ * @property {"ended"|"started"} phase
+ * @property {"click"|"key"|"voice"} channel
+ * @property {string} at
+ * @property {string} sent
+ * @property {string} [text]
+ * @property {Array<string>} [commands]
+ * @property {boolean} [counts]
+ * @property {boolean} [asks]
+ * @property {string|null} [speech]
+ * @property {string|null} [intent]
+ * @property {string|null} [error]
+ */
+
+/**
+ * The last command a robot saw and what became of it. `id` is what the skill waits for.
+ * @typedef {object} LastCommand
+ * @property {string} id
+ * @property {string} action
+ * @property {"accepted"|"cancelled"|"done"|"failed"|"rejected"} result
+ * @property {string|null} [reason]
+ */
+
+/**
+ * A point on the floor in the `map` frame, in metres.
+ * @typedef {object} Point
+ * @property {number} x
+ * @property {number} y
+ */
+
+/**
+ * A planar pose in the `map` frame: metres and radians.
+ * @typedef {object} Pose
+ * @property {number} x
+ * @property {number} y
+ * @property {number} theta
+ */
+
+/**
+ * A robot came online or went offline.
+ * @typedef {object} PresenceMessage
+ * @property {"presence"} type
+ * @property {string} thing
+ * @property {boolean} online
+ * @property {number|null} last_seen
+ */
+
+/**
+ * Puzzle pieces the observer counted (a negative count corrects a miscount).
+ * @typedef {object} PuzzleInput
+ * @property {"puzzle"} kind
+ * @property {string} session
+ * @property {number} count
+ * @property {string} at
+ * @property {string} sent
+ */
+
+/**
+ * A robot's reported state. The first five fields are the contract; the rest help speech.
+ * @typedef {object} Reported
+ * @property {"error"|"idle"|"loading"|"navigating"|"stopped"|"stuck"|"unloading"|"waiting"} [status]
+ * @property {string|null} [zone]
+ * @property {boolean} [cargo]
+ * @property {LastCommand|null} [last_command]
+ * @property {boolean} [connected]
+ * @property {string|null} [destination]
+ * @property {string|null} [task]
+ * @property {ShadowPose|null} [pose]
+ */
+
+/**
+ * A robot as the page draws it: its spoken name, its key (1-9, None past nine robots) and where
+ * it starts.
+ * @typedef {object} RobotEntry
+ * @property {string} thing
+ * @property {string} name
+ * @property {string|null} key
+ * @property {Pose} start
+ */
+
+/**
+ * What a page knows of one robot: its reported shadow and version, presence, when it was last
+ * seen (ms since the epoch), its last event and the progress of the drive under way. None until
+ * known.
+ * @typedef {object} RobotView
+ * @property {Reported|null} reported
+ * @property {number|null} version
+ * @property {boolean|null} online
+ * @property {number|null} last_seen
+ * @property {Event|null} last_event
+ * @property {Event|null} progress
+ */
+
+/**
+ * A straight piece of wall from `start` to `end`.
+ * @typedef {object} Segment
+ * @property {Point} start
+ * @property {Point} end
+ */
+
+/**
+ * A robot's whole reported state after an accepted update, with its version.
+ * @typedef {object} ShadowMessage
+ * @property {"shadow"} type
+ * @property {string} thing
+ * @property {Reported} reported
+ * @property {number} version
+ * @property {number|null} last_seen
+ */
+
+/**
+ * @typedef {object} ShadowPose
+ * @property {number} x
+ * @property {number} y
+ * @property {number} [theta]
+ */
+
+/**
+ * What a page starts from: the fleet, every robot, the conversation so far, the commands seen
+ * with their acknowledgments, the session, and the station's clock (ms since the epoch) for the
+ * page to correct its own.
+ * @typedef {object} SnapshotMessage
+ * @property {"snapshot"} type
+ * @property {FleetView} fleet
+ * @property {Record<string, RobotView>} robots
+ * @property {Array<TurnMessage|CommandMessage|EventMessage>} conversation
+ * @property {Record<string, CommandMessage>} commands
+ * @property {ExperimentStatus|null} experiment
+ * @property {number} server_time
+ */
+
+/**
+ * One task as the judge sees it now: not started, running (with the verdict so far), or ended
+ * with success or failure and why.
+ * @typedef {object} TaskStatus
+ * @property {"failure"|"running"|"success"|"waiting"} state
+ * @property {string} [reason]
+ * @property {string} [title]
+ * @property {string|null} [started_at]
+ * @property {string|null} [ended_at]
+ */
+
+/**
+ * One exchange with the assistant, with the robots it concerns.
+ * @typedef {object} TurnMessage
+ * @property {"turn"} type
+ * @property {Array<string>} robots
+ * @property {string} utterance
+ * @property {string} speech
+ * @property {string|null} [intent]
+ * @property {Record<string, Record<string, string|null>>} [slots]
+ * @property {Array<string>} [commands]
+ * @property {number} [latency_ms]
+ * @property {boolean} [session_open]
+ * @property {string} [request_type]
+ * @property {string|null} [reprompt]
+ * @property {string} [origin]
+ * @property {Heard|null} [heard]
+ * @property {string|null} [at]
+ */
+
+/**
+ * A zone as the page draws it, with its key (its first letter, None if another zone took it).
+ * @typedef {object} ZoneEntry
+ * @property {string} id
+ * @property {string} name
+ * @property {Pose} pose
+ * @property {number} radius
+ * @property {"loader"|"unloader"|null} arm
+ * @property {string|null} key
+ */
+
+/** @typedef {SnapshotMessage|ShadowMessage|PresenceMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage} PageMessage */
+
+/** @typedef {TurnMessage|CommandMessage|EventMessage} ConversationEntry */
+
+/** @typedef {Interaction|PuzzleInput} StationInput */
+
+/** What a robot can report it did. @typedef {"accepted"|"rejected"|"progress"|"arrived"|"loaded"|"delivered"|"stuck"|"failed"|"stopped"|"done"|"cancelled"|"waiting"|"said"|"heard"|"interpreted"} EventKind */
+
+/** Events after which a robot is no longer driving: the page stops moving it. @type {ReadonlyArray<EventKind>} */
+export const DRIVE_ENDS = Object.freeze(["arrived", "cancelled", "delivered", "failed", "stopped", "stuck"]);
+
+/** The robots' own exchanges with the assistant, which the conversation shows. @type {ReadonlyArray<EventKind>} */
+export const EXCHANGE_EVENTS = Object.freeze(["heard", "interpreted", "said"]);
+
+/** Commands whose acknowledgments the station follows; older ones are forgotten. @type {number} */
+export const COMMANDS_LIMIT = 1000;
+
+/** Conversation entries the station keeps for a new page. @type {number} */
+export const CONVERSATION_LIMIT = 400;
