@@ -20,7 +20,7 @@ from vahr.protocol import Presence, ProtocolError, decode_command, decode_event,
 
 if TYPE_CHECKING:
     from robot_agent.backends.port import NavigationBackend
-    from robot_agent.core.clock import Clock
+    from robot_agent.clock import Clock
     from robot_agent.core.executor import ExecutorSettings
     from robot_agent.core.recent_ids import RecentIds
     from robot_agent.voice.port import Voice

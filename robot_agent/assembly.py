@@ -24,8 +24,8 @@ if TYPE_CHECKING:
     import asyncio
 
     from robot_agent.backends.port import NavigationBackend
+    from robot_agent.clock import ScaledClock
     from robot_agent.config import AgentConfig
-    from robot_agent.core.clock import ScaledClock
     from robot_agent.link.mqtt5 import Mqtt5Link
     from robot_agent.voice.port import Voice
     from vahr.protocol import Fleet

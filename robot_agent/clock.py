@@ -1,5 +1,8 @@
 """Injected time: the executor and the simulator never call `time` or `asyncio.sleep` directly.
 
+It sits beside the core rather than in it: the simulator backend keeps time too, and a
+backend never imports the core that drives it.
+
 A `ScaledClock` runs simulated time `speed_factor` times faster than the wall clock, so a
 30-second delivery takes 0.3 s in a test with a factor of 100. Timestamps on the wire stay
 wall-clock UTC (`now`), since peers and the skill compare them with their own clocks.

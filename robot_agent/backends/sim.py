@@ -20,7 +20,7 @@ from vahr.protocol import Pose
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from robot_agent.core.clock import Clock
+    from robot_agent.clock import Clock
     from vahr.protocol import Zone
 
 

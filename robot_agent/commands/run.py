@@ -61,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
 
 async def serve(config: AgentConfig) -> int:
     from robot_agent.assembly import build_agent, build_link, build_voice, load_robot_fleet
-    from robot_agent.core.clock import ScaledClock
+    from robot_agent.clock import ScaledClock
 
     # Everything that can be wrong in the settings fails before anything connects.
     fleet = load_robot_fleet(config)

@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from collections.abc import Awaitable, Callable
 
     from robot_agent.backends.port import NavigationBackend, Progress
-    from robot_agent.core.clock import Clock
+    from robot_agent.clock import Clock
     from robot_agent.voice.port import Voice
     from vahr.protocol import Command, Fleet, Pose, Result, Status, Zone
 

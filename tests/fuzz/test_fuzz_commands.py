@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 
 from robot_agent.agent import RobotAgent
 from robot_agent.backends.sim import SimBackend
-from robot_agent.core.clock import ScaledClock
+from robot_agent.clock import ScaledClock
 from robot_agent.core.recent_ids import RecentIds
 from tests.fuzz.strategies import command_payloads
 from tests.fuzz.tally import TALLY, budget

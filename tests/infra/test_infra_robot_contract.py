@@ -20,8 +20,8 @@ from infra.constructs.robot_policy import RobotPolicy
 from robot_agent.agent import RobotAgent
 from robot_agent.assembly import build_link
 from robot_agent.backends.sim import SimBackend
+from robot_agent.clock import ScaledClock
 from robot_agent.config import AgentConfig, SimSettings
-from robot_agent.core.clock import ScaledClock
 from robot_agent.core.recent_ids import RecentIds
 from vahr.protocol import encode, new_command, topics
 

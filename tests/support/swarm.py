@@ -28,8 +28,8 @@ from typing import TYPE_CHECKING, Any
 
 from robot_agent.agent import RobotAgent
 from robot_agent.backends.sim import SimBackend
+from robot_agent.clock import ScaledClock
 from robot_agent.config import ExecutorSettings, SimSettings
-from robot_agent.core.clock import ScaledClock
 from robot_agent.core.recent_ids import RecentIds
 from vahr.errors import VahrError
 from vahr.protocol import (

@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
+from robot_agent.clock import ScaledClock
 from robot_agent.config import ExecutorSettings
-from robot_agent.core.clock import ScaledClock
 from robot_agent.core.executor import Executor
 from tests.unit.agent.conftest import Recorder
 from vahr.local.lifetime import spawn

@@ -10,8 +10,8 @@ from typing import TYPE_CHECKING
 import pytest
 
 from robot_agent.backends.sim import SimBackend
+from robot_agent.clock import ScaledClock
 from robot_agent.config import ExecutorSettings, SimSettings
-from robot_agent.core.clock import ScaledClock
 from robot_agent.core.executor import Executor
 
 if TYPE_CHECKING:

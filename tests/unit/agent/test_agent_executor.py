@@ -358,7 +358,7 @@ class ThreadedFeedbackBackend:
 
 
 async def test_no_progress_is_reported_for_a_task_after_its_cancelled_event(fleet: Fleet) -> None:
-    from robot_agent.core.clock import ScaledClock
+    from robot_agent.clock import ScaledClock
     from robot_agent.core.executor import Executor
     from tests.unit.agent.conftest import Recorder
 

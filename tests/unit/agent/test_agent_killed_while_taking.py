@@ -15,8 +15,8 @@ import pytest
 
 from robot_agent.agent import RobotAgent
 from robot_agent.backends.sim import SimBackend
+from robot_agent.clock import ScaledClock
 from robot_agent.config import SimSettings
-from robot_agent.core.clock import ScaledClock
 from robot_agent.core.in_flight import InFlight
 from robot_agent.core.recent_ids import RecentIds
 from vahr.protocol import decode_event, encode, new_command, topics
