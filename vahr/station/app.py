@@ -27,6 +27,7 @@ from vahr.errors import VahrError
 from vahr.experiment.procedures import ProcedureViolation
 from vahr.protocol import ProtocolError
 from vahr.speech.errors import SpeechError
+from vahr.station.errors import RequestError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -45,15 +46,6 @@ MAX_SPEECH_CHARS = 1_000
 SAY_ORIGINS = frozenset({"station", "station-weather"})
 
 Json = dict[str, Any]
-
-
-class RequestError(Exception):
-    """A request the station refuses: `status` and a one-line reason."""
-
-    def __init__(self, status: int, message: str) -> None:
-        super().__init__(message)
-        self.status = status
-        self.message = message
 
 
 @dataclass(frozen=True)

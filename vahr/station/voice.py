@@ -18,7 +18,7 @@ import wave
 from typing import TYPE_CHECKING, Any
 
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio
-from vahr.station.app import RequestError
+from vahr.station.errors import RequestError
 
 if TYPE_CHECKING:
     from collections.abc import Callable

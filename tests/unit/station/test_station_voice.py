@@ -11,7 +11,7 @@ import pytest
 
 from vahr.speech.pronounce import arpabet, compound_phones
 from vahr.speech.stt import NOTHING_HEARD, Recognition
-from vahr.station.app import RequestError
+from vahr.station.errors import RequestError
 from vahr.station.vocabulary import load_model, sentences, spell_numbers
 from vahr.station.voice import SORRY, PushToTalk, read_clip
 
