@@ -18,7 +18,6 @@ from __future__ import annotations
 import hashlib
 import json
 import zlib
-from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -28,6 +27,7 @@ import numpy as np
 
 from vahr.errors import VahrError
 from vahr.speech.audio import Audio, add_white_noise
+from vahr.speech.scoring import OutcomeTally
 from vahr.speech.text import normalize
 
 if TYPE_CHECKING:
@@ -158,28 +158,10 @@ def load_manifest(directory: Path) -> Manifest:
 
 
 @dataclass
-class Tally:
-    """Outcomes for one group of clips."""
-
-    counts: Counter[str] = field(default_factory=Counter)
-
-    @property
-    def total(self) -> int:
-        return sum(self.counts.values())
-
-    def rate(self, outcome: str) -> float:
-        return self.counts[outcome] / self.total if self.total else 0.0
-
-    def to_json(self) -> dict[str, Any]:
-        rates = {f"{outcome}_rate": round(self.rate(outcome), 4) for outcome in OUTCOMES}
-        return {"n": self.total, **{o: self.counts[o] for o in OUTCOMES}, **rates}
-
-
-@dataclass
 class Report:
     """Tallies per condition and expected intent, plus every clip that went wrong."""
 
-    tallies: dict[str, dict[str, Tally]] = field(default_factory=dict)
+    tallies: dict[str, dict[str, OutcomeTally]] = field(default_factory=dict)
     misses: list[dict[str, Any]] = field(default_factory=list)
     seconds: list[float] = field(default_factory=list)
 
@@ -187,7 +169,7 @@ class Report:
         outcome = outcome_of(clip.expected, heard.intent)
         group = clip.expected if clip.expected != "unknown" else UNRELATED
         by_intent = self.tallies.setdefault(clip.condition, {})
-        by_intent.setdefault(group, Tally()).counts[outcome] += 1
+        by_intent.setdefault(group, OutcomeTally(OUTCOMES)).counts[outcome] += 1
         self.seconds.append(seconds)
         if outcome != "right":
             self.misses.append(
@@ -195,21 +177,22 @@ class Report:
                  "intent": heard.intent, "heard": heard.text, "reason": heard.reason}
             )  # fmt: skip
 
-    def tally(self, condition: str, group: str) -> Tally:
-        return self.tallies.get(condition, {}).get(group, Tally())
+    def tally(self, condition: str, group: str) -> OutcomeTally:
+        return self.tallies.get(condition, {}).get(group, OutcomeTally(OUTCOMES))
 
-    def answers(self, condition: str) -> Tally:
+    def answers(self, condition: str) -> OutcomeTally:
         """Sunny and rainy together, for one condition."""
-        joined = Tally()
+        joined = OutcomeTally(OUTCOMES)
         for group, tally in self.tallies.get(condition, {}).items():
             if group != UNRELATED:
-                joined.counts.update(tally.counts)
+                joined.add(tally)
         return joined
 
-    def unrelated(self) -> Tally:
-        joined = Tally()
+    def unrelated(self) -> OutcomeTally:
+        joined = OutcomeTally(OUTCOMES)
         for by_intent in self.tallies.values():
-            joined.counts.update(by_intent.get(UNRELATED, Tally()).counts)
+            if UNRELATED in by_intent:
+                joined.add(by_intent[UNRELATED])
         return joined
 
     def to_json(self) -> dict[str, Any]:

@@ -20,7 +20,9 @@ def budget(ci: int) -> int:
     return ci if profile_examples <= 100 else max(ci, profile_examples)
 
 
-class Tally:
+class InputTally:
+    """Generated inputs per boundary: how many were accepted, and rejected by which field."""
+
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._counts: dict[str, Counter[str]] = {}
@@ -51,4 +53,4 @@ class Tally:
             }
 
 
-TALLY = Tally()
+TALLY = InputTally()

@@ -128,7 +128,7 @@ class TaskOutcome:
 
 
 @dataclass(frozen=True)
-class Tally:
+class SuccessTally:
     """Successes out of attempts, with the reason of each failure."""
 
     successes: int = 0
@@ -156,13 +156,13 @@ class Tally:
 @dataclass(frozen=True)
 class SessionVerdict:
     tasks: dict[str, TaskOutcome]
-    commands: Tally
-    communication: Tally
+    commands: SuccessTally
+    communication: SuccessTally
 
     @property
-    def task_tally(self) -> Tally:
+    def task_tally(self) -> SuccessTally:
         outcomes = list(self.tasks.values())
-        return Tally(
+        return SuccessTally(
             successes=sum(outcome.success for outcome in outcomes),
             total=len(outcomes),
             failures=tuple(f"task {o.task}: {o.reason}" for o in outcomes if not o.success),
@@ -310,7 +310,7 @@ def judge_task(
     )
 
 
-def judge_commands(entries: list[LogEntry]) -> Tally:
+def judge_commands(entries: list[LogEntry]) -> SuccessTally:
     """Each command on the wire succeeds when acknowledged and neither rejected nor failed."""
     events_by_command: dict[str, list[dict[str, Any]]] = {}
     for entry in entries:
@@ -331,10 +331,10 @@ def judge_commands(entries: list[LogEntry]) -> Tally:
             successes += 1
         else:
             failures.append(f"{entry.data.get('action')} {command_id} was never acknowledged")
-    return Tally(successes, total, tuple(failures))
+    return SuccessTally(successes, total, tuple(failures))
 
 
-def judge_communication(entries: list[LogEntry]) -> Tally:
+def judge_communication(entries: list[LogEntry]) -> SuccessTally:
     """Person-to-assistant interactions that led to a command, and robot-to-assistant
     exchanges whose answer was understood."""
     successes, total, failures = 0, 0, []
@@ -363,7 +363,7 @@ def judge_communication(entries: list[LogEntry]) -> Tally:
                 failures.append(
                     f"{entry.data.get('thing')} did not understand {entry.data.get('text')!r}"
                 )
-    return Tally(successes, total, tuple(failures))
+    return SuccessTally(successes, total, tuple(failures))
 
 
 def judge_session(entries: list[LogEntry], plan: Plan) -> SessionVerdict:

@@ -15,8 +15,7 @@ sentences the skill should not act on. Each utterance ends in one of four outcom
 
 from __future__ import annotations
 
-from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -25,6 +24,7 @@ import msgspec
 from vahr.errors import VahrError
 from vahr.local.alexa.nlu import FALLBACK
 from vahr.local.alexa.simulator import strip_invocation
+from vahr.speech.scoring import OutcomeTally
 
 if TYPE_CHECKING:
     from vahr.local.alexa.nlu import InteractionModel, Understanding
@@ -61,24 +61,6 @@ class LabelledSet(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
         return [*self.utterances, *(LabelledUtterance(t, FALLBACK) for t in self.out_of_domain)]
 
 
-@dataclass
-class Tally:
-    """Outcomes for one intent (or all)."""
-
-    counts: Counter[str] = field(default_factory=Counter)
-
-    @property
-    def total(self) -> int:
-        return sum(self.counts.values())
-
-    def rate(self, outcome: str) -> float:
-        return self.counts[outcome] / self.total if self.total else 0.0
-
-    def to_json(self) -> dict[str, Any]:
-        rates = {f"{outcome}_rate": round(self.rate(outcome), 4) for outcome in OUTCOMES}
-        return {"n": self.total, **{o: self.counts[o] for o in OUTCOMES}, **rates}
-
-
 @dataclass(frozen=True)
 class Scored:
     item: LabelledUtterance
@@ -107,9 +89,9 @@ class Scored:
 class Report:
     """What `vahr nlu --eval` prints: tallies per expected intent, in-domain, out of domain."""
 
-    per_intent: dict[str, Tally]
-    in_domain: Tally
-    out_of_domain: Tally
+    per_intent: dict[str, OutcomeTally]
+    in_domain: OutcomeTally
+    out_of_domain: OutcomeTally
     scored: list[Scored]
 
     def to_json(self) -> dict[str, Any]:
@@ -151,8 +133,8 @@ def outcome(model: InteractionModel, item: LabelledUtterance, got: Understanding
 
 def evaluate(model: InteractionModel, labelled: LabelledSet) -> Report:
     """Understand every utterance of `labelled` and tally the outcomes."""
-    per_intent: dict[str, Tally] = {}
-    in_domain, out_of_domain = Tally(), Tally()
+    per_intent: dict[str, OutcomeTally] = {}
+    in_domain, out_of_domain = OutcomeTally(OUTCOMES), OutcomeTally(OUTCOMES)
     scored = []
     for item in labelled.items():
         understood = model.understand(strip_invocation(model.invocation_name, item.text))
@@ -161,6 +143,6 @@ def evaluate(model: InteractionModel, labelled: LabelledSet) -> Report:
         if item.intent == FALLBACK:
             out_of_domain.counts[result] += 1
             continue
-        per_intent.setdefault(item.intent, Tally()).counts[result] += 1
+        per_intent.setdefault(item.intent, OutcomeTally(OUTCOMES)).counts[result] += 1
         in_domain.counts[result] += 1
     return Report(dict(sorted(per_intent.items())), in_domain, out_of_domain, scored)
