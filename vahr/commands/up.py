@@ -56,6 +56,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
     from vahr.local.system import LocalSystem, SystemConfig
+    from vahr.station.deployment import on_local_system
 
     setup_logging(args.log_level)
     for flag in ("api_port", "mqtts_port", "mqtt_port", "station_port"):
@@ -82,7 +83,11 @@ def run(args: argparse.Namespace) -> int:
         signum: signal.signal(signum, lambda *_: stopping.set())
         for signum in (signal.SIGINT, signal.SIGTERM)
     }
-    system = LocalSystem(config, on_event=lambda event: _print_event(event, args.json))
+    system = LocalSystem(
+        config,
+        on_event=lambda event: _print_event(event, args.json),
+        start_station=on_local_system,
+    )
     try:
         system.start()
         if system.stack.recovered:

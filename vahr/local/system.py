@@ -3,7 +3,11 @@ the room assistant robots talk to, the operator station, and one robot-agent pro
 robot.
 
 `LocalSystem` is what `vahr up` and `vahr demo` run. It reports each robot event to a
-callback (the live lines of `vahr up`) and can wait until every robot is online.
+callback (the live lines of `vahr up`) and can wait until every robot is online. The
+operator station sits above the local stack (docs/architecture.md), so the system does not
+import it: whoever wants one passes `start_station` in (`vahr up` passes
+`vahr.station.deployment.on_local_system`), and the system starts it on its broker and its
+simulator, in its place among the parts.
 """
 
 from __future__ import annotations
@@ -15,9 +19,10 @@ import threading
 import time
 from collections import deque
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from vahr.errors import VahrError
+from vahr.local.client import SimulatorAssistant
 from vahr.local.mqtt import MqttClient
 from vahr.local.ports import ensure_free
 from vahr.local.robots import ProgressRate, RobotProcesses, fleet_of, write_fleet
@@ -30,8 +35,8 @@ if TYPE_CHECKING:
     from pathlib import Path
 
     from vahr.local.alexa.simulator import AlexaSimulator
+    from vahr.local.client import Assistant
     from vahr.protocol import Fleet
-    from vahr.station.station import Station
 
 log = logging.getLogger(__name__)
 
@@ -59,13 +64,46 @@ class SystemConfig:
     progress: ProgressRate = "local"
 
 
+class ServedStation(Protocol):
+    """The operator station as the system sees it: where its page is, and how it stops."""
+
+    @property
+    def url(self) -> str: ...
+
+    def stop(self) -> None: ...
+
+
+class StartStation(Protocol):
+    """Build the operator station on the system's parts and start it serving on `port`."""
+
+    def __call__(
+        self,
+        *,
+        port: int,
+        fleet: Fleet,
+        link: MqttClient,
+        assistant: Assistant,
+        read_shadow: Callable[[str], bytes | None],
+    ) -> ServedStation: ...
+
+
 class LocalSystem:
-    """Start everything in order; `stop()` stops it in reverse. A context manager."""
+    """Start everything in order; `stop()` stops it in reverse. A context manager.
+
+    `start_station` builds the operator station when `config.station_port` asks for one.
+    """
 
     def __init__(
-        self, config: SystemConfig, *, on_event: Callable[[Event], None] | None = None
+        self,
+        config: SystemConfig,
+        *,
+        on_event: Callable[[Event], None] | None = None,
+        start_station: StartStation | None = None,
     ) -> None:
+        if config.station_port is not None and start_station is None:
+            raise ValueError("station_port: a station needs start_station to build it")
         self.config = config
+        self.start_station = start_station
         self.on_event = on_event
         self.fleet: Fleet = fleet_of(config.robots)
         self.stack = LocalStack(
@@ -82,7 +120,7 @@ class LocalSystem:
         self._room: Any = None
         self._room_client: MqttClient | None = None
         self._station_client: MqttClient | None = None
-        self.station: Station | None = None
+        self.station: ServedStation | None = None
         self._online: dict[str, bool] = {}
         self._changed = threading.Condition()
         self._restarts: dict[str, deque[float]] = {}
@@ -162,20 +200,18 @@ class LocalSystem:
     def _start_station(self, port: int) -> None:
         """The operator station on this stack: the simulator in-process, shadows read from
         the store, every turn seen on the broker."""
-        from vahr.local.client import SimulatorAssistant
-        from vahr.station.station import Station, StationConfig
-
+        assert self.start_station is not None
         assert self.alexa is not None and self.stack.dataplane is not None
         self._station_client = MqttClient(
             self.stack.service_endpoint(), client_id="vahr-station-local"
         ).connect()
-        self.station = Station(
-            StationConfig(port=port),
-            self.fleet,
+        self.station = self.start_station(
+            port=port,
+            fleet=self.fleet,
             link=self._station_client,
             assistant=SimulatorAssistant(self.alexa),
             read_shadow=self._stored_shadow,
-        ).start()
+        )
         self.stack.dataplane.redirects["/vahr/dashboard"] = self.station.url
 
     def _stored_shadow(self, thing: str) -> bytes | None:

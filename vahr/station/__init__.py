@@ -4,14 +4,19 @@ conversation, the paper's keyboard-and-mouse panel, push-to-talk and the experim
 
 - `feed`: what the page shows, kept from the broker's messages and pushed to every page;
 - `controls`: the keyboard-and-mouse panel's orders, checked against the paper's procedure;
-- `assistant`: where typed and spoken requests go (the Alexa simulator, in-process or over
-  the local stack's HTTP API);
-- `voice`: push-to-talk: a WAV in, the transcript, the assistant's reply;
-- `experiment`: the running session as the page shows it, and the participant's input
-  forwarded to the session's log;
+- `desk`: the running experiment session as the station sees it, and the participant's
+  input forwarded to the session's log;
+- `voice` and `vocabulary`: push-to-talk (a WAV in, the transcript, the assistant's reply)
+  and the sentences its recognizer listens for;
+- `app`: the API's routes, apart from HTTP; `errors`: the one error a request is refused
+  with;
 - `server`: the HTTP server (the page, its files, the API and the event stream);
-- `station`: everything above wired together, for `vahr up` and `vahr station`.
+- `contract`: the page's side of the messages, written from `vahr.protocol.station`;
+- `station`: everything above wired together; `deployment`: a station built for `vahr up`
+  (in its process) or for `vahr station` (against any deployment).
 
-It sits in the top layer beside `vahr.local` and `vahr.experiment` and never imports
-`robot_agent`.
+Typed and spoken requests go to an assistant (`vahr.local.client.Assistant`). The station
+sits in the top layer above `vahr.experiment` and `vahr.local` (docs/architecture.md): it
+imports them, they never import it, and it reaches the Alexa simulator only through what
+`vahr.local.alexa` exports. It never imports `robot_agent`.
 """

@@ -10,6 +10,10 @@ the iot-data endpoint (`--api`). The assistant depends on what `--api` is:
   handler, configured for that endpoint (the AWS credentials of the environment need the
   skill's iot-data rights, docs/station.md). Alexa itself publishes no turns, so the
   conversation holds the station's own turns and the robots' exchanges.
+
+`vahr up`'s own station runs in the stack's process instead: `on_local_system`, which
+`vahr.local.system.LocalSystem` calls with its broker client, its simulator as the
+assistant and its shadow store (the local stack does not import the station).
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ from vahr.local.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
 from vahr.protocol.broker import parse_broker_url
 from vahr.station.feed import Feed
-from vahr.station.station import Station
+from vahr.station.station import Station, StationConfig
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -37,7 +41,6 @@ if TYPE_CHECKING:
     from vahr.local.client import Assistant
     from vahr.protocol import Fleet
     from vahr.protocol.broker import ClientCredentials
-    from vahr.station.station import StationConfig
 
 log = logging.getLogger(__name__)
 
@@ -102,14 +105,26 @@ def build_station(config: StationConfig, deployment: Deployment) -> Station:
         raise
 
 
+def on_local_system(
+    *,
+    port: int,
+    fleet: Fleet,
+    link: MqttClient,
+    assistant: Assistant,
+    read_shadow: Callable[[str], bytes | None],
+) -> Station:
+    """`vahr up`'s station, started: on the stack's broker, the simulator in-process, shadows
+    read from the store, every turn seen on the broker."""
+    return Station(
+        StationConfig(port=port), fleet, link=link, assistant=assistant, read_shadow=read_shadow
+    ).start()
+
+
 def _simulator_for(
     api: str, model_file: Path | None, deployment: Deployment, feed: Feed, link: MqttClient
 ) -> Assistant:
     """The Alexa simulator and the real skill in this process, for AWS's iot-data endpoint."""
-    from vahr.local.alexa.commands_seen import CommandLog
-    from vahr.local.alexa.nlu import InteractionModel
-    from vahr.local.alexa.simulator import AlexaSimulator
-    from vahr.local.alexa.skill import load_skill_handler
+    from vahr.local.alexa import AlexaSimulator, CommandLog, InteractionModel, load_skill_handler
 
     commands = CommandLog()
     # The skill publishes through iot-data; its commands are seen coming back from the broker.

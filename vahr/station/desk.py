@@ -1,10 +1,11 @@
 """The station's side of a running experiment session.
 
 The session runs in `vahr experiment` (maybe on another machine); the station learns of it
-from the retained status on `topics.EXPERIMENT_STATUS` (kept by the `Feed`) and sends what
-the participant did on the page to `topics.EXPERIMENT_INPUT`, where the session's recorder
-logs it (`vahr.experiment.station_input`). While a session runs, orders from the panel
-follow the paper's procedure for its method and task (`vahr.experiment.procedures`).
+from the retained status on `topics.EXPERIMENT_STATUS` (kept by the `Feed`; published by
+`vahr.experiment.station_link`) and sends what the participant did on the page to
+`topics.EXPERIMENT_INPUT`, where the session's recorder logs it
+(`vahr.experiment.recorder.Recorder`). While a session runs, orders from the panel follow
+the paper's procedure for its method and task (`vahr.experiment.procedures`).
 """
 
 from __future__ import annotations

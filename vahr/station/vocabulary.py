@@ -5,7 +5,7 @@ its slots filled, each slot going through all of its type's values and synonyms 
 copies of the sample (so
 every value appears in every sample's context once, without multiplying out samples with
 several slots), plus the built-in intents' phrases (those the simulator knows them by,
-`vahr.local.alexa.background`) and the invocation forms ("ask robot fleet to ..."). The
+`vahr.local.alexa.built_in_phrases`) and the invocation forms ("ask robot fleet to ..."). The
 interaction model is generated from `fleet.yaml`, so the robots' and
 zones' names follow the fleet. Numbers are spelled out, as people say them.
 """
@@ -18,9 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from vahr.errors import VahrError
-from vahr.local.alexa.background import built_in_phrases
-from vahr.local.alexa.nlu import DEFAULT_MODEL
-from vahr.local.alexa.weather_rule import RULE_SLOTS
+from vahr.local.alexa import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases
 from vahr.speech.text import normalize
 
 if TYPE_CHECKING:

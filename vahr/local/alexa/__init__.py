@@ -1,2 +1,33 @@
 """The Alexa simulator: NLU from the skill package, ASK request envelopes, and the skill
-handler invoked in-process, as Alexa would drive it."""
+handler invoked in-process, as Alexa would drive it.
+
+What the rest of the house uses (the operator station among it) is exported here; the
+modules behind it are the simulator's own, and import-linter keeps the station and the
+experiment out of them (pyproject.toml, docs/architecture.md):
+
+- `AlexaSimulator` (the simulated Echo) and `Turn` (one exchange with it);
+- `InteractionModel` (the NLU built from an interaction model; `DEFAULT_MODEL`, the one
+  that ships with the package), `load_skill_handler` (the skill's Lambda handler
+  in-process) and `CommandLog` (the commands the skill published during a turn): what a
+  simulator is built from;
+- `built_in_phrases` (what the simulator knows Alexa's built-in intents by) and
+  `RULE_SLOTS` (the weather rule's slots): what a vocabulary of the model is made from.
+"""
+
+from vahr.local.alexa.background import built_in_phrases
+from vahr.local.alexa.commands_seen import CommandLog
+from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel
+from vahr.local.alexa.simulator import AlexaSimulator, Turn
+from vahr.local.alexa.skill import load_skill_handler
+from vahr.local.alexa.weather_rule import RULE_SLOTS
+
+__all__ = [
+    "DEFAULT_MODEL",
+    "RULE_SLOTS",
+    "AlexaSimulator",
+    "CommandLog",
+    "InteractionModel",
+    "Turn",
+    "built_in_phrases",
+    "load_skill_handler",
+]
