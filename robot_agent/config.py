@@ -52,6 +52,9 @@ class SimSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, froz
     # Fault injection: goals to these zones stop moving half way / abort half way.
     stuck_zones: tuple[str, ...] = ()
     fail_zones: tuple[str, ...] = ()
+    # Development only: accept faults injected at run time on the robot's fault topic
+    # (`vahr fault`; robot_agent.dev_faults). `vahr up` sets it for its robots.
+    accept_faults: bool = False
 
 
 class ExecutorSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):

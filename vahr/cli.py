@@ -17,6 +17,10 @@ SUBCOMMANDS: Subcommands = {
         "vahr.commands.station",
         "serve the operator station page (map, panel, push-to-talk) for any deployment",
     ),
+    "fault": (
+        "vahr.commands.fault",
+        "inject a fault (stuck, fail, offline, clear) into a running simulated robot",
+    ),
     "nlu": ("vahr.commands.nlu", "show how an utterance is understood, without executing it"),
     "demo": ("vahr.commands.demo", "run the paper's scenario end to end on this machine"),
     "experiment": ("vahr.commands.experiment", "run one experiment session (tasks I-III)"),

@@ -50,12 +50,18 @@ class SimBackend:
         return self._pose
 
     def inject_stuck(self) -> None:
-        """The next goal stops moving half way and never arrives (a blocked corridor)."""
+        """The robot stops where it is and never arrives (a blocked corridor): at once on
+        the way it is driving, else half way along its next goal."""
         self._faults.stuck_next = True
 
     def inject_failure(self, reason: str = "the planner found no path") -> None:
-        """The next goal aborts half way with `reason` (as move_base aborts)."""
+        """The goal aborts with `reason` (as move_base aborts): at once on the way it is
+        driving, else half way along its next goal."""
         self._faults.fail_next = reason
+
+    def clear_faults(self) -> None:
+        """Forget injected faults not yet applied (zones configured to fail stay so)."""
+        self._faults.stuck_next, self._faults.fail_next = False, None
 
     async def go_to(self, zone: Zone, on_progress: Callable[[Progress], None]) -> None:
         stuck = self._faults.stuck_next or zone.id in self._faults.stuck_zones
@@ -70,14 +76,22 @@ class SimBackend:
         await self._turn_to(heading)
         tick = self.settings.tick_s
         travelled = 0.0
+        # Where a stuck or failing goal stops: half way, or where an injection found it.
+        halt_at = total / 2
         last = self._clock.monotonic()
         while travelled < total:
             await self._clock.sleep(tick)
+            # A fault injected while driving applies from where the robot is now.
+            if self._faults.stuck_next or self._faults.fail_next:
+                stuck = stuck or self._faults.stuck_next
+                failure = failure or self._faults.fail_next
+                self._faults.stuck_next, self._faults.fail_next = False, None
+                halt_at = travelled
             # Integrate over the time that really passed, so a busy machine (or a high
             # speed factor) changes how often the pose is updated, never the robot's speed.
             now = self._clock.monotonic()
             elapsed, last = now - last, now
-            if (stuck or failure) and travelled >= total / 2:
+            if (stuck or failure) and travelled >= halt_at:
                 if failure:
                     raise NavigationFailed(f"goal to {zone.id} aborted: {failure}")
                 # Stuck: the robot holds its place and keeps reporting the same progress,
@@ -86,7 +100,7 @@ class SimBackend:
                 continue
             travelled = min(total, travelled + self.settings.speed_mps * elapsed)
             if stuck or failure:
-                travelled = min(travelled, total / 2)
+                travelled = min(travelled, halt_at)
             self._pose = Pose(
                 start.x + (goal.x - start.x) * travelled / total,
                 start.y + (goal.y - start.y) * travelled / total,

@@ -71,6 +71,10 @@ async def serve(config: AgentConfig) -> int:
     voice = build_voice(config, link)
     agent = build_agent(config, fleet, link, clock, voice)
     agent.attach()
+    if config.sim.accept_faults:
+        from robot_agent.dev_faults import DevFaults
+
+        DevFaults(thing=agent.thing, link=link, backend=agent.executor.backend).attach()
     stopping = asyncio.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(signum, stopping.set)

@@ -157,6 +157,22 @@ class Mqtt5Link:
         )
         await asyncio.to_thread(self._stopped.wait, timeout_s)
 
+    async def go_away(self, away_s: float, timeout_s: float = 5.0) -> None:
+        """Drop the connection as a lost network would (the broker publishes the last will),
+        stay away `away_s` wall seconds, then connect again (`vahr fault ... offline`)."""
+        await self.flush(timeout_s)  # what was said before going away (the fault's answer)
+        self._stopping = True
+        self._stopped.clear()
+        self._client.stop(
+            mqtt5.DisconnectPacket(
+                reason_code=mqtt5.DisconnectReasonCode.DISCONNECT_WITH_WILL_MESSAGE
+            )
+        )
+        await asyncio.to_thread(self._stopped.wait, timeout_s)
+        await asyncio.sleep(away_s)
+        self._stopping = False
+        self._client.start()
+
     # -- awscrt callbacks (on awscrt's threads) -----------------------------------------
 
     def _build_client(self) -> mqtt5.Client:

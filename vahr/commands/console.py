@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import sys
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import argparse
@@ -14,18 +14,47 @@ PROMPT = "you> "
 
 def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--api", help="the running system's API (default $VAHR_API or :8180)")
-    parser.add_argument("--speak", action="store_true", help="speak replies with espeak-ng")
+    parser.add_argument(
+        "--speak",
+        action="store_true",
+        help="speak replies, and what the assistant announces unprompted, with espeak-ng",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
-    from vahr.errors import VahrError
-    from vahr.local.client import call, default_api, say
+    from vahr.local.client import call, default_api
 
     api = args.api or default_api()
     call(api, "GET", "/vahr/health")  # fail now, with one line, if nothing runs
     interactive = sys.stdin.isatty()
     if interactive:
         print("Talk to the robot fleet (e.g. 'Alexa, open robot fleet'); Ctrl-D ends.")
+    feed = _announcements(api, speak=args.speak) if args.speak else None
+    try:
+        _converse(api, args, interactive)
+    finally:
+        if feed is not None:
+            feed.stop()
+    return 0
+
+
+def _announcements(api: str, *, speak: bool) -> Any:
+    """Say each new announcement (a robot stuck, failed, offline) as the Echo would."""
+    from vahr.local.announcement_feed import AnnouncementFeed
+    from vahr.local.speaker import speak as say_aloud
+
+    def tell(announcement: dict[str, Any]) -> None:
+        print(f"\nalexa> {announcement['speech']}  [announcement: {announcement['kind']}]")
+        if speak:
+            say_aloud(announcement["speech"])
+
+    return AnnouncementFeed(api, tell).start()
+
+
+def _converse(api: str, args: argparse.Namespace, interactive: bool) -> None:
+    from vahr.errors import VahrError
+    from vahr.local.client import say
+
     for line in _lines(interactive):
         utterance = line.strip()
         if not utterance:
@@ -44,7 +73,6 @@ def run(args: argparse.Namespace) -> int:
             from vahr.local.speaker import speak
 
             speak(turn["speech"])
-    return 0
 
 
 def _lines(interactive: bool) -> Iterator[str]:

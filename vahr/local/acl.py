@@ -59,6 +59,9 @@ def render_acl(*, service_user: str = SERVICE_COMMON_NAME, open_anonymous: bool 
         # The room: a robot speaks to the assistant and hears only answers meant for it.
         f"pattern write {_pattern(topics.room_robot_speech(_PLACEHOLDER))}",
         f"pattern read {_pattern(topics.room_assistant_speech(_PLACEHOLDER))}",
+        # Development only (`vahr fault`): a robot hears faults for itself and answers them.
+        f"pattern read {_pattern(topics.robot_fault(_PLACEHOLDER))}",
+        f"pattern write {_pattern(topics.robot_fault_answer(_PLACEHOLDER))}",
     ]
     return "\n".join(lines) + "\n"
 

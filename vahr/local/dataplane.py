@@ -77,6 +77,9 @@ class DataPlane:
         self.local_routes: dict[tuple[str, str], Callable[[Json], tuple[int, Json]]] = {}
         # GET paths answered with a redirect (the old dashboard, now the operator station).
         self.redirects: dict[str, str] = {}
+        # What `GET /vahr/health` answers; the system adds what a client must adopt (the
+        # robots' `sim_speed_factor`).
+        self.health: Json = {"ok": True}
 
     def handle(self, method: str, raw_path: str, body: bytes) -> tuple[int, bytes]:
         """One request -> (status, response body)."""
@@ -178,7 +181,7 @@ class DataPlane:
 
     def _local(self, method: str, path: str, body: bytes) -> tuple[int, bytes]:
         if (method, path) == ("GET", "/vahr/health"):
-            return 200, _encode({"ok": True})
+            return 200, _encode(self.health)
         if (method, path) == ("GET", "/vahr/meter"):
             return 200, _encode(self.meter.snapshot())
         if (method, path) == ("POST", "/vahr/meter/reset"):

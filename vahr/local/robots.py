@@ -78,7 +78,9 @@ SAME_CLOCK = "executor:\n  peer_clock_skew_s: 0\n"
 # often as the station wants for smooth drawing; on AWS the agent's defaults report far
 # less often (docs/robot-agent.md, "Progress reports").
 LOCAL_PROGRESS = "  progress_interval_s: 1\n  progress_step: 0\n"
-LOCAL_AGENT_CONFIG = SAME_CLOCK + LOCAL_PROGRESS
+# `vahr fault` may inject faults into the robots of `vahr up` (robot_agent.dev_faults).
+ACCEPT_FAULTS = "sim:\n  accept_faults: true\n"
+LOCAL_AGENT_CONFIG = SAME_CLOCK + LOCAL_PROGRESS + ACCEPT_FAULTS
 # Which progress rate the robots of `vahr up` use: the local one, or the agent's own
 # defaults (the rate a deployment on AWS gets; for measuring what it would bill).
 ProgressRate = Literal["local", "aws"]
@@ -118,7 +120,9 @@ class RobotProcesses:
     def command(self, thing: str) -> list[str]:
         credentials = self.ca.issue_client(thing, self.state_dir / thing / "certs")
         config = self.state_dir / thing / "agent.yaml"
-        config.write_text(LOCAL_AGENT_CONFIG if self.progress == "local" else SAME_CLOCK)
+        config.write_text(
+            LOCAL_AGENT_CONFIG if self.progress == "local" else SAME_CLOCK + ACCEPT_FAULTS
+        )
         command = [
             sys.executable, "-m", "robot_agent.cli", "run",
             "--config", str(config),

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
 from vahr.errors import VahrError
+from vahr.local.announcer import LocalAnnouncer
 from vahr.local.client import SimulatorAssistant
 from vahr.local.mqtt import MqttClient
 from vahr.local.ports import ensure_free
@@ -117,6 +118,7 @@ class LocalSystem:
         self.robots: RobotProcesses | None = None
         self.alexa: AlexaSimulator | None = None
         self._watcher: MqttClient | None = None
+        self.announcer: LocalAnnouncer | None = None
         self._room: Any = None
         self._room_client: MqttClient | None = None
         self._station_client: MqttClient | None = None
@@ -160,6 +162,7 @@ class LocalSystem:
             self._watcher = MqttClient(self.stack.service_endpoint()).connect()
             self._watcher.subscribe(topics.ALL_EVENTS, self._on_event)
             self._watcher.subscribe(topics.ALL_PRESENCE, self._on_presence)
+            self._start_announcer()
             if self.voice_enabled:
                 self._start_room()
             if cfg.station_port is not None:
@@ -179,6 +182,20 @@ class LocalSystem:
             self.stop()
             raise
         return self
+
+    def _start_announcer(self) -> None:
+        """Robots' troubles told unprompted (`GET /vahr/announcements`); the running speed
+        factor on `GET /vahr/health`, so a rehearsal against this stack can adopt it."""
+        from vahr.local.faults import FaultInjector
+
+        dataplane = self.stack.dataplane
+        assert dataplane is not None and self._watcher is not None
+        self.announcer = LocalAnnouncer(self.stack.service_endpoint(), self.fleet).start()
+        dataplane.local_routes[("GET", "/vahr/announcements")] = self.announcer.announcer.route
+        dataplane.local_routes[("POST", "/vahr/fault")] = FaultInjector(
+            self._watcher, self.fleet
+        ).route
+        dataplane.health["sim_speed_factor"] = self.config.sim_speed_factor
 
     def _start_room(self) -> None:
         """The assistant robots talk to: a second simulated Echo on the same skill."""
@@ -324,6 +341,9 @@ class LocalSystem:
         if self.station is not None:
             self.station.stop()
             self.station = None
+        if self.announcer is not None:
+            self.announcer.stop()
+            self.announcer = None
         for client in (self._room_client, self._watcher, self._station_client):
             if client is not None:
                 client.stop()

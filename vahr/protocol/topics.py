@@ -133,6 +133,29 @@ def parse_room_topic(topic: str) -> tuple[str, str] | None:
 
 
 # The operator station's topics (docs/station.md).
+# Development only: a fault injected into a simulated robot of the local stack (`vahr
+# fault`), and the robot's answer. The local broker's ACL lets a robot hear only its own;
+# the cloud's robot policy allows neither, so no robot on AWS IoT Core ever gets one.
+ALL_FAULT_ANSWERS = "vahr/dev/robots/+/fault/answer"
+_FAULT_ANSWER_TOPIC = re.compile(r"^vahr/dev/robots/(?P<thing>[^/]+)/fault/answer$")
+
+
+def robot_fault(thing: str) -> str:
+    """Where a fault for `thing` is sent (development only)."""
+    return f"vahr/dev/robots/{check_thing(thing)}/fault"
+
+
+def robot_fault_answer(thing: str) -> str:
+    """Where `thing` answers a fault request."""
+    return f"{robot_fault(thing)}/answer"
+
+
+def parse_fault_answer_topic(topic: str) -> str | None:
+    """The thing that answered on `topic`, or None."""
+    found = _FAULT_ANSWER_TOPIC.match(topic)
+    return found["thing"] if found else None
+
+
 # Every exchange with the local Alexa simulator (`vahr up`'s), one message per turn; AWS's
 # Alexa publishes nothing here.
 ASSISTANT_TURNS = "vahr/assistant/turns"
