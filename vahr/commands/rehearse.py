@@ -45,18 +45,19 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--speed-factor",
         type=float,
-        default=DEFAULT_SPEED,
-        help="study seconds per wall second; with --api it must equal the running "
-        f"`vahr up --sim-speed-factor` (default {DEFAULT_SPEED:g})",
+        default=None,
+        help="study seconds per wall second (default: with --api the running stack's "
+        f"`vahr up --sim-speed-factor`, which it must equal; else {DEFAULT_SPEED:g})",
     )
     parser.add_argument("--seed", type=int, default=1, help="the study's seed (default 1)")
     parser.add_argument(
         "--monitoring",
-        choices=["glance", "watch"],
+        choices=["glance", "watch", "announce"],
         default="glance",
         help="how participants monitor a robot they wait for: a glance at each puzzle "
-        "part's end (the model, default) or eyes on the screen until it happens "
-        "(a sensitivity variant)",
+        "part's end (the model, default), eyes on the screen until it happens "
+        "(a sensitivity variant), or no looking at all, acting on the assistant's "
+        "announcements of finished tasks",
     )
     parser.add_argument(
         "--task-timeout",
@@ -72,7 +73,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def _check(args: argparse.Namespace) -> None:
     if args.participants < 1 or args.trials < 1:
         raise VahrError("--participants and --trials must be 1 or more")
-    if not args.speed_factor > 0:
+    if args.speed_factor is not None and not args.speed_factor > 0:
         raise VahrError("--speed-factor must be more than 0")
     if args.task_timeout <= 0:
         raise VahrError("--task-timeout must be more than 0")
@@ -80,11 +81,39 @@ def _check(args: argparse.Namespace) -> None:
         raise VahrError("--api and --broker go together (a running `vahr up`'s endpoints)")
 
 
+def speed_factor(api: str | None, asked: float | None) -> float:
+    """The factor to rehearse at: a running stack's own (its `GET /vahr/health` tells it),
+    which `asked` must equal; without a stack, `asked` or the default.
+
+    A rehearsal at another factor than its robots' runs without a word and measures task
+    times off by the ratio (x1 robots under a x30 participant: some 1,800 study seconds).
+    """
+    if api is None:
+        return asked if asked is not None else DEFAULT_SPEED
+    from vahr.local.client import call
+
+    running = call(api, "GET", "/vahr/health").get("sim_speed_factor")
+    if not isinstance(running, int | float) or running <= 0:
+        if asked is None:
+            raise VahrError(
+                f"{api} does not tell its robots' speed factor; give --speed-factor (it must "
+                "equal the robots' --sim-speed-factor)"
+            )
+        return asked
+    if asked is not None and asked != running:
+        raise VahrError(
+            f"--speed-factor {asked:g} differs from the running stack's x{running:g} "
+            f"(vahr up --sim-speed-factor {running:g}): drop --speed-factor to adopt it"
+        )
+    return float(running)
+
+
 def run(args: argparse.Namespace) -> int:
     from vahr.experiment.study import StudySpec, run_study
 
     _check(args)
     setup_logging(args.log_level)
+    args.speed_factor = speed_factor(args.api, args.speed_factor)
     spec = StudySpec(
         participants=args.participants,
         trials=args.trials,

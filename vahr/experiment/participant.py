@@ -13,9 +13,11 @@ How it spends a task:
 2. otherwise it works on the puzzle; each time a part is done, if some step waits for
    something to be seen (a robot loaded, a robot delivered), it glances at the screen and
    sees what has happened by then (or, with `Person.monitoring == "watch"`, it keeps its
-   eyes on the screen until it sees it). What is heard (a robot's exchange with the
-   assistant ending) is noticed at once. Looking counts as interaction, as the paper
-   counts watching;
+   eyes on the screen until it sees it; with `"announce"` it never looks, and learns that
+   a robot was loaded or delivered when the assistant announces its finished task, as
+   `vahr.announce` decides with `done` on). What is heard (a robot's exchange with the
+   assistant ending) is noticed at once. Looking and listening to an announcement count
+   as interaction, as the paper counts watching;
 3. once every step is taken it keeps solving the puzzle until the task is decided.
 
 Clock: durations are study seconds, slept for `seconds / speed_factor` of wall time, so a
@@ -30,13 +32,18 @@ from __future__ import annotations
 import itertools
 import random
 import time
+from datetime import UTC, datetime, timedelta
 from typing import TYPE_CHECKING, Any
 
+import msgspec
+
+from vahr.announce import AnnouncePolicy, settings_from, signals_from_event
+from vahr.announce.speech import Names
 from vahr.errors import VahrError
 from vahr.experiment import timing
 from vahr.experiment.eventlog import Kind
 from vahr.experiment.procedures import Observation, check_action, heard_weather, procedure_for
-from vahr.protocol import Pose, encode, new_command, topics
+from vahr.protocol import Event, Pose, ProtocolError, encode, new_command, topics
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -46,6 +53,7 @@ if TYPE_CHECKING:
     from vahr.experiment.tasks import Plan
     from vahr.local.client import Assistant
     from vahr.protocol import Fleet
+    from vahr.protocol.announcements import Announcement
 
 # A question the assistant does not answer with a weather is asked again, up to this often.
 QUESTION_ATTEMPTS = 3
@@ -54,6 +62,10 @@ POLL_S = 0.25
 # Never poll more often than this in wall time: a fast rehearsal must not spin on 2 cores.
 POLL_WALL_S = 0.02
 GLANCE_TEXT = "glance at the screen"
+HEAR_TEXT = "hear an announcement"
+# What the assistant announces to a participant who monitors by announcements: the
+# announcer's defaults with finished tasks on.
+ANNOUNCED = ("stuck", "failed", "offline", "done")
 WATCH_TEXT = "watch the screen"
 
 
@@ -122,8 +134,22 @@ class SimulatedParticipant:
         self._cursor = timing.screen_point(Pose(5.0, 4.0, 0.0))  # the map's middle
         self._block: str | None = None  # "voice"/"click" while a block of steps goes on
         self._last_listen_s = 0.0
+        # `announce` monitoring: the announcer's policy on the study's clock.
+        self._began = (time.monotonic(), datetime.now(UTC))
+        self._announcer = (
+            AnnouncePolicy(
+                settings_from({"kinds": list(ANNOUNCED)}), Names.of(fleet), self._study_now
+            )
+            if person.monitoring == "announce"
+            else None
+        )
+        self._heard: list[Announcement] = []
 
     # -- the clock ------------------------------------------------------------------------
+
+    def _study_now(self) -> datetime:
+        wall, at = self._began
+        return at + timedelta(seconds=(time.monotonic() - wall) * self.speed_factor)
 
     def _sleep(self, study_s: float) -> None:
         if study_s > 0:
@@ -164,6 +190,9 @@ class SimulatedParticipant:
             if self._take_ready_steps():
                 continue
             self._block = None
+            if self._heard:
+                self._hear(self._heard.pop(0))
+                continue
             if self.person.monitoring == "watch" and self._must_watch():
                 self._watch(decided, deadline, poll)
                 continue
@@ -177,7 +206,7 @@ class SimulatedParticipant:
                     task=self._task,
                 )
                 part_left = timing.puzzle_part_s(self.rng)
-                if self._must_watch():
+                if self._must_watch() and self._announcer is None:
                     self._glance()
         return decided()
 
@@ -199,6 +228,7 @@ class SimulatedParticipant:
                 self._poses[thing] = Pose(float(reported["x"]), float(reported["y"]), 0.0)
             if entry.seq <= self._start_seq:
                 continue
+            self._announce(entry.data)
             if event in ("loaded", "delivered"):
                 self._visible.add(Observation(thing, event))
             elif event == "interpreted":
@@ -283,6 +313,27 @@ class SimulatedParticipant:
         self._sleep(self.person.glance_s())
         seen = self._look(sight=True)
         self._end(ident, "watch", GLANCE_TEXT, counts=False, commands=[], seen=seen)
+
+    def _announce(self, data: dict[str, Any]) -> None:
+        """What the assistant announces about this robot event (`announce` monitoring)."""
+        if self._announcer is None:
+            return
+        try:
+            event = msgspec.convert(data, Event, strict=False)
+        except (msgspec.ValidationError, ProtocolError):
+            return
+        self._heard += self._announcer.observe(signals_from_event(event))
+
+    def _hear(self, announcement: Announcement) -> None:
+        """Listen to an announcement; a finished task tells what its robot's marker shows."""
+        ident = self._interaction("voice", HEAR_TEXT, counts=False)
+        self._sleep(self.person.hearing_s(announcement.speech))
+        learnt = {o for o in self._visible if o.thing == announcement.thing}
+        self._observed |= learnt
+        self._end(
+            ident, "voice", HEAR_TEXT, counts=False, commands=[],
+            speech=announcement.speech, seen=sorted(o.describe() for o in learnt),
+        )  # fmt: skip
 
     def _watch(self, decided: Callable[[], bool], deadline: float, poll: float) -> None:
         """Keep the eyes on the screen until something awaited shows (the `watch` variant)."""

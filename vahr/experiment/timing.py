@@ -140,15 +140,16 @@ def fitts_s(distance_px: float, width_px: float) -> float:
     return max(0.0, FITTS_INTERCEPT.value + FITTS_SLOPE.value * index)
 
 
-MONITORING = ("glance", "watch")
+MONITORING = ("glance", "watch", "announce")
 
 
 @dataclass(frozen=True)
 class Person:
     """One simulated participant: how fast they are relative to the KLM's average person,
     and how they monitor a robot whose arrival they wait for: `glance` (the model above:
-    a look at each puzzle part's end) or `watch` (eyes on the screen until it happens; a
-    sensitivity variant with no constant of its own, see docs/experiment.md)."""
+    a look at each puzzle part's end), `watch` (eyes on the screen until it happens; a
+    sensitivity variant with no constant of its own, see docs/experiment.md) or `announce`
+    (never looks; hears the assistant announce each finished task, `hearing_s`)."""
 
     tempo: float = 1.0
     monitoring: str = "glance"
@@ -183,6 +184,14 @@ class Person:
 
     def turn_gap_s(self) -> float:
         return TURN_GAP.value * self.tempo
+
+    def hearing_s(self, announcement: str) -> float:
+        """Noticing an announcement and taking it in: a perceptual and a cognitive cycle
+        (the Model Human Processor's, as a glance has them), then listening to it to its end
+        at the assistant's rate (`listening_s`)."""
+        return (PERCEPTUAL_CYCLE.value + COGNITIVE_CYCLE.value) * self.tempo + listening_s(
+            announcement
+        )
 
     def glance_s(self) -> float:
         """A look at the screen and back: two eye movements, perceive, decide."""
