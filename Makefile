@@ -19,12 +19,12 @@ ROS_SITE := $(VENV)/ros-site
 export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
 export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 
-.PHONY: hearing-adaptation sense-heard demo test test-repeat soak-test lint typecheck pytest setup system-packages bench synth deploy skill-model clean
+.PHONY: hearing-adaptation sense-heard demo test test-repeat soak-test lint typecheck jstest pytest setup system-packages bench synth deploy skill-model clean
 
 demo: setup
 	$(BIN)/vahr demo
 
-test: setup lint typecheck pytest
+test: setup lint typecheck jstest pytest
 
 setup: system-packages $(VENV)/.installed $(ROS_SITE)/.linked node_modules/.installed
 
@@ -63,6 +63,13 @@ lint: setup
 	$(BIN)/ruff format --check --quiet .
 	$(BIN)/python -m vahr.skill_model --check
 	$(BIN)/lint-imports --no-cache
+	$(BIN)/python -m vahr.station.contract --check
+	npx tsc -p vahr/station
+
+# The station page's own logic in Node's test runner (tests/js/*.test.mjs): the map's motion
+# and the participant's interaction time. A failing test exits non-zero, and so does make.
+jstest: setup
+	node --test tests/js/
 
 typecheck: setup
 	$(BIN)/mypy

@@ -1,7 +1,43 @@
+// @ts-check
 // The station's API from the page: JSON requests, and speaking a reply aloud.
+
+/** @import { Heard } from "./contract.js" */
+
+/**
+ * The assistant's answer to an utterance (`/api/say`, and the turn of a push-to-talk).
+ * @typedef {object} SayReply
+ * @property {string} speech
+ * @property {string | null} [intent]
+ * @property {string[]} [commands]
+ */
+
+/**
+ * What push-to-talk heard and what came of it (`/api/voice`).
+ * @typedef {object} VoiceReply
+ * @property {Heard} heard
+ * @property {number} recognizer_ms
+ * @property {boolean} understood
+ * @property {string} speech
+ * @property {SayReply | null} turn
+ */
+
+/** The id of a command the station sent (`/api/command`, `/api/stop`). @typedef {{id: string}} CommandReply */
 
 export class ApiError extends Error {}
 
+/** What went wrong, in words (an ApiError's message says it). @param {unknown} err */
+export function reason(err) {
+  return (err instanceof Error && err.message) || String(err);
+}
+
+/**
+ * POST `body` as JSON to the station; resolves with its JSON answer, rejects with an ApiError
+ * that says why in words.
+ * @template [T=unknown]
+ * @param {string} path
+ * @param {object} [body]
+ * @returns {Promise<T>}
+ */
 export async function post(path, body) {
   let response;
   try {
@@ -16,6 +52,7 @@ export async function post(path, body) {
   return answer(response);
 }
 
+/** @param {Blob} blob a WAV file @returns {Promise<VoiceReply>} */
 export async function postWav(blob) {
   let response;
   try {
@@ -30,7 +67,9 @@ export async function postWav(blob) {
   return answer(response);
 }
 
+/** @param {Response} response @returns {Promise<any>} */
 async function answer(response) {
+  /** @type {{error?: string}} */
   let body = {};
   try {
     body = await response.json();
@@ -55,11 +94,14 @@ export function replyVoice() {
   return voices.length ? "browser" : "espeak";
 }
 
+/** @param {string} value */
 export function setReplyVoice(value) {
   localStorage.setItem(VOICE_KEY, value);
 }
 
+/** @type {HTMLAudioElement | null} */
 let playing = null;
+/** @type {((value?: unknown) => void) | null} */
 let finishPlaying = null;
 
 // Stop speaking at once (the person pressed to talk again).
@@ -70,6 +112,7 @@ export function hush() {
 }
 
 // Speak `text`; resolves when it has been spoken (or at once when muted or on failure).
+/** @param {string | null | undefined} text */
 export async function speak(text) {
   if (!text) return;
   const voice = replyVoice();

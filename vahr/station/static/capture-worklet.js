@@ -1,3 +1,4 @@
+// @ts-check
 // Push-to-talk's capture: hands the microphone's samples (mono, the context's rate) to the
 // page in blocks, with the block's peak level for the meter.
 
@@ -8,6 +9,7 @@ class Capture extends AudioWorkletProcessor {
     this.filled = 0;
   }
 
+  /** @param {Float32Array[][]} inputs */
   process(inputs) {
     const channel = inputs[0] && inputs[0][0];
     if (channel) {

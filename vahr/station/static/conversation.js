@@ -1,3 +1,4 @@
+// @ts-check
 // The conversation: every exchange with the assistant in order (what was said or heard,
 // the intent and slots understood, the reply, the commands it sent and how fast the robots
 // acknowledged them), the orders from the keyboard and mouse, and the robots' own
@@ -6,7 +7,11 @@
 import { clock, node } from "./dom.js";
 import { zoneText } from "./map.js";
 import { sourceName } from "./robots.js";
+import { CONVERSATION_LIMIT } from "./contract.js";
 
+/** @import { CommandMessage, ConversationEntry, EventMessage, FleetView, TurnMessage } from "./contract.js" */
+
+/** @type {Record<string, string>} */
 const ORIGINS = {
   "station-voice": "You, by voice",
   station: "You, typed",
@@ -15,23 +20,34 @@ const ORIGINS = {
   console: "Console",
 };
 const FALLBACK = "AMAZON.FallbackIntent";
-const ENTRIES_KEPT = 400; // as many as the station keeps for a new page (feed.py)
+const ENTRIES_KEPT = CONVERSATION_LIMIT; // as many as the station keeps for a new page
 
 
+/** @param {string} text */
 function quoted(text) {
   const q = node("q", "", text);
   return q;
 }
 
 export class Conversation {
+  /**
+   * @param {HTMLElement} list
+   * @param {HTMLElement} filters
+   * @param {{commands: Record<string, CommandMessage>, names: Record<string, string>}} shared
+   *   the commands seen by id and the robots' spoken names (the page's store)
+   */
   constructor(list, filters, { commands, names }) {
     this.list = list;
     this.filters = filters;
-    this.commands = commands; // id -> command (shared with the page's store)
-    this.names = names; // thing -> spoken name
+    this.commands = commands;
+    this.names = names;
+    /** @type {string | null} */
     this.filter = null;
-    this.refreshers = new Map(); // command id -> [functions that redraw what shows it]
-    this.stale = new Set(); // commands acknowledged since the last frame
+    /** Per command id, the functions that redraw what shows it. @type {Map<string, Array<() => void>>} */
+    this.refreshers = new Map();
+    /** Commands acknowledged since the last frame. @type {Set<string>} */
+    this.stale = new Set();
+    /** @type {number | null} */
     this.frame = null;
     // The list follows the newest entry while the reader is at its end, and stays where
     // the reader scrolled to otherwise: entries never pull the text away from them.
@@ -57,13 +73,15 @@ export class Conversation {
     this.stale.clear();
   }
 
+  /** @param {FleetView} fleet @param {ConversationEntry[]} entries */
   build(fleet, entries) {
     this.list.replaceChildren();
     this.resized.disconnect();
     this.resized.observe(this.list);
     this.refreshers.clear();
     this.filters.replaceChildren();
-    const chips = [[null, "All"], ...fleet.robots.slice(0, 8).map((r) => [r.thing, r.name])];
+    /** @type {Array<[string | null, string]>} */
+    const chips = [[null, "All"], ...fleet.robots.slice(0, 8).map((r) => /** @type {[string, string]} */ ([r.thing, r.name]))];
     for (const [thing, label] of chips) {
       const chip = node("button", "chip", label);
       chip.type = "button";
@@ -78,21 +96,27 @@ export class Conversation {
     this.follow();
   }
 
+  /** @param {string | null} thing */
   setFilter(thing) {
     this.filter = thing;
-    for (const chip of this.filters.children) chip.setAttribute("aria-pressed", String((chip.dataset.thing || null) === thing));
-    for (const item of this.list.querySelectorAll(".entry")) item.hidden = !this.visible(item);
+    for (const chip of this.filters.children) chip.setAttribute("aria-pressed", String((chip.getAttribute("data-thing") || null) === thing));
+    for (const item of this.entries()) item.hidden = !this.visible(item);
     this.showEmpty();
     this.sticky = true;
     this.follow();
   }
 
+  entries() {
+    return /** @type {NodeListOf<HTMLElement>} */ (this.list.querySelectorAll(".entry"));
+  }
+
+  /** @param {HTMLElement} item */
   visible(item) {
     return this.filter === null || (item.dataset.robots || "").split(" ").includes(this.filter);
   }
 
   showEmpty() {
-    const shown = [...this.list.querySelectorAll(".entry")].some((item) => !item.hidden);
+    const shown = [...this.entries()].some((item) => !item.hidden);
     let empty = this.list.querySelector(".empty");
     if (shown && empty) empty.remove();
     if (!shown && !empty) {
@@ -102,6 +126,7 @@ export class Conversation {
   }
 
   // One conversation message from the feed (turn, command, or a robot's exchange event).
+  /** @param {ConversationEntry} message */
   add(message) {
     let item = null;
     if (message.type === "turn") item = this.turn(message);
@@ -114,26 +139,33 @@ export class Conversation {
     this.list.appendChild(item);
     this.resized.observe(item);
     // The oldest entries go, so a long session does not grow the page without end.
-    while (this.list.children.length > ENTRIES_KEPT) {
-      this.resized.unobserve(this.list.firstElementChild);
-      this.list.firstElementChild.remove();
+    for (let oldest = this.list.firstElementChild; oldest && this.list.children.length > ENTRIES_KEPT; oldest = this.list.firstElementChild) {
+      this.resized.unobserve(oldest);
+      oldest.remove();
     }
     this.showEmpty();
   }
 
+  /** @param {string} commandId */
   acknowledged(commandId) {
     this.stale.add(commandId);
     if (this.frame === null) this.frame = requestAnimationFrame(() => this.redrawStale());
   }
 
+  /** @param {string} commandId @param {() => void} redraw */
   watch(commandId, redraw) {
-    if (!this.refreshers.has(commandId)) this.refreshers.set(commandId, []);
-    this.refreshers.get(commandId).push(redraw);
+    const redraws = this.refreshers.get(commandId) ?? [];
+    this.refreshers.set(commandId, redraws);
+    redraws.push(redraw);
     // Acknowledgments come within seconds: the oldest commands' redraws can go.
-    while (this.refreshers.size > ENTRIES_KEPT) this.refreshers.delete(this.refreshers.keys().next().value);
+    for (const oldest of this.refreshers.keys()) {
+      if (this.refreshers.size <= ENTRIES_KEPT) break;
+      this.refreshers.delete(oldest);
+    }
     redraw();
   }
 
+  /** @param {string} commandId */
   commandLine(commandId) {
     const command = this.commands[commandId];
     if (!command) return `command ${commandId.slice(0, 8)}`;
@@ -150,9 +182,10 @@ export class Conversation {
     return `${who}: ${command.action}${zone} · ${how}`;
   }
 
+  /** @param {TurnMessage} message */
   turn(message) {
     const item = node("li", "entry turn");
-    item.append(node("span", "who", ORIGINS[message.origin] || message.origin || "Someone"), node("time", "", clock(message.at ?? Date.now())));
+    item.append(node("span", "who", ORIGINS[message.origin ?? ""] || message.origin || "Someone"), node("time", "", clock(message.at ?? Date.now())));
     const said = node("div", "said");
     said.appendChild(quoted(message.utterance || "(session ended)"));
     item.appendChild(said);
@@ -182,6 +215,7 @@ export class Conversation {
     return item;
   }
 
+  /** @param {CommandMessage} message */
   command(message) {
     const robotSource = message.source.startsWith("robot:");
     const item = node("li", `entry ${robotSource ? "robot-exchange" : "console"}`);
@@ -193,6 +227,7 @@ export class Conversation {
     return item;
   }
 
+  /** @param {EventMessage} message */
   exchange(message) {
     const name = this.names[message.thing] || message.thing;
     const item = node("li", "entry robot-exchange");

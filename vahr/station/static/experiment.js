@@ -1,137 +1,60 @@
+// @ts-check
 // The experiment view and the participant's interactions.
 //
 // While `vahr experiment` runs a session, the page shows the participant's briefing (task I
 // assignments, the task under way and its time; with the keyboard-and-mouse method the
 // weather once the assistant has told it), the judge's live verdict per task, and a puzzle
 // counter for the observer. Every click, key press and push-to-talk on the page is sent to
-// the session's log as an interaction with its start and end: a click from the start of the
-// pointer's movement towards it to the button's release, a key from press to release, a
-// push-to-talk from the press to the end of the spoken reply. What an interaction caused
-// (commands, the assistant's answer) goes with its end.
+// the session's log as an interaction with its start and end (interactions.js measures
+// them; `watchInteractions` hands it the page's clicks and keys).
 
 import { post } from "./api.js";
 
-const STILL_MS = 400; // a pointer at rest this long starts a new movement when it moves
-const REACH_MS = 4000; // a movement longer ago than this is not the reach for this click
+/** @import { ExperimentStatus } from "./contract.js" */
+/** @import { Interactions } from "./interactions.js" */
+
 const WEATHERS = ["sunny", "rainy"];
+/** @type {Record<string, string>} */
 const METHODS = { vahr: "voice (VAHR)", keyboard: "keyboard and mouse" };
 const ROMAN = ["I", "II", "III"];
+/** @type {Record<string, string>} */
+const VERDICTS = { waiting: "not yet", running: "running", success: "✓ success", failure: "✗ failure" };
 
-const iso = (ms) => new Date(ms).toISOString();
-
-export class Interactions {
-  constructor() {
-    this.session = null;
-    this.count = 0;
-    this.prefix = Math.random().toString(36).slice(2, 8);
-    this.active = null;
-    this.keys = new Map();
-    this.pointer = null;
-    this.lastMove = 0;
-    this.moveStart = 0;
-    document.addEventListener("pointermove", (event) => this.moved(event), { capture: true, passive: true });
-    document.addEventListener("pointerdown", (event) => this.pointerDown(event), { capture: true });
-    document.addEventListener("pointerup", (event) => this.pointerUp(event), { capture: true });
-    document.addEventListener("pointercancel", (event) => this.pointerUp(event), { capture: true });
-    document.addEventListener("keydown", (event) => this.keyDown(event), { capture: true });
-    document.addEventListener("keyup", (event) => this.keyUp(event), { capture: true });
-  }
-
-  setSession(session) {
-    this.session = session;
-  }
-
-  // -- one interaction ---------------------------------------------------------------
-
-  start(channel, text, at) {
-    this.count += 1;
-    const interaction = { id: `${this.prefix}-${this.count}`, channel, text, at, commands: [], counts: false, asks: false, pending: [], session: this.session };
-    this.active = interaction;
-    this.send(interaction, "started", at);
-    return interaction;
-  }
-
-  // What an action started during the current interaction will report when it settles.
-  attach(promise, interaction = this.active) {
-    if (!interaction) return;
-    interaction.pending.push(promise.then((outcome) => {
-      if (!outcome) return;
-      if (outcome.commands?.length) { interaction.commands.push(...outcome.commands); interaction.counts = true; }
-      if (outcome.asks) { interaction.asks = true; interaction.counts = true; }
-      for (const field of ["speech", "intent", "error"]) if (outcome[field] !== undefined) interaction[field] = outcome[field];
-    }));
-  }
-
-  async end(interaction, at) {
-    if (!interaction || interaction.ended) return;
-    interaction.ended = true;
-    // A click's action starts after the release: give it a moment to attach itself.
-    await new Promise((resolve) => setTimeout(resolve, 60));
-    if (this.active === interaction) this.active = null;
-    await Promise.allSettled(interaction.pending);
-    this.send(interaction, "ended", at);
-  }
-
-  send(interaction, phase, at) {
-    if (!interaction.session) return; // no session: nothing is logged anywhere
-    const body = { id: interaction.id, phase, channel: interaction.channel, at: iso(at), text: String(interaction.text || "").slice(0, 200) };
-    if (phase === "ended") {
-      Object.assign(body, { commands: interaction.commands.slice(0, 16), counts: interaction.counts, asks: interaction.asks });
-      for (const field of ["speech", "intent", "error"]) {
-        if (interaction[field] !== undefined && interaction[field] !== null) body[field] = String(interaction[field]).slice(0, field === "speech" ? 1000 : 200);
-      }
-    }
-    body.sent = iso(Date.now());
-    post("/api/interaction", body).catch(() => {});
-  }
-
-  // -- clicks and keys, everywhere on the page --------------------------------------------
-
-  moved(event) {
-    const t = Date.now();
-    if (t - this.lastMove > STILL_MS) this.moveStart = t;
-    this.lastMove = t;
-  }
-
-  ignored(event) {
-    return event.target instanceof Element && event.target.closest("[data-observer], #talk");
-  }
-
-  pointerDown(event) {
-    if (!event.isPrimary || this.ignored(event)) return;
-    const t = Date.now();
-    const reach = event.pointerType === "mouse" && t - this.moveStart < REACH_MS ? this.moveStart : t;
-    this.pointer = this.start("click", describe(event.target), Math.min(reach, t));
-  }
-
-  pointerUp(event) {
-    if (!event.isPrimary || !this.pointer) return;
-    const interaction = this.pointer;
-    this.pointer = null;
-    this.end(interaction, Date.now());
-  }
-
-  keyDown(event) {
-    if (event.repeat || this.keys.has(event.code) || (event.code === "Space" && !typingIn(event.target))) return;
-    this.keys.set(event.code, this.start("key", `key ${event.key}`, Date.now()));
-  }
-
-  keyUp(event) {
-    const interaction = this.keys.get(event.code);
-    if (!interaction) return;
-    this.keys.delete(event.code);
-    this.end(interaction, Date.now());
-  }
+// Every click and key press anywhere on the page, handed to `interactions` as plain facts
+// (the observer's controls and push-to-talk, which measures itself, are left out).
+/** @param {Interactions} interactions @param {Document} [page] */
+export function watchInteractions(interactions, page = document) {
+  page.addEventListener("pointermove", () => interactions.moved(), { capture: true, passive: true });
+  page.addEventListener("pointerdown", (event) => {
+    if (!event.isPrimary || ignored(event.target)) return;
+    interactions.pointerDown({ mouse: event.pointerType === "mouse", text: describe(event.target) });
+  }, { capture: true });
+  /** @param {PointerEvent} event */
+  const up = (event) => { if (event.isPrimary) interactions.pointerUp(); };
+  page.addEventListener("pointerup", up, { capture: true });
+  page.addEventListener("pointercancel", up, { capture: true });
+  page.addEventListener("keydown", (event) => {
+    if (event.repeat || (event.code === "Space" && !typingIn(event.target))) return;
+    interactions.keyDown(event.code, event.key);
+  }, { capture: true });
+  page.addEventListener("keyup", (event) => interactions.keyUp(event.code), { capture: true });
 }
 
+/** @param {EventTarget | null} target */
+function ignored(target) {
+  return target instanceof Element && target.closest("[data-observer], #talk") !== null;
+}
+
+/** @param {EventTarget | null} target */
 function typingIn(target) {
   return target instanceof HTMLElement && ["INPUT", "TEXTAREA"].includes(target.tagName);
 }
 
+/** @param {EventTarget | null} target */
 function describe(target) {
   if (!(target instanceof Element)) return "click";
-  const thing = target.closest("[data-thing]")?.dataset.thing;
-  const zone = target.closest("[data-zone]")?.dataset.zone;
+  const thing = target.closest("[data-thing]")?.getAttribute("data-thing");
+  const zone = target.closest("[data-zone]")?.getAttribute("data-zone");
   const labelled = target.closest("button, summary, select, input, [role=button]");
   const label = labelled?.getAttribute("aria-label") || labelled?.textContent?.trim();
   if (zone) return `click zone ${zone}`;
@@ -140,18 +63,45 @@ function describe(target) {
   return "click";
 }
 
+/**
+ * The experiment card's elements, the robots' spoken names, and the station's time (the
+ * page's clock corrected by what the station said).
+ * @typedef {object} ExperimentParts
+ * @property {HTMLElement} card
+ * @property {HTMLElement} chip
+ * @property {HTMLElement} briefing
+ * @property {HTMLElement} verdicts
+ * @property {HTMLElement} clock
+ * @property {HTMLOutputElement} puzzle
+ * @property {HTMLElement} less
+ * @property {HTMLElement} more
+ * @property {Record<string, string>} names
+ * @property {() => number} now
+ */
+
 export class ExperimentView {
-  // `now` is the station's time (the page's clock corrected by what the station said).
+  /** @param {ExperimentParts} parts */
   constructor({ card, chip, briefing, verdicts, clock, puzzle, less, more, names, now }) {
-    Object.assign(this, { card, chip, briefing, verdicts, clock, puzzle, names, now });
+    this.card = card;
+    this.chip = chip;
+    this.briefing = briefing;
+    this.verdicts = verdicts;
+    this.clock = clock;
+    this.puzzle = puzzle;
+    this.names = names;
+    this.now = now;
+    /** @type {ExperimentStatus | null} */
     this.status = null;
+    /** @type {string | null} */
     this.weather = null;
-    this.timer = null;
+    /** @type {number | undefined} */
+    this.timer = undefined;
     less.addEventListener("click", () => this.puzzleStep(-1));
     more.addEventListener("click", () => this.puzzleStep(1));
   }
 
   // The session's status from `vahr experiment` (null when none runs).
+  /** @param {ExperimentStatus | null} status */
   update(status) {
     const previous = this.status;
     this.status = status && !status.ended ? status : null;
@@ -171,6 +121,7 @@ export class ExperimentView {
 
   // A reply of the assistant: with the keyboard-and-mouse method the participant learns the
   // weather by asking, so the briefing shows it once it has been said.
+  /** @param {string | null | undefined} speech */
   heard(speech) {
     if (!this.status || this.status.method !== "keyboard" || !speech) return;
     const words = new Set(speech.toLowerCase().match(/[a-z]+/g) || []);
@@ -183,7 +134,9 @@ export class ExperimentView {
 
   render() {
     const s = this.status;
+    if (!s) return;
     this.briefing.replaceChildren();
+    /** @param {string} className @param {string} text */
     const line = (className, text) => {
       const div = document.createElement("div");
       div.className = className;
@@ -205,7 +158,7 @@ export class ExperimentView {
       const item = document.createElement("li");
       item.className = verdict.state;
       item.dataset.task = task;
-      const label = { waiting: "not yet", running: "running", success: "✓ success", failure: "✗ failure" }[verdict.state];
+      const label = VERDICTS[verdict.state];
       for (const [className, text] of [["task", `Task ${task}`], ["state", label], ["why", verdict.reason || ""]]) {
         const span = document.createElement("span");
         span.className = className;
@@ -228,6 +181,7 @@ export class ExperimentView {
     this.clock.textContent = `${String(Math.floor(seconds / 60)).padStart(2, "0")}:${String(seconds % 60).padStart(2, "0")}`;
   }
 
+  /** @param {number} count */
   puzzleStep(count) {
     if (!this.status) return;
     const now = new Date().toISOString();

@@ -1,127 +1,105 @@
+// @ts-check
 // The floor, top-down, drawn from fleet.yaml, with every robot where it was last reported.
 //
-// Robots report their pose now and then (every second on the local stack, far less often
-// on AWS), so between reports the map moves each robot along its path: a straight line
-// from the last reported pose toward the destination zone, at the speed its reports imply
-// (or that of its previous drive). A report that disagrees is eased into over a moment,
-// never jumped to, and a robot is never drawn sliding backwards along its path.
+// Robots report their pose now and then, so between reports the map moves each robot
+// along its path (motion.js): toward its destination zone at the speed its reports imply,
+// easing into a report that disagrees, never jumping or sliding back.
 
 import { clock } from "./dom.js";
+import { Motion, angleDelta, distance } from "./motion.js";
+
+/** @import { Conveyor, Event, FleetView, Point, Pose, Reported, RobotEntry, RobotView, ZoneEntry } from "./contract.js" */
+/** @import { ReportedPose } from "./motion.js" */
+
+/**
+ * What the map and the robots panel show of one robot.
+ * @typedef {object} RobotState
+ * @property {string} status "offline", or the reported status ("idle" before any)
+ * @property {Reported} reported
+ * @property {boolean | null} [online]
+ * @property {number | null} [lastSeen]
+ * @property {Event | null} [progress]
+ */
+
+/**
+ * One robot's parts on the map.
+ * @typedef {object} DrawnRobot
+ * @property {SVGGElement} group
+ * @property {SVGGElement} rotor
+ * @property {SVGCircleElement} body
+ * @property {SVGRectElement} cargo
+ * @property {SVGTextElement | null} label
+ * @property {SVGTextElement | null} detail
+ * @property {SVGLineElement} path
+ * @property {SVGCircleElement} destination
+ * @property {Motion} motion
+ * @property {Partial<RobotState>} state
+ * @property {string} [colour]
+ * @property {string} [labelAt]
+ */
+
+/** @typedef {"floor" | "fixtures" | "zones" | "paths" | "robots"} Layer */
 
 const SVG = "http://www.w3.org/2000/svg";
-const DEFAULT_SPEED = 0.5; // metres a second: the simulator's, until reports say otherwise
-const EASE_MS = 600;
-const TURN_RATE = 5; // radians a second at which the drawn heading follows
 const LABELS_UP_TO = 12; // more robots than this: numbers only, no names under them
 // Frames a second the map moves robots at: smooth for a few, calmer (and cheaper) for many.
 const FRAME_MS_FEW = 0, FRAME_MS_MANY = 50, MANY = 20;
 
+/**
+ * @template {keyof SVGElementTagNameMap} K
+ * @param {K} name
+ * @param {Record<string, string | number>} [attributes]
+ * @param {Element | null} [parent]
+ * @returns {SVGElementTagNameMap[K]}
+ */
 function el(name, attributes = {}, parent = null) {
   const node = document.createElementNS(SVG, name);
-  for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, value);
+  for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, String(value));
   if (parent) parent.appendChild(node);
   return node;
 }
 
 // Write an attribute only when its value changes: every write, even of the same value,
 // makes the browser restyle and lay the map out again.
+/** @param {Element} node @param {string} name @param {string | number} value */
 function put(node, name, value) {
   const text = String(value);
   if (node.getAttribute(name) !== text) node.setAttribute(name, text);
 }
 
 const now = () => performance.now();
-const distance = (a, b) => Math.hypot(a.x - b.x, a.y - b.y);
-const smooth = (t) => 1 - Math.pow(1 - Math.min(Math.max(t, 0), 1), 3);
-const angleDelta = (a, b) => Math.atan2(Math.sin(b - a), Math.cos(b - a));
-
-// Where one robot is drawn: reported poses in, a position at any moment out.
-class Motion {
-  constructor(pose) {
-    this.anchor = { x: pose.x, y: pose.y, t: now() };
-    this.theta = pose.theta ?? 0;
-    this.heading = this.theta;
-    this.target = null;
-    this.speed = DEFAULT_SPEED;
-    this.offset = { x: 0, y: 0, t: 0 };
-    this.last = null;
-  }
-
-  position(t) {
-    let { x, y } = this.anchor;
-    if (this.target) {
-      const remaining = distance(this.anchor, this.target);
-      const travelled = Math.min(remaining, (this.speed * (t - this.anchor.t)) / 1000);
-      if (remaining > 1e-6) {
-        x += ((this.target.x - x) * travelled) / remaining;
-        y += ((this.target.y - y) * travelled) / remaining;
-      }
-    }
-    const fade = 1 - smooth((t - this.offset.t) / EASE_MS);
-    return { x: x + this.offset.x * fade, y: y + this.offset.y * fade };
-  }
-
-  get settling() {
-    return now() - this.offset.t < EASE_MS;
-  }
-
-  get driving() {
-    return this.target !== null && distance(this.position(now()), this.target) > 0.01;
-  }
-
-  // A reported `pose`; `target` is the destination's pose while driving, else null.
-  report(pose, target) {
-    const t = now();
-    const shown = this.position(t);
-    if (target && this.last && this.last.target && distance(this.last.target, target) < 1e-6) {
-      const seconds = (t - this.last.t) / 1000;
-      const covered = distance(this.last.pose, pose);
-      if (seconds > 0.05 && covered > 0.01) {
-        // The speed the reports imply, blended with what was believed before.
-        this.speed = 0.5 * this.speed + 0.5 * Math.min(Math.max(covered / seconds, 0.02), 100);
-      }
-    }
-    let anchor = { x: pose.x, y: pose.y, t };
-    if (target && distance(shown, target) < distance(pose, target)) {
-      // The robot is behind where it was drawn: hold the drawn place rather than back up;
-      // the speed just measured lets the report catch up.
-      anchor = { x: shown.x, y: shown.y, t };
-    }
-    this.offset = { x: shown.x - anchor.x, y: shown.y - anchor.y, t };
-    this.anchor = anchor;
-    this.target = target;
-    if (pose.theta !== undefined && pose.theta !== null) this.theta = pose.theta;
-    this.last = target ? { pose: { x: pose.x, y: pose.y }, t, target } : null;
-  }
-
-  headingAt(t, dt) {
-    let wanted = this.theta;
-    if (this.target) {
-      const at = this.position(t);
-      if (distance(at, this.target) > 0.05) wanted = Math.atan2(this.target.y - at.y, this.target.x - at.x);
-    }
-    const step = TURN_RATE * dt;
-    const delta = angleDelta(this.heading, wanted);
-    this.heading += Math.abs(delta) <= step ? delta : Math.sign(delta) * step;
-    return this.heading;
-  }
-}
 
 export class MapView {
+  /**
+   * @param {SVGSVGElement} svg
+   * @param {{onRobot: (thing: string) => void, onZone: (zone: string) => void}} handlers
+   */
   constructor(svg, { onRobot, onZone }) {
     this.svg = svg;
     this.onRobot = onRobot;
     this.onZone = onZone;
-    this.robots = new Map(); // thing -> {node parts, motion}
+    /** @type {Map<string, DrawnRobot>} */
+    this.robots = new Map();
+    /** @type {Map<string, {group: SVGGElement, zone: ZoneEntry, half: number}>} */
     this.zones = new Map();
+    /** @type {Map<string, SVGGElement>} */
     this.arms = new Map();
+    /** @type {number | null} */
     this.frame = null;
     this.lastFrame = 0;
+    /** @type {string | null} */
     this.selected = null;
+    /** @type {FleetView | undefined} */
+    this.fleet = undefined;
+    this.scale = 1;
+    this.labels = true;
+    /** @type {SVGGElement | null} */
+    this.led = null;
   }
 
   // -- drawing the floor ---------------------------------------------------------------
 
+  /** @param {FleetView} fleet */
   build(fleet) {
     this.fleet = fleet;
     this.svg.replaceChildren();
@@ -145,8 +123,8 @@ export class MapView {
     this.scale = Math.max(1, Math.max(right - left, top - bottom) / 13);
     this.labels = fleet.robots.length <= LABELS_UP_TO;
 
-    const layers = {};
-    for (const name of ["floor", "fixtures", "zones", "paths", "robots"]) layers[name] = el("g", { class: `layer-${name}` }, this.svg);
+    const layers = /** @type {Record<Layer, SVGGElement>} */ ({});
+    for (const name of /** @type {Layer[]} */ (["floor", "fixtures", "zones", "paths", "robots"])) layers[name] = el("g", { class: `layer-${name}` }, this.svg);
     this.layers = layers;
 
     el("rect", { class: "floor", x: floor.origin.x, y: -(floor.origin.y + floor.height), width: floor.width, height: floor.height }, layers.floor);
@@ -166,6 +144,7 @@ export class MapView {
     fleet.robots.forEach((robot, index) => this.drawRobot(robot, index, layers));
   }
 
+  /** @param {Conveyor} conveyor @param {SVGGElement} parent */
   drawConveyor(conveyor, parent) {
     const { start, end, width } = conveyor;
     const length = distance(start, end);
@@ -179,6 +158,7 @@ export class MapView {
     }
   }
 
+  /** @param {ZoneEntry} zone @param {SVGGElement} parent */
   drawZone(zone, parent) {
     // The box is the arrival circle's square with room around it; a robot stops at its
     // centre, so the letter sits in the top-left corner and the name along the bottom.
@@ -190,15 +170,16 @@ export class MapView {
     const big = zone.id.length <= 2 ? zone.id : zone.key;
     const letter = el("text", { class: "zone-letter", x: x - half + 0.26, y: -y - half + 0.3, "font-size": big ? 0.42 : 0.2 }, group);
     letter.textContent = big || zone.name;
-    if (!big) letter.setAttribute("x", x);
+    if (!big) letter.setAttribute("x", String(x));
     const name = el("text", { class: "zone-name", x, y: -y + half - 0.09, "font-size": 0.16 }, group);
     name.textContent = zone.name;
     group.addEventListener("click", () => this.onZone(zone.id));
     this.zones.set(zone.id, { group, zone, half });
   }
 
+  /** @param {string} zoneId @param {Point} at @param {SVGGElement} parent */
   drawArm(zoneId, at, parent) {
-    const zone = this.fleet.zones.find((z) => z.id === zoneId);
+    const zone = this.fleet?.zones.find((z) => z.id === zoneId);
     if (!zone) return;
     const group = el("g", { class: "arm" }, parent);
     el("title", {}, group).textContent = zone.arm === "loader" ? "Loading arm" : `Unloading arm of zone ${zone.id}`;
@@ -209,6 +190,7 @@ export class MapView {
     this.arms.set(zoneId, group);
   }
 
+  /** @param {Point} at @param {SVGGElement} parent */
   drawLed(at, parent) {
     const group = el("g", { class: "led" }, parent);
     el("title", {}, group).textContent = "Task III LED: lights when both robots delivered to D in order";
@@ -217,6 +199,7 @@ export class MapView {
     this.led = group;
   }
 
+  /** @param {RobotEntry} robot @param {number} index @param {Record<Layer, SVGGElement>} layers */
   drawRobot(robot, index, layers) {
     const group = el("g", { class: "robot", "data-thing": robot.thing, role: "button", "aria-label": robot.name }, layers.robots);
     el("title", {}, group).textContent = robot.name;
@@ -243,14 +226,18 @@ export class MapView {
 
   // -- state ---------------------------------------------------------------------------
 
+  /** @param {string | null | undefined} zoneId @returns {Pose | null} */
   zonePose(zoneId) {
+    if (!zoneId) return null;
     return this.zones.get(zoneId)?.zone.pose ?? null;
   }
 
   // A robot's whole state changed (shadow, presence, an event): redraw what it shows.
+  /** @param {string} thing @param {RobotView} robot */
   update(thing, robot) {
     const drawn = this.robots.get(thing);
     if (!drawn) return;
+    /** @type {Reported} */
     const reported = robot.reported || {};
     const status = robot.online === false ? "offline" : reported.status || "idle";
     drawn.state = { status, reported, online: robot.online, lastSeen: robot.last_seen, progress: robot.progress };
@@ -262,12 +249,18 @@ export class MapView {
     }
     put(drawn.cargo, "visibility", reported.cargo ? "visible" : "hidden");
     if (drawn.detail) {
-      const text = describe(drawn.state);
+      const text = describe(/** @type {RobotState} */ (drawn.state));
       if (drawn.detail.textContent !== text) drawn.detail.textContent = text;
     }
   }
 
   // A reported pose (from the shadow or an event): move the robot's motion.
+  /**
+   * @param {string} thing
+   * @param {ReportedPose | null | undefined} pose
+   * @param {string | null | undefined} destinationZone
+   * @param {boolean} driving
+   */
   report(thing, pose, destinationZone, driving) {
     const drawn = this.robots.get(thing);
     if (!drawn || !pose) return;
@@ -276,10 +269,12 @@ export class MapView {
     this.animate();
   }
 
+  /** @param {boolean | undefined} on */
   setLed(on) {
     this.led?.classList.toggle("on", Boolean(on));
   }
 
+  /** @param {string | null} thing */
   select(thing) {
     this.selected = thing;
     for (const [name, drawn] of this.robots) drawn.group.classList.toggle("selected", name === thing);
@@ -291,7 +286,7 @@ export class MapView {
     const working = new Set();
     for (const drawn of this.robots.values()) {
       const { status, reported } = drawn.state;
-      if ((status === "loading" || status === "unloading") && reported.zone) working.add(reported.zone);
+      if ((status === "loading" || status === "unloading") && reported?.zone) working.add(reported.zone);
     }
     for (const [zoneId, arm] of this.arms) arm.classList.toggle("working", working.has(zoneId));
   }
@@ -320,8 +315,10 @@ export class MapView {
   }
 
   // Draw one robot at time t; true while it is still moving (or settling, or turning).
+  /** @param {string} thing @param {number} t @param {number} dt */
   place(thing, t, dt) {
     const drawn = this.robots.get(thing);
+    if (!drawn) return false;
     const { motion } = drawn;
     const at = motion.position(t);
     const heading = motion.headingAt(t, dt);
@@ -346,8 +343,10 @@ export class MapView {
 
   // Names go beside a robot on the side facing the middle of the floor, clear of the zone
   // it stands in, so they never cover a zone's letter.
+  /** @param {DrawnRobot} drawn @param {Point} at */
   placeLabel(drawn, at) {
-    const floor = this.fleet.floor;
+    const floor = this.fleet?.floor;
+    if (!floor) return;
     const side = at.x > floor.origin.x + floor.width / 2 ? -1 : 1;
     let offset = 0.42;
     for (const { zone, half } of this.zones.values()) {
@@ -360,44 +359,53 @@ export class MapView {
     if (drawn.labelAt === `${x}${anchor}`) return;
     drawn.labelAt = `${x}${anchor}`;
     for (const text of [drawn.label, drawn.detail]) {
-      text.setAttribute("x", x);
-      text.setAttribute("text-anchor", anchor);
+      text?.setAttribute("x", x);
+      text?.setAttribute("text-anchor", anchor);
     }
   }
 
   // Where a robot is drawn now (tests and benchmarks read it).
+  /** @param {string} thing */
   drawnPosition(thing) {
     const drawn = this.robots.get(thing);
     return drawn ? drawn.motion.position(now()) : null;
   }
 }
 
+/** The colour (a CSS variable's name) of each status. @type {Record<string, string>} */
+const STATUS_COLOURS = {
+  idle: "idle",
+  navigating: "navigating",
+  loading: "loading",
+  unloading: "loading",
+  waiting: "waiting",
+  stopped: "stopped",
+  stuck: "stuck",
+  error: "error",
+  offline: "offline",
+};
+
+/** @param {string} status */
 export function statusColour(status) {
-  return {
-    idle: "idle",
-    navigating: "navigating",
-    loading: "loading",
-    unloading: "loading",
-    waiting: "waiting",
-    stopped: "stopped",
-    stuck: "stuck",
-    error: "error",
-    offline: "offline",
-  }[status] || "idle";
+  return STATUS_COLOURS[status] || "idle";
 }
 
+/** @type {Record<string, string>} */
 const zoneNames = {};
 
+/** @param {ZoneEntry[]} zones */
 export function setZoneNames(zones) {
   for (const zone of zones) zoneNames[zone.id] = zone.name;
 }
 
 // How a zone is named in running text: its id when it is a letter ("B"), else its name.
+/** @param {string | null | undefined} id */
 export function zoneText(id) {
   if (!id) return "";
   return id.length <= 2 || !zoneNames[id] ? id : zoneNames[id];
 }
 
+/** @param {RobotState} state @param {{where?: boolean}} [options] */
 export function describe(state, { where = true } = {}) {
   const { status, reported } = state;
   if (status === "offline") {

@@ -1,12 +1,33 @@
+// @ts-check
 // The keyboard-and-mouse panel: the paper's baseline method. Select a robot (a click on the
 // map or here, or keys 1-9), then a zone (a click, or its key: A-D, L) to send it there; the
 // arms load and unload on arrival. Esc stops every robot. "Ask the weather" asks the
 // assistant, as the paper's keyboard participants did.
 
-import { post } from "./api.js";
+import { post, reason } from "./api.js";
 import { statusColour, zoneText } from "./map.js";
 import { typing } from "./talk.js";
 
+/** @import { Acknowledgment, CommandMessage, FleetView, ZoneEntry } from "./contract.js" */
+/** @import { CommandReply, SayReply } from "./api.js" */
+/** @import { Interactions } from "./interactions.js" */
+
+/**
+ * The panel's elements, the page's interactions, and what it shares with the page's store.
+ * @typedef {object} PanelParts
+ * @property {HTMLElement} robots the robots' buttons go here
+ * @property {HTMLElement} zones the zones' buttons go here
+ * @property {HTMLButtonElement} stopAll
+ * @property {HTMLButtonElement} weather
+ * @property {HTMLElement} status
+ * @property {HTMLElement} note
+ * @property {Interactions} interactions
+ * @property {(thing: string) => void} onSelect
+ * @property {Record<string, string>} names the robots' spoken names
+ * @property {Record<string, CommandMessage>} commands the commands seen, by id
+ */
+
+/** @param {string | undefined} label @param {string} [className] */
 function button(label, className = "btn") {
   const made = document.createElement("button");
   made.type = "button";
@@ -15,6 +36,7 @@ function button(label, className = "btn") {
   return made;
 }
 
+/** @param {string} letter */
 function key(letter) {
   const kbd = document.createElement("kbd");
   kbd.textContent = letter;
@@ -22,6 +44,7 @@ function key(letter) {
 }
 
 export class Panel {
+  /** @param {PanelParts} parts */
   constructor({ robots, zones, stopAll, weather, status, note, interactions, onSelect, names, commands }) {
     this.commands = commands;
     this.robotsBox = robots;
@@ -31,22 +54,32 @@ export class Panel {
     this.interactions = interactions;
     this.onSelect = onSelect;
     this.names = names;
+    /** @type {string | null} */
     this.selected = null;
     this.ordersAllowed = true;
-    this.pending = new Map(); // command id -> what the status line says about it
+    /** Per command id, what the status line says about it. @type {Map<string, string>} */
+    this.pending = new Map();
+    /** @type {FleetView | null} */
+    this.fleet = null;
+    /** @type {Map<string, {made: HTMLButtonElement, dot: HTMLSpanElement}>} */
+    this.robotButtons = new Map();
+    /** @type {Map<string, HTMLButtonElement>} */
+    this.zoneButtons = new Map();
     stopAll.addEventListener("click", () => this.stopAll());
     weather.addEventListener("click", () => this.askWeather());
     this.weatherButton = weather;
     document.addEventListener("keydown", (event) => this.onKey(event));
   }
 
+  /** @param {FleetView} fleet */
   build(fleet) {
     this.fleet = fleet;
     this.robotButtons = new Map();
     this.zoneButtons = new Map();
     this.robotsBox.replaceChildren();
     this.zonesBox.replaceChildren();
-    for (const robot of fleet.robots.filter((r) => r.key)) {
+    for (const robot of fleet.robots) {
+      if (!robot.key) continue;
       const made = button(undefined);
       const dot = document.createElement("span");
       dot.className = "robot-dot";
@@ -81,11 +114,13 @@ export class Panel {
     this.refresh();
   }
 
+  /** @param {string} thing @param {string} status */
   colour(thing, status) {
     const parts = this.robotButtons?.get(thing);
     if (parts) parts.dot.style.background = `var(--${statusColour(status)})`;
   }
 
+  /** @param {string | null} thing */
   select(thing) {
     this.selected = thing;
     for (const [name, { made }] of this.robotButtons) made.setAttribute("aria-pressed", String(name === thing));
@@ -93,6 +128,7 @@ export class Panel {
   }
 
   // While a voice session runs, orders are given by voice: the panel only selects and stops.
+  /** @param {boolean} allowed @param {string | null} note */
   allowOrders(allowed, note) {
     this.ordersAllowed = allowed;
     this.note.dataset.session = note ? "true" : "false";
@@ -108,6 +144,7 @@ export class Panel {
     }
   }
 
+  /** @param {string} message */
   tell(message, bad = false) {
     this.status.textContent = message;
     this.status.classList.toggle("error", bad);
@@ -115,7 +152,9 @@ export class Panel {
 
   // -- orders --------------------------------------------------------------------------
 
+  /** @param {{robot: string, action: string, zone: string}} body @param {string} describe */
   async order(body, describe) {
+    /** @type {Promise<CommandReply>} */
     const sent = post("/api/command", body);
     const result = sent.then((answer) => ({ commands: [answer.id] }), (err) => ({ error: err.message }));
     this.interactions.attach(result);
@@ -128,11 +167,12 @@ export class Panel {
       for (const [thing, ack] of Object.entries(this.commands[id]?.acks || {})) this.acknowledged(id, thing, ack);
       return id;
     } catch (err) {
-      this.tell(err.message, true);
+      this.tell(reason(err), true);
       return null;
     }
   }
 
+  /** @param {string | null} thing @param {string} zone */
   navigate(thing, zone) {
     if (!thing) {
       this.tell("Select a robot first: click it on the map, or press its number.", true);
@@ -143,6 +183,7 @@ export class Panel {
   }
 
   async stopAll() {
+    /** @type {Promise<CommandReply>} */
     const sent = post("/api/stop", {});
     this.interactions.attach(sent.then((answer) => ({ commands: [answer.id] }), (err) => ({ error: err.message })));
     try {
@@ -150,12 +191,13 @@ export class Panel {
       this.pending.set(id, "Stop all");
       this.tell("Stop all: sent.");
     } catch (err) {
-      this.tell(err.message, true);
+      this.tell(reason(err), true);
     }
   }
 
   async askWeather() {
     this.weatherButton.disabled = true;
+    /** @type {Promise<SayReply>} */
     const sent = post("/api/say", { utterance: "what is the weather", origin: "station-weather" });
     this.interactions.attach(sent.then(
       (turn) => ({ asks: true, speech: turn.speech, intent: turn.intent, commands: turn.commands || [] }),
@@ -168,13 +210,14 @@ export class Panel {
       const { speak } = await import("./api.js");
       await speak(turn.speech);
     } catch (err) {
-      this.tell(err.message, true);
+      this.tell(reason(err), true);
     } finally {
       this.weatherButton.disabled = false;
     }
   }
 
   // A robot acknowledged (or rejected) a command this panel sent.
+  /** @param {string} id @param {string} thing @param {Acknowledgment} ack */
   acknowledged(id, thing, ack) {
     const describe = this.pending.get(id);
     if (!describe) return;
@@ -183,6 +226,7 @@ export class Panel {
     else this.tell(`${describe}: acknowledged by ${name} in ${Math.round(ack.latency_ms)} ms.`);
   }
 
+  /** @param {KeyboardEvent} event */
   onKey(event) {
     if (event.repeat || event.ctrlKey || event.metaKey || event.altKey || typing(event.target)) return;
     if (event.key === "Escape") {
@@ -205,6 +249,7 @@ export class Panel {
 }
 
 // "Zone A" for a one-letter zone, else its spoken name with a capital ("Loading zone").
+/** @param {ZoneEntry} zone */
 export function zoneLabel(zone) {
   if (zone.id.length === 1) return `Zone ${zone.id}`;
   return zone.name.charAt(0).toUpperCase() + zone.name.slice(1);

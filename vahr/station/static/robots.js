@@ -1,3 +1,4 @@
+// @ts-check
 // The robots panel: per robot its presence, status, zone, cargo, the command under way with
 // its progress, the last result with its reason, and the reported shadow on demand.
 //
@@ -7,23 +8,56 @@
 import { clock, node } from "./dom.js";
 import { describe, statusColour, zoneText } from "./map.js";
 
+/** @import { CommandMessage, FleetView, Reported, RobotView } from "./contract.js" */
 
 // Up to this many robots the list is as tall as its rows; beyond, it has the card's whole
 // height whatever its rows say, so a row that changes lays out the list alone, not the page.
 const ROWS_SIZED_BY_CONTENT = 4;
 
 // Set a property only when it changes (reading is cheap, writing makes the browser work).
+/**
+ * @template {object} T
+ * @template {keyof T} K
+ * @param {T} target
+ * @param {K} key
+ * @param {T[K]} value
+ */
 function put(target, key, value) {
   if (target[key] !== value) target[key] = value;
 }
 
+/**
+ * One robot's row and the parts of it an update rewrites.
+ * @typedef {object} Row
+ * @property {HTMLLIElement} row
+ * @property {HTMLButtonElement} badge
+ * @property {HTMLSpanElement} presence
+ * @property {HTMLSpanElement} presenceText
+ * @property {HTMLSpanElement} status
+ * @property {HTMLElement} zone
+ * @property {HTMLSpanElement} cargo
+ * @property {HTMLDivElement} task
+ * @property {HTMLSpanElement} taskWhat
+ * @property {HTMLSpanElement} bar
+ * @property {HTMLSpanElement} fill
+ * @property {HTMLSpanElement} percent
+ * @property {HTMLSpanElement} source
+ * @property {HTMLDivElement} last
+ * @property {HTMLDetailsElement} details
+ * @property {HTMLPreElement} raw
+ * @property {Reported} reported
+ */
+
 export class RobotsPanel {
+  /** @param {HTMLElement} list @param {{onSelect: (thing: string) => void}} handlers */
   constructor(list, { onSelect }) {
     this.list = list;
     this.onSelect = onSelect;
+    /** @type {Map<string, Row>} */
     this.rows = new Map();
   }
 
+  /** @param {FleetView} fleet */
   build(fleet) {
     this.list.replaceChildren();
     this.list.classList.toggle("many", fleet.robots.length > ROWS_SIZED_BY_CONTENT);
@@ -67,13 +101,16 @@ export class RobotsPanel {
     });
   }
 
+  /** @param {string | null} thing */
   select(thing) {
     for (const [name, parts] of this.rows) parts.row.classList.toggle("selected", name === thing);
   }
 
+  /** @param {string} thing @param {RobotView} robot @param {Record<string, CommandMessage>} commands */
   update(thing, robot, commands) {
     const parts = this.rows.get(thing);
     if (!parts) return;
+    /** @type {Reported} */
     const reported = robot.reported || {};
     parts.reported = reported;
     const online = robot.online;
@@ -115,6 +152,7 @@ export class RobotsPanel {
   }
 }
 
+/** Who sent a command, in words. @param {string} source */
 export function sourceName(source) {
   if (source === "alexa") return "the assistant";
   if (source === "console") return "keyboard and mouse";
@@ -122,6 +160,7 @@ export function sourceName(source) {
   return source;
 }
 
+/** @param {string} source */
 function shortSource(source) {
   if (source === "alexa") return "voice";
   if (source === "console") return "keyboard";

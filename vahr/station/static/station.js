@@ -1,59 +1,96 @@
+// @ts-check
 // The station page: one stream of the station's messages (server-sent events, pushed as
 // things happen; the page never polls), one store, and the views that draw it.
 
-import { post, replyVoice, setReplyVoice, speak } from "./api.js";
+import { post, reason, replyVoice, setReplyVoice, speak } from "./api.js";
+import { COMMANDS_LIMIT, DRIVE_ENDS, EXCHANGE_EVENTS } from "./contract.js";
 import { Conversation } from "./conversation.js";
-import { ExperimentView, Interactions } from "./experiment.js";
+import { byId } from "./dom.js";
+import { ExperimentView, watchInteractions } from "./experiment.js";
+import { Interactions } from "./interactions.js";
 import { MapView, setZoneNames } from "./map.js";
 import { Panel } from "./panel.js";
 import { RobotsPanel } from "./robots.js";
 import { Talk } from "./talk.js";
 
-const $ = (id) => document.getElementById(id);
+/** @import { CommandMessage, EventMessage, ExperimentStatus, FleetView, PageMessage, Reported, RobotView, ShadowMessage, SnapshotMessage } from "./contract.js" */
+/** @import { SayReply } from "./api.js" */
+
+/**
+ * What the page knows, kept from the station's messages.
+ * @typedef {object} Store
+ * @property {FleetView | null} fleet
+ * @property {Record<string, RobotView>} robots
+ * @property {Record<string, CommandMessage>} commands the commands seen, by id (the views share it)
+ * @property {ExperimentStatus | null} experiment the session running, if any
+ * @property {string | null} selected the robot selected
+ * @property {number} skew the station's clock less the page's, in ms
+ */
+
+/** A shadow update on its way to the screen. @typedef {{thing: string, version: number, received: number}} PaintMarker */
+
+/**
+ * What was drawn when, for benchmarks and tests (`?metrics=1`, `window.vahrMetrics`).
+ * @typedef {object} Metrics
+ * @property {Array<PaintMarker & {at: number}>} painted
+ * @property {Array<{reply_shown_ms: number, recognizer_ms: number, transcript: string}>} ptt
+ * @property {Array<{thing: string, status: string, cargo: boolean, zone: string | null}>} shown
+ * @property {number} messages
+ */
 
 // Benchmarks and tests read what was drawn when (`?metrics=1`).
+/** @type {Metrics | null} */
 const metrics = new URLSearchParams(location.search).has("metrics") ? { painted: [], ptt: [], shown: [], messages: 0 } : null;
 if (metrics) window.vahrMetrics = metrics;
 
-const COMMANDS_KEPT = 1000; // as many as the station's feed follows (feed.py)
+/** @type {Store} */
 const store = { fleet: null, robots: {}, commands: {}, experiment: null, selected: null, skew: 0 };
+/** The robots' spoken names. @type {Record<string, string>} */
 const names = {};
-const interactions = new Interactions();
+const interactions = new Interactions({ send: (body) => { post("/api/interaction", body).catch(() => {}); } });
+watchInteractions(interactions);
 
-const map = new MapView($("map"), { onRobot: select, onZone: (zone) => panel.navigate(store.selected, zone) });
-const robots = new RobotsPanel($("robots"), { onSelect: select });
-const conversation = new Conversation($("conversation"), $("conversation-filters"), { commands: store.commands, names });
+const map = new MapView(byId("map", SVGSVGElement), { onRobot: select, onZone: (zone) => panel.navigate(store.selected, zone) });
+const robots = new RobotsPanel(byId("robots", HTMLElement), { onSelect: select });
+const conversation = new Conversation(byId("conversation", HTMLElement), byId("conversation-filters", HTMLElement), { commands: store.commands, names });
 const panel = new Panel({
-  robots: $("robot-buttons"), zones: $("zone-buttons"), stopAll: $("stop-all"), weather: $("ask-weather"),
-  status: $("panel-status"), note: $("panel-note"), interactions, onSelect: select, names, commands: store.commands,
+  robots: byId("robot-buttons", HTMLElement), zones: byId("zone-buttons", HTMLElement), stopAll: byId("stop-all", HTMLButtonElement),
+  weather: byId("ask-weather", HTMLButtonElement), status: byId("panel-status", HTMLElement), note: byId("panel-note", HTMLElement),
+  interactions, onSelect: select, names, commands: store.commands,
 });
 const experiment = new ExperimentView({
-  card: $("experiment"), chip: $("session-chip"), briefing: $("briefing"), verdicts: $("verdicts"),
-  clock: $("experiment-clock"), puzzle: $("puzzle-count"), less: $("puzzle-less"), more: $("puzzle-more"), names,
+  card: byId("experiment", HTMLElement), chip: byId("session-chip", HTMLElement), briefing: byId("briefing", HTMLElement),
+  verdicts: byId("verdicts", HTMLElement), clock: byId("experiment-clock", HTMLElement), puzzle: byId("puzzle-count", HTMLOutputElement),
+  less: byId("puzzle-less", HTMLElement), more: byId("puzzle-more", HTMLElement), names,
   now: () => Date.now() + store.skew,
 });
-new Talk({ button: $("talk"), level: $("talk-level"), state: $("talk-state"), interactions, metrics });
+new Talk({ button: byId("talk", HTMLButtonElement), level: byId("talk-level", HTMLElement), state: byId("talk-state", HTMLElement), interactions, metrics });
 
-const voice = $("reply-voice");
+const voice = byId("reply-voice", HTMLSelectElement);
 voice.value = replyVoice();
 voice.addEventListener("change", () => setReplyVoice(voice.value));
 
+/** Select `thing` (again: deselect it). @param {string} thing */
 function select(thing) {
   store.selected = store.selected === thing ? null : thing;
   map.select(store.selected);
   robots.select(store.selected);
   panel.select(store.selected);
-  $("map-hint").textContent = store.selected
+  byId("map-hint", HTMLElement).textContent = store.selected
     ? `${names[store.selected]} selected: click a zone (or press its key) to send it there.`
     : "Click a robot, then a zone to send it there.";
 }
 
 // -- drawing changes, at most once a frame ---------------------------------------------
 
+/** @type {Set<string>} */
 const dirty = new Set();
+/** @type {number | null} */
 let frame = null;
+/** @type {PaintMarker[]} */
 const painted = [];
 
+/** @param {string} thing @param {PaintMarker | null} [marker] */
 function changed(thing, marker = null) {
   dirty.add(thing);
   if (marker) painted.push(marker);
@@ -69,7 +106,7 @@ function draw() {
     robots.update(thing, robot, store.commands);
     const status = robot.online === false ? "offline" : robot.reported?.status || "idle";
     panel.colour(thing, status);
-    if (metrics) record(thing, status, robot.reported || {});
+    if (metrics) record(metrics, thing, status, robot.reported || {});
   }
   dirty.clear();
   map.updateArms();
@@ -81,16 +118,20 @@ function draw() {
   }
 }
 
+/** @type {PaintMarker[][]} */
 const afterFrame = [];
 const frameDone = new MessageChannel();
 frameDone.port1.onmessage = () => {
+  if (!metrics) return;
   const at = performance.timeOrigin + performance.now();
-  for (const marker of afterFrame.shift()) metrics.painted.push({ ...marker, at });
+  for (const marker of afterFrame.shift() ?? []) metrics.painted.push({ ...marker, at });
 };
 
 // Each robot's status, cargo and zone as drawn, whenever one of them changes (`?metrics=1`).
+/** @type {Record<string, string>} */
 const lastShown = {};
-function record(thing, status, reported) {
+/** @param {Metrics} metrics @param {string} thing @param {string} status @param {Reported} reported */
+function record(metrics, thing, status, reported) {
   const shown = { thing, status, cargo: Boolean(reported.cargo), zone: reported.zone ?? null };
   const key = JSON.stringify(shown);
   if (lastShown[thing] === key) return;
@@ -100,6 +141,7 @@ function record(thing, status, reported) {
 
 // -- the stream --------------------------------------------------------------------------
 
+/** @param {SnapshotMessage} snapshot */
 function reset(snapshot) {
   const first = store.fleet === null;
   store.fleet = snapshot.fleet;
@@ -116,6 +158,7 @@ function reset(snapshot) {
   }
   conversation.build(snapshot.fleet, snapshot.conversation);
   for (const [thing, robot] of Object.entries(store.robots)) {
+    /** @type {Reported} */
     const reported = robot.reported || {};
     const pose = robot.progress?.pose || reported.pose;
     const driving = reported.status === "navigating" && reported.destination;
@@ -126,6 +169,7 @@ function reset(snapshot) {
   if (store.selected) select(store.selected);
 }
 
+/** @param {ShadowMessage} message */
 function onShadow(message) {
   const robot = store.robots[message.thing];
   if (!robot) return;
@@ -139,6 +183,7 @@ function onShadow(message) {
   changed(message.thing, metrics ? { thing: message.thing, version: message.version, received: performance.timeOrigin + performance.now() } : null);
 }
 
+/** @param {EventMessage} message */
 function onEvent(message) {
   const robot = store.robots[message.thing];
   if (!robot) return;
@@ -147,14 +192,15 @@ function onEvent(message) {
   if (message.event === "progress") {
     robot.progress = message;
     map.report(message.thing, message.pose, message.zone, true);
-  } else if (["arrived", "stopped", "stuck", "failed", "cancelled", "delivered"].includes(message.event)) {
+  } else if (DRIVE_ENDS.includes(message.event)) {
     robot.progress = null;
     if (message.pose) map.report(message.thing, message.pose, null, false);
   }
-  if (["said", "heard", "interpreted"].includes(message.event)) conversation.add({ ...message, robots: [message.thing] });
+  if (EXCHANGE_EVENTS.includes(message.event)) conversation.add({ ...message, robots: [message.thing] });
   changed(message.thing);
 }
 
+/** @param {ExperimentStatus | null} status */
 function onExperiment(status) {
   store.experiment = status && !status.ended ? status : null;
   interactions.setSession(store.experiment ? store.experiment.session : null);
@@ -164,6 +210,7 @@ function onExperiment(status) {
   panel.allowOrders(!voiceSession, voiceSession ? "Voice session: orders are given by voice. The panel selects and stops robots." : null);
 }
 
+/** What the page does with each message, by its type. @type {{[T in PageMessage["type"]]: (message: Extract<PageMessage, {type: T}>) => void}} */
 const handlers = {
   snapshot: reset,
   shadow: onShadow,
@@ -179,7 +226,7 @@ const handlers = {
     store.commands[message.id] = message;
     // Keep as many commands as the station does: a long session must not grow the page.
     const ids = Object.keys(store.commands);
-    for (const old of ids.slice(0, Math.max(0, ids.length - COMMANDS_KEPT))) delete store.commands[old];
+    for (const old of ids.slice(0, Math.max(0, ids.length - COMMANDS_LIMIT))) delete store.commands[old];
     if (message.source !== "alexa") conversation.add(message);
   },
   ack(message) {
@@ -199,8 +246,8 @@ const handlers = {
 };
 
 function connect() {
-  const state = $("link-state");
-  const label = state.querySelector(".label");
+  const state = byId("link-state", HTMLElement);
+  const label = /** @type {HTMLElement} */ (state.querySelector(".label"));
   const stream = new EventSource("/api/stream");
   stream.onopen = () => { state.dataset.state = "live"; label.textContent = "Live"; };
   stream.onerror = () => {
@@ -208,21 +255,24 @@ function connect() {
     label.textContent = stream.readyState === EventSource.CLOSED ? "Disconnected: reload the page" : "Reconnecting…";
   };
   stream.onmessage = (event) => {
-    for (const message of JSON.parse(event.data)) {
+    for (const message of /** @type {PageMessage[]} */ (JSON.parse(event.data))) {
       if (metrics) metrics.messages += 1;
-      handlers[message.type]?.(message);
+      // A message of a type this page does not know (a newer station) is passed over.
+      const handle = /** @type {((message: PageMessage) => void) | undefined} */ (handlers[message.type]);
+      handle?.(message);
     }
   };
 }
 
 // -- typing to the assistant ------------------------------------------------------------
 
-$("say-form").addEventListener("submit", async (event) => {
+byId("say-form", HTMLFormElement).addEventListener("submit", async (event) => {
   event.preventDefault();
-  const input = $("say-input");
+  const input = byId("say-input", HTMLInputElement);
   const utterance = input.value.trim();
   if (!utterance) return;
   input.value = "";
+  /** @type {Promise<SayReply>} */
   const sent = post("/api/say", { utterance, origin: "station" });
   interactions.attach(sent.then(
     (turn) => ({ speech: turn.speech, intent: turn.intent, commands: turn.commands || [], asks: turn.intent === "WeatherIntent" }),
@@ -232,7 +282,7 @@ $("say-form").addEventListener("submit", async (event) => {
     const turn = await sent;
     await speak(turn.speech);
   } catch (err) {
-    panel.tell(err.message, true);
+    panel.tell(reason(err), true);
   }
 });
 

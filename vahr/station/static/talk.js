@@ -1,12 +1,30 @@
+// @ts-check
 // Push-to-talk: hold the button (or the space bar), speak, let go. The page records the
 // microphone as 16 kHz mono 16-bit PCM, sends it as a WAV file, and shows what was heard,
 // how sure the recognizer was, and the assistant's reply, which it then speaks.
 
-import { ApiError, hush, postWav, speak } from "./api.js";
+import { ApiError, hush, postWav, reason, speak } from "./api.js";
+
+/** @import { VoiceReply } from "./api.js" */
+/** @import { Interaction, Interactions } from "./interactions.js" */
+/** @import { Metrics } from "./station.js" */
+
+/**
+ * One push-to-talk under way: the microphone's blocks so far, and the interaction it is.
+ * @typedef {object} Recording
+ * @property {Float32Array[]} chunks
+ * @property {number} pressedAt
+ * @property {Interaction} interaction
+ * @property {boolean} released
+ * @property {Promise<void> | null} ready resolves once the microphone is open (or failed to)
+ * @property {unknown} [error] why the microphone did not open
+ * @property {{stream: MediaStream, context: AudioContext, source: MediaStreamAudioSourceNode, capture: AudioWorkletNode} | null} [audio]
+ */
 
 const RATE = 16000;
 const SHORTEST_MS = 300;
 
+/** A 16 kHz mono 16-bit WAV file of the blocks recorded at `rate`. @param {Float32Array[]} chunks @param {number} rate */
 export function wavFile(chunks, rate) {
   let length = 0;
   for (const chunk of chunks) length += chunk.length;
@@ -16,7 +34,7 @@ export function wavFile(chunks, rate) {
   const pcm = rate === RATE ? samples : resample(samples, rate, RATE);
   const buffer = new ArrayBuffer(44 + pcm.length * 2);
   const view = new DataView(buffer);
-  const ascii = (at, text) => { for (let i = 0; i < text.length; i += 1) view.setUint8(at + i, text.charCodeAt(i)); };
+  const ascii = (/** @type {number} */ at, /** @type {string} */ text) => { for (let i = 0; i < text.length; i += 1) view.setUint8(at + i, text.charCodeAt(i)); };
   ascii(0, "RIFF"); view.setUint32(4, 36 + pcm.length * 2, true); ascii(8, "WAVE");
   ascii(12, "fmt "); view.setUint32(16, 16, true); view.setUint16(20, 1, true); view.setUint16(22, 1, true);
   view.setUint32(24, RATE, true); view.setUint32(28, RATE * 2, true); view.setUint16(32, 2, true); view.setUint16(34, 16, true);
@@ -28,6 +46,7 @@ export function wavFile(chunks, rate) {
   return new Blob([buffer], { type: "audio/wav" });
 }
 
+/** @param {Float32Array} samples @param {number} from @param {number} to */
 function resample(samples, from, to) {
   const out = new Float32Array(Math.floor((samples.length * to) / from));
   for (let i = 0; i < out.length; i += 1) {
@@ -40,12 +59,22 @@ function resample(samples, from, to) {
 }
 
 export class Talk {
+  /**
+   * @param {object} parts
+   * @param {HTMLButtonElement} parts.button the button to hold (it holds a `.talk-label`)
+   * @param {HTMLElement} parts.level the level meter
+   * @param {HTMLElement} parts.state what was heard and answered
+   * @param {Interactions} parts.interactions
+   * @param {Metrics | null} parts.metrics
+   */
   constructor({ button, level, state, interactions, metrics }) {
     this.button = button;
+    this.label = /** @type {HTMLElement} */ (button.querySelector(".talk-label"));
     this.level = level;
     this.state = state;
     this.interactions = interactions;
     this.metrics = metrics;
+    /** @type {Recording | null} */
     this.recording = null;
     this.busy = false;
     if (!navigator.mediaDevices?.getUserMedia) {
@@ -59,7 +88,7 @@ export class Talk {
       button.setPointerCapture?.(event.pointerId);
       this.press("button");
     });
-    for (const kind of ["pointerup", "pointercancel", "lostpointercapture"]) {
+    for (const kind of /** @type {const} */ (["pointerup", "pointercancel", "lostpointercapture"])) {
       button.addEventListener(kind, () => this.release());
     }
     button.addEventListener("keydown", (event) => { if (event.key === "Enter" && !event.repeat) this.press("key"); });
@@ -76,25 +105,29 @@ export class Talk {
     });
   }
 
+  /** @param {string} html */
   say(html) {
     this.state.textContent = html;
   }
 
+  /** @param {"button" | "key"} how */
   async press(how) {
     if (this.recording || this.busy) return;
     hush(); // pressing again cuts the last reply short
     const pressedAt = Date.now();
     const interaction = this.interactions.start("voice", "push-to-talk", pressedAt);
+    /** @type {Recording} */
     const recording = { chunks: [], pressedAt, interaction, released: false, ready: null };
     this.recording = recording;
     this.button.dataset.state = "listening";
-    this.button.querySelector(".talk-label").textContent = "Listening… let go to send";
+    this.label.textContent = "Listening… let go to send";
     this.say("Listening…");
     recording.ready = this.open(recording).catch((err) => {
       recording.error = err;
     });
   }
 
+  /** @param {Recording} recording */
   async open(recording) {
     const stream = await navigator.mediaDevices.getUserMedia({ audio: { channelCount: 1, echoCancellation: false, noiseSuppression: false, autoGainControl: false } });
     const context = new AudioContext({ sampleRate: RATE });
@@ -111,6 +144,7 @@ export class Talk {
     if (recording.released) this.close(recording);
   }
 
+  /** @param {Recording} recording */
   close(recording) {
     const audio = recording.audio;
     if (!audio) return;
@@ -133,11 +167,11 @@ export class Talk {
     const rate = RATE;
     this.busy = true;
     this.button.dataset.state = "thinking";
-    this.button.querySelector(".talk-label").textContent = "Understanding…";
+    this.label.textContent = "Understanding…";
     const { interaction } = recording;
     interaction.counts = true;
     try {
-      if (recording.error) throw new ApiError(`The microphone is not available: ${recording.error.message || recording.error}`);
+      if (recording.error) throw new ApiError(`The microphone is not available: ${reason(recording.error)}`);
       if (Date.now() - recording.pressedAt < SHORTEST_MS || !recording.chunks.length) {
         interaction.counts = false;
         this.say("Hold the button while you speak, and let go when you are done.");
@@ -157,8 +191,8 @@ export class Talk {
       // The exchange lasts until the reply has been heard (or cut short by a new press).
       await speak(result.speech);
     } catch (err) {
-      interaction.error = String(err.message || err);
-      this.say(err.message || String(err));
+      interaction.error = reason(err);
+      this.say(reason(err));
     } finally {
       this.idle();
       this.interactions.end(interaction, Date.now());
@@ -169,9 +203,10 @@ export class Talk {
     this.busy = false;
     if (this.recording) return;
     this.button.dataset.state = "idle";
-    this.button.querySelector(".talk-label").textContent = "Hold to talk";
+    this.label.textContent = "Hold to talk";
   }
 
+  /** @param {VoiceReply} result */
   show(result) {
     const { heard } = result;
     this.state.replaceChildren();
@@ -191,6 +226,7 @@ export class Talk {
   }
 }
 
+/** True when `target` takes text (a key there is typing, not a command). @param {EventTarget | null} target */
 export function typing(target) {
   return target instanceof HTMLElement && (target.isContentEditable || ["INPUT", "TEXTAREA", "SELECT"].includes(target.tagName));
 }
