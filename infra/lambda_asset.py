@@ -48,7 +48,7 @@ RUNTIME_PROVIDED = ("boto3",)
 FORBIDDEN_TOP_LEVEL = ("awscrt", "awsiot", "boto3", "botocore", "s3transfer")
 # The project files the skill needs, relative to the repository root.
 VAHR_FILES = ("vahr/__init__.py", "vahr/errors.py")
-VAHR_PACKAGES = ("vahr/protocol",)
+VAHR_PACKAGES = ("vahr/protocol", "vahr/announce")
 SKILL_DIR = "lambda/skill"
 # Where `vahr.protocol.fleet` looks for the bundled fleet definition.
 FLEET_IN_BUNDLE = "vahr/protocol/fleet.yaml"

@@ -1,0 +1,112 @@
+"""The announcer's Lambda handler: robot events and presence in (from the IoT topic rule),
+Alexa notifications out. Thin: parse, run `announce`, report.
+
+The rule's SQL (infra/constructs/announcer.py) gives each event as the robot sent it plus
+`sender` (the thing named by the topic), and each presence as `{"online", "at",
+"sender"}`. A malformed message is logged and skipped (retrying cannot mend it); a failure
+to deliver raises `AnnouncerError`, so Lambda retries the event and then dead-letters it.
+"""
+
+from __future__ import annotations
+
+import logging
+from datetime import UTC, datetime
+from functools import cache
+from typing import TYPE_CHECKING, Any
+
+import msgspec
+
+from skill.announcer.aws import SkillCredentials, StateStore
+from skill.announcer.config import AnnouncerConfig
+from skill.announcer.errors import AnnouncerError, DeliveryFailed, StateConflict
+from skill.announcer.proactive_events import ProactiveEvents
+from vahr.announce import AnnouncePolicy, signals_from_event, signals_from_presence
+from vahr.announce.speech import Names
+from vahr.protocol import Event, Presence, load_fleet
+
+if TYPE_CHECKING:
+    from vahr.announce import Signal
+
+log = logging.getLogger("skill.announcer")
+# How often a save that lost a race is tried again with the state read anew.
+SAVE_ATTEMPTS = 3
+
+
+class Runtime(msgspec.Struct, frozen=True, kw_only=True, dict=True):
+    config: AnnouncerConfig
+    names: Names
+    store: Any
+    alexa: Any
+
+
+@cache
+def runtime() -> Runtime:
+    """Built once per cold start: configuration, fleet names, adapters."""
+    config = AnnouncerConfig.from_env()
+    logging.getLogger("skill").setLevel(config.log_level)
+    return Runtime(
+        config=config,
+        names=Names.of(load_fleet()),
+        store=StateStore(config.table),
+        alexa=ProactiveEvents(
+            token_url=config.token_url,
+            events_url=config.events_url,
+            credentials=SkillCredentials(config.secret),
+        ),
+    )
+
+
+def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
+    try:
+        return announce(event, runtime())
+    except AnnouncerError as err:
+        log.error("announcement not delivered: %s", err)
+        raise
+    except Exception as err:  # a bug: still one line in the log, still retried
+        log.exception("announcer failed")
+        raise AnnouncerError(f"announcer failed: {type(err).__name__}: {err}") from err
+
+
+def signals_of(message: dict[str, Any]) -> list[Signal]:
+    """What the rule delivered, as the policy's signals; [] for what is not understood."""
+    sender = message.get("sender")
+    try:
+        if "online" in message:
+            presence = msgspec.convert(
+                {"online": message.get("online"), "at": message.get("at")}, Presence, strict=False
+            )
+            return signals_from_presence(str(sender), presence) if sender else []
+        event = msgspec.convert(
+            {k: v for k, v in message.items() if k != "sender"}, Event, strict=False
+        )
+    except msgspec.ValidationError as err:
+        log.warning("ignoring a malformed message from %s: %s", sender, err)
+        return []
+    if sender is not None and sender != event.thing:
+        log.warning("ignoring an event for %s sent on %s's topic", event.thing, sender)
+        return []
+    return signals_from_event(event)
+
+
+def announce(message: dict[str, Any], rt: Runtime) -> dict[str, Any]:
+    """Decide on one message and deliver what is due; the state is saved only after every
+    announcement was accepted, so a retry decides again (and Alexa drops the duplicates)."""
+    signals = signals_of(message)
+    for attempt in range(1, SAVE_ATTEMPTS + 1):
+        state, version = rt.store.load()
+        policy = AnnouncePolicy(rt.config.settings, rt.names, lambda: datetime.now(UTC), state)
+        told = policy.observe(signals)
+        for announcement in told:
+            urgent = announcement.priority >= rt.config.settings.urgent_priority
+            outcome = rt.alexa.send(
+                announcement, creator=rt.names.robot(announcement.thing), urgent=urgent
+            )
+            log.info("announced %s (%s): %s", announcement.id, outcome, announcement.speech)
+        try:
+            rt.store.save(policy.state, version)
+        except StateConflict:
+            if attempt == SAVE_ATTEMPTS:
+                raise
+            continue
+        return {"told": [a.id for a in told], "held": policy.state.held}
+    raise DeliveryFailed("unreachable")  # pragma: no cover
