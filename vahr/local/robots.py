@@ -1,15 +1,17 @@
 """Robot-agent processes for the local stack: one `robot-agent run` per robot, each with
-its own certificate from the local CA, the simulator backend and its own log file."""
+its own certificate from the local CA, the simulator backend and its own log file.
+
+A robot runs from the installed package, as it would on a robot: nothing puts a checkout
+on its import path, and it starts in this process's working directory.
+"""
 
 from __future__ import annotations
 
 import logging
-import os
 import signal
 import subprocess
 import sys
 import threading
-from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
 import msgspec
@@ -19,12 +21,13 @@ from vahr.local.lifetime import spawn
 from vahr.protocol import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from vahr.pki import LocalCA
 
 log = logging.getLogger(__name__)
 
 STOP_TIMEOUT_S = 8.0
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
@@ -148,10 +151,6 @@ class RobotProcesses:
 
     def restart(self, thing: str) -> None:
         """Start `thing`'s process (again, after it ended); its log file is appended to."""
-        env = {
-            **os.environ,
-            "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
-        }
         log_path = self.log_file(thing)
         log_path.parent.mkdir(parents=True, exist_ok=True)
         with log_path.open("ab") as log_stream:
@@ -160,8 +159,6 @@ class RobotProcesses:
             process = spawn(
                 self.command(thing),
                 started_for=self.state_dir,
-                cwd=ROOT,
-                env=env,
                 stdin=subprocess.DEVNULL,
                 stdout=log_stream,
                 stderr=subprocess.STDOUT,
