@@ -1,5 +1,6 @@
 """The layer contracts (pyproject's [tool.importlinter], docs/architecture.md) hold, and a
-change that breaks one fails the check `make lint` runs."""
+change that breaks one fails the check `make lint` runs. No module imports itself through
+others, a package and its own modules included."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import grimp
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -25,8 +27,16 @@ def lint_imports(tree: Path) -> subprocess.CompletedProcess[str]:
 
 @pytest.fixture
 def tree(tmp_path: Path) -> Path:
-    """A copy of the three packages the contracts speak of, importable from `tmp_path`."""
-    ignore = shutil.ignore_patterns("__pycache__", "*.pyc")
+    """A copy of the three packages the contracts speak of (their Python files, which is
+    all the check reads), importable from `tmp_path`."""
+
+    def ignore(directory: str, names: list[str]) -> set[str]:
+        return {
+            name
+            for name in names
+            if name == "__pycache__" or not (name.endswith(".py") or Path(directory, name).is_dir())
+        }
+
     for package, source in (
         ("vahr", "vahr"),
         ("robot_agent", "robot_agent"),
@@ -50,12 +60,22 @@ def test_the_packages_keep_every_contract(tree: Path) -> None:
         ("robot_agent/agent.py", "import vahr.local.room", "robot_agent never imports"),
         ("vahr/local/system.py", "import robot_agent.assembly", "vahr never imports robot_agent"),
         ("skill/app.py", "import vahr.speech.tts", "The skill imports only the protocol"),
+        # The local stack starting the station itself again: a package cycle in the top layer.
+        ("vahr/local/system.py", "import vahr.station.deployment", "The top layer is one-way"),
+        ("vahr/local/system.py", "import vahr.station.deployment", "No import cycle"),
+        ("vahr/experiment/bus.py", "import vahr.station.desk", "The top layer is one-way"),
+        ("vahr/station/vocabulary.py", "import vahr.local.alexa.nlu", "The station and the"),
+        ("robot_agent/link/shadow.py", "import robot_agent.voice.port", "robot_agent's adapters"),
+        # Cycles no layer names: two modules of one package, two packages of robot_agent.
+        ("vahr/experiment/tlx.py", "import vahr.experiment.results", "No import cycle"),
+        ("vahr/station/errors.py", "import vahr.station.app", "No import cycle"),
+        ("robot_agent/backends/sim.py", "import robot_agent.core.executor", "No import cycle"),
     ],
 )
 def test_an_import_against_a_layer_fails_the_check_naming_the_contract(
     tree: Path, module: str, line: str, contract: str
 ) -> None:
-    # Given one module that imports across a layer boundary
+    # Given one module with one more import: across a layer boundary, or round a loop
     path = tree / module
     path.write_text(path.read_text() + f"\n{line}  # noqa\n")
     # When the contracts are checked
@@ -64,3 +84,71 @@ def test_an_import_against_a_layer_fails_the_check_naming_the_contract(
     assert result.returncode != 0
     broken = [line for line in result.stdout.splitlines() if line.endswith("BROKEN")]
     assert any(name.startswith(contract) for name in broken), result.stdout
+
+
+def import_cycles(graph: grimp.ImportGraph) -> list[list[str]]:
+    """Every set of modules that import one another round a loop (Tarjan's strongly
+    connected components of more than one module), each sorted."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    cycles: list[list[str]] = []
+    for root in sorted(graph.modules):
+        if root in index:
+            continue
+        # An iterative depth-first walk: (module, the modules it imports not yet walked).
+        work = [(root, iter(sorted(graph.find_modules_directly_imported_by(root))))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            module, imported = work[-1]
+            for target in imported:
+                if target not in index:
+                    index[target] = low[target] = len(index)
+                    stack.append(target)
+                    on_stack.add(target)
+                    work.append(
+                        (target, iter(sorted(graph.find_modules_directly_imported_by(target))))
+                    )
+                    break
+                if target in on_stack:
+                    low[module] = min(low[module], index[target])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[module])
+                if low[module] == index[module]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == module:
+                            break
+                    if len(component) > 1:
+                        cycles.append(sorted(component))
+    return cycles
+
+
+def test_no_module_imports_itself_through_others() -> None:
+    # Given the import graph of the three packages, imports inside functions and under
+    # TYPE_CHECKING included (the one lint-imports checks)
+    graph = grimp.build_graph("vahr", "robot_agent", "skill", cache_dir=None)
+    # Then no module reaches itself: not two siblings (lint-imports says so too), nor a
+    # package's __init__ and a module inside it, which lint-imports does not look at
+    assert import_cycles(graph) == []
+
+
+def test_a_package_and_its_own_module_importing_each_other_is_a_cycle() -> None:
+    # Given a package whose __init__ re-exports a module that imports the package back
+    graph = grimp.ImportGraph()
+    for module in ("pkg", "pkg.model", "pkg.other", "pkg.leaf"):
+        graph.add_module(module)
+    graph.add_import(importer="pkg", imported="pkg.model")
+    graph.add_import(importer="pkg.model", imported="pkg.leaf")
+    graph.add_import(importer="pkg.model", imported="pkg")
+    graph.add_import(importer="pkg.other", imported="pkg.leaf")
+    # When its cycles are looked for, then the loop is found, and only the loop
+    assert import_cycles(graph) == [["pkg", "pkg.model"]]
