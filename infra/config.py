@@ -61,6 +61,15 @@ class InfraConfig:
     bot_name: str = "vahr-weather-answers"
     bot_alias_name: str = "live"
     role_alias_name: str = "vahr-robot-lex"
+    # The announcer (infra/constructs/announcer.py): Alexa notifications of robots' troubles.
+    announcer: bool = False
+    announcer_secret_name: str = "vahr/skill-messaging"
+    announcer_rule_prefix: str = "vahr_announcer"
+    # Where the skill's users are (NA, EU, FE) and which Proactive Events stage to use.
+    alexa_region: str = "NA"
+    announcer_stage: str = "development"
+    # vahr.announce.AnnounceSettings as JSON, checked at synth.
+    announce_settings: str = "{}"
 
     @classmethod
     def from_context(cls, get: Callable[[str], Any]) -> InfraConfig:
@@ -108,7 +117,20 @@ class InfraConfig:
             lex=_flag(get, "lex"),
             weather_answers_file=_path(get, "weatherAnswersFile", defaults.weather_answers_file),
             role_alias_name=_text(get, "roleAliasName") or defaults.role_alias_name,
+            announcer=_flag(get, "announcer"),
+            announcer_secret_name=(
+                _text(get, "announcerSecretName") or defaults.announcer_secret_name
+            ),
+            alexa_region=(_text(get, "alexaRegion") or defaults.alexa_region).upper(),
+            announcer_stage=_text(get, "announcerStage") or defaults.announcer_stage,
+            announce_settings=_announce_settings(get("announce")),
         )
+        if config.alexa_region not in ("NA", "EU", "FE"):
+            raise VahrError(f"alexaRegion: {config.alexa_region!r} must be NA, EU or FE")
+        if config.announcer_stage not in ("development", "live"):
+            raise VahrError(
+                f"announcerStage: {config.announcer_stage!r} must be development or live"
+            )
         for key, value in (
             ("robotPolicyName", config.robot_policy_name),
             ("operatorPolicyName", config.operator_policy_name),
@@ -119,6 +141,20 @@ class InfraConfig:
         if config.log_level not in ("DEBUG", "INFO", "WARNING", "ERROR"):
             raise VahrError(f"logLevel: {config.log_level!r} must be DEBUG, INFO, WARNING or ERROR")
         return config
+
+
+def _announce_settings(value: Any) -> str:
+    """The `announce` context (an object, or JSON text) checked as the announcer will read it."""
+    from vahr.announce import settings_from
+    from vahr.protocol import ProtocolError
+
+    try:
+        settings = settings_from(value if value is not None else {})
+    except ProtocolError as err:
+        raise VahrError(f"announce.{err}") from err
+    import msgspec
+
+    return msgspec.json.encode(settings).decode()
 
 
 def ask_states_skill_id(states_file: Path, profile: str) -> str | None:

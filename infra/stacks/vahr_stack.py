@@ -8,13 +8,16 @@ import aws_cdk as cdk
 from aws_cdk import aws_logs as logs
 
 from infra.constructs.alexa_skill import AlexaSkill
+from infra.constructs.announcer import Announcer
 from infra.constructs.iot_endpoint import IotEndpoint
 from infra.constructs.iot_fleet import IotFleet
 from infra.constructs.operator_policy import OperatorPolicy
 from infra.constructs.presence_rule import PresenceRule
 from infra.constructs.robot_policy import RobotPolicy
 from infra.constructs.skill_function import SkillFunction
+from infra.constructs.skill_function import skill_code as bundled_code
 from infra.constructs.weather_bot import WeatherBot
+from skill.announcer.config import events_url
 
 if TYPE_CHECKING:
     from aws_cdk import aws_lambda as lambda_
@@ -91,6 +94,17 @@ class VahrStack(cdk.Stack):
             data_endpoint=self.data_endpoint.address,
             code=skill_code,
         )
+        self.announcer = (
+            Announcer(
+                self,
+                "Announcer",
+                config=config,
+                code=skill_code or bundled_code(config),
+                events_url=events_url(config.alexa_region, config.announcer_stage),
+            )
+            if config.announcer
+            else None
+        )
         self.credentials_endpoint = (
             IotEndpoint(
                 self,
@@ -114,10 +128,10 @@ class VahrStack(cdk.Stack):
             else None
         )
         self._outputs(config)
-        self._acknowledge_findings()
+        self._acknowledge_findings(config)
         cdk.Tags.of(self).add("project", "vahr")
 
-    def _acknowledge_findings(self) -> None:
+    def _acknowledge_findings(self, config: InfraConfig) -> None:
         """The cdk-nag findings this stack accepts, each for a stated reason."""
 
         def acknowledge(scope: Construct, finding: str, reason: str) -> None:
@@ -141,6 +155,26 @@ class VahrStack(cdk.Stack):
                     "iot:DescribeEndpoint has no resource type in IAM, so its only valid "
                     "resource is '*'; the statement allows that one read-only action.",
                 )
+        if self.announcer is not None:
+            acknowledge(
+                self.announcer.function,
+                "L1",
+                "Pinned to python3.12 with the skill function: it runs from the same bundle, "
+                "whose compiled wheels are cross-built for cp312.",
+            )
+            acknowledge(
+                self.announcer.role,
+                f"IAM5[Resource::arn:<AWS::Partition>:secretsmanager:<AWS::Region>:"
+                f"<AWS::AccountId>:secret:{config.announcer_secret_name}-??????]",
+                "The one secret the announcer reads, named by you; '-??????' stands only for "
+                "the six random characters Secrets Manager appends to every secret's ARN.",
+            )
+            acknowledge(
+                self.announcer.dead_letters,
+                "SQS3",
+                "This queue is itself the dead-letter queue of the announcer function and its "
+                "rules' error action; a dead-letter queue of its own would hold nothing.",
+            )
         acknowledge(
             self.skill_function,
             "L1",

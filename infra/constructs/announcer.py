@@ -1,0 +1,189 @@
+"""The announcer: topic rules on the robots' events and presence, feeding the skill's
+announcer function (`skill.announcer.app.lambda_handler`), which tells the person through
+Alexa's Proactive Events API what the announcement policy finds worth telling.
+
+Least privilege: the function may read one secret (the skill's Alexa Skill Messaging
+client id and secret, created by you, never in the template), read and write its one
+state table, write its own logs and send to its dead-letter queue. IoT may invoke it only
+from these two rules. A message the rule cannot deliver (the function throttled or
+missing) and an event the function failed on after Lambda's two retries both land in the
+same encrypted queue, kept 14 days: nothing is lost silently.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import aws_cdk as cdk
+from aws_cdk import aws_dynamodb as dynamodb
+from aws_cdk import aws_iam as iam
+from aws_cdk import aws_iot as iot
+from aws_cdk import aws_lambda as lambda_
+from aws_cdk import aws_logs as logs
+from aws_cdk import aws_sqs as sqs
+from constructs import Construct
+
+from infra.config import LOG_RETENTION_NAMES
+from vahr.protocol import topics
+
+if TYPE_CHECKING:
+    from infra.config import InfraConfig
+
+HANDLER = "skill.announcer.app.lambda_handler"
+TIMEOUT = cdk.Duration.seconds(30)
+MEMORY_MB = 256
+# The events that open or clear a fault; progress reports (most of the traffic) are left
+# out by the rule, so they cost no invocation.
+ANNOUNCED_EVENTS = ("stuck", "failed", "accepted", "stopped", "arrived", "done")
+
+
+def events_sql() -> str:
+    which = " OR ".join(f"event = '{name}'" for name in ANNOUNCED_EVENTS)
+    return f"SELECT *, topic(3) AS sender FROM '{topics.ALL_EVENTS}' WHERE {which}"
+
+
+def presence_sql() -> str:
+    return (
+        "SELECT online, at, topic(3) AS sender "
+        f"FROM '{topics.ALL_PRESENCE}' WHERE isBoolean(online)"
+    )
+
+
+class Announcer(Construct):
+    """Two rules, the function and its role, its state table and its dead-letter queue."""
+
+    def __init__(
+        self,
+        scope: Construct,
+        construct_id: str,
+        *,
+        config: InfraConfig,
+        code: lambda_.Code,
+        events_url: str,
+    ) -> None:
+        super().__init__(scope, construct_id)
+        stack = cdk.Stack.of(self)
+        self.table = dynamodb.Table(
+            self,
+            "State",
+            partition_key=dynamodb.Attribute(name="id", type=dynamodb.AttributeType.STRING),
+            billing_mode=dynamodb.BillingMode.PAY_PER_REQUEST,
+            point_in_time_recovery_specification=dynamodb.PointInTimeRecoverySpecification(
+                point_in_time_recovery_enabled=True
+            ),
+            removal_policy=cdk.RemovalPolicy.DESTROY,
+        )
+        self.dead_letters = sqs.Queue(
+            self,
+            "DeadLetters",
+            encryption=sqs.QueueEncryption.SQS_MANAGED,
+            enforce_ssl=True,
+            retention_period=cdk.Duration.days(14),
+        )
+        self.log_group = logs.LogGroup(
+            self,
+            "Logs",
+            retention=logs.RetentionDays[LOG_RETENTION_NAMES[config.log_retention_days]],
+            removal_policy=cdk.RemovalPolicy.DESTROY,
+        )
+        self.role = iam.Role(
+            self,
+            "Role",
+            assumed_by=iam.ServicePrincipal("lambda.amazonaws.com"),
+            description="VAHR announcer: its secret, its state, its logs, its dead letters",
+        )
+        # `from_secret_name_v2` ends the ARN in `-??????`, Secrets Manager's random suffix.
+        self.secret_arn = stack.format_arn(
+            service="secretsmanager",
+            resource="secret",
+            resource_name=f"{config.announcer_secret_name}-??????",
+            arn_format=cdk.ArnFormat.COLON_RESOURCE_NAME,
+        )
+        self.role.add_to_policy(
+            iam.PolicyStatement(
+                sid="ReadSkillMessagingSecret",
+                actions=["secretsmanager:GetSecretValue"],
+                resources=[self.secret_arn],
+            )
+        )
+        self.role.add_to_policy(
+            iam.PolicyStatement(
+                sid="KeepPolicyState",
+                actions=["dynamodb:GetItem", "dynamodb:PutItem"],
+                resources=[self.table.table_arn],
+            )
+        )
+        self.function = lambda_.Function(
+            self,
+            "Function",
+            description="VAHR announcer: robots' troubles to Alexa notifications",
+            runtime=lambda_.Runtime.PYTHON_3_12,
+            architecture=(
+                lambda_.Architecture.ARM_64
+                if config.architecture == "arm64"
+                else lambda_.Architecture.X86_64
+            ),
+            handler=HANDLER,
+            code=code,
+            memory_size=MEMORY_MB,
+            timeout=TIMEOUT,
+            role=self.role,
+            log_group=self.log_group,
+            dead_letter_queue=self.dead_letters,
+            retry_attempts=2,
+            max_event_age=cdk.Duration.hours(1),
+            environment={
+                "VAHR_ANNOUNCER_SECRET": config.announcer_secret_name,
+                "VAHR_ANNOUNCER_TABLE": self.table.table_name,
+                "VAHR_PROACTIVE_EVENTS_URL": events_url,
+                "VAHR_ANNOUNCE_SETTINGS": config.announce_settings,
+                "VAHR_LOG_LEVEL": config.log_level,
+            },
+        )
+        self.log_group.grant_write(self.role)
+        self.rule_role = iam.Role(
+            self,
+            "RuleRole",
+            assumed_by=iam.ServicePrincipal("iot.amazonaws.com"),
+            description="Lets the VAHR announcer rules dead-letter what they cannot deliver",
+        )
+        self.dead_letters.grant_send_messages(self.rule_role)
+        self.rules = [
+            self._rule("Events", f"{config.announcer_rule_prefix}_events", events_sql()),
+            self._rule("Presence", f"{config.announcer_rule_prefix}_presence", presence_sql()),
+        ]
+
+    def _rule(self, construct_id: str, name: str, sql: str) -> iot.CfnTopicRule:
+        rule = iot.CfnTopicRule(
+            self,
+            construct_id,
+            rule_name=name,
+            topic_rule_payload=iot.CfnTopicRule.TopicRulePayloadProperty(
+                sql=sql,
+                aws_iot_sql_version="2016-03-23",
+                rule_disabled=False,
+                description="Robot events and presence -> the VAHR announcer",
+                actions=[
+                    iot.CfnTopicRule.ActionProperty(
+                        lambda_=iot.CfnTopicRule.LambdaActionProperty(
+                            function_arn=self.function.function_arn
+                        )
+                    )
+                ],
+                error_action=iot.CfnTopicRule.ActionProperty(
+                    sqs=iot.CfnTopicRule.SqsActionProperty(
+                        queue_url=self.dead_letters.queue_url,
+                        role_arn=self.rule_role.role_arn,
+                        use_base64=False,
+                    )
+                ),
+            ),
+        )
+        self.function.add_permission(
+            f"{construct_id}RuleInvoke",
+            principal=iam.ServicePrincipal("iot.amazonaws.com"),
+            action="lambda:InvokeFunction",
+            source_arn=rule.attr_arn,
+            source_account=cdk.Stack.of(self).account,
+        )
+        return rule
