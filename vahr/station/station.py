@@ -4,8 +4,9 @@
 Core's with an operator certificate), an assistant, and a way to read a robot's shadow at
 start-up; it subscribes the feed, reads every robot's shadow once, and serves the page.
 
-- `vahr up` builds one on its own stack (`LocalSystem`): the simulator in-process, shadows
-  read from the store;
+- `vahr up` builds one on its own stack: `LocalSystem` calls the builder `vahr up` hands it
+  (`vahr.station.deployment.on_local_system`): the simulator in-process, shadows read from
+  the store;
 - `vahr station` builds one against any deployment (`vahr.station.deployment`).
 """
 
