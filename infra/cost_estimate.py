@@ -41,6 +41,10 @@ class Prices:
     lex_text_request: float = 0.00075  # Lex V2 RecognizeText
     log_ingestion_gb: float = 0.50  # CloudWatch Logs
     secret_month: float = 0.40  # Secrets Manager, the Login-with-Amazon secret
+    secret_api_call: float = 0.05 / 10_000  # Secrets Manager GetSecretValue
+    # DynamoDB on demand (https://aws.amazon.com/dynamodb/pricing/on-demand/).
+    dynamodb_read: float = 0.125 / 1e6  # per read request unit (4 KB, strongly consistent)
+    dynamodb_write: float = 0.625 / 1e6  # per write request unit (1 KB)
 
 
 @dataclass(frozen=True)
@@ -141,6 +145,39 @@ def estimate(usage: LabUsage, prices: Prices, *, lex: bool, skill: bool) -> list
     if skill:
         lines.append(Line("Secrets Manager", 1, "secret-month", prices.secret_month))
     return lines
+
+
+# -- the announcer (infra/constructs/announcer.py) ----------------------------------------
+
+
+@dataclass(frozen=True)
+class AnnouncerUsage:
+    """One announcer invocation: the rule fires on a fault-related event (never on progress),
+    the function reads and writes its state item (under 1 KB) and, on a cold start, reads
+    its secret. Alexa's Proactive Events API itself is free."""
+
+    function_seconds: float = 0.3  # token cached; one HTTPS request to Alexa
+    memory_gb: float = 0.25
+    log_bytes: int = 1_000
+    cold_start_share: float = 0.1  # of invocations that read the secret again
+    # Events the rule passes per announcement: the fault itself, the failed that ends a
+    # stuck task, and the accepted/arrived/done that clear it, all invoking the function.
+    invocations_per_announcement: float = 4.0
+
+
+def announcement_cost(prices: Prices, usage: AnnouncerUsage = AnnouncerUsage()) -> float:
+    """USD for one announcement, counting every invocation that leads to it."""
+    per_invocation = (
+        prices.rule_triggered
+        + prices.rule_action
+        + prices.lambda_request
+        + usage.function_seconds * usage.memory_gb * prices.lambda_gb_second
+        + prices.dynamodb_read
+        + prices.dynamodb_write
+        + usage.log_bytes / 1e9 * prices.log_ingestion_gb
+        + usage.cold_start_share * prices.secret_api_call
+    )
+    return usage.invocations_per_announcement * per_invocation
 
 
 # -- cost of measured operations (bench/billable_operations.py) ---------------------------

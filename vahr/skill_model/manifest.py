@@ -14,6 +14,10 @@ from vahr.protocol.assistant import INVOCATION_NAME
 from vahr.skill_model.intents import LOCALE
 
 SKILL_NAME = "VAHR Robot Fleet"
+# The announcer (skill.announcer) sends Alexa notifications of robots' troubles: the skill
+# asks for the notifications permission and declares the one event schema it publishes.
+NOTIFICATIONS_PERMISSION = "alexa::devices:all:notifications:write"
+PUBLISHED_EVENTS = ("AMAZON.MessageAlert.Activated",)
 
 
 def build_manifest(endpoint: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -52,6 +56,8 @@ def build_manifest(endpoint: dict[str, Any] | None = None) -> dict[str, Any]:
                 "category": "PRODUCTIVITY",
             },
             "apis": {"custom": custom},
+            "permissions": [{"name": NOTIFICATIONS_PERMISSION}],
+            "events": {"publications": [{"eventName": name} for name in PUBLISHED_EVENTS]},
             "privacyAndCompliance": {
                 "allowsPurchases": False,
                 "usesPersonalInfo": False,
