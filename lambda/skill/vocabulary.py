@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
+from vahr.protocol.text import normalize
 
 if TYPE_CHECKING:
     from vahr.protocol import Fleet, Zone
@@ -21,10 +22,6 @@ DEFAULT_FLEET_NAMES = FLEET_GROUP_NAMES
 LOADING = "LOADING"
 
 
-def _normalise(text: str) -> str:
-    return " ".join(text.lower().replace(".", " ").split())
-
-
 def _upper_letters(name: str) -> str:
     # "zone a" must be spoken as the letter, so single letters become capitals.
     return " ".join(word.upper() if len(word) == 1 else word for word in name.split())
@@ -32,7 +29,7 @@ def _upper_letters(name: str) -> str:
 
 def zone_phrase(zone: Zone) -> str:
     """The zone's name as it reads inside a sentence: "zone A", "the loading zone"."""
-    names = [_normalise(name) for name in zone.spoken]
+    names = [normalize(name) for name in zone.spoken]
     with_zone = [name for name in names if "zone" in name.split()]
     preferred = [name for name in with_zone if name.startswith("the ")] or with_zone
     if preferred:
@@ -62,17 +59,17 @@ class Vocabulary:
         self.fleet_names = tuple(group.spoken) if group else DEFAULT_FLEET_NAMES
         self._robot_ids: dict[str, str] = {FLEET: FLEET}
         for name in self.fleet_names:
-            self._robot_ids[_normalise(name)] = FLEET
+            self._robot_ids[normalize(name)] = FLEET
         for robot in fleet.robots:
             self._robot_ids[robot.thing.lower()] = robot.thing
             for name in robot.spoken:
-                self._robot_ids[_normalise(name)] = robot.thing
+                self._robot_ids[normalize(name)] = robot.thing
         self._zone_ids: dict[str, str] = {}
         self._zone_names: dict[str, str] = {}
         for zone in fleet.zones:
             self._zone_ids[zone.id.lower()] = zone.id
             for name in zone.spoken:
-                self._zone_ids[_normalise(name)] = zone.id
+                self._zone_ids[normalize(name)] = zone.id
             self._zone_names[zone.id] = zone_phrase(zone)
 
     @property
@@ -83,18 +80,18 @@ class Vocabulary:
     def robot(self, thing: str) -> str:
         """What to call a robot (or the fleet) in speech, in lower case."""
         if thing == FLEET:
-            return _normalise(self.fleet_names[0])
-        return _normalise(self.fleet.spoken_name(thing))
+            return normalize(self.fleet_names[0])
+        return normalize(self.fleet.spoken_name(thing))
 
     def zone(self, zone_id: str) -> str:
         return self._zone_names.get(zone_id, f"zone {zone_id}")
 
     def robot_id(self, heard: str) -> str | None:
         """The id for a spoken robot name (or thing name), if the fleet has one."""
-        return self._robot_ids.get(_normalise(heard))
+        return self._robot_ids.get(normalize(heard))
 
     def zone_id(self, heard: str) -> str | None:
-        return self._zone_ids.get(_normalise(heard))
+        return self._zone_ids.get(normalize(heard))
 
     def robot_choices(self, *, include_fleet: bool = True) -> str:
         names = [self.robot(thing) for thing in self.fleet.robot_things]

@@ -44,9 +44,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from vahr.lifeline import lifeline_command
+from vahr.protocol.text import normalize
 from vahr.speech.audio import SAMPLE_RATE, add_white_noise
 from vahr.speech.errors import SpeechError
-from vahr.speech.text import normalize
 
 if TYPE_CHECKING:
     from collections.abc import Iterable, Iterator, Sequence

@@ -14,9 +14,9 @@ from typing import TYPE_CHECKING, Any, cast
 
 import yaml
 
+from vahr.protocol.text import normalize
 from vahr.protocol.weather import WEATHERS
 from vahr.speech.errors import SpeechError
-from vahr.speech.text import normalize
 
 if TYPE_CHECKING:
     from robot_agent.voice.port import WeatherIntent

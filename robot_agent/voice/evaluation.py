@@ -26,9 +26,9 @@ import msgspec
 import numpy as np
 
 from vahr.errors import VahrError
+from vahr.protocol.text import normalize
 from vahr.speech.audio import Audio, add_white_noise
 from vahr.speech.scoring import OutcomeTally
-from vahr.speech.text import normalize
 
 if TYPE_CHECKING:
     from collections.abc import Callable

@@ -30,7 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
-from vahr.speech.text import normalize
+from vahr.protocol.text import normalize
 
 if TYPE_CHECKING:
     from robot_agent.voice.answers import Cues, WeatherAnswers

@@ -2,10 +2,10 @@
 
 Import from here: topic builders (`topics`), messages (`Command`, `Event`, `Presence`),
 the reported shadow state (`Reported`), the fleet model (`Fleet`, `load_fleet`), the domain
-facts (`WEATHER_ZONES`; `assistant` for the invocation name), and the one error type
-decoding raises (`ProtocolError`). `link` is the port MQTT adapters implement and `broker`
-how they reach the broker. This package ships in the Lambda, so it
-imports only msgspec (and PyYAML lazily, when a fleet file is read).
+facts (`WEATHER_ZONES`; `assistant` for the invocation name), how spoken phrases are
+compared (`text`), and the one error type decoding raises (`ProtocolError`). `link` is the
+port MQTT adapters implement and `broker` how they reach the broker. This package ships in
+the Lambda, so it imports only msgspec (and PyYAML lazily, when a fleet file is read).
 """
 
 from __future__ import annotations

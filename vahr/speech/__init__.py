@@ -7,11 +7,11 @@ station.
   caller supplies: the robot's weather answers, the room's questions, an interaction model);
 - `lm_stt`: speech-to-text in open phrasing (pocketsphinx with a language model built from
   the caller's example sentences, and each word's posterior);
-- `text`: how phrases are normalized before they are compared or put in a grammar;
 - `scoring`: the `OutcomeTally` the NLU's and the hearing's evaluations count outcomes in;
 - `room`: the room channel, speech as audio over a `vahr.protocol.link.Link`, and its message;
 - `errors`: `SpeechError`, the one error this package raises.
 
-It imports `vahr.protocol` and its own libraries (numpy, pocketsphinx, sox and espeak-ng as
+Phrases are compared as `vahr.protocol.text.normalize` writes them. It imports
+`vahr.protocol` and its own libraries (numpy, pocketsphinx, sox and espeak-ng as
 processes), nothing above them.
 """

@@ -19,14 +19,12 @@ from typing import TYPE_CHECKING, Any
 
 from vahr.errors import VahrError
 from vahr.local.alexa import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases
-from vahr.speech.text import normalize
+from vahr.protocol.text import normalize, spell_numbers
 
 if TYPE_CHECKING:
     from vahr.speech.lm_stt import LanguageModelRecognizer
 
 _SLOT = re.compile(r"\{([A-Za-z0-9_.]+)\}")
-_ONES = "zero one two three four five six seven eight nine ten eleven twelve thirteen fourteen fifteen sixteen seventeen eighteen nineteen".split()  # noqa: E501
-_TENS = "_ _ twenty thirty forty fifty sixty seventy eighty ninety".split()
 # The weather delivery's rule said aloud ("deliver to zone a if it's sunny and zone c if it's
 # raining") is left out: its zone-and-weather sentences, filled with every name, crowded the
 # model until "send placebot two to zone c" was heard "send placebots to that zone c" (the
@@ -34,21 +32,6 @@ _TENS = "_ _ twenty thirty forty fifty sixty seventy eighty ninety".split()
 _RULE_SLOTS = frozenset(RULE_SLOTS.values())
 # Ways of leaving a session, which the simulator answers like Alexa does.
 EXITS = ("exit", "goodbye", "stop", "cancel")
-
-
-def spell_numbers(text: str) -> str:
-    """Whole numbers under 100 written as words ("placebot 2" -> "placebot two")."""
-    return " ".join(_spelled(word) if word.isdigit() else word for word in text.split())
-
-
-def _spelled(number: str) -> str:
-    value = int(number)
-    if value >= 100:
-        return number
-    if value < 20:
-        return _ONES[value]
-    tens, ones = divmod(value, 10)
-    return _TENS[tens] + (f" {_ONES[ones]}" if ones else "")
 
 
 def _phrase(text: str) -> str:

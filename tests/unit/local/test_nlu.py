@@ -9,7 +9,12 @@ from typing import TYPE_CHECKING
 import pytest
 
 from vahr.local.alexa import envelope
-from vahr.local.alexa.nlu import CONFIDENCE_THRESHOLD, FALLBACK, InteractionModel, normalize
+from vahr.local.alexa.nlu import (
+    CONFIDENCE_THRESHOLD,
+    FALLBACK,
+    InteractionModel,
+    normalize_utterance,
+)
 from vahr.local.alexa.simulator import strip_invocation
 
 if TYPE_CHECKING:
@@ -137,8 +142,8 @@ def test_paraphrases_are_understood(
 
 
 def test_numbers_and_punctuation_are_normalized() -> None:
-    assert normalize("Send PlaceBot-1 to Zone B!") == "send placebot one to zone b"
-    assert normalize("placebot2, go") == "placebot two go"
+    assert normalize_utterance("Send PlaceBot-1 to Zone B!") == "send placebot one to zone b"
+    assert normalize_utterance("placebot2, go") == "placebot two go"
 
 
 def test_a_misheard_name_resolves_with_its_similarity(model: InteractionModel) -> None:

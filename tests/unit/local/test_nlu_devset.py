@@ -11,7 +11,7 @@ import pytest
 
 from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
 from vahr.local.alexa.evaluation import DEVELOPMENT_SET, LabelledSet, Report, evaluate
-from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel, normalize
+from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel, normalize_utterance
 from vahr.local.alexa.simulator import strip_invocation
 
 TUNING_SET = DEVELOPMENT_SET.with_name("tuning-en-US.yaml")
@@ -32,7 +32,7 @@ def generated_patterns() -> list[re.Pattern[str]]:
     language = json.loads(Path(DEFAULT_MODEL).read_text())["interactionModel"]["languageModel"]
     names = {
         t["name"]: "|".join(
-            re.escape(normalize(name))
+            re.escape(normalize_utterance(name))
             for value in t["values"]
             for name in [value["name"]["value"], *value["name"]["synonyms"]]
         )
@@ -62,9 +62,9 @@ def test_no_evaluation_sentence_is_trained_on(devset: LabelledSet) -> None:
     # built-in or out-of-domain phrases, nor a sentence of the tuning set.
     patterns = generated_patterns()
     background = {*out_of_domain_phrases(), *(p for v in built_in_phrases().values() for p in v)}
-    tuning = {normalize(item.text) for item in LabelledSet.load(TUNING_SET).items()}
+    tuning = {normalize_utterance(item.text) for item in LabelledSet.load(TUNING_SET).items()}
     for item in devset.items():
-        text = normalize(strip_invocation("robot fleet", item.text))
+        text = normalize_utterance(strip_invocation("robot fleet", item.text))
         assert not any(pattern.match(text) for pattern in patterns), item.text
         assert text not in background, item.text
         assert text not in tuning, item.text

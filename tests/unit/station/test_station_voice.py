@@ -9,10 +9,11 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
+from vahr.protocol.text import spell_numbers
 from vahr.speech.pronounce import arpabet, compound_phones
 from vahr.speech.stt import NOTHING_HEARD, Recognition
 from vahr.station.errors import RequestError
-from vahr.station.vocabulary import load_model, sentences, spell_numbers
+from vahr.station.vocabulary import load_model, sentences
 from vahr.station.voice import SORRY, PushToTalk, read_clip
 
 if TYPE_CHECKING:

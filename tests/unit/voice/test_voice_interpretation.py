@@ -7,10 +7,11 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from robot_agent.voice.answers import WeatherAnswers, normalize
+from robot_agent.voice.answers import WeatherAnswers
 from robot_agent.voice.evaluation import EVALUATION_SET, TUNING_SET, Phrasings
 from robot_agent.voice.interpreter import LocalInterpreter
 from robot_agent.voice.sense import SENSE_FILE, training_sentences
+from vahr.protocol.text import normalize
 from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:

@@ -33,7 +33,7 @@ from vahr.errors import VahrError
 from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
 from vahr.local.alexa.consistency import SlotConsistency
 from vahr.local.alexa.intent_classifier import load_or_train
-from vahr.local.alexa.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize
+from vahr.local.alexa.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize_utterance
 from vahr.local.alexa.slot_roles import assign_slots
 from vahr.local.alexa.weather_rule import states_a_weather_rule
 from vahr.protocol import FLEET_GROUP
@@ -47,7 +47,7 @@ __all__ = [
     "InteractionModel",
     "SlotValue",
     "Understanding",
-    "normalize",
+    "normalize_utterance",
 ]
 
 # The interaction model ships with the package (in a checkout, a link to skill-package/).
@@ -221,7 +221,7 @@ class InteractionModel:
         return self._classifier
 
     def find_slots(self, utterance: str) -> tuple[list[str], list[SlotMatch]]:
-        words = normalize(utterance).split()
+        words = normalize_utterance(utterance).split()
         return words, self._finder.find(words)
 
     def understand(self, utterance: str) -> Understanding:
@@ -292,7 +292,7 @@ class InteractionModel:
     def _abstract_sample(self, intent: str, sample: str) -> str:
         types = self.intent_slots.get(intent, {})
         words = [
-            types.get(word[1:-1], word) if word.startswith("{") else normalize(word)
+            types.get(word[1:-1], word) if word.startswith("{") else normalize_utterance(word)
             for word in sample.split()
         ]
         return " ".join(word for word in words if word)
@@ -304,7 +304,7 @@ def _slot_type(document: dict[str, Any]) -> SlotTypeValues:
         name = value["name"]["value"]
         value_id = value.get("id") or name
         for phrase in [name, *value["name"].get("synonyms", [])]:
-            names.setdefault(normalize(phrase), (value_id, name))
+            names.setdefault(normalize_utterance(phrase), (value_id, name))
     return SlotTypeValues(document["name"], names)
 
 

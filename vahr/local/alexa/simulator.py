@@ -19,7 +19,7 @@ from datetime import UTC, datetime
 from typing import TYPE_CHECKING, Any
 
 from vahr.local.alexa import envelope
-from vahr.local.alexa.nlu import Understanding, normalize
+from vahr.local.alexa.nlu import Understanding, normalize_utterance
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -95,11 +95,11 @@ def strip_invocation(invocation_name: str, utterance: str) -> str:
     phrasings Alexa supports for a request with an invocation name: "Alexa, ask robot fleet
     to send robot one to zone b", "tell robot fleet that ...", "open robot fleet and ...",
     "... using robot fleet" -> "send robot one to zone b"."""
-    text = normalize(utterance).removeprefix("alexa ")
+    text = normalize_utterance(utterance).removeprefix("alexa ")
     # The skill addressed by its name alone, as people do inside a session ("robot fleet,
     # placebot one go to zone b"): the name is no part of the request.
-    text = text.removeprefix(normalize(invocation_name) + " ")
-    invocation = re.escape(normalize(invocation_name))
+    text = text.removeprefix(normalize_utterance(invocation_name) + " ")
+    invocation = re.escape(normalize_utterance(invocation_name))
     for pattern in (
         rf"(?:ask|tell|have)\s+{invocation}(?:\s+(?:to|for|about|if|whether|that))?",
         rf"(?:open|launch|start|use|talk\s+to)\s+{invocation}\s+(?:and|to)",
@@ -134,7 +134,7 @@ class AlexaSimulator:
         self.on_turn = on_turn
         self._session: _Session | None = None
         self._lock = threading.Lock()
-        invocation = re.escape(normalize(model.invocation_name))
+        invocation = re.escape(normalize_utterance(model.invocation_name))
         self._one_shot = re.compile(
             rf"^(?:alexa\s+)?(?:ask|tell)\s+{invocation}(?:\s+(?:to|for|about|if|whether))?"
             rf"(?:\s+(?P<rest>.*))?$"
@@ -179,7 +179,7 @@ class AlexaSimulator:
             log.exception("the turn observer failed")
 
     def _say(self, utterance: str) -> Turn:
-        text = normalize(utterance)
+        text = normalize_utterance(utterance)
         opening = self._open.match(text)
         if opening:
             self._session = _Session()

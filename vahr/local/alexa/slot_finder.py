@@ -27,13 +27,13 @@ would name another robot or zone. Some spans need more than a name:
 
 from __future__ import annotations
 
-import re
 from collections import defaultdict
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from rapidfuzz import fuzz, process
 
+from vahr.protocol.text import normalize, spell_numbers
 from vahr.skill_model.intents import ROBOT_TYPE
 
 if TYPE_CHECKING:
@@ -42,14 +42,10 @@ if TYPE_CHECKING:
 # Misheard words closer than this (rapidfuzz ratio, 0-100) to a word of a slot name are read
 # as that word; below it they stay unknown.
 FUZZY_CUTOFF = 75.0
-_WORD_NUMBERS = (
-    "zero one two three four five six seven eight nine ten eleven twelve thirteen fourteen "
-    "fifteen sixteen seventeen eighteen nineteen twenty"
-).split()
-NUMBER_WORDS = frozenset(_WORD_NUMBERS)
-_NOT_A_WORD = re.compile(r"[^a-z0-9' ]+")
-_DIGITS = re.compile(r"\d+")
-_LETTER_DIGIT = re.compile(r"(?<=[a-z])(?=\d)|(?<=\d)(?=[a-z])")
+# The NLU reads numbers up to twenty as words (a larger one stays digits), and never bends
+# those words into a slot word: a changed number would name another robot or zone.
+SPELLED_BELOW = 21
+NUMBER_WORDS = frozenset(spell_numbers(str(number)) for number in range(SPELLED_BELOW))
 _ARTICLES = frozenset({"the", "a", "an"})
 # Words that join a second value to a name with its shared words left out ("robot one and
 # two"); `slot_roles` reads "and" as a list and "or" as a choice to ask about.
@@ -64,17 +60,10 @@ OTHER_ROBOT = ("the", "other")
 _OTHER_HEADS = frozenset({"robot", "one", "placebot", "bot"})
 
 
-def normalize(text: str) -> str:
-    """Lower case, punctuation dropped (apostrophes kept), numbers spelled out, single spaces:
-    "Send PlaceBot-1 to Zone B!" -> "send placebot one to zone b"."""
-    text = _NOT_A_WORD.sub(" ", text.lower().replace("-", " "))
-    text = _LETTER_DIGIT.sub(" ", text)
-    return " ".join(_DIGITS.sub(_spell, text).split())
-
-
-def _spell(found: re.Match[str]) -> str:
-    number = int(found[0])
-    return _WORD_NUMBERS[number] if number < len(_WORD_NUMBERS) else found[0]
+def normalize_utterance(text: str) -> str:
+    """An utterance as the NLU reads it: `vahr.protocol.text.normalize`d, with numbers to
+    twenty in words: "Send PlaceBot-1 to Zone B!" -> "send placebot one to zone b"."""
+    return spell_numbers(normalize(text), below=SPELLED_BELOW)
 
 
 @dataclass(frozen=True)
