@@ -38,7 +38,8 @@ if TYPE_CHECKING:
 TEST_NAMES = {"paired_t": "paired t", "wilcoxon": "Wilcoxon", "rm_anova": "RM ANOVA"}
 
 
-def method_order(rows: list[ResultRow]) -> list[str]:
+def methods_reported(rows: list[ResultRow]) -> list[str]:
+    """The methods the rows hold: the paper's first, in its order, then any other by name."""
     present = {row.method for row in rows}
     return [m for m in METHODS if m in present] + sorted(present - set(METHODS))
 
@@ -95,7 +96,7 @@ def build_report(
     rows: list[ResultRow], *, source: str = "", simulated: bool = False
 ) -> dict[str, Any]:
     """The report.json document for `rows`."""
-    methods = method_order(rows)
+    methods = methods_reported(rows)
     objective = {
         metric: _summary(rows, methods, value) for metric, (_, _, value) in OBJECTIVE.items()
     }

@@ -60,7 +60,7 @@ def participant_ids(count: int) -> list[str]:
     return [f"P{number:02d}" for number in range(1, count + 1)]
 
 
-def method_order(position: int) -> tuple[str, ...]:
+def counterbalanced_methods(position: int) -> tuple[str, ...]:
     """AB/BA counterbalancing: the first participant starts with VAHR, the next with the
     keyboard and mouse, and so on."""
     return METHODS if position % 2 == 0 else tuple(reversed(METHODS))
@@ -88,7 +88,7 @@ def run_study(
     assistant = HttpAssistant(api_url)
     for position, participant in enumerate(participant_ids(spec.participants)):
         person = person_for(spec.seed, participant, spec.monitoring)
-        for method in method_order(position):
+        for method in counterbalanced_methods(position):
             for trial in range(1, spec.trials + 1):
                 path = session_file(spec.log_dir, participant, method, trial)
                 if _finished(path):
