@@ -1,5 +1,5 @@
 """The robot's hearing on the spoken evaluation set: accuracy per condition and intent, and
-time per clip (the whole understanding beside the recognizer alone).
+time per clip (the whole hearing beside the recognizer alone).
 
 Renders `robot_agent/voice/data/hearing-eval.yaml` (three espeak-ng voices, clean, 20 dB
 and 10 dB SNR, answers and unrelated speech) into a temporary directory, hears every clip
@@ -29,9 +29,9 @@ from robot_agent.voice.evaluation import (  # noqa: E402
     render,
     score,
 )
+from robot_agent.voice.hearing import Hearing, weather_recognizer  # noqa: E402
 from robot_agent.voice.interpreter import LocalInterpreter  # noqa: E402
 from robot_agent.voice.sense import SenseCheck  # noqa: E402
-from robot_agent.voice.understanding import Understanding, weather_recognizer  # noqa: E402
 from vahr.speech.audio import Audio  # noqa: E402
 from vahr.speech.tts import EspeakSynthesizer  # noqa: E402
 
@@ -56,11 +56,11 @@ def main() -> None:
         begun = time.perf_counter()
         sense = SenseCheck.train(answers, cache_dir=Path(cache))
         sense_warm_s = time.perf_counter() - begun
-    understanding = Understanding(recognizer, LocalInterpreter(answers), sense=sense)
+    hearing = Hearing(recognizer, LocalInterpreter(answers), sense=sense)
     with tempfile.TemporaryDirectory() as folder:
         directory = Path(folder)
         manifest = render(phrasings, directory, EspeakSynthesizer, source=args.phrasings.name)
-        report = score(directory, understanding.hear, time.perf_counter)
+        report = score(directory, hearing.hear, time.perf_counter)
         alone: list[float] = []
         for clip in load_manifest(directory).clips:
             audio = Audio.from_wav((directory / clip.file).read_bytes())

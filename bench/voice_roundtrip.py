@@ -23,8 +23,8 @@ from _results import median, percentile, write_section
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from robot_agent.voice.answers import WeatherAnswers  # noqa: E402
+from robot_agent.voice.hearing import offline_hearing, weather_recognizer  # noqa: E402
 from robot_agent.voice.interpreter import LocalInterpreter  # noqa: E402
-from robot_agent.voice.understanding import offline_understanding, weather_recognizer  # noqa: E402
 from vahr.local.room import QUESTIONS  # noqa: E402
 from vahr.speech.audio import add_white_noise  # noqa: E402
 from vahr.speech.stt import GrammarRecognizer  # noqa: E402
@@ -113,7 +113,7 @@ def room_round_trip(runs: int) -> list[float]:
 
 
 def accuracy() -> tuple[str, int, int, list[str]]:
-    understanding = offline_understanding()
+    hearing = offline_hearing()
     rng = np.random.default_rng(8)
     rows, accepted, total, wrongly = [], 0, 0, []
     for voice in VOICES:
@@ -126,13 +126,13 @@ def accuracy() -> tuple[str, int, int, list[str]]:
                     if snr is not None:
                         audio = add_white_noise(audio, snr, rng)
                     count += 1
-                    right += understanding.hear(audio).intent == intent
+                    right += hearing.hear(audio).intent == intent
             for text in UNRELATED:
                 audio = tts.synthesize(text)
                 if snr is not None:
                     audio = add_white_noise(audio, snr, rng)
                 total += 1
-                heard = understanding.hear(audio)
+                heard = hearing.hear(audio)
                 if heard.intent != "unknown":
                     accepted += 1
                     wrongly.append(f"{text!r} ({voice}, {'clean' if snr is None else '20 dB'})")

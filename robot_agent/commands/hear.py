@@ -77,7 +77,7 @@ def heard_json(heard: Heard) -> dict[str, object]:
 def _hear_file(args: argparse.Namespace) -> int:
     import sys
 
-    from robot_agent.voice.understanding import offline_understanding
+    from robot_agent.voice.hearing import offline_hearing
     from vahr.speech.audio import Audio
 
     path: Path = args.file
@@ -86,7 +86,7 @@ def _hear_file(args: argparse.Namespace) -> int:
     except OSError as err:
         raise VahrError(f"{path}: {err.strerror}") from err
     try:
-        heard = offline_understanding(args.answers).hear(Audio.from_wav(data))
+        heard = offline_hearing(args.answers).hear(Audio.from_wav(data))
     except SpeechError as err:
         raise VahrError(f"{path}: {err}") from err
     if args.json:
@@ -119,11 +119,11 @@ def _evaluate(args: argparse.Namespace) -> int:
     import time
 
     from robot_agent.voice.evaluation import score
-    from robot_agent.voice.understanding import offline_understanding
+    from robot_agent.voice.hearing import offline_hearing
 
     try:
-        understanding = offline_understanding(args.answers)
-        report = score(args.eval, understanding.hear, time.perf_counter)
+        hearing = offline_hearing(args.answers)
+        report = score(args.eval, hearing.hear, time.perf_counter)
     except SpeechError as err:
         raise VahrError(str(err)) from err
     if args.json:

@@ -33,7 +33,7 @@ from vahr.speech.errors import SpeechError
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from robot_agent.voice.understanding import Understanding
+    from robot_agent.voice.hearing import Hearing
     from vahr.speech.tts import Synthesizer
 
 PLAY_GRACE_S = 5.0
@@ -59,7 +59,7 @@ class DeviceVoice:
     def __init__(
         self,
         synthesizer: Synthesizer,
-        understanding: Understanding,
+        hearing: Hearing,
         *,
         player: Sequence[str],
         recorder: Sequence[str],
@@ -67,7 +67,7 @@ class DeviceVoice:
         settings: ListenSettings | None = None,
     ) -> None:
         self.synthesizer = synthesizer
-        self.understanding = understanding
+        self.hearing = hearing
         self.player = list(player)
         self.recorder = list(recorder)
         self.detector = detector or SpeechDetector()
@@ -81,7 +81,7 @@ class DeviceVoice:
         audio = await asyncio.to_thread(self.record, timeout_s)
         if audio is None:
             return Heard("", "unknown", 0.0)
-        return await asyncio.to_thread(self.understanding.hear, audio)
+        return await asyncio.to_thread(self.hearing.hear, audio)
 
     def play(self, audio: Audio) -> None:
         try:

@@ -17,8 +17,8 @@ from vahr.speech.errors import SpeechError
 if TYPE_CHECKING:
     from robot_agent.config import AgentConfig
     from robot_agent.voice.devices import DeviceVoice
+    from robot_agent.voice.hearing import Hearing
     from robot_agent.voice.room import RoomVoice
-    from robot_agent.voice.understanding import Understanding
     from vahr.protocol.link import Link
     from vahr.speech.tts import Synthesizer
 
@@ -31,17 +31,17 @@ def synthesizer_for(config: AgentConfig) -> Synthesizer:
     return make_synthesizer(spec if ":" in spec or spec in ("polly", "gtts") else f"espeak:{spec}")
 
 
-def understanding_for(thing: str, config: AgentConfig) -> Understanding:
+def hearing_for(thing: str, config: AgentConfig) -> Hearing:
     """pocketsphinx, then the local interpreter or Lex as `voice.interpreter` says."""
     from robot_agent.voice.answers import WeatherAnswers
-    from robot_agent.voice.understanding import (
-        Understanding,
-        offline_understanding,
+    from robot_agent.voice.hearing import (
+        Hearing,
+        offline_hearing,
         weather_recognizer,
     )
 
     if config.voice.interpreter == "local":
-        return offline_understanding()
+        return offline_hearing()
     from robot_agent.voice.iot_credentials import IotCredentialsProvider
     from robot_agent.voice.lex import LexInterpreter
 
@@ -75,14 +75,14 @@ def understanding_for(thing: str, config: AgentConfig) -> Understanding:
         credentials=provider.get,
         endpoint_url=lex.endpoint_url,
     )
-    return Understanding(weather_recognizer(WeatherAnswers.load()), interpreter)
+    return Hearing(weather_recognizer(WeatherAnswers.load()), interpreter)
 
 
 def room(*, thing: str, config: AgentConfig, link: Link) -> RoomVoice:
     """A `RoomVoice` speaking over the agent's own link (one connection per robot)."""
     from robot_agent.voice.room import RoomVoice
 
-    return RoomVoice(thing, link, synthesizer_for(config), understanding_for(thing, config))
+    return RoomVoice(thing, link, synthesizer_for(config), hearing_for(thing, config))
 
 
 def device(*, thing: str, config: AgentConfig) -> DeviceVoice:
@@ -92,7 +92,7 @@ def device(*, thing: str, config: AgentConfig) -> DeviceVoice:
     voice = config.voice
     return DeviceVoice(
         synthesizer_for(config),
-        understanding_for(thing, config),
+        hearing_for(thing, config),
         player=voice.play_command or default_player(),
         recorder=voice.record_command or default_recorder(),
         settings=voice.listen,

@@ -17,7 +17,7 @@ from vahr.protocol import topics
 from vahr.speech.room import RoomChannel, Utterance
 
 if TYPE_CHECKING:
-    from robot_agent.voice.understanding import Understanding
+    from robot_agent.voice.hearing import Hearing
     from vahr.protocol.link import Link
     from vahr.speech.tts import Synthesizer
 
@@ -30,12 +30,12 @@ class RoomVoice:
         thing: str,
         link: Link,
         synthesizer: Synthesizer,
-        understanding: Understanding,
+        hearing: Hearing,
     ) -> None:
         self.thing = topics.check_thing(thing)
         self.room = RoomChannel(link)
         self.synthesizer = synthesizer
-        self.understanding = understanding
+        self.hearing = hearing
         self._loop: asyncio.AbstractEventLoop | None = None
         self._answers: asyncio.Queue[Utterance] | None = None
         self._last_said: str | None = None
@@ -77,4 +77,4 @@ class RoomVoice:
             # An answer to an earlier question (a late reply) is not this one's answer.
             if utterance.in_reply_to not in (None, self._last_said):
                 continue
-            return await asyncio.to_thread(self.understanding.hear, utterance.audio)
+            return await asyncio.to_thread(self.hearing.hear, utterance.audio)

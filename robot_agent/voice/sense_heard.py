@@ -83,7 +83,7 @@ def write_heard(
 def main(argv: Sequence[str] | None = None) -> int:
     """Remake data/answer-sense-heard.yaml from the sense check's training sentences."""
     from robot_agent.voice.evaluation import held_out_sentences
-    from robot_agent.voice.understanding import weather_recognizer
+    from robot_agent.voice.hearing import weather_recognizer
     from vahr.speech.tts import EspeakSynthesizer
 
     parser = argparse.ArgumentParser(description=main.__doc__)

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from robot_agent.voice.understanding import Understanding, offline_understanding
+from robot_agent.voice.hearing import Hearing, offline_hearing
 
 
 @pytest.fixture(scope="session")
-def understanding() -> Understanding:
-    return offline_understanding()
+def hearing() -> Hearing:
+    return offline_hearing()

@@ -19,19 +19,19 @@ from robot_agent.voice.evaluation import EVALUATION_SET, Phrasings, Report, rend
 from vahr.speech.tts import EspeakSynthesizer
 
 if TYPE_CHECKING:
-    from robot_agent.voice.understanding import Understanding
+    from robot_agent.voice.hearing import Hearing
 
 # Rendering and hearing 1,233 clips takes two to three minutes on two cores.
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(420)]
 
 
 @pytest.fixture(scope="module")
-def report(understanding: Understanding, tmp_path_factory: pytest.TempPathFactory) -> Report:
+def report(hearing: Hearing, tmp_path_factory: pytest.TempPathFactory) -> Report:
     # Given the evaluation set, rendered as `--make-eval-set` does
     directory = tmp_path_factory.mktemp("evaluation")
     render(Phrasings.load(EVALUATION_SET), directory, EspeakSynthesizer)
     # When the robot hears every clip
-    return score(directory, understanding.hear, time.perf_counter)
+    return score(directory, hearing.hear, time.perf_counter)
 
 
 CONDITIONS = ("clean", "snr20", "snr10")

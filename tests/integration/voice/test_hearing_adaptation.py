@@ -21,8 +21,8 @@ from robot_agent.voice.adaptation import (
 )
 from robot_agent.voice.answers import WeatherAnswers
 from robot_agent.voice.evaluation import EVALUATION_SET, TUNING_SET, Phrasings
+from robot_agent.voice.hearing import Hearing, hearing_adaptation
 from robot_agent.voice.interpreter import LocalInterpreter
-from robot_agent.voice.understanding import Understanding, hearing_adaptation
 from vahr.speech.errors import SpeechError
 from vahr.speech.lm_stt import LanguageModelRecognizer
 from vahr.speech.stt import GrammarRecognizer
@@ -74,7 +74,7 @@ def test_an_adaptation_estimated_from_speech_is_heard_with(tmp_path: Path) -> No
         exact = GrammarRecognizer(answers.all_phrases(), adaptation=adaptation)
         assert exact.recognize(answer).text == "the weather is sunny"
         wider = LanguageModelRecognizer(answers.corpus(), adaptation=adaptation)
-        hearing = Understanding(wider, LocalInterpreter(answers))
+        hearing = Hearing(wider, LocalInterpreter(answers))
         assert hearing.hear(answer).intent == "sunny"
 
 

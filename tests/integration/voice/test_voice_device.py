@@ -18,7 +18,7 @@ from vahr.speech.tts import EspeakSynthesizer
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from robot_agent.voice.understanding import Understanding
+    from robot_agent.voice.hearing import Hearing
 
 RAW_16K = ["-t", "raw", "-r", "16000", "-c", "1", "-b", "16", "-e", "signed-integer", "-"]
 
@@ -34,7 +34,7 @@ def tts() -> EspeakSynthesizer:
 
 
 def test_listen_hears_the_answer_between_silences(
-    tmp_path: Path, understanding: Understanding, tts: EspeakSynthesizer
+    tmp_path: Path, hearing: Hearing, tts: EspeakSynthesizer
 ) -> None:
     # Given a microphone that picks up a second of silence, the answer, then a long silence
     # and more talk (which must not be part of the answer)
@@ -46,7 +46,7 @@ def test_listen_hears_the_answer_between_silences(
     )
     wav = tmp_path / "room.wav"
     wav.write_bytes(room.to_wav())
-    voice = DeviceVoice(tts, understanding, player=["true"], recorder=recorder_of(wav))
+    voice = DeviceVoice(tts, hearing, player=["true"], recorder=recorder_of(wav))
     # When the robot listens
     heard = asyncio.run(voice.listen(timeout_s=5.0))
     # Then it understood the answer only
@@ -54,11 +54,11 @@ def test_listen_hears_the_answer_between_silences(
 
 
 def test_listen_times_out_on_silence(
-    tmp_path: Path, understanding: Understanding, tts: EspeakSynthesizer
+    tmp_path: Path, hearing: Hearing, tts: EspeakSynthesizer
 ) -> None:
     wav = tmp_path / "quiet.wav"
     wav.write_bytes(Audio.silence(10.0).to_wav())
-    voice = DeviceVoice(tts, understanding, player=["true"], recorder=recorder_of(wav))
+    voice = DeviceVoice(tts, hearing, player=["true"], recorder=recorder_of(wav))
     started = time.monotonic()
     heard = asyncio.run(voice.listen(timeout_s=2.0))
     assert (heard.intent, heard.text, heard.confidence) == ("unknown", "", 0.0)
@@ -66,11 +66,11 @@ def test_listen_times_out_on_silence(
 
 
 def test_listen_bounds_a_stalled_microphone_by_wall_time(
-    understanding: Understanding, tts: EspeakSynthesizer
+    hearing: Hearing, tts: EspeakSynthesizer
 ) -> None:
     # A recorder that never delivers a byte (a wedged device)
     voice = DeviceVoice(
-        tts, understanding, player=["true"], recorder=["sleep", "30"],
+        tts, hearing, player=["true"], recorder=["sleep", "30"],
         settings=ListenSettings(max_utterance_s=0.5),
     )  # fmt: skip
     started = time.monotonic()
@@ -80,36 +80,34 @@ def test_listen_bounds_a_stalled_microphone_by_wall_time(
 
 
 def test_say_plays_the_speech_on_the_player(
-    tmp_path: Path, understanding: Understanding, tts: EspeakSynthesizer
+    tmp_path: Path, hearing: Hearing, tts: EspeakSynthesizer
 ) -> None:
     # Given a player that writes what it is sent to a file (as aplay would play it)
     played = tmp_path / "played.wav"
     voice = DeviceVoice(
-        tts, understanding, player=["sox", "-t", "wav", "-", str(played)], recorder=["true"]
+        tts, hearing, player=["sox", "-t", "wav", "-", str(played)], recorder=["true"]
     )
     # When the robot speaks
     asyncio.run(voice.say("The weather is sunny."))
     # Then the played audio is that sentence
-    heard = understanding.hear(Audio.from_wav(played.read_bytes()))
+    heard = hearing.hear(Audio.from_wav(played.read_bytes()))
     assert heard.text == "the weather is sunny"
 
 
 def test_a_missing_device_command_is_a_voice_error(
-    understanding: Understanding, tts: EspeakSynthesizer
+    hearing: Hearing, tts: EspeakSynthesizer
 ) -> None:
-    voice = DeviceVoice(
-        tts, understanding, player=["no-such-player"], recorder=["no-such-recorder"]
-    )
+    voice = DeviceVoice(tts, hearing, player=["no-such-player"], recorder=["no-such-recorder"])
     with pytest.raises(SpeechError, match="audio player 'no-such-player' not found"):
         asyncio.run(voice.say("hello"))
     with pytest.raises(SpeechError, match="audio recorder 'no-such-recorder' not found"):
         asyncio.run(voice.listen(1.0))
 
 
-def test_a_failing_recorder_says_why(understanding: Understanding, tts: EspeakSynthesizer) -> None:
+def test_a_failing_recorder_says_why(hearing: Hearing, tts: EspeakSynthesizer) -> None:
     voice = DeviceVoice(
         tts,
-        understanding,
+        hearing,
         player=["true"],
         recorder=["sh", "-c", "echo 'no such device' >&2; exit 1"],
     )

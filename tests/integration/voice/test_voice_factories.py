@@ -87,7 +87,7 @@ def test_lex_is_chosen_with_the_robot_certificate(tmp_path: Path) -> None:
         cert=str(robot.cert_file), key=str(robot.key_file), ca=str(robot.ca_file),
     )  # fmt: skip
     voice = device(thing="placebot1", config=config)
-    lex = voice.understanding.interpreter
+    lex = voice.hearing.interpreter
     assert isinstance(lex, LexInterpreter)
     assert (lex.bot_id, lex.bot_alias_id, lex.locale_id, lex.session_id, lex.region) == (
         "BOTID12345", "ALIAS12345", "en_US", "placebot1", "eu-west-1",

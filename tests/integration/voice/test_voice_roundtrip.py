@@ -13,7 +13,7 @@ from vahr.speech.audio import SAMPLE_RATE, Audio, add_white_noise, concatenate
 from vahr.speech.tts import EspeakSynthesizer
 
 if TYPE_CHECKING:
-    from robot_agent.voice.understanding import Understanding
+    from robot_agent.voice.hearing import Hearing
 
 VOICES = ("en-us+f2", "en-us+m3")
 SUNNY = (
@@ -35,9 +35,7 @@ ANSWERS = [(text, "sunny") for text in SUNNY] + [(text, "rainy") for text in RAI
 
 @pytest.mark.parametrize("voice", VOICES)
 @pytest.mark.parametrize("snr_db", [None, 20.0], ids=["clean", "snr20"])
-def test_every_phrasing_is_understood(
-    understanding: Understanding, voice: str, snr_db: float | None
-) -> None:
+def test_every_phrasing_is_understood(hearing: Hearing, voice: str, snr_db: float | None) -> None:
     # Given the answers spoken by espeak-ng at 16 kHz, with or without white noise
     tts = EspeakSynthesizer(voice)
     rng = np.random.default_rng(20)
@@ -48,7 +46,7 @@ def test_every_phrasing_is_understood(
         if snr_db is not None:
             audio = add_white_noise(audio, snr_db, rng)
         # When the robot hears them
-        heard = understanding.hear(audio)
+        heard = hearing.hear(audio)
         # Then each is recognized and interpreted as its intent, with the posterior of the
         # words it rests on as the confidence
         if heard.intent != intent or not 0.0 < heard.confidence <= 1.0:
@@ -57,9 +55,7 @@ def test_every_phrasing_is_understood(
 
 
 @pytest.mark.parametrize("voice", VOICES)
-def test_silence_and_an_unrelated_sentence_are_unknown(
-    understanding: Understanding, voice: str
-) -> None:
+def test_silence_and_an_unrelated_sentence_are_unknown(hearing: Hearing, voice: str) -> None:
     tts = EspeakSynthesizer(voice)
     rng = np.random.default_rng(3)
     cases = {
@@ -69,14 +65,14 @@ def test_silence_and_an_unrelated_sentence_are_unknown(
     for text in UNRELATED:
         cases[text] = tts.synthesize(text)
         cases[f"{text} (20 dB SNR)"] = add_white_noise(cases[text], 20.0, rng)
-    heard = {name: understanding.hear(audio) for name, audio in cases.items()}
+    heard = {name: hearing.hear(audio) for name, audio in cases.items()}
     # Then none is taken for an answer, each says why, and nothing is heard in silence
     assert {name: h.intent for name, h in heard.items()} == {name: "unknown" for name in cases}
     assert all(h.reason for h in heard.values())
     assert (heard["silence"].text, heard["silence"].reason) == ("", "no speech")
 
 
-def test_a_sentence_after_the_answer_does_not_hide_it(understanding: Understanding) -> None:
+def test_a_sentence_after_the_answer_does_not_hide_it(hearing: Hearing) -> None:
     # Given the skill's answer followed by a second sentence after a pause
     tts = EspeakSynthesizer("en-us+f2")
     audio = concatenate(
@@ -85,7 +81,7 @@ def test_a_sentence_after_the_answer_does_not_hide_it(understanding: Understandi
         tts.synthesize("Is there anything else I can help with?"),
     )
     # Then the answer is still understood, and the rest heard as no weather
-    heard = understanding.hear(audio)
+    heard = hearing.hear(audio)
     assert heard.intent == "rainy" and heard.evidence == ("rainy",)
     assert heard.text.startswith("the weather is rainy is there anything")
 

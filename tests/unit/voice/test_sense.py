@@ -8,9 +8,9 @@ from typing import TYPE_CHECKING
 import pytest
 
 from robot_agent.voice.answers import WeatherAnswers
+from robot_agent.voice.hearing import Hearing
 from robot_agent.voice.interpreter import LocalInterpreter
 from robot_agent.voice.sense import SENSE_FILE, SenseCheck, features, training_sentences
-from robot_agent.voice.understanding import Understanding
 from vahr.speech.errors import SpeechError
 from vahr.speech.stt import HeardWord, Recognition
 from vahr.speech.text_classifier import TextClassifier, export, fit
@@ -65,18 +65,18 @@ def test_weather_words_in_another_sense_do_not(sense: SenseCheck, text: str) -> 
 def test_a_cue_in_another_sense_is_heard_as_no_answer(
     answers: WeatherAnswers, sense: SenseCheck
 ) -> None:
-    # Given the offline understanding with the sense check, hearing a sentence whose cue
+    # Given the offline hearing with the sense check, hearing a sentence whose cue
     # ("shower") is not about the weather
     heard = _Heard("the shower in the second bathroom is broken")
-    understanding = Understanding(heard, LocalInterpreter(answers), sense=sense)
+    hearing = Hearing(heard, LocalInterpreter(answers), sense=sense)
     # When it decides
-    result = understanding.hear(None)  # type: ignore[arg-type]
+    result = hearing.hear(None)  # type: ignore[arg-type]
     # Then it is unknown, the cue reported, and the reason says why
     assert result.intent == "unknown"
     assert result.evidence == ("shower",)
     assert result.reason.startswith("reads as no answer")
     # And without the check the cue alone would have decided
-    alone = Understanding(heard, LocalInterpreter(answers)).hear(None)  # type: ignore[arg-type]
+    alone = Hearing(heard, LocalInterpreter(answers)).hear(None)  # type: ignore[arg-type]
     assert alone.intent == "rainy"
 
 
@@ -120,7 +120,7 @@ def test_an_answer_followed_by_the_assistants_question_is_still_an_answer(
 ) -> None:
     # Given the skill's answer and the question it goes on with, heard as one text
     heard = _Heard("the weather is rainy is there anything else i can help with")
-    understanding = Understanding(heard, LocalInterpreter(answers), sense=sense)
+    hearing = Hearing(heard, LocalInterpreter(answers), sense=sense)
     # Then the answer is read in the sentence its cue was said in
     assert LocalInterpreter(answers).interpret(heard.text).sentence == "the weather is rainy"
-    assert understanding.hear(None).intent == "rainy"  # type: ignore[arg-type]
+    assert hearing.hear(None).intent == "rainy"  # type: ignore[arg-type]

@@ -56,8 +56,9 @@ DEFAULT_MIN_POSTERIOR = 0.0
 BACKGROUND_WORDS = 3000
 
 
-class Understanding:
-    """A recognizer and an interpreter used together, and optionally the sense check."""
+class Hearing:
+    """The robot's hearing: a recognizer and an interpreter used together, and optionally
+    the sense check."""
 
     def __init__(
         self,
@@ -135,7 +136,7 @@ def hearing_adaptation(setting: str | None = None) -> Path | None:
     return None if value == "none" else Path(value)
 
 
-def offline_understanding(answers_file: str | None = None) -> Understanding:
+def offline_hearing(answers_file: str | None = None) -> Hearing:
     """pocketsphinx with a language model of `weather_answers.yaml`, the local interpreter
     of its cues, and the sense check."""
     from robot_agent.voice.answers import ANSWERS_FILE, WeatherAnswers
@@ -143,6 +144,6 @@ def offline_understanding(answers_file: str | None = None) -> Understanding:
     from robot_agent.voice.sense import SenseCheck
 
     answers = WeatherAnswers.load(Path(answers_file) if answers_file else ANSWERS_FILE)
-    return Understanding(
+    return Hearing(
         weather_recognizer(answers), LocalInterpreter(answers), sense=SenseCheck.train(answers)
     )
