@@ -1,9 +1,9 @@
 """The assistant's expected weather answers, read from `weather_answers.yaml`.
 
 The same file feeds the offline recognizer's language model (every sentence in it), the
-local interpreter (the cues, negations and the rules for what is no answer) and the CDK
-Lex bot (the intents' sentences), so what the robot can hear and what it understands
-never drift apart.
+local interpreter (the cues and the rules for what is no answer; the negations are
+`vahr.protocol.weather.NEGATIONS`) and the CDK Lex bot (the intents' sentences), so what the
+robot can hear and what it understands never drift apart.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any, cast
 import yaml
 
 from vahr.protocol.text import normalize
-from vahr.protocol.weather import WEATHERS
+from vahr.protocol.weather import NEGATIONS, WEATHERS
 from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
@@ -24,7 +24,6 @@ if TYPE_CHECKING:
 ANSWERS_FILE = Path(__file__).with_name("weather_answers.yaml")
 INTENTS: tuple[WeatherIntent, ...] = WEATHERS
 _WORD_LISTS = (
-    "negations",
     "clause_breaks",
     "question_openers",
     "question_verbs",
@@ -182,6 +181,10 @@ def _cues(document: dict[str, Any], source: str) -> Cues:
         raise SpeechError(f"{source}: cues must be a mapping of sunny, rainy and denied")
     denied = cues.get("denied", {})
     said = _phrase_lists({k: v for k, v in cues.items() if k != "denied"}, "cues", source)
+    if "negations" in document:
+        raise SpeechError(
+            f"{source}: negations are vahr.protocol.weather.NEGATIONS, not listed here"
+        )
     lists = {key: frozenset(_sentences(document.get(key, []), key, source)) for key in _WORD_LISTS}
     reach = document.get("negation_reach", 3)
     if not isinstance(reach, int) or not 1 <= reach <= 8:
@@ -189,7 +192,7 @@ def _cues(document: dict[str, Any], source: str) -> Cues:
     return Cues(
         said=said,
         denied=_phrase_lists(denied, "cues.denied", source),
-        negations=lists["negations"],
+        negations=frozenset(NEGATIONS),
         negation_reach=reach,
         clause_breaks=lists["clause_breaks"],
         question_openers=lists["question_openers"],

@@ -8,6 +8,10 @@ Slot values (robot, zone and group names) never appear here: they live in fleet.
 
 from __future__ import annotations
 
+from vahr.protocol.weather import SAMPLED_WEATHER_WORDS
+
+_SUNNY, _RAINY = ("|".join(SAMPLED_WEATHER_WORDS[w]) for w in ("sunny", "rainy"))
+
 RULES: dict[str, str] = {
     # How a request opens: bare, polite, indirect, or with a filler first.
     "ask": (
@@ -36,7 +40,8 @@ RULES: dict[str, str] = {
         "|in line with) the weather"
     ),
     "weather_job": "the weather (delivery|task|navigation|run|job|mission|errand)",
-    # A condition of the weather delivery's rule.
-    "if_sunny": "(if|when|in case) [it's|it is|the weather is] (sunny|nice|clear|dry)",
-    "if_rainy": "(if|when|in case) [it's|it is|the weather is] (rainy|raining|wet|pouring)",
+    # A condition of the weather delivery's rule, in the words of
+    # vahr.protocol.weather.SAMPLED_WEATHER_WORDS.
+    "if_sunny": f"(if|when|in case) [it's|it is|the weather is] ({_SUNNY})",
+    "if_rainy": f"(if|when|in case) [it's|it is|the weather is] ({_RAINY})",
 }

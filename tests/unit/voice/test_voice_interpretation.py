@@ -169,6 +169,10 @@ def test_normalize_drops_punctuation_and_case() -> None:
             "intents: {sunny: [a], rainy: [b]}\ncues: {sunny: [sun]}\nnegation_reach: 0",
             "negation_reach",
         ),
+        (
+            "intents: {sunny: [a], rainy: [b]}\ncues: {sunny: [sun]}\nnegations: [not]",
+            "negations are vahr.protocol.weather.NEGATIONS",
+        ),
         ("intents: [unclosed", "not valid YAML"),
     ],
 )

@@ -16,28 +16,21 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+from vahr.protocol.weather import PLAIN_NEGATIONS, WEATHER_WORDS
 from vahr.skill_model.intents import RAINY_ZONE, SUNNY_ZONE
 
 if TYPE_CHECKING:
     from vahr.local.alexa.slot_finder import SlotMatch
 
 # The words that say which weather a zone of the weather delivery's rule is for.
-_WEATHER_WORDS = {
-    **dict.fromkeys(
-        ("sunny", "sunshine", "sun", "nice", "clear", "dry", "fine", "bright"), "sunny"
-    ),
-    **dict.fromkeys(
-        ("rainy", "rain", "raining", "rains", "wet", "pouring", "showers", "drizzle", "stormy"),
-        "rainy",
-    ),
-}
+_WEATHER_WORDS = {word: weather for weather, words in WEATHER_WORDS.items() for word in words}
 _OTHER_WEATHER = frozenset({"otherwise", "else"})
 # Words that make a weather a condition ("if it's sunny", "in case of rain", "a for sunny",
 # "depending on the weather"), as a rule says it and a report ("it's raining, go to c")
 # does not.
 _CONDITIONS = frozenset({"if", "when", "case", "for", "unless", "depending", "according", "based"})
 _RULE_VERBS = frozenset({"means", "goes", "go", "zone", "is"})
-_NOT = frozenset({"not", "isn't", "no"})
+_NOT = frozenset(PLAIN_NEGATIONS)
 RULE_SLOTS = {"sunny": SUNNY_ZONE.name, "rainy": RAINY_ZONE.name}
 
 
