@@ -28,7 +28,7 @@ import numpy as np
 from vahr.errors import VahrError
 from vahr.protocol.text import normalize
 from vahr.speech.audio import Audio, add_white_noise
-from vahr.speech.scoring import OutcomeTally
+from vahr.speech.scoring import OutcomeTally, read_labelled_set
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -54,16 +54,7 @@ class Phrasings(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
 
     @classmethod
     def load(cls, path: Path) -> Phrasings:
-        try:
-            source = path.read_bytes()
-        except OSError as err:
-            raise VahrError(f"cannot read {path}: {err.strerror}") from err
-        try:
-            return msgspec.yaml.decode(source, type=cls)
-        except msgspec.ValidationError as err:
-            raise VahrError(f"{path}: {err}") from err
-        except msgspec.DecodeError as err:
-            raise VahrError(f"{path} is not valid YAML: {err}") from err
+        return read_labelled_set(path, cls)
 
     def sentences(self) -> list[tuple[str, str, str]]:
         """(name, expected intent, text) for every sentence, answers first."""

@@ -1,15 +1,40 @@
-"""How an understanding is scored: each item's outcome counted, per group, with its rate.
+"""How an understanding is scored: a labelled set read, and each item's outcome counted,
+per group, with its rate.
 
 The simulator's NLU (`vahr nlu --eval`: right, wrong, fallback, asks) and the robot's
-hearing (`robot-agent hear --eval`: right, wrong, fallback) both count what became of each
-labelled utterance or clip in an `OutcomeTally`; each names its own outcomes.
+hearing (`robot-agent hear --eval`: right, wrong, fallback) both read their labelled set
+with `read_labelled_set` and count what became of each utterance or clip in an
+`OutcomeTally`; each names its own outcomes.
 """
 
 from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeVar
+
+import msgspec
+
+from vahr.errors import VahrError
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+LabelledSet = TypeVar("LabelledSet", bound=msgspec.Struct)
+
+
+def read_labelled_set(path: Path, kind: type[LabelledSet]) -> LabelledSet:
+    """The YAML file at `path` as a `kind`, or one `VahrError` line saying what is wrong."""
+    try:
+        source = path.read_bytes()
+    except OSError as err:
+        raise VahrError(f"cannot read {path}: {err.strerror}") from err
+    try:
+        return msgspec.yaml.decode(source, type=kind)
+    except msgspec.ValidationError as err:
+        raise VahrError(f"{path}: {err}") from err
+    except msgspec.DecodeError as err:
+        raise VahrError(f"{path} is not valid YAML: {err}") from err
 
 
 @dataclass

@@ -21,10 +21,9 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
-from vahr.errors import VahrError
 from vahr.local.alexa.nlu import FALLBACK
 from vahr.local.alexa.simulator import strip_invocation
-from vahr.speech.scoring import OutcomeTally
+from vahr.speech.scoring import OutcomeTally, read_labelled_set
 
 if TYPE_CHECKING:
     from vahr.local.alexa.nlu import InteractionModel, Understanding
@@ -46,16 +45,7 @@ class LabelledSet(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
 
     @classmethod
     def load(cls, path: Path) -> LabelledSet:
-        try:
-            source = path.read_bytes()
-        except OSError as err:
-            raise VahrError(f"cannot read {path}: {err.strerror}") from err
-        try:
-            return msgspec.yaml.decode(source, type=cls)
-        except msgspec.ValidationError as err:
-            raise VahrError(f"{path}: {err}") from err
-        except msgspec.DecodeError as err:
-            raise VahrError(f"{path} is not valid YAML: {err}") from err
+        return read_labelled_set(path, cls)
 
     def items(self) -> list[LabelledUtterance]:
         return [*self.utterances, *(LabelledUtterance(t, FALLBACK) for t in self.out_of_domain)]
