@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
+from tests.support.scheduling import FileGroupScheduling, slow_files_first
 from vahr.local.broker import BrokerConfig, Mosquitto
 from vahr.local.ports import free_port
 from vahr.local.stack import LocalStack, StackConfig
@@ -16,17 +17,24 @@ from vahr.protocol import Fleet, load_fleet
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
+    from xdist.remote import Producer
+
 EVENTS_DIR = Path(__file__).parent / "events"
-INFRA_DIR = Path(__file__).parent / "infra"
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """With pytest-xdist's `--dist loadgroup`, keep each file's tests on one worker (its
-    module fixtures, a stack or a robot, start once) and every infra test on one worker
-    (the CDK apps they share are synthesized once per session)."""
-    for item in items:
-        group = "infra" if INFRA_DIR in item.path.parents else str(item.path)
-        item.add_marker(pytest.mark.xdist_group(group))
+    """Files with a slow test run first, so that the two workers finish close together."""
+    slow_files_first(items)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log: Producer) -> FileGroupScheduling | None:
+    """With `--dist loadgroup`, each test file runs whole on one worker (its module fixtures,
+    a stack or a robot, start once), and every infra test on one worker (the CDK apps they
+    share are synthesized once per session): tests/support/scheduling.py."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    return FileGroupScheduling(config, log)
 
 
 @pytest.fixture(scope="session")
