@@ -1,13 +1,20 @@
-"""Build the skill's Lambda code bundle: the one build used by CDK and by the ASK CLI path.
+"""Build the Lambda code bundle (the skill and the announcer): the one build used by CDK and by
+the ASK CLI path.
 
     python -m infra.lambda_asset OUT_DIR [--architecture x86_64|arm64] [--zip FILE]
 
-The bundle holds `skill/` (from `lambda/skill`, handler `skill.app.lambda_handler`), the
-parts of `vahr` the skill imports (`vahr/__init__.py`, `vahr/errors.py`, `vahr/protocol`),
-`fleet.yaml` as `vahr/protocol/fleet.yaml` (where `vahr.protocol.fleet` looks for it), the skill's
-runtime dependencies installed from wheels built for the Lambda runtime (CPython 3.12 on
-Amazon Linux), so no Docker is needed. boto3 comes from the Lambda runtime and awscrt
-must stay out: botocore imports awscrt whenever it is present, which costs cold start.
+The bundle holds two functions' code roots: `skill/` (from `lambda/skill`, handler
+`skill.app.lambda_handler`) and `announcer/` (from `lambda/announcer`, handler
+`announcer.app.lambda_handler`); the parts of `vahr` they import (`vahr/__init__.py`,
+`vahr/errors.py`, `vahr/protocol`, and `vahr/announce` for the announcer), `fleet.yaml` as
+`vahr/protocol/fleet.yaml` (where `vahr.protocol.fleet` looks for it), and the runtime
+dependencies installed from wheels built for the Lambda runtime (CPython 3.12 on Amazon
+Linux), so no Docker is needed. boto3 comes from the Lambda runtime and awscrt must stay
+out: botocore imports awscrt whenever it is present, which costs cold start.
+
+One bundle serves both functions: a cold start pays for the modules a handler imports, not
+for the files it leaves alone (the announcer imports no ASK SDK), and one build, one asset
+hash and one upload stay simpler than two.
 
 Installed dependencies are cached under `.cache/lambda-deps/<key>`, keyed by the pins and
 the target platform, so a rebuild copies files instead of running pip.
@@ -46,10 +53,13 @@ RUNTIME_PROVIDED = ("boto3",)
 # Provided by the runtime (boto3, botocore) or harmful there (awscrt slows every boto3
 # client's import; awsiot is the robots' SDK).
 FORBIDDEN_TOP_LEVEL = ("awscrt", "awsiot", "boto3", "botocore", "s3transfer")
-# The project files the skill needs, relative to the repository root.
+# The project files the functions need, relative to the repository root (vahr.announce
+# for the announcer only).
 VAHR_FILES = ("vahr/__init__.py", "vahr/errors.py")
 VAHR_PACKAGES = ("vahr/protocol", "vahr/announce")
 SKILL_DIR = "lambda/skill"
+# Each function's code root: its package name in the bundle, and where it lives here.
+CODE_ROOTS = {"skill": SKILL_DIR, "announcer": "lambda/announcer"}
 # Where `vahr.protocol.fleet` looks for the bundled fleet definition.
 FLEET_IN_BUNDLE = "vahr/protocol/fleet.yaml"
 _IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".mypy_cache", ".pytest_cache")
@@ -102,10 +112,11 @@ def constraints() -> list[str]:
 def _source_files(fleet_file: Path) -> list[tuple[Path, str]]:
     """(source file, path inside the bundle) for every project file the bundle carries."""
     pairs: list[tuple[Path, str]] = []
-    skill_root = REPO_ROOT / SKILL_DIR
-    for path in sorted(skill_root.rglob("*")):
-        if path.is_file() and "__pycache__" not in path.parts and path.suffix != ".pyc":
-            pairs.append((path, "skill/" + path.relative_to(skill_root).as_posix()))
+    for package, directory in CODE_ROOTS.items():
+        root = REPO_ROOT / directory
+        for path in sorted(root.rglob("*")):
+            if path.is_file() and "__pycache__" not in path.parts and path.suffix != ".pyc":
+                pairs.append((path, f"{package}/" + path.relative_to(root).as_posix()))
     for name in VAHR_FILES:
         pairs.append((REPO_ROOT / name, name))
     for package in VAHR_PACKAGES:
@@ -185,10 +196,10 @@ def _install_dependencies(
     return target, False
 
 
-def _vahr_imports(skill_dir: Path) -> set[str]:
-    """Every `vahr...` module the skill's code imports (absolute imports only)."""
+def _vahr_imports(code_root: Path) -> set[str]:
+    """Every `vahr...` module a function's code imports (absolute imports only)."""
     modules: set[str] = set()
-    for path in skill_dir.rglob("*.py"):
+    for path in code_root.rglob("*.py"):
         tree = ast.parse(path.read_text(), filename=str(path))
         for node in ast.walk(tree):
             if isinstance(node, ast.Import):
@@ -202,17 +213,20 @@ def _check_bundle(out_dir: Path) -> None:
     for name in FORBIDDEN_TOP_LEVEL:
         if (out_dir / name).exists():
             raise VahrError(f"the Lambda bundle must not contain {name}/ (remove it from the deps)")
-    if not (out_dir / "skill" / "app.py").is_file():
-        raise VahrError(f"{SKILL_DIR}/app.py is missing: the handler is skill.app.lambda_handler")
-    for module in sorted(_vahr_imports(out_dir / "skill")):
-        parts = module.split(".")
-        as_package = out_dir.joinpath(*parts, "__init__.py")
-        as_module = out_dir.joinpath(*parts[:-1], parts[-1] + ".py")
-        if not as_package.exists() and not as_module.exists():
+    for package, directory in CODE_ROOTS.items():
+        if not (out_dir / package / "app.py").is_file():
             raise VahrError(
-                f"the skill imports {module}, which the bundle does not carry "
-                f"(add it to VAHR_FILES or VAHR_PACKAGES in infra/lambda_asset.py)"
+                f"{directory}/app.py is missing: the handler is {package}.app.lambda_handler"
             )
+        for module in sorted(_vahr_imports(out_dir / package)):
+            parts = module.split(".")
+            as_package = out_dir.joinpath(*parts, "__init__.py")
+            as_module = out_dir.joinpath(*parts[:-1], parts[-1] + ".py")
+            if not as_package.exists() and not as_module.exists():
+                raise VahrError(
+                    f"the {package} imports {module}, which the bundle does not carry "
+                    f"(add it to VAHR_FILES or VAHR_PACKAGES in infra/lambda_asset.py)"
+                )
 
 
 def _tree_size(root: Path) -> tuple[int, int]:

@@ -1,6 +1,7 @@
-"""The announcer: topic rules on the robots' events and presence, feeding the skill's
-announcer function (`skill.announcer.app.lambda_handler`), which tells the person through
-Alexa's Proactive Events API what the announcement policy finds worth telling.
+"""The announcer: topic rules on the robots' events and presence, feeding the announcer
+function (`announcer.app.lambda_handler`, its own code root `lambda/announcer` in the
+skill's bundle), which tells the person through Alexa's Proactive Events API what the
+announcement policy finds worth telling.
 
 Least privilege: the function may read one secret (the skill's Alexa Skill Messaging
 client id and secret, created by you, never in the template), read and write its one
@@ -29,7 +30,7 @@ from vahr.protocol import topics
 if TYPE_CHECKING:
     from infra.config import InfraConfig
 
-HANDLER = "skill.announcer.app.lambda_handler"
+HANDLER = "announcer.app.lambda_handler"
 TIMEOUT = cdk.Duration.seconds(30)
 MEMORY_MB = 256
 # The events that open or clear a fault; progress reports (most of the traffic) are left

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 import aws_cdk as cdk
 from aws_cdk import aws_logs as logs
 
+from announcer.config import events_url
 from infra.constructs.alexa_skill import AlexaSkill
 from infra.constructs.announcer import Announcer
 from infra.constructs.iot_endpoint import IotEndpoint
@@ -17,7 +18,6 @@ from infra.constructs.robot_policy import RobotPolicy
 from infra.constructs.skill_function import SkillFunction
 from infra.constructs.skill_function import skill_code as bundled_code
 from infra.constructs.weather_bot import WeatherBot
-from skill.announcer.config import events_url
 
 if TYPE_CHECKING:
     from aws_cdk import aws_lambda as lambda_
@@ -86,20 +86,22 @@ class VahrStack(cdk.Stack):
         self.data_endpoint = IotEndpoint(
             self, "DataEndpoint", endpoint_type="iot:Data-ATS", provider_logs=provider_logs
         )
+        # One bundle holds both functions' code roots (infra/lambda_asset.py): built once.
+        code = skill_code or bundled_code(config)
         self.skill_function = SkillFunction(
             self,
             "Skill",
             config=config,
             fleet=fleet,
             data_endpoint=self.data_endpoint.address,
-            code=skill_code,
+            code=code,
         )
         self.announcer = (
             Announcer(
                 self,
                 "Announcer",
                 config=config,
-                code=skill_code or bundled_code(config),
+                code=code,
                 events_url=events_url(config.alexa_region, config.announcer_stage),
             )
             if config.announcer

@@ -54,7 +54,7 @@ def test_the_function_runs_the_announcer_with_retries_and_a_dead_letter_queue(
     template: dict[str, Any],
 ) -> None:
     function = only(template, "AWS::Lambda::Function")
-    assert function["Handler"] == "skill.announcer.app.lambda_handler"
+    assert function["Handler"] == "announcer.app.lambda_handler"
     assert function["Runtime"] == "python3.12"
     [queue_id] = resources(template, "AWS::SQS::Queue")
     assert function["DeadLetterConfig"] == {"TargetArn": f"<{queue_id}.Arn>"}

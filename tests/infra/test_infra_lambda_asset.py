@@ -63,11 +63,14 @@ def run_in_lambda_python(bundle: Path, script: str, **env: str) -> subprocess.Co
     )  # fmt: skip
 
 
-def test_the_bundle_holds_the_skill_the_protocol_and_the_fleet(
+def test_the_bundle_holds_the_skill_the_announcer_the_protocol_and_the_fleet(
     bundle: lambda_asset.BuildResult,
 ) -> None:
     root = bundle.out_dir
     assert (root / "skill" / "app.py").is_file()
+    assert (root / "announcer" / "app.py").is_file()
+    assert not (root / "skill" / "announcer").exists()
+    assert (root / "vahr" / "announce" / "policy.py").is_file()
     assert (root / "vahr" / "protocol" / "topics.py").is_file()
     assert (root / "vahr" / "errors.py").is_file()
     fleet = root / "vahr" / "protocol" / "fleet.yaml"
@@ -111,6 +114,26 @@ def test_a_clean_python_3_12_imports_the_handler_from_the_bundle_alone(
     assert all(file.startswith(str(bundle.out_dir)) for file in seen["files"]), seen["files"]
     assert seen["fleet"] == str(bundle.out_dir / "vahr" / "protocol" / "fleet.yaml")
     assert seen["awscrt"] is False
+
+
+def test_the_announcer_loads_from_the_same_bundle_without_the_skills_sdk(
+    bundle: lambda_asset.BuildResult,
+) -> None:
+    # When a clean 3.12 imports the announcer's handler from the bundle
+    script = (
+        "import json, sys, announcer.app\n"
+        "print(json.dumps({'handler': callable(announcer.app.lambda_handler),"
+        " 'file': announcer.app.__file__,"
+        " 'loaded': sorted(m for m in ('skill', 'ask_sdk_core', 'ask_sdk_model', 'awscrt',"
+        " 'vahr.announce', 'vahr.protocol') if m in sys.modules)}))"
+    )
+    result = run_in_lambda_python(bundle.out_dir, script)
+    assert result.returncode == 0, result.stderr
+    seen = json.loads(result.stdout)
+    # Then it comes from the bundle, and its cold start pays for none of the skill's modules
+    assert seen["handler"] is True
+    assert seen["file"] == str(bundle.out_dir / "announcer" / "app.py")
+    assert seen["loaded"] == ["vahr.announce", "vahr.protocol"]
 
 
 class IotDataRecorder(BaseHTTPRequestHandler):

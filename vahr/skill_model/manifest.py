@@ -14,8 +14,9 @@ from vahr.protocol.assistant import INVOCATION_NAME
 from vahr.skill_model.intents import LOCALE
 
 SKILL_NAME = "VAHR Robot Fleet"
-# The announcer (skill.announcer) sends Alexa notifications of robots' troubles: the skill
-# asks for the notifications permission and declares the one event schema it publishes.
+# The announcer function (lambda/announcer) sends Alexa notifications of robots' troubles:
+# the skill asks for the notifications permission and declares the one event schema it
+# publishes.
 NOTIFICATIONS_PERMISSION = "alexa::devices:all:notifications:write"
 PUBLISHED_EVENTS = ("AMAZON.MessageAlert.Activated",)
 

@@ -12,7 +12,7 @@ import msgspec
 from botocore.config import Config
 from botocore.exceptions import BotoCoreError, ClientError
 
-from skill.announcer.errors import AnnouncerError, ConfigError, StateConflict
+from announcer.errors import AnnouncerError, ConfigError, StateConflict
 from vahr.announce import PolicyState
 
 CLIENT_CONFIG = Config(

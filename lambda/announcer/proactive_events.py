@@ -27,14 +27,14 @@ import urllib.request
 from datetime import timedelta
 from typing import TYPE_CHECKING, Any
 
-from skill.announcer.errors import DeliveryFailed
+from announcer.errors import DeliveryFailed
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from vahr.protocol.announcements import Announcement
 
-log = logging.getLogger("skill.announcer")
+log = logging.getLogger("announcer")
 
 SCOPE = "alexa::proactive_events"
 EVENT_NAME = "AMAZON.MessageAlert.Activated"

@@ -19,11 +19,11 @@ import boto3
 import pytest
 from moto import mock_aws
 
-from skill.announcer import app
-from skill.announcer.aws import SkillCredentials, StateStore
-from skill.announcer.config import AnnouncerConfig, events_url
-from skill.announcer.errors import AnnouncerError, ConfigError, DeliveryFailed
-from skill.announcer.proactive_events import ProactiveEvents
+from announcer import app
+from announcer.aws import SkillCredentials, StateStore
+from announcer.config import AnnouncerConfig, events_url
+from announcer.errors import AnnouncerError, ConfigError, DeliveryFailed
+from announcer.proactive_events import ProactiveEvents
 from vahr.announce.speech import Names
 
 if TYPE_CHECKING:

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from skill.announcer.errors import ConfigError
+from announcer.errors import ConfigError
 from vahr.announce import AnnounceSettings, settings_from
 from vahr.protocol import ProtocolError
 

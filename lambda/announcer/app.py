@@ -16,10 +16,10 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
-from skill.announcer.aws import SkillCredentials, StateStore
-from skill.announcer.config import AnnouncerConfig
-from skill.announcer.errors import AnnouncerError, DeliveryFailed, StateConflict
-from skill.announcer.proactive_events import ProactiveEvents
+from announcer.aws import SkillCredentials, StateStore
+from announcer.config import AnnouncerConfig
+from announcer.errors import AnnouncerError, DeliveryFailed, StateConflict
+from announcer.proactive_events import ProactiveEvents
 from vahr.announce import AnnouncePolicy, signals_from_event, signals_from_presence
 from vahr.announce.speech import Names
 from vahr.protocol import Event, Presence, load_fleet
@@ -27,7 +27,7 @@ from vahr.protocol import Event, Presence, load_fleet
 if TYPE_CHECKING:
     from vahr.announce import Signal
 
-log = logging.getLogger("skill.announcer")
+log = logging.getLogger("announcer")
 # How often a save that lost a race is tried again with the state read anew.
 SAVE_ATTEMPTS = 3
 
@@ -43,7 +43,7 @@ class Runtime(msgspec.Struct, frozen=True, kw_only=True, dict=True):
 def runtime() -> Runtime:
     """Built once per cold start: configuration, fleet names, adapters."""
     config = AnnouncerConfig.from_env()
-    logging.getLogger("skill").setLevel(config.log_level)
+    logging.getLogger("announcer").setLevel(config.log_level)
     return Runtime(
         config=config,
         names=Names.of(load_fleet()),
