@@ -43,7 +43,9 @@ class Runtime(msgspec.Struct, frozen=True, kw_only=True, dict=True):
 def runtime() -> Runtime:
     """Built once per cold start: configuration, fleet names, adapters."""
     config = AnnouncerConfig.from_env()
-    logging.getLogger("announcer").setLevel(config.log_level)
+    # The policy logs what it does not tell (cleared before its turn, dropped past its bound).
+    for name in ("announcer", "vahr.announce"):
+        logging.getLogger(name).setLevel(config.log_level)
     return Runtime(
         config=config,
         names=Names.of(load_fleet()),
@@ -108,5 +110,11 @@ def announce(message: dict[str, Any], rt: Runtime) -> dict[str, Any]:
             if attempt == SAVE_ATTEMPTS:
                 raise
             continue
-        return {"told": [a.id for a in told], "held": policy.state.held}
+        state = policy.state
+        return {
+            "told": [a.id for a in told],
+            "held": state.held,
+            "withdrawn": state.withdrawn,
+            "dropped": state.dropped,
+        }
     raise DeliveryFailed("unreachable")  # pragma: no cover

@@ -11,11 +11,14 @@ memory. The rules:
 - one fault, one announcement: a fault already open is not told again until it clears.
   `stuck` and `failed` clear when the robot takes a new command, stops, arrives or
   finishes; `offline` when it is back online; `waiting` when the task is dispatched;
-- per person, at most `max_per_window` announcements in any `window_s`; what the limit
-  holds back is told, highest priority first, as soon as the window allows (`tick`),
-  unless it cleared meanwhile; kinds below `urgent_priority` leave `reserve_for_urgent`
-  of the window free;
-- a finished task (`done`, off by default) is told only while it is news.
+- per person, at most `max_per_window` announcements in any `window_s`; kinds below
+  `urgent_priority` leave `reserve_for_urgent` of the window free;
+- nothing is lost silently: what the limit holds back is told later, highest priority
+  first, as soon as the window allows (`tick`), however long it waited. Only a fault that
+  clears before its turn is not told (a cleared fault is not news), and the log says so.
+  At most `max_held` wait at once; past that the last in line is dropped with a warning
+  in the log and counted in `PolicyState.dropped`;
+- a finished task (`done`, off by default) is told once, like a fault that never clears.
 
 There is no fleet task queue yet. `Queued` and `Dispatched` are the signals one will
 send (a task id, the robot it is for if any, when it was queued); `tick` tells the tasks
@@ -25,6 +28,7 @@ that waited too long.
 from __future__ import annotations
 
 import hashlib
+import logging
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import TYPE_CHECKING
@@ -40,6 +44,8 @@ if TYPE_CHECKING:
     from vahr.announce.settings import AnnounceSettings
     from vahr.announce.speech import Names
     from vahr.protocol import Event, Presence
+
+log = logging.getLogger(__name__)
 
 STUCK_PREFIX = "stuck:"
 # Events after which a robot that was stuck or failed is no longer so.
@@ -139,6 +145,15 @@ class Fault(msgspec.Struct, kw_only=True):
     reason: str | None = None
     zone: str | None = None
     told: bool = False
+    # The rate limit held it back at least once (counted once in `PolicyState.held`).
+    held: bool = False
+    # Dropped from a line longer than `max_held`: never told, but still open, so the same
+    # fault again is not told either until it clears.
+    dropped: bool = False
+
+    @property
+    def pending(self) -> bool:
+        return not self.told and not self.dropped
 
 
 class QueuedTask(msgspec.Struct, kw_only=True):
@@ -153,8 +168,11 @@ class PolicyState(msgspec.Struct, kw_only=True):
     queued: list[QueuedTask] = msgspec.field(default_factory=list)
     # person -> the times (epoch seconds) they were told something within the window.
     told: dict[str, list[float]] = msgspec.field(default_factory=dict)
-    # How many announcements were held back by the rate limit, and dropped as stale.
+    # How many announcements the rate limit held back (each counted once), how many of
+    # those cleared before their turn (not news any more), and how many were dropped
+    # because more than `max_held` waited at once.
     held: int = 0
+    withdrawn: int = 0
     dropped: int = 0
 
 
@@ -199,11 +217,9 @@ class AnnouncePolicy:
         if isinstance(signal, Opened):
             self._open(signal, opened_at=signal.at.timestamp())
         elif isinstance(signal, Cleared):
-            self.state.faults = [
-                f
-                for f in self.state.faults
-                if not (f.thing == signal.thing and f.kind in signal.kinds and f.kind != "waiting")
-            ]
+            self._clear(
+                lambda f: f.thing == signal.thing and f.kind in signal.kinds and f.kind != "waiting"
+            )
         elif isinstance(signal, Finished):
             if "done" in self.settings.kinds:
                 self.state.finished.append(
@@ -225,11 +241,24 @@ class AnnouncePolicy:
                 )
         else:  # Dispatched
             self.state.queued = [t for t in self.state.queued if t.task != signal.task]
-            self.state.faults = [
-                f
-                for f in self.state.faults
-                if not (f.kind == "waiting" and f.subject == signal.task)
-            ]
+            self._clear(lambda f: f.kind == "waiting" and f.subject == signal.task)
+
+    def _clear(self, over: Callable[[Fault], bool]) -> None:
+        """Forget the faults that are `over`; one not yet told is not news any more."""
+        kept: list[Fault] = []
+        for fault in self.state.faults:
+            if not over(fault):
+                kept.append(fault)
+            elif fault.pending:
+                if fault.held:
+                    self.state.withdrawn += 1
+                log.info(
+                    "not announcing %s %s: it cleared before it was told (%s)",
+                    fault.subject,
+                    fault.kind,
+                    "held back by the rate limit" if fault.held else "still within its grace",
+                )
+        self.state.faults = kept
 
     def _open(self, signal: Opened, *, opened_at: float) -> None:
         if signal.kind not in self.settings.kinds:
@@ -255,17 +284,17 @@ class AnnouncePolicy:
 
     # -- deciding ------------------------------------------------------------------------
 
+    def _in_line(self, faults: Iterable[Fault]) -> list[Fault]:
+        """Most urgent first, then the oldest: the order in which they are told."""
+        return sorted(
+            faults, key=lambda f: (-self.settings.priority(f.kind), f.opened_at, f.subject)
+        )
+
     def _due(self, now: datetime) -> list[Announcement]:
         settings, seconds = self.settings, now.timestamp()
-        fresh = [f for f in self.state.finished if seconds - f.seen_at <= settings.done_max_age_s]
-        self.state.dropped += len(self.state.finished) - len(fresh)
-        self.state.finished = fresh
-        waiting = [f for f in self.state.faults if not f.told and self._ripe(f, seconds)]
-        candidates = sorted(
-            waiting + fresh, key=lambda f: (-settings.priority(f.kind), f.opened_at, f.subject)
-        )
+        waiting = [f for f in self.state.faults if f.pending and self._ripe(f, seconds)]
         announcements: list[Announcement] = []
-        for fault in candidates:
+        for fault in self._in_line(waiting + self.state.finished):
             person = settings.person_for(fault.thing)
             told = [t for t in self.state.told.get(person, []) if seconds - t < settings.window_s]
             self.state.told[person] = told
@@ -273,7 +302,9 @@ class AnnouncePolicy:
             if settings.priority(fault.kind) < settings.urgent_priority:
                 limit -= settings.reserve_for_urgent
             if len(told) >= limit:
-                self.state.held += 1
+                if not fault.held:
+                    fault.held = True
+                    self.state.held += 1
                 continue
             told.append(seconds)
             if fault.kind == "done":
@@ -283,7 +314,28 @@ class AnnouncePolicy:
             announcements.append(self._announcement(fault, now, person))
         # Forget the send times of people told nothing within the window.
         self.state.told = {p: times for p, times in self.state.told.items() if times}
+        self._bound_the_line()
         return announcements
+
+    def _bound_the_line(self) -> None:
+        """Keep at most `max_held` waiting to be told: drop the last in line, loudly."""
+        untold = [f for f in self.state.faults if f.pending] + self.state.finished
+        excess = len(untold) - self.settings.max_held
+        if excess <= 0:
+            return
+        for fault in self._in_line(untold)[-excess:]:
+            if fault.kind == "done":
+                self.state.finished.remove(fault)
+            else:
+                fault.dropped = True
+            self.state.dropped += 1
+            log.warning(
+                "dropped the announcement of %s %s (opened at %s): more than %d were waiting",
+                fault.subject,
+                fault.kind,
+                datetime.fromtimestamp(fault.opened_at, UTC).isoformat(),
+                self.settings.max_held,
+            )
 
     def _ripe(self, fault: Fault, seconds: float) -> bool:
         if fault.kind == "offline":

@@ -54,8 +54,10 @@ class AnnounceSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown
     offline_grace_s: Seconds = 0.0
     # A queued task that has waited longer than this is worth telling.
     queue_wait_s: PositiveSeconds = 300.0
-    # A finished task held back by the rate limit longer than this is no news any more.
-    done_max_age_s: PositiveSeconds = 120.0
+    # What the rate limit holds back is told later, never dropped for its age. To keep the
+    # memory (and the cloud's one state item) bounded, at most this many wait at once; past
+    # it the last in line (lowest priority, newest) is dropped, logged and counted.
+    max_held: Annotated[int, msgspec.Meta(ge=1, le=5000)] = 500
     # thing -> person; robots not named go to `default_person`.
     audience: dict[str, Person] = msgspec.field(default_factory=dict)
     default_person: Person = EVERYONE

@@ -2,7 +2,8 @@
 
 `Announcer` knows no transport: robot event and presence payloads go in (`on_event`,
 `on_presence`), the policy (`vahr.announce`) decides, and each announcement is kept in a
-bounded history (`GET /vahr/announcements`, newest last), published on
+bounded history (`GET /vahr/announcements`, newest last, with how many the rate limit held
+back, how many of those cleared before their turn and how many were dropped), published on
 `vahr/assistant/announcements` and handed to every listener (`add_listener`: the operator
 station's server side subscribes here). A tick thread tells what the rate limit held back
 as soon as it may. `LocalAnnouncer` connects it to the broker with the service identity.
@@ -108,9 +109,19 @@ class Announcer:
         self._tell(told)
         return told
 
+    def counts(self) -> dict[str, int]:
+        """Announcements held back by the rate limit, withdrawn (cleared before their turn)
+        and dropped (more than `max_held` waiting), since the start."""
+        with self._lock:
+            state = self._policy.state
+            return {"held": state.held, "withdrawn": state.withdrawn, "dropped": state.dropped}
+
     def route(self, request: dict[str, Any]) -> tuple[int, dict[str, Any]]:
-        """`GET /vahr/announcements`: the history, newest last."""
-        return 200, {"announcements": [announcement_json(a) for a in self.history()]}
+        """`GET /vahr/announcements`: the history, newest last, and the counts."""
+        return 200, {
+            "announcements": [announcement_json(a) for a in self.history()],
+            **self.counts(),
+        }
 
     def _tell(self, told: list[Announcement]) -> None:
         if not told:

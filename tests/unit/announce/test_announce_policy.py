@@ -4,6 +4,7 @@ most urgent first, on an injected clock."""
 from __future__ import annotations
 
 import json
+import logging
 from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 from typing import TYPE_CHECKING
@@ -156,7 +157,10 @@ def test_routine_news_leaves_room_for_urgent_news(fleet: Fleet) -> None:
     assert [a.kind for a in robot_event(p, "robot_event_stuck")] == ["stuck"]
 
 
-def test_a_held_fault_that_clears_before_its_turn_is_not_told(fleet: Fleet) -> None:
+def test_a_held_fault_that_clears_before_its_turn_is_not_told_and_the_log_says_so(
+    fleet: Fleet, caplog: pytest.LogCaptureFixture
+) -> None:
+    caplog.set_level(logging.INFO, logger="vahr.announce")
     clock = Clock()
     p = policy(fleet, clock, max_per_window=1, reserve_for_urgent=0)
     robot_event(p, "robot_event_failed")
@@ -164,6 +168,112 @@ def test_a_held_fault_that_clears_before_its_turn_is_not_told(fleet: Fleet) -> N
     robot_event(p, "robot_event_accepted")  # the person sent placebot1 a new command
     clock.advance(61)
     assert p.tick() == []
+    # Then it is counted as withdrawn, not dropped, and the log tells why it was not told
+    assert (p.state.held, p.state.withdrawn, p.state.dropped) == (1, 1, 0)
+    assert (
+        "not announcing placebot1 stuck: it cleared before it was told (held back by the rate limit)"
+        in caplog.text
+    )
+
+
+def test_what_the_rate_limit_holds_back_is_told_however_long_it_waited(fleet: Fleet) -> None:
+    # Given one announcement a minute, taken by a stuck robot, and a finished task behind it
+    clock = Clock()
+    p = policy(fleet, clock, max_per_window=1, reserve_for_urgent=0, kinds=["stuck", "done"])
+    assert [a.kind for a in robot_event(p, "robot_event_stuck")] == ["stuck"]
+    assert robot_event(p, "robot_event_done") == []
+    # When nothing else happens for ten minutes and the announcer only ticks
+    told: list[Announcement] = []
+    for _ in range(40):
+        clock.advance(15)
+        told += p.tick()
+    # Then the finished task was told once, as soon as the window allowed, and nothing was
+    # dropped; holding it back was counted once, not once a tick
+    assert [(a.kind, a.time - T0) for a in told] == [("done", timedelta(seconds=60))]
+    assert (p.state.held, p.state.dropped) == (1, 0)
+    assert p.state.finished == []
+
+
+def test_a_held_finished_task_is_told_at_the_first_chance_even_if_old(fleet: Fleet) -> None:
+    clock = Clock()
+    p = policy(fleet, clock, max_per_window=1, reserve_for_urgent=0, kinds=["stuck", "done"])
+    robot_event(p, "robot_event_stuck")
+    robot_event(p, "robot_event_done", at=T0.isoformat())
+    clock.advance(59)
+    assert p.tick() == []
+    # When the announcer next looks five minutes after it finished (no tick in between)
+    clock.advance(241)
+    # Then it is still told: an old announcement is late, not lost
+    [late] = p.tick()
+    assert late.speech == "Placebot two has finished its task at zone c."
+    assert late.time - late.opened_at == timedelta(minutes=5)
+
+
+def test_held_announcements_are_told_most_urgent_first_then_oldest_first(fleet: Fleet) -> None:
+    # Given a full window and, held behind it, a finished task, a failed task and a stuck robot
+    clock = Clock()
+    p = policy(fleet, clock, max_per_window=1, reserve_for_urgent=0,
+               kinds=["stuck", "failed", "offline", "done"])  # fmt: skip
+    presence(p, "placebot1", "robot_presence_offline")
+    robot_event(p, "robot_event_done", at=(T0 + timedelta(seconds=1)).isoformat())
+    robot_event(p, "robot_event_failed", at=(T0 + timedelta(seconds=2)).isoformat())
+    robot_event(p, "robot_event_stuck", at=(T0 + timedelta(seconds=3)).isoformat())
+    # Then one a minute is told: stuck, failed, then done
+    told = []
+    for _ in range(3):
+        clock.advance(60)
+        told += [a.kind for a in p.tick()]
+    assert told == ["stuck", "failed", "done"]
+
+
+def test_past_max_held_the_last_in_line_is_dropped_logged_and_counted(
+    fleet: Fleet, caplog: pytest.LogCaptureFixture
+) -> None:
+    # Given room for two waiting announcements, and a full window
+    clock = Clock()
+    p = policy(fleet, clock, max_per_window=1, reserve_for_urgent=0, max_held=2,
+               kinds=["stuck", "failed", "done"])  # fmt: skip
+    robot_event(p, "robot_event_stuck")
+    # When three finished tasks wait behind it
+    for second in (1, 2, 3):
+        robot_event(p, "robot_event_done", at=(T0 + timedelta(seconds=second)).isoformat())
+    # Then the newest, last in line, is dropped with a warning naming it, and counted
+    assert p.state.dropped == 1
+    [warning] = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert warning == (
+        "dropped the announcement of placebot2 done (opened at 2026-11-22T10:15:06.120000+00:00): "
+        "more than 2 were waiting"
+    )
+    # And the two kept are told, oldest first, as the window allows
+    clock.advance(60)
+    [first] = p.tick()
+    clock.advance(60)
+    [second] = p.tick()
+    assert [first.opened_at, second.opened_at] == [
+        T0 + timedelta(seconds=1),
+        T0 + timedelta(seconds=2),
+    ]
+
+
+def test_a_dropped_fault_stays_open_so_its_repeat_is_not_told_until_it_clears(
+    fleet: Fleet,
+) -> None:
+    # Given room for one waiting announcement behind a full window
+    clock = Clock()
+    p = policy(fleet, clock, max_per_window=1, reserve_for_urgent=0, max_held=1)
+    presence(p, "placebot1", "robot_presence_offline")  # told
+    robot_event(p, "robot_event_stuck")  # held
+    robot_event(p, "robot_event_failed")  # held, then dropped: failed is less urgent
+    assert p.state.dropped == 1
+    # When placebot2's failure arrives again (a redelivery) it is the same fault
+    clock.advance(60)
+    assert [a.kind for a in p.tick()] == ["stuck"]
+    clock.advance(60)
+    assert robot_event(p, "robot_event_failed") == []
+    # And once placebot2 takes a new command and fails again, that is told
+    robot_event(p, "robot_event_accepted", thing="placebot2")
+    again = robot_event(p, "robot_event_failed", at=clock.now.isoformat())
+    assert [a.kind for a in again] == ["failed"]
 
 
 def test_the_rate_limit_is_per_person(fleet: Fleet) -> None:
@@ -176,16 +286,10 @@ def test_the_rate_limit_is_per_person(fleet: Fleet) -> None:
     assert [(a.thing, a.person) for a in told] == [("placebot1", alice), ("placebot2", bob)]
 
 
-def test_done_is_off_by_default_and_stale_done_is_dropped(fleet: Fleet) -> None:
-    clock = Clock()
-    assert robot_event(policy(fleet, clock), "robot_event_done") == []
-    p = policy(fleet, clock, max_per_window=1, reserve_for_urgent=0, done_max_age_s=30,
-               kinds=["stuck", "done"])  # fmt: skip
-    robot_event(p, "robot_event_stuck")
-    robot_event(p, "robot_event_done")  # held behind the stuck robot
-    clock.advance(61)
-    assert p.tick() == []
-    assert p.state.dropped == 1
+def test_done_is_off_by_default(fleet: Fleet) -> None:
+    p = policy(fleet, Clock())
+    assert robot_event(p, "robot_event_done") == []
+    assert p.state.finished == []
 
 
 def test_a_queued_task_waiting_too_long_is_told_once_until_dispatched(fleet: Fleet) -> None:
@@ -232,6 +336,7 @@ def test_the_same_fault_keeps_the_same_id_so_a_retry_is_a_duplicate(fleet: Fleet
         ({"reserve_for_urgent": 4}, "reserve_for_urgent: 4 must be less than max_per_window"),
         ({"kinds": ["late"]}, "kinds.0: invalid enum value 'late'"),
         ({"windows": 3}, "windows: is not a known field"),
+        ({"max_held": 0}, "max_held: expected `int` >= 1"),
         ({"audience": {"placebot1": "bob"}}, "audience"),
     ],
 )

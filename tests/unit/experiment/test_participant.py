@@ -6,15 +6,24 @@ import io
 import os
 import threading
 import time
+from datetime import UTC, datetime
 from typing import TYPE_CHECKING, Any
 
 import pytest
 
+from vahr.announce import AnnouncePolicy, Finished, Opened, settings_from
+from vahr.announce.speech import Names
 from vahr.errors import VahrError
+from vahr.experiment import participant as participant_module
 from vahr.experiment import timing
 from vahr.experiment.eventlog import EventLog, Kind
 from vahr.experiment.observer import ObserverConsole
-from vahr.experiment.participant import Console, SimulatedParticipant
+from vahr.experiment.participant import (
+    ANNOUNCE_SETTINGS,
+    HEAR_TEXT,
+    Console,
+    SimulatedParticipant,
+)
 from vahr.experiment.procedures import procedure_for
 from vahr.experiment.tasks import draw_plan
 from vahr.protocol import decode_command
@@ -204,6 +213,103 @@ def test_the_keyboard_participant_asks_the_weather_per_robot_and_clicks_navigati
     assert len(clicks) == 4 and all(c.data["clicks"] == 2 for c in clicks)
     questions = [e for e in entries if e.kind == Kind.INTERACTION_ENDED and e.data.get("asks")]
     assert [q.data["asks"] for q in questions] == ["placebot1", "placebot2"]
+
+
+def finished(log: EventLog, thing: str, zone: str) -> None:
+    """A robot's navigation ends as it does on the wire: arrived, loaded, done."""
+    at = datetime.now(UTC).isoformat()
+    for event in ("arrived", "loaded", "done"):
+        robot_event(log, thing, event, zone=zone, at=at, command_id=f"{thing}-{zone}",
+                    action="navigate")  # fmt: skip
+
+
+def announce_participant(
+    fleet: Fleet, log: EventLog, sent: list[tuple[str, bytes]]
+) -> SimulatedParticipant:
+    """A keyboard participant who never looks and acts on the assistant's announcements."""
+    return SimulatedParticipant(
+        method="keyboard",
+        fleet=fleet,
+        plan=draw_plan(fleet, 3),
+        log=log,
+        person=timing.Person(monitoring="announce"),
+        seed=3,
+        speed_factor=SPEED,
+        assistant=ScriptedAssistant(),
+        console=Console(lambda topic, payload: sent.append((topic, payload))),
+    )
+
+
+def test_the_announce_participant_never_looks_and_acts_on_each_finished_task(
+    fleet: Fleet, tmp_path: Path
+) -> None:
+    # Given a keyboard participant in task I who monitors by announcements
+    sent: list[tuple[str, bytes]] = []
+    with EventLog.open(tmp_path / "log.sqlite") as log:
+        log.append(Kind.TASK_STARTED, {"task": "I"}, task="I")
+        participant = announce_participant(fleet, log, sent)
+        participant.perform("I")
+        assert len(sent) == 2  # both robots sent to LOADING
+        # When both robots are loaded and finish at the same moment
+        for thing in fleet.robot_things:
+            finished(log, thing, "LOADING")
+        decided = participant.wait(lambda: len(sent) == 4, timeout_s=600)
+        entries = log.entries()
+    # Then it heard one announcement per finished task and sent each robot on after its own,
+    # without a single look at the screen
+    assert decided
+    heard = [e for e in entries if e.kind == Kind.INTERACTION_ENDED and e.data["text"] == HEAR_TEXT]
+    assert [h.data["speech"] for h in heard] == [
+        "Placebot one has finished its task at loading zone.",
+        "Placebot two has finished its task at loading zone.",
+    ]
+    assert [h.data["seen"] for h in heard] == [["placebot1 was loaded"], ["placebot2 was loaded"]]
+    assert all(h.data["counts"] is False for h in heard)
+    assert not [
+        e for e in entries if e.kind == Kind.INTERACTION_ENDED and e.data["channel"] == "watch"
+    ]
+    clicks = [
+        e for e in entries if e.kind == Kind.INTERACTION_STARTED and e.data["channel"] == "click"
+    ]
+    assert clicks[2].seq > heard[0].seq and clicks[3].seq > heard[1].seq
+
+
+def test_the_rehearsals_settings_never_hold_back_the_finished_tasks_of_two_tasks(
+    fleet: Fleet,
+) -> None:
+    # Given the announcer as the announce rehearsal sets it up, and the most finished tasks
+    # two of the paper's tasks bring (four each) in the same minute
+    now = datetime(2026, 11, 22, 10, 0, tzinfo=UTC)
+    policy = AnnouncePolicy(settings_from(ANNOUNCE_SETTINGS), Names.of(fleet), lambda: now)
+    signals = [Finished(thing, now, zone="A") for thing in fleet.robot_things * 4]
+    # Then every one is told at once, and a stuck robot still gets through after them
+    assert len(policy.observe(signals)) == 8
+    stuck = Opened("placebot1", "stuck", now, reason="no progress towards B for 10 s")
+    assert [a.kind for a in policy.observe([stuck])] == ["stuck"]
+    assert policy.state.held == 0
+
+
+def test_a_held_announcement_reaches_the_participant_without_another_robot_event(
+    fleet: Fleet, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Given an announcer that may tell one thing a minute (study time)
+    monkeypatch.setattr(participant_module, "ANNOUNCE_SETTINGS", {
+        "kinds": ["done"], "max_per_window": 1, "reserve_for_urgent": 0, "window_s": 60.0,
+    })  # fmt: skip
+    sent: list[tuple[str, bytes]] = []
+    with EventLog.open(tmp_path / "log.sqlite") as log:
+        log.append(Kind.TASK_STARTED, {"task": "I"}, task="I")
+        participant = announce_participant(fleet, log, sent)
+        participant.perform("I")
+        # When both robots finish at once and then nothing else happens
+        for thing in fleet.robot_things:
+            finished(log, thing, "LOADING")
+        started = time.monotonic()
+        decided = participant.wait(lambda: len(sent) == 4, timeout_s=600)
+        waited_study_s = (time.monotonic() - started) * SPEED
+    # Then the second is told once the minute is over, and the participant acts on it
+    assert decided
+    assert 60 <= waited_study_s < 120
 
 
 def test_the_observer_marks_utterances_watching_clicks_and_puzzle_pieces(tmp_path: Path) -> None:
