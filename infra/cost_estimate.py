@@ -180,6 +180,29 @@ def announcement_cost(prices: Prices, usage: AnnouncerUsage = AnnouncerUsage()) 
     return usage.invocations_per_announcement * per_invocation
 
 
+@dataclass(frozen=True)
+class AnnouncerTicks:
+    """The schedule that wakes the announcer once a minute: each tick reads the state item
+    and, with nothing held back, writes nothing. EventBridge does not charge for the
+    scheduled events of its rules."""
+
+    per_month: int = 60 * 24 * 30  # once a minute for 30 days
+    function_seconds: float = 0.05  # warm: one DynamoDB read
+    memory_gb: float = 0.25
+    log_bytes: int = 200  # the runtime's start, end and report lines
+
+
+def announcer_ticks_cost(prices: Prices, ticks: AnnouncerTicks = AnnouncerTicks()) -> float:
+    """USD a month for the announcer's schedule alone (announcements cost on top)."""
+    per_tick = (
+        prices.lambda_request
+        + ticks.function_seconds * ticks.memory_gb * prices.lambda_gb_second
+        + prices.dynamodb_read
+        + ticks.log_bytes / 1e9 * prices.log_ingestion_gb
+    )
+    return ticks.per_month * per_tick
+
+
 # -- cost of measured operations (bench/billable_operations.py) ---------------------------
 
 

@@ -2,7 +2,8 @@
 
 A Lambda function of its own beside the skill (`lambda/announcer`, imported as `announcer`,
 handler `announcer.app.lambda_handler`), shipped in the skill's bundle. An IoT topic rule
-sends the robots' events and presence to it; the announcement policy (`vahr.announce`)
+sends the robots' events and presence to it, and an EventBridge schedule wakes it once a
+minute to tell what the rate limit held back; the announcement policy (`vahr.announce`)
 decides what is worth telling, with its state kept in DynamoDB between invocations; each
 announcement becomes an Alexa Proactive Events API `AMAZON.MessageAlert.Activated` event
 (`proactive_events`), sent with a token got with the skill's client credentials from

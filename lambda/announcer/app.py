@@ -3,8 +3,11 @@ Alexa notifications out. Thin: parse, run `announce`, report.
 
 The rule's SQL (infra/constructs/announcer.py) gives each event as the robot sent it plus
 `sender` (the thing named by the topic), and each presence as `{"online", "at",
-"sender"}`. A malformed message is logged and skipped (retrying cannot mend it); a failure
-to deliver raises `AnnouncerError`, so Lambda retries the event and then dead-letters it.
+"sender"}`. An EventBridge schedule also invokes it once a minute (`"source":
+"aws.events"`): nothing happened, but time passed, so what the rate limit held back is told
+without waiting for the next robot event. A malformed message is logged and skipped
+(retrying cannot mend it); a failure to deliver raises `AnnouncerError`, so Lambda retries
+the event and then dead-letters it. The state is written only when it changed.
 """
 
 from __future__ import annotations
@@ -30,6 +33,8 @@ if TYPE_CHECKING:
 log = logging.getLogger("announcer")
 # How often a save that lost a race is tried again with the state read anew.
 SAVE_ATTEMPTS = 3
+# An EventBridge scheduled event's source and detail type.
+SCHEDULE = ("aws.events", "Scheduled Event")
 
 
 class Runtime(msgspec.Struct, frozen=True, kw_only=True, dict=True):
@@ -69,8 +74,16 @@ def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
         raise AnnouncerError(f"announcer failed: {type(err).__name__}: {err}") from err
 
 
+def is_tick(message: dict[str, Any]) -> bool:
+    """The once-a-minute schedule: no robot said anything, but time passed."""
+    return (message.get("source"), message.get("detail-type")) == SCHEDULE
+
+
 def signals_of(message: dict[str, Any]) -> list[Signal]:
-    """What the rule delivered, as the policy's signals; [] for what is not understood."""
+    """What the rule delivered, as the policy's signals; [] for a tick and for what is not
+    understood."""
+    if is_tick(message):
+        return []
     sender = message.get("sender")
     try:
         if "online" in message:
@@ -96,6 +109,7 @@ def announce(message: dict[str, Any], rt: Runtime) -> dict[str, Any]:
     signals = signals_of(message)
     for attempt in range(1, SAVE_ATTEMPTS + 1):
         state, version = rt.store.load()
+        before = msgspec.json.encode(state)
         policy = AnnouncePolicy(rt.config.settings, rt.names, lambda: datetime.now(UTC), state)
         told = policy.observe(signals)
         for announcement in told:
@@ -105,7 +119,9 @@ def announce(message: dict[str, Any], rt: Runtime) -> dict[str, Any]:
             )
             log.info("announced %s (%s): %s", announcement.id, outcome, announcement.speech)
         try:
-            rt.store.save(policy.state, version)
+            # Most ticks find nothing to tell: they cost a read, not a write.
+            if msgspec.json.encode(policy.state) != before:
+                rt.store.save(policy.state, version)
         except StateConflict:
             if attempt == SAVE_ATTEMPTS:
                 raise

@@ -82,10 +82,29 @@ def test_the_function_may_read_one_secret_and_its_state_only(template: dict[str,
         ("Allow", "logs:CreateLogStream", f"<{group_id}.Arn>"),
         ("Allow", "logs:PutLogEvents", f"<{group_id}.Arn>"),
     }  # fmt: skip
-    # And IoT may invoke it only from its own rules
+    # And IoT may invoke it only from its own rules, EventBridge only from its schedule
+    rules = resources(template, "AWS::IoT::TopicRule")
+    [schedule_id] = resources(template, "AWS::Events::Rule")
     permissions = resources(template, "AWS::Lambda::Permission").values()
-    assert {p["Principal"] for p in permissions} == {"iot.amazonaws.com"}
-    assert all(p["SourceArn"].endswith(".Arn>") for p in permissions)
+    assert sorted((p["Principal"], p["SourceArn"]) for p in permissions) == sorted(
+        [("iot.amazonaws.com", f"<{rule_id}.Arn>") for rule_id in rules]
+        + [("events.amazonaws.com", f"<{schedule_id}.Arn>")]
+    )
+
+
+def test_a_schedule_wakes_the_function_once_a_minute_and_never_piles_up(
+    template: dict[str, Any],
+) -> None:
+    # Given the announcer's EventBridge rule
+    schedule = only(template, "AWS::Events::Rule")
+    [function_id] = resources(template, "AWS::Lambda::Function")
+    # Then it runs once a minute and invokes the announcer function only
+    assert schedule["ScheduleExpression"] == "rate(1 minute)"
+    assert schedule["State"] == "ENABLED"
+    [target] = schedule["Targets"]
+    assert target["Arn"] == f"<{function_id}.Arn>"
+    # and a tick it could not deliver is dropped, not retried: the next one does its work
+    assert target["RetryPolicy"] == {"MaximumRetryAttempts": 0, "MaximumEventAgeInSeconds": 60}
 
 
 def test_the_app_with_the_announcer_passes_cdk_nag(tmp_path: Path) -> None:

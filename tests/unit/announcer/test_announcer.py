@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import re
 import threading
+import time
 from datetime import datetime, timedelta
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
@@ -18,12 +19,14 @@ from urllib.parse import parse_qs
 import boto3
 import pytest
 from moto import mock_aws
+from msgspec.structs import replace
 
 from announcer import app
 from announcer.aws import SkillCredentials, StateStore
 from announcer.config import AnnouncerConfig, events_url
 from announcer.errors import AnnouncerError, ConfigError, DeliveryFailed
 from announcer.proactive_events import ProactiveEvents
+from vahr.announce import settings_from
 from vahr.announce.speech import Names
 
 if TYPE_CHECKING:
@@ -293,6 +296,37 @@ def test_a_redelivered_event_after_a_lost_answer_is_a_duplicate_not_a_second_ale
     alexa.script = [(409, {"message": "duplicate referenceId"}, {})]
     told = app.announce(load_event("iot_rule_robot_stuck"), runtime)
     assert len(told["told"]) == 1 and alexa.events == []
+
+
+def test_a_scheduled_tick_tells_what_the_rate_limit_held_back(
+    runtime: app.Runtime, alexa: AlexaStandIn, caplog: pytest.LogCaptureFixture
+) -> None:
+    # Given an announcer that may tell one thing in any half second
+    settings = settings_from({"max_per_window": 1, "reserve_for_urgent": 0, "window_s": 0.5})
+    rt = replace(runtime, config=replace(runtime.config, settings=settings))
+    # When a robot gets stuck and the other goes offline at once
+    first = app.announce(load_event("iot_rule_robot_stuck"), rt)
+    held = app.announce(load_event("iot_rule_presence_offline"), rt)
+    assert len(first["told"]) == 1 and held["told"] == [] and held["held"] == 1
+    # and no robot says anything more until the schedule's tick, after the window
+    time.sleep(0.6)
+    ticked = app.announce(load_event("eventbridge_schedule"), rt)
+    # Then the tick tells what was held back, and takes the schedule for no robot's message
+    assert len(ticked["told"]) == 1 and ticked["dropped"] == 0
+    assert [e["event"]["payload"]["messageGroup"]["creator"]["name"] for e in alexa.events] == [
+        "placebot one", "placebot two",
+    ]  # fmt: skip
+    assert "malformed" not in caplog.text
+
+
+def test_a_tick_with_nothing_to_tell_writes_nothing(
+    runtime: app.Runtime, alexa: AlexaStandIn
+) -> None:
+    app.announce(load_event("iot_rule_robot_stuck"), runtime)
+    _, version = runtime.store.load()
+    assert app.announce(load_event("eventbridge_schedule"), runtime)["told"] == []
+    assert runtime.store.load()[1] == version
+    assert len(alexa.events) == 1
 
 
 def test_malformed_or_spoofed_messages_are_skipped(
