@@ -154,7 +154,8 @@ def estimate(usage: LabUsage, prices: Prices, *, lex: bool, skill: bool) -> list
 class AnnouncerUsage:
     """One announcer invocation: the rule fires on a fault-related event (never on progress),
     the function reads and writes its state item (under 1 KB) and, on a cold start, reads
-    its secret. Alexa's Proactive Events API itself is free."""
+    its secret; each announcement is also published for the operator station. Alexa's
+    Proactive Events API itself is free."""
 
     function_seconds: float = 0.3  # token cached; one HTTPS request to Alexa
     memory_gb: float = 0.25
@@ -163,6 +164,9 @@ class AnnouncerUsage:
     # Events the rule passes per announcement: the fault itself, the failed that ends a
     # stuck task, and the accepted/arrived/done that clear it, all invoking the function.
     invocations_per_announcement: float = 4.0
+    # The announcement on vahr/assistant/announcements: its publish and one operator
+    # station's delivery, each metered as a message.
+    topic_messages: float = 2.0
 
 
 def announcement_cost(prices: Prices, usage: AnnouncerUsage = AnnouncerUsage()) -> float:
@@ -177,7 +181,9 @@ def announcement_cost(prices: Prices, usage: AnnouncerUsage = AnnouncerUsage()) 
         + usage.log_bytes / 1e9 * prices.log_ingestion_gb
         + usage.cold_start_share * prices.secret_api_call
     )
-    return usage.invocations_per_announcement * per_invocation
+    return (
+        usage.invocations_per_announcement * per_invocation + usage.topic_messages * prices.message
+    )
 
 
 @dataclass(frozen=True)

@@ -6,9 +6,13 @@ announcement policy finds worth telling.
 An EventBridge schedule invokes it once a minute as well, so what the policy's rate limit
 held back is told within a minute of its turn even when no robot says anything more.
 
+Each announcement Alexa accepted is also published on `vahr/assistant/announcements`, so an
+operator station on AWS hears it as it does on the local stack.
+
 Least privilege: the function may read one secret (the skill's Alexa Skill Messaging
 client id and secret, created by you, never in the template), read and write its one
-state table, write its own logs and send to its dead-letter queue. IoT may invoke it only
+state table, publish on the one announcements topic, write its own logs and send to its
+dead-letter queue. IoT may invoke it only
 from these two rules, EventBridge only from its schedule. A message the rule cannot
 deliver (the function throttled or missing) and an event the function failed on after
 Lambda's two retries both land in the same encrypted queue, kept 14 days: nothing is lost
@@ -72,7 +76,10 @@ class Announcer(Construct):
         config: InfraConfig,
         code: lambda_.Code,
         events_url: str,
+        data_endpoint: str,
     ) -> None:
+        """`data_endpoint` is the account's iot:Data-ATS host, where announcements are
+        published for the operator station."""
         super().__init__(scope, construct_id)
         stack = cdk.Stack.of(self)
         self.table = dynamodb.Table(
@@ -102,7 +109,9 @@ class Announcer(Construct):
             self,
             "Role",
             assumed_by=iam.ServicePrincipal("lambda.amazonaws.com"),
-            description="VAHR announcer: its secret, its state, its logs, its dead letters",
+            description=(
+                "VAHR announcer: its secret, its state, its topic, its logs, its dead letters"
+            ),
         )
         # `from_secret_name_v2` ends the ARN in `-??????`, Secrets Manager's random suffix.
         self.secret_arn = stack.format_arn(
@@ -123,6 +132,14 @@ class Announcer(Construct):
                 sid="KeepPolicyState",
                 actions=["dynamodb:GetItem", "dynamodb:PutItem"],
                 resources=[self.table.table_arn],
+            )
+        )
+        self.topic_arn = stack.format_arn(
+            service="iot", resource="topic", resource_name=topics.ASSISTANT_ANNOUNCEMENTS
+        )
+        self.role.add_to_policy(
+            iam.PolicyStatement(
+                sid="PublishAnnouncements", actions=["iot:Publish"], resources=[self.topic_arn]
             )
         )
         self.function = lambda_.Function(
@@ -148,6 +165,7 @@ class Announcer(Construct):
                 "VAHR_ANNOUNCER_SECRET": config.announcer_secret_name,
                 "VAHR_ANNOUNCER_TABLE": self.table.table_name,
                 "VAHR_PROACTIVE_EVENTS_URL": events_url,
+                "VAHR_IOT_DATA_ENDPOINT": f"https://{data_endpoint}",
                 "VAHR_ANNOUNCE_SETTINGS": config.announce_settings,
                 "VAHR_LOG_LEVEL": config.log_level,
             },

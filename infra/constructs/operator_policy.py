@@ -5,9 +5,11 @@ They connect with certificates of their own (not a robot's), under client ids st
 `vahr-experiment-`, `vahr-console-` or `vahr-station-`, so they can never take over a
 robot's session. They may send commands to the fleet's robots (the keyboard method) and
 watch commands, events and presence; the station also watches the robots' shadow documents
-(read only), and the station and the recorder exchange the session's status (retained, the
-recorder's last will clearing it) and the participant's input. They cannot speak for a
-robot, and no shadow can be changed or asked for over MQTT.
+(read only) and hears the assistant's announcements (`vahr/assistant/announcements`, which
+only the announcer function publishes), and the station and the recorder exchange the
+session's status (retained, the recorder's last will clearing it) and the participant's
+input. They cannot speak for a robot or for the assistant, and no shadow can be changed or
+asked for over MQTT.
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ CLIENT_ID_PREFIXES = ("vahr-experiment-", "vahr-console-", "vahr-station-")
 def operator_policy_document(*, arn_prefix: str, things: Sequence[str]) -> dict[str, Any]:
     """The policy document; `arn_prefix` is `arn:<partition>:iot:<region>:<account>`."""
     session = (topics.EXPERIMENT_STATUS, topics.EXPERIMENT_INPUT)
+    # What the assistant says unprompted: heard, never said, by the people's side.
+    heard = (topics.ASSISTANT_ANNOUNCEMENTS,)
     documents = [topics.shadow(thing, "update/documents") for thing in things]
     watch = [
         topics.ALL_EVENTS.replace("+", "*"),
@@ -64,7 +68,7 @@ def operator_policy_document(*, arn_prefix: str, things: Sequence[str]) -> dict[
                 "Action": "iot:Subscribe",
                 "Resource": [
                     f"{arn_prefix}:topicfilter/{topic}"
-                    for topic in (*watch, *wildcard_filters, *session)
+                    for topic in (*watch, *wildcard_filters, *session, *heard)
                 ],
             },
             {
@@ -72,7 +76,8 @@ def operator_policy_document(*, arn_prefix: str, things: Sequence[str]) -> dict[
                 "Effect": "Allow",
                 "Action": "iot:Receive",
                 "Resource": [
-                    f"{arn_prefix}:topic/{topic}" for topic in (*watch, *documents, *session)
+                    f"{arn_prefix}:topic/{topic}"
+                    for topic in (*watch, *documents, *session, *heard)
                 ],
             },
             {

@@ -103,6 +103,7 @@ class VahrStack(cdk.Stack):
                 config=config,
                 code=code,
                 events_url=events_url(config.alexa_region, config.announcer_stage),
+                data_endpoint=self.data_endpoint.address,
             )
             if config.announcer
             else None

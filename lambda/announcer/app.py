@@ -3,7 +3,8 @@ Alexa notifications out. Thin: parse, run `announce`, report.
 
 The rule's SQL (infra/constructs/announcer.py) gives each event as the robot sent it plus
 `sender` (the thing named by the topic), and each presence as `{"online", "at",
-"sender"}`. An EventBridge schedule also invokes it once a minute (`"source":
+"sender"}`. Each announcement Alexa accepted is published on `vahr/assistant/announcements`
+for the operator station. An EventBridge schedule also invokes it once a minute (`"source":
 "aws.events"`): nothing happened, but time passed, so what the rate limit held back is told
 without waiting for the next robot event. A malformed message is logged and skipped
 (retrying cannot mend it); a failure to deliver raises `AnnouncerError`, so Lambda retries
@@ -19,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
-from announcer.aws import SkillCredentials, StateStore
+from announcer.aws import AnnouncementTopic, SkillCredentials, StateStore
 from announcer.config import AnnouncerConfig
 from announcer.errors import AnnouncerError, DeliveryFailed, StateConflict
 from announcer.proactive_events import ProactiveEvents
@@ -42,6 +43,7 @@ class Runtime(msgspec.Struct, frozen=True, kw_only=True, dict=True):
     names: Names
     store: Any
     alexa: Any
+    topic: Any
 
 
 @cache
@@ -60,6 +62,7 @@ def runtime() -> Runtime:
             events_url=config.events_url,
             credentials=SkillCredentials(config.secret),
         ),
+        topic=AnnouncementTopic(config.iot_data_endpoint),
     )
 
 
@@ -117,6 +120,9 @@ def announce(message: dict[str, Any], rt: Runtime) -> dict[str, Any]:
             outcome = rt.alexa.send(
                 announcement, creator=rt.names.robot(announcement.thing), urgent=urgent
             )
+            # Once Alexa has it: a retry after a failed publish is a duplicate (409) there,
+            # and the station knows a repeated announcement by its id.
+            rt.topic.publish(announcement)
             log.info("announced %s (%s): %s", announcement.id, outcome, announcement.speech)
         try:
             # Most ticks find nothing to tell: they cost a read, not a write.

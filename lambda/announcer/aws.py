@@ -1,19 +1,24 @@
-"""The announcer's boto3 adapters: the skill's client credentials (Secrets Manager) and the
-policy's state (one DynamoDB item, written only if nobody wrote it meanwhile). Library
-errors become the announcer's errors here and nowhere else."""
+"""The announcer's boto3 adapters: the skill's client credentials (Secrets Manager), the
+policy's state (one DynamoDB item, written only if nobody wrote it meanwhile) and the
+announcements topic (iot-data Publish, for the operator station). Library errors become
+the announcer's errors here and nowhere else."""
 
 from __future__ import annotations
 
 import json
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import boto3
 import msgspec
 from botocore.config import Config
 from botocore.exceptions import BotoCoreError, ClientError
 
-from announcer.errors import AnnouncerError, ConfigError, StateConflict
+from announcer.errors import AnnouncerError, ConfigError, DeliveryFailed, StateConflict
 from vahr.announce import PolicyState
+from vahr.protocol import encode, topics
+
+if TYPE_CHECKING:
+    from vahr.protocol.announcements import Announcement
 
 CLIENT_CONFIG = Config(
     connect_timeout=2.0, read_timeout=3.0, retries={"mode": "standard", "total_max_attempts": 3}
@@ -85,3 +90,24 @@ class StateStore:
             raise AnnouncerError(f"cannot save the announcer's state: {err}") from err
         except BotoCoreError as err:
             raise AnnouncerError(f"cannot save the announcer's state: {err}") from err
+
+
+class AnnouncementTopic:
+    """Publishes each announcement on `vahr/assistant/announcements` (QoS 1), where an
+    operator station hears it as it does on the local stack."""
+
+    def __init__(self, endpoint: str | None, client: Any = None) -> None:
+        self._client = client or boto3.client(
+            "iot-data", endpoint_url=endpoint, config=CLIENT_CONFIG
+        )
+
+    def publish(self, announcement: Announcement) -> None:
+        try:
+            self._client.publish(
+                topic=topics.ASSISTANT_ANNOUNCEMENTS, qos=1, payload=encode(announcement)
+            )
+        except (ClientError, BotoCoreError) as err:
+            raise DeliveryFailed(
+                f"cannot publish announcement {announcement.id} on "
+                f"{topics.ASSISTANT_ANNOUNCEMENTS}: {err}"
+            ) from err

@@ -6,6 +6,8 @@
 - `VAHR_PROACTIVE_EVENTS_URL`: the Proactive Events endpoint of the skill's region and
   stage (`events_url`);
 - `VAHR_LWA_TOKEN_URL`: Login with Amazon's token endpoint (default `LWA_TOKEN_URL`);
+- `VAHR_IOT_DATA_ENDPOINT`: the iot-data endpoint announcements are published at for the
+  operator station (the CDK stack sets the account's; unset: boto3's default);
 - `VAHR_ANNOUNCE_SETTINGS`: the policy's settings as JSON (`vahr.announce.AnnounceSettings`);
 - `VAHR_LOG_LEVEL`: DEBUG, INFO, WARNING or ERROR (default INFO).
 """
@@ -47,6 +49,7 @@ class AnnouncerConfig(msgspec.Struct, frozen=True, kw_only=True):
     table: str
     events_url: str
     token_url: str = LWA_TOKEN_URL
+    iot_data_endpoint: str | None = None
     settings: AnnounceSettings = msgspec.field(default_factory=AnnounceSettings)
     log_level: str = "INFO"
 
@@ -64,7 +67,7 @@ class AnnouncerConfig(msgspec.Struct, frozen=True, kw_only=True):
         ]
         if missing:
             raise ConfigError(f"{', '.join(missing)}: not set (the CDK stack sets them)")
-        for name in ("VAHR_PROACTIVE_EVENTS_URL", "VAHR_LWA_TOKEN_URL"):
+        for name in ("VAHR_PROACTIVE_EVENTS_URL", "VAHR_LWA_TOKEN_URL", "VAHR_IOT_DATA_ENDPOINT"):
             url = env.get(name, "https://")
             if not url.startswith(("https://", "http://127.0.0.1")):
                 raise ConfigError(f"{name}: {url[:60]!r} must be an https:// URL")
@@ -80,6 +83,7 @@ class AnnouncerConfig(msgspec.Struct, frozen=True, kw_only=True):
             table=env["VAHR_ANNOUNCER_TABLE"],
             events_url=env["VAHR_PROACTIVE_EVENTS_URL"],
             token_url=env.get("VAHR_LWA_TOKEN_URL") or LWA_TOKEN_URL,
+            iot_data_endpoint=env.get("VAHR_IOT_DATA_ENDPOINT") or None,
             settings=settings,
             log_level=level,
         )

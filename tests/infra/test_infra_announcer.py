@@ -20,12 +20,13 @@ if TYPE_CHECKING:
 
 PREFIX = "arn:aws:us-east-1:123456789012"
 URL = "https://api.amazonalexa.com/v1/proactiveEvents/stages/development"
+DATA = "a1b2c3d4e5f6g7-ats.iot.us-east-1.amazonaws.com"
 
 
 @pytest.fixture(scope="module")
 def template(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     stack = bare_stack(tmp_path_factory.mktemp("announcer"))
-    Announcer(stack, "Announcer", config=InfraConfig(), events_url=URL,
+    Announcer(stack, "Announcer", config=InfraConfig(), events_url=URL, data_endpoint=DATA,
               code=lambda_.Code.from_inline("def lambda_handler(e, c): pass"))  # fmt: skip
     return Template.from_stack(stack).to_json()
 
@@ -61,13 +62,16 @@ def test_the_function_runs_the_announcer_with_retries_and_a_dead_letter_queue(
     variables = function["Environment"]["Variables"]
     assert variables["VAHR_PROACTIVE_EVENTS_URL"] == URL
     assert variables["VAHR_ANNOUNCER_SECRET"] == "vahr/skill-messaging"
+    assert variables["VAHR_IOT_DATA_ENDPOINT"] == f"https://{DATA}"
     invoke = only(template, "AWS::Lambda::EventInvokeConfig")
     assert invoke["MaximumRetryAttempts"] == 2
     queue = resources(template, "AWS::SQS::Queue")[queue_id]
     assert queue["SqsManagedSseEnabled"] is True and queue["MessageRetentionPeriod"] == 14 * 86400
 
 
-def test_the_function_may_read_one_secret_and_its_state_only(template: dict[str, Any]) -> None:
+def test_the_function_may_read_one_secret_keep_its_state_and_publish_one_topic(
+    template: dict[str, Any],
+) -> None:
     function = only(template, "AWS::Lambda::Function")
     role_id = function["Role"].strip("<>").split(".")[0]
     [table_id] = resources(template, "AWS::DynamoDB::Table")
@@ -78,6 +82,7 @@ def test_the_function_may_read_one_secret_and_its_state_only(template: dict[str,
          "arn:aws:secretsmanager:us-east-1:123456789012:secret:vahr/skill-messaging-??????"),
         ("Allow", "dynamodb:GetItem", f"<{table_id}.Arn>"),
         ("Allow", "dynamodb:PutItem", f"<{table_id}.Arn>"),
+        ("Allow", "iot:Publish", "arn:aws:iot:us-east-1:123456789012:topic/vahr/assistant/announcements"),
         ("Allow", "sqs:SendMessage", f"<{queue_id}.Arn>"),
         ("Allow", "logs:CreateLogStream", f"<{group_id}.Arn>"),
         ("Allow", "logs:PutLogEvents", f"<{group_id}.Arn>"),

@@ -91,3 +91,15 @@ def test_the_recorder_and_the_station_share_the_session(operator: IotPolicy) -> 
     # Nothing else is retained, and the assistant's turns are not the operators' to send
     assert not operator.can_publish(topics.EXPERIMENT_INPUT, retain=True)
     assert not operator.can_publish(topics.ASSISTANT_TURNS)
+
+
+def test_the_station_hears_the_assistants_announcements_and_cannot_make_them(
+    operator: IotPolicy,
+) -> None:
+    # The announcer function publishes them on AWS; the station subscribes and receives
+    assert operator.can_subscribe(topics.ASSISTANT_ANNOUNCEMENTS)
+    assert operator.can_receive(topics.ASSISTANT_ANNOUNCEMENTS)
+    # but nobody on the people's side speaks for the assistant
+    assert not operator.can_publish(topics.ASSISTANT_ANNOUNCEMENTS)
+    assert not operator.can_publish(topics.ASSISTANT_ANNOUNCEMENTS, retain=True)
+    assert not operator.can_subscribe("vahr/assistant/#")

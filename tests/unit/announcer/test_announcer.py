@@ -18,16 +18,21 @@ from urllib.parse import parse_qs
 
 import boto3
 import pytest
+from botocore.exceptions import ClientError
 from moto import mock_aws
+from moto.core import DEFAULT_ACCOUNT_ID
+from moto.iotdata.models import iotdata_backends
 from msgspec.structs import replace
 
 from announcer import app
-from announcer.aws import SkillCredentials, StateStore
+from announcer.aws import AnnouncementTopic, SkillCredentials, StateStore
 from announcer.config import AnnouncerConfig, events_url
 from announcer.errors import AnnouncerError, ConfigError, DeliveryFailed
 from announcer.proactive_events import ProactiveEvents
 from vahr.announce import settings_from
 from vahr.announce.speech import Names
+from vahr.protocol import topics
+from vahr.protocol.announcements import decode_announcement
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -197,6 +202,7 @@ def runtime(
                 token_url=config.token_url, events_url=config.events_url,
                 credentials=SkillCredentials(config.secret), sleep=lambda s: None,
             ),
+            topic=AnnouncementTopic(config.iot_data_endpoint),
         )  # fmt: skip
 
 
@@ -216,6 +222,47 @@ def test_a_stuck_robot_becomes_one_urgent_message_alert(
     }  # fmt: skip
     assert sent["relevantAudience"] == {"type": "Multicast", "payload": {}}
     assert alexa.tokens_issued == 1
+
+
+def published() -> list[tuple[str, bytes]]:
+    """What the function published on AWS IoT, as moto recorded it."""
+    return list(iotdata_backends[DEFAULT_ACCOUNT_ID][REGION].published_payloads)
+
+
+def test_each_announcement_alexa_took_is_published_for_the_operator_station(
+    runtime: app.Runtime, alexa: AlexaStandIn
+) -> None:
+    # Given a stuck robot told, and its redelivered failed event (the same fault)
+    first = app.announce(load_event("iot_rule_robot_stuck"), runtime)
+    app.announce(load_event("iot_rule_robot_failed_stuck"), runtime)
+    # Then the station's topic got the one announcement, as the local stack sends it
+    [(topic, payload)] = published()
+    assert topic == topics.ASSISTANT_ANNOUNCEMENTS
+    told = decode_announcement(payload)
+    assert told.id == first["told"][0] == alexa.events[0]["referenceId"]
+    assert told.speech == "Placebot one is stuck on its way to zone b and needs your help."
+
+
+class RefusedPublish:
+    def publish(self, **request: Any) -> None:
+        raise ClientError({"Error": {"Code": "ForbiddenException", "Message": "denied"}}, "Publish")
+
+
+def test_a_refused_publish_raises_so_the_event_is_retried_and_nothing_is_lost(
+    runtime: app.Runtime, alexa: AlexaStandIn
+) -> None:
+    # Given a topic IoT refuses
+    refused = replace(runtime, topic=AnnouncementTopic(None, client=RefusedPublish()))
+    # Then the invocation raises in one line naming the topic, and saves no state
+    with pytest.raises(
+        DeliveryFailed,
+        match=r"^cannot publish announcement vahr~stuck~\w+ on vahr/assistant/announcements: ",
+    ):
+        app.announce(load_event("iot_rule_robot_stuck"), refused)
+    # And the retry tells it again: Alexa knows the duplicate, the station hears it once
+    alexa.script = [(409, {"message": "duplicate referenceId"}, {})]
+    again = app.announce(load_event("iot_rule_robot_stuck"), runtime)
+    assert len(again["told"]) == 1 and len(published()) == 1
 
 
 def test_offline_presence_is_told_and_the_token_is_reused(
