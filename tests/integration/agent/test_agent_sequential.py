@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-import time
-from datetime import UTC, datetime
+from datetime import datetime, timedelta
 from typing import TYPE_CHECKING
 
 from tests.integration.agent.harness import command
@@ -66,10 +65,11 @@ def test_a_delivery_from_an_earlier_task_does_not_release_a_new_sequence(
     for thing in ("placebot1", "placebot2"):
         tap.reported(thing, lambda r: r["connected"] is True)
     tap.publish("vahr/robots/placebot1/cmd", command("task2", "deliver", {"zone": "A"}))
-    tap.event("placebot1", "delivered", "task2", timeout_s=30)
-    time.sleep(3.0)  # past the 2 s clock-skew tolerance, as a next task would be
-    # When a new sequence is issued: placebot1 to D, then placebot2 to D
-    issued_at = datetime.now(UTC).isoformat().replace("+00:00", "Z")
+    earlier = tap.event("placebot1", "delivered", "task2", timeout_s=30)
+    # When a new sequence is issued 3 s after that delivery (past the 2 s clock-skew
+    # tolerance, as a next task would be): placebot1 to D, then placebot2 to D
+    issued = datetime.fromisoformat(earlier["at"]) + timedelta(seconds=3)
+    issued_at = issued.isoformat().replace("+00:00", "Z")
     tap.publish(
         "vahr/robots/placebot2/cmd",
         command(

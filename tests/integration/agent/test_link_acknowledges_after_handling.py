@@ -7,8 +7,10 @@ PUBACK and never sent it again). The soak found one such command in a few hundre
 from __future__ import annotations
 
 import asyncio
-import time
+import threading
 from typing import TYPE_CHECKING
+
+from awscrt import mqtt5
 
 from robot_agent.config import MqttSettings
 from robot_agent.link.mqtt5 import LinkSettings, Mqtt5Link
@@ -19,10 +21,23 @@ if TYPE_CHECKING:
     from vahr.local.broker import Mosquitto
 
 TOPIC = "vahr/robots/placebot1/cmd"
+BARRIER = "vahr/robots/placebot1/barrier"
 
 
-def _link(port: int, loop: asyncio.AbstractEventLoop) -> Mqtt5Link:
-    return Mqtt5Link(
+class _WatchedLink(Mqtt5Link):
+    """The real link, telling when a message reached it from the client library."""
+
+    def __init__(self, settings: LinkSettings, loop: asyncio.AbstractEventLoop) -> None:
+        self.received = threading.Event()
+        super().__init__(settings, loop)
+
+    def _on_publish_received(self, data: mqtt5.PublishReceivedData) -> None:
+        super()._on_publish_received(data)
+        self.received.set()
+
+
+def _link(port: int, loop: asyncio.AbstractEventLoop) -> _WatchedLink:
+    return _WatchedLink(
         LinkSettings(
             client_id="placebot1",
             host="127.0.0.1",
@@ -42,13 +57,17 @@ def test_a_message_the_robot_never_handled_is_delivered_again_when_it_is_back(
     link = _link(port, frozen)
     first: list[bytes] = []
     link.add_route(TOPIC, lambda _topic, payload: first.append(payload))
-    frozen.run_until_complete(link.start(10))
-    time.sleep(0.5)  # its subscription is in place
+    frozen.run_until_complete(link.start(10))  # returns once its subscription is in place
     # When a command reaches it, and the robot goes away before handling it
     sender = MqttClient(MqttEndpoint(port=port)).connect()
     try:
         sender.publish(TOPIC, b'{"id": "never-handled"}')
-        time.sleep(0.5)  # received by the client library, never dispatched
+        # received by the client library, never dispatched
+        assert link.received.wait(5)
+        # A publish of the robot's own, once the broker acknowledged it, is a barrier: an
+        # acknowledgment of the command sent too early would have reached the broker first.
+        barrier = mqtt5.PublishPacket(topic=BARRIER, payload=b"", qos=mqtt5.QoS.AT_LEAST_ONCE)
+        link._client.publish(barrier).result(timeout=5)
         # (its client stops without the frozen loop ever turning again)
         link._client.stop()
         assert link._stopped.wait(5)
