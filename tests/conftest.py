@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from tests.support.scheduling import FileGroupScheduling, slow_files_first
+from tests.support.scheduling import FileGroupScheduling, longest_files_first
 from vahr.local.broker import BrokerConfig, Mosquitto
 from vahr.local.ports import free_port
 from vahr.local.stack import LocalStack, StackConfig
@@ -33,8 +33,8 @@ def pytest_configure() -> None:
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Files with a slow test run first, so that the two workers finish close together."""
-    slow_files_first(items)
+    """The longest files run first, so that the two workers finish close together."""
+    longest_files_first(items)
 
 
 @pytest.hookimpl(optionalhook=True)

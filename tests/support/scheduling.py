@@ -9,9 +9,10 @@ structured node ids no longer allow (pytest-dev/pytest-xdist#1386): the `xdist_g
 were ignored and every test was scheduled alone, on either worker. The group is therefore
 read from the node id here, in the scheduler, instead.
 
-Units are handed out in collection order, which `slow_files_first` sets: the files with a
-test marked `slow` go first, so that no long file is left to start when the other worker
-has run out of work.
+Units are handed out in collection order, which `longest_files_first` sets: the files whose
+tests declare a longer timeout of their own (the hearing acceptance, the installed package)
+go first, then the files with a test marked `slow`, so that no long file is left to start
+when the other worker has run out of work.
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ class FileGroupScheduling(LoadGroupScheduling):
 
     def __init__(self, config: pytest.Config, log: Producer | None = None) -> None:
         super().__init__(config, log)
-        # Keep the collection order (slow files first) rather than the largest file first.
+        # Keep the collection order (longest files first) rather than the largest first.
         config.option.loadscopereorder = False
 
     def _split_scope(self, nodeid: str) -> str:
@@ -47,8 +48,22 @@ class FileGroupScheduling(LoadGroupScheduling):
         return named if named != nodeid else group_of(nodeid)
 
 
-def slow_files_first(items: list[pytest.Item]) -> None:
-    """Reorder `items` in place: whole files holding a `slow` test first, each file's own
-    order and the order of the files otherwise kept."""
-    slow = {group_of(item.nodeid) for item in items if item.get_closest_marker("slow")}
-    items.sort(key=lambda item: group_of(item.nodeid) not in slow)
+def longest_files_first(items: list[pytest.Item]) -> None:
+    """Reorder `items` in place, whole files at a time: the longest timeout a file's tests
+    declare first, then files holding a `slow` test; each file's own order, and the order
+    of files that tie, kept."""
+    timeout: dict[str, float] = {}
+    slow: set[str] = set()
+    for item in items:
+        group = group_of(item.nodeid)
+        marker = item.get_closest_marker("timeout")
+        if marker is not None and marker.args:
+            timeout[group] = max(timeout.get(group, 0.0), float(marker.args[0]))
+        if item.get_closest_marker("slow") is not None:
+            slow.add(group)
+
+    def order(item: pytest.Item) -> tuple[float, bool]:
+        group = group_of(item.nodeid)
+        return -timeout.get(group, 0.0), group not in slow
+
+    items.sort(key=order)

@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from tests.support.scheduling import FileGroupScheduling, group_of, slow_files_first
+from tests.support.scheduling import FileGroupScheduling, group_of, longest_files_first
 
 
 def _scheduler() -> FileGroupScheduling:
@@ -31,29 +31,31 @@ def test_the_scheduler_groups_by_file_and_honours_an_xdist_group_suffix() -> Non
     assert scheduler._split_scope("tests/unit/test_a.py::test_one[a@b]") == "tests/unit/test_a.py"
     assert scheduler._split_scope("tests/infra/test_x.py::test_one") == "infra"
     assert scheduler._split_scope("tests/unit/test_a.py::test_one@named") == "named"
-    # The collection order (slow files first) is the order work is handed out in.
+    # The collection order (longest files first) is the order work is handed out in.
     assert scheduler.config.option.loadscopereorder is False
 
 
-def test_files_with_a_slow_test_come_first_whole_and_in_order() -> None:
-    def item(nodeid: str, *, slow: bool = False) -> Any:
-        marker = pytest.mark.slow.mark if slow else None
-        return SimpleNamespace(nodeid=nodeid, get_closest_marker=lambda name: marker)
+def test_files_that_declare_a_long_timeout_then_slow_files_come_first_whole() -> None:
+    def item(nodeid: str, *marks: pytest.MarkDecorator) -> Any:
+        found = {mark.name: mark.mark for mark in marks}
+        return SimpleNamespace(nodeid=nodeid, get_closest_marker=found.get)
 
     items = [
         item("tests/unit/test_a.py::one"),
         item("tests/unit/test_b.py::one"),
-        item("tests/unit/test_b.py::two", slow=True),
+        item("tests/unit/test_b.py::two", pytest.mark.slow),
         item("tests/infra/test_c.py::one"),
-        item("tests/infra/test_d.py::one", slow=True),
-        item("tests/unit/test_e.py::one"),
+        item("tests/infra/test_d.py::one", pytest.mark.timeout(240)),
+        item("tests/unit/test_e.py::one", pytest.mark.slow, pytest.mark.timeout(420)),
+        item("tests/unit/test_f.py::one"),
     ]
-    slow_files_first(items)
+    longest_files_first(items)
     assert [i.nodeid for i in items] == [
-        "tests/unit/test_b.py::one",
-        "tests/unit/test_b.py::two",
+        "tests/unit/test_e.py::one",
         "tests/infra/test_c.py::one",
         "tests/infra/test_d.py::one",
+        "tests/unit/test_b.py::one",
+        "tests/unit/test_b.py::two",
         "tests/unit/test_a.py::one",
-        "tests/unit/test_e.py::one",
+        "tests/unit/test_f.py::one",
     ]
