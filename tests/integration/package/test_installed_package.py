@@ -70,9 +70,11 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> Path:
     [wheel] = wheels.glob("vahr-*.whl")
     venv = work / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, timeout=120)
+    # Without byte-compiling every dependency at install (botocore's thousands of modules
+    # among them): a module is compiled when it is first imported, as pip would have done.
     subprocess.run(
         [str(venv / "bin" / "pip"), "install", "-q", "--disable-pip-version-check",
-         "-c", str(ROOT / "requirements.txt"), str(wheel)],
+         "--no-compile", "-c", str(ROOT / "requirements.txt"), str(wheel)],
         check=True, capture_output=True, timeout=INSTALL_TIMEOUT_S,
     )  # fmt: skip
     return venv / "bin"
