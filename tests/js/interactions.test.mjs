@@ -60,6 +60,17 @@ describe("start and stop", () => {
     assert.equal(sent.at(-1).counts, false);
   });
 
+  test("a key that acknowledged an alert ends saying so", async () => {
+    const { interactions, sent, clock } = recorder();
+    interactions.keyDown("Enter", "Enter");
+    interactions.attach(Promise.resolve({ text: "acknowledge alert placebot1 stuck" }));
+    clock.ms += 120;
+    interactions.keyUp("Enter");
+    await settled(interactions);
+    assert.deepEqual(sent.map((m) => [m.phase, m.text]), [["started", "key Enter"], ["ended", "acknowledge alert placebot1 stuck"]]);
+    assert.equal(sent.at(-1).counts, false); // interaction time, not an order to a robot
+  });
+
   test("a click's action that starts just after the release still belongs to it", async () => {
     const { interactions, sent, waits } = recorder();
     interactions.pointerDown({ mouse: false, text: "click Stop all" });

@@ -9,12 +9,16 @@ from datetime import UTC, datetime, timedelta
 
 import msgspec
 import pytest
+from conftest import load_event
 
 from vahr.protocol import EventKind, ProtocolError
+from vahr.protocol.announcements import decode_announcement
 from vahr.protocol.station import (
     DRIVE_ENDS,
     EXCHANGE_EVENTS,
     AckMessage,
+    AlertAcknowledgedMessage,
+    AnnouncementMessage,
     EventMessage,
     ExperimentStatus,
     Interaction,
@@ -117,6 +121,19 @@ def test_page_messages_are_told_apart_by_their_type() -> None:
     # An event is sent as the robot sent it, with its type and when it was last seen
     assert body == {"type": "event", "event": "said", "thing": "placebot1",
                     "at": "2026-11-23T10:00:00Z", "text": "hi", "last_seen": 5.0}  # fmt: skip
+
+
+def test_an_announcement_reaches_the_page_as_said_with_its_type_and_robots() -> None:
+    announced = load_event("announcement_stuck")
+    announcement = decode_announcement(json.dumps(announced).encode())
+    message = AnnouncementMessage(**msgspec.structs.asdict(announcement), robots=["placebot1"])
+    # The page gets every field the announcer sent, as it sent it, with its type and robots
+    body = json.loads(encode_page_message(message))
+    assert body == {"type": "announcement", **announced, "robots": ["placebot1"]}
+    decoder = msgspec.json.Decoder(PageMessage)
+    assert decoder.decode(encode_page_message(message)) == message
+    acknowledged = decoder.decode(b'{"type": "alert_acknowledged", "ids": ["a1", "a2"]}')
+    assert acknowledged == AlertAcknowledgedMessage(ids=["a1", "a2"])
 
 
 def test_a_turn_handed_over_in_process_is_checked_like_one_from_the_broker() -> None:

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import msgspec
 
+from vahr.protocol.announcements import Announcement
 from vahr.protocol.errors import ProtocolError, from_validation_error
 
 # The page's structs name these in annotations, which msgspec reads at run time.
@@ -273,14 +274,16 @@ class CommandParams(msgspec.Struct, frozen=True, omit_defaults=True):
 
 class SnapshotMessage(msgspec.Struct, kw_only=True, tag="snapshot", tag_field="type"):
     """What a page starts from: the fleet, every robot, the conversation so far, the
-    commands seen with their acknowledgments, the session, and the station's clock (ms
-    since the epoch) for the page to correct its own."""
+    commands seen with their acknowledgments, the session, the announcements nobody has
+    acknowledged yet (oldest first), and the station's clock (ms since the epoch) for the
+    page to correct its own."""
 
     fleet: FleetView
     robots: dict[str, RobotView]
     conversation: list[ConversationEntry]
     commands: dict[str, CommandMessage]
     experiment: ExperimentStatus | None
+    alerts: list[AnnouncementMessage]
     server_time: float
 
 
@@ -348,7 +351,25 @@ class ExperimentMessage(
     status: ExperimentStatus | None
 
 
-ConversationEntry = TurnMessage | CommandMessage | EventMessage
+class AnnouncementMessage(Announcement, frozen=True, tag="announcement", tag_field="type"):
+    """What the assistant told the person unprompted (a robot stuck, failed, offline...),
+    with the robots it concerns. The page shows it as an alert until someone acknowledges
+    it, and in the conversation."""
+
+    robots: list[str]
+
+
+class AlertAcknowledgedMessage(
+    msgspec.Struct, frozen=True, kw_only=True, tag="alert_acknowledged", tag_field="type"
+):
+    """Someone acknowledged an alert on a station page: these announcements (the one
+    acknowledged and any other still open about the same robot and trouble) are no longer
+    shown as alerts."""
+
+    ids: list[str]
+
+
+ConversationEntry = TurnMessage | CommandMessage | EventMessage | AnnouncementMessage
 PageMessage = (
     SnapshotMessage
     | ShadowMessage
@@ -358,6 +379,8 @@ PageMessage = (
     | AckMessage
     | TurnMessage
     | ExperimentMessage
+    | AnnouncementMessage
+    | AlertAcknowledgedMessage
 )
 
 _page_encoder = msgspec.json.Encoder()

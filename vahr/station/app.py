@@ -12,6 +12,7 @@ Routes (all JSON unless said otherwise; errors are `{"error": "one line"}`):
 | `POST /api/voice` (a WAV file) | push-to-talk: transcript, the assistant's reply |
 | `POST /api/speech` `{"text"}` | the text spoken by espeak-ng, as a WAV file |
 | `POST /api/interaction`, `POST /api/puzzle` | the participant's input, for the session's log |
+| `POST /api/acknowledge` `{"id"}` | an alert acknowledged: `{"acknowledged": [ids]}` |
 
 The page itself, its files and the event stream are the server's (`server.py`).
 """
@@ -89,6 +90,7 @@ class StationApp:
             ("POST", "/api/speech"): self.speech,
             ("POST", "/api/interaction"): lambda body: self.participant("interaction", body),
             ("POST", "/api/puzzle"): lambda body: self.participant("puzzle", body),
+            ("POST", "/api/acknowledge"): self.acknowledge,
         }
 
     def is_json_route(self, method: str, path: str) -> bool:
@@ -159,6 +161,10 @@ class StationApp:
     def participant(self, kind: str, request: Json) -> Reply:
         logged = self.desk.forward(kind, request)
         return json_reply({"logged": logged}, 202 if logged else 200)
+
+    def acknowledge(self, request: Json) -> Reply:
+        """An alert acknowledged on a page: no page shows it from now on."""
+        return json_reply({"acknowledged": self.feed.acknowledge(_text(request, "id", 100))})
 
     def voice(self, wav: bytes) -> Reply:
         """Push-to-talk: a WAV clip in, what was heard and answered out."""

@@ -16,7 +16,14 @@ the typedefs of `static/contract.js`:
 - `ack`: the first answer of a robot to a command, with the time it took from the command
   being seen here (the acknowledgment latency the conversation shows);
 - `turn`: one exchange with the assistant;
-- `experiment`: the running session (or `null` when none).
+- `experiment`: the running session (or `null` when none);
+- `announcement`: what the assistant told the person unprompted (a robot stuck, failed,
+  offline; `topics.ASSISTANT_ANNOUNCEMENTS`), shown as an alert until acknowledged;
+- `alert_acknowledged`: someone acknowledged an alert on a page (`acknowledge`): the
+  announcement and any other still open about the same robot and trouble.
+
+Acknowledgments are the station's, not one page's: every page stops showing the alert, and
+a page that reloads does not raise it again.
 
 Nothing here waits on a page: a page that falls `SUBSCRIBER_LIMIT` messages behind is
 dropped, and its browser reconnects and starts again from a snapshot.
@@ -41,11 +48,14 @@ from vahr.protocol import (
     decode_presence,
     topics,
 )
+from vahr.protocol.announcements import Announcement, decode_announcement
 from vahr.protocol.station import (
     DRIVE_ENDS,
     EXCHANGE_EVENTS,
     AckMessage,
     Acknowledgment,
+    AlertAcknowledgedMessage,
+    AnnouncementMessage,
     AssistantTurn,
     CommandMessage,
     CommandParams,
@@ -81,6 +91,11 @@ SUBSCRIBER_LIMIT = 20_000
 CONVERSATION_LIMIT = 400
 # Commands whose acknowledgments are followed; older ones are forgotten.
 COMMANDS_LIMIT = 1_000
+# Alerts kept until acknowledged; past this many the oldest is let go (the rate limit tells
+# at most a few a minute, so this is hours of nobody looking).
+ALERTS_LIMIT = 100
+# Announcement ids remembered, so one delivered twice (QoS 1) is shown once.
+ANNOUNCEMENTS_REMEMBERED = 1_000
 Json = dict[str, Any]
 
 
@@ -195,6 +210,8 @@ class Feed:
         self._conversation: deque[ConversationEntry] = deque(maxlen=CONVERSATION_LIMIT)
         self._commands: OrderedDict[str, CommandMessage] = OrderedDict()
         self._experiment: ExperimentStatus | None = None
+        self._alerts: OrderedDict[str, AnnouncementMessage] = OrderedDict()
+        self._announced: OrderedDict[str, None] = OrderedDict()
         self.closed = False
 
     # -- pages ----------------------------------------------------------------------------
@@ -236,6 +253,7 @@ class Feed:
             conversation=list(self._conversation),
             commands=self._commands,
             experiment=self._experiment,
+            alerts=list(self._alerts.values()),
             server_time=self._clock(),
         )
 
@@ -262,7 +280,9 @@ class Feed:
     # -- the broker's messages -------------------------------------------------------------
 
     def routes(self, *, turns: bool) -> list[tuple[str, Callable[[str, bytes], None]]]:
-        """(filter, handler) pairs to subscribe; `turns` adds the local simulator's turns."""
+        """(filter, handler) pairs to subscribe; `turns` adds the local simulator's turns.
+        Announcements come from the local announcer and from the cloud's announcer
+        function alike, so they are always subscribed."""
         found: list[tuple[str, Callable[[str, bytes], None]]] = [
             (topics.ALL_SHADOW_DOCUMENTS, self.on_shadow_documents),
             (topics.ALL_PRESENCE, self.on_presence),
@@ -270,6 +290,7 @@ class Feed:
             (topics.ALL_ROBOT_CMDS, self.on_command),
             (topics.FLEET_CMD, self.on_command),
             (topics.EXPERIMENT_STATUS, self.on_experiment_status),
+            (topics.ASSISTANT_ANNOUNCEMENTS, self.on_announcement),
         ]
         if turns:
             found.append((topics.ASSISTANT_TURNS, self.on_turn))
@@ -445,6 +466,56 @@ class Feed:
             message = TurnMessage(**msgspec.structs.asdict(turn), robots=sorted(robots))
             self._conversation.append(message)
             self._broadcast(message)
+
+    def on_announcement(self, topic: str, payload: bytes) -> None:
+        try:
+            announcement = decode_announcement(payload)
+        except ProtocolError as err:
+            log.warning("ignoring an announcement: %s", err)
+            return
+        self.add_announcement(announcement)
+
+    def add_announcement(self, announcement: Announcement) -> None:
+        """What the assistant said unprompted: into the conversation, and an alert until
+        acknowledged. The same announcement twice (a redelivery) is shown once."""
+        thing = announcement.thing
+        with self._lock:
+            if announcement.id in self._announced:
+                return
+            self._announced[announcement.id] = None
+            while len(self._announced) > ANNOUNCEMENTS_REMEMBERED:
+                self._announced.popitem(last=False)
+            message = AnnouncementMessage(
+                **msgspec.structs.asdict(announcement),
+                robots=[thing] if thing in self._things else [],
+            )
+            self._conversation.append(message)
+            self._alerts[announcement.id] = message
+            while len(self._alerts) > ALERTS_LIMIT:
+                self._alerts.popitem(last=False)
+            self._broadcast(message)
+
+    def acknowledge(self, announcement_id: str) -> list[str]:
+        """Someone acknowledged the alert of `announcement_id`: it, and every other alert
+        still open about the same robot and trouble, is no longer shown on any page.
+        Returns the ids acknowledged (none if it was not, or no longer, an alert)."""
+        with self._lock:
+            alert = self._alerts.get(announcement_id)
+            if alert is None:
+                return []
+            ids = [
+                key
+                for key, open_alert in self._alerts.items()
+                if key == announcement_id
+                or (
+                    alert.thing is not None
+                    and (open_alert.thing, open_alert.kind) == (alert.thing, alert.kind)
+                )
+            ]
+            for key in ids:
+                del self._alerts[key]
+            self._broadcast(AlertAcknowledgedMessage(ids=ids))
+            return ids
 
     def on_experiment_status(self, topic: str, payload: bytes) -> None:
         if not payload:

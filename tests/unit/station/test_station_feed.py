@@ -8,10 +8,22 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 import pytest
+from conftest import load_event
 
+from tests.support.station import RecordingAssistant, Wire
 from vahr.protocol import Event, EventPose, Presence, encode, new_command, topics, utc_now
-from vahr.protocol.station import PageMessage, ShadowMessage, SnapshotMessage, TurnMessage
-from vahr.station.feed import Feed, Subscriber, fleet_view
+from vahr.protocol.station import (
+    AlertAcknowledgedMessage,
+    AnnouncementMessage,
+    PageMessage,
+    ShadowMessage,
+    SnapshotMessage,
+    TurnMessage,
+)
+from vahr.station.app import StationApp
+from vahr.station.controls import Controls
+from vahr.station.desk import Desk
+from vahr.station.feed import ALERTS_LIMIT, Feed, Subscriber, fleet_view
 
 if TYPE_CHECKING:
     from vahr.protocol import Fleet
@@ -248,10 +260,13 @@ def test_every_message_a_page_is_sent_is_a_page_message_of_the_contract(
         topics.EXPERIMENT_STATUS,
         b'{"session": "P01-vahr-trial1", "participant": "P01", "method": "vahr", "trial": 1}',
     )
+    feed.on_announcement(topics.ASSISTANT_ANNOUNCEMENTS, stuck_announcement())
+    feed.acknowledge(load_event("announcement_stuck")["id"])
     # Then each message the page gets decodes as the contract's struct of its type
     told = [PAGE.decode(message) for message in page.take(0) or []]
     assert [m.__struct_config__.tag for m in told] == [
-        "snapshot", "command", "ack", "event", "shadow", "presence", "turn", "experiment"
+        "snapshot", "command", "ack", "event", "shadow", "presence", "turn", "experiment",
+        "announcement", "alert_acknowledged",
     ]  # fmt: skip
     # And what the robot reported is passed on whole, fields beyond the contract too
     shadow = told[4]
@@ -294,3 +309,120 @@ def test_the_stations_own_turns_reach_pages_as_the_brokers_do(feed: Feed) -> Non
     assert first == second
     assert isinstance(first, TurnMessage) and first.robots == [] and first.origin == "station"
     assert first.at == datetime(2026, 11, 23, 10, 0, tzinfo=UTC)
+
+
+# -- announcements: the assistant telling without being asked ------------------------------
+
+
+def stuck_announcement(**changes: Any) -> bytes:
+    """The local announcer's message for a stuck placebot1 (tests/events), with `changes`."""
+    return json.dumps({**load_event("announcement_stuck"), **changes}).encode()
+
+
+def test_the_feed_listens_for_announcements_on_every_deployment(feed: Feed) -> None:
+    # Both the local announcer and the cloud's announcer function publish them
+    for turns in (True, False):
+        routes = dict(feed.routes(turns=turns))
+        assert routes[topics.ASSISTANT_ANNOUNCEMENTS] == feed.on_announcement
+
+
+def test_an_announcement_reaches_pages_as_an_alert_and_in_the_conversation(feed: Feed) -> None:
+    page = feed.subscribe()
+    messages(page)
+    # When the announcer says placebot1 is stuck
+    feed.on_announcement(topics.ASSISTANT_ANNOUNCEMENTS, stuck_announcement())
+    # Then every page is told, naming the robot and in the assistant's words
+    (told,) = [PAGE.decode(m) for m in page.take(0) or []]
+    assert isinstance(told, AnnouncementMessage)
+    assert (told.thing, told.kind, told.robots) == ("placebot1", "stuck", ["placebot1"])
+    assert told.speech == "Placebot one is stuck on its way to zone b and needs your help."
+    # And a page opened now starts with it as an open alert, and in the conversation
+    snapshot = feed.snapshot()
+    assert [a["id"] for a in snapshot["alerts"]] == [told.id]
+    assert snapshot["conversation"][-1]["type"] == "announcement"
+
+
+def test_an_announcement_delivered_twice_is_shown_once(feed: Feed) -> None:
+    page = feed.subscribe()
+    messages(page)
+    feed.on_announcement(topics.ASSISTANT_ANNOUNCEMENTS, stuck_announcement())
+    feed.on_announcement(topics.ASSISTANT_ANNOUNCEMENTS, stuck_announcement())
+    assert [m["type"] for m in messages(page)] == ["announcement"]
+    assert len(feed.snapshot()["alerts"]) == 1
+
+
+def test_a_malformed_announcement_is_ignored(feed: Feed) -> None:
+    page = feed.subscribe()
+    messages(page)
+    feed.on_announcement(topics.ASSISTANT_ANNOUNCEMENTS, b"not json")
+    feed.on_announcement(topics.ASSISTANT_ANNOUNCEMENTS, stuck_announcement(kind="bored"))
+    assert messages(page) == []
+    assert feed.snapshot()["alerts"] == []
+
+
+def test_acknowledging_an_alert_lets_go_of_it_and_its_repeats_on_every_page(
+    feed: Feed,
+) -> None:
+    first = json.loads(stuck_announcement())["id"]
+    # Given placebot1 announced stuck twice (the fault cleared and came back) and placebot2
+    # announced offline, none acknowledged
+    feed.on_announcement(topics.ASSISTANT_ANNOUNCEMENTS, stuck_announcement())
+    feed.on_announcement(topics.ASSISTANT_ANNOUNCEMENTS, stuck_announcement(id="vahr~stuck~2"))
+    feed.on_announcement(
+        topics.ASSISTANT_ANNOUNCEMENTS,
+        stuck_announcement(
+            id="vahr~offline~1",
+            thing="placebot2",
+            kind="offline",
+            speech="Placebot two has gone offline.",
+        ),
+    )
+    pages = [feed.subscribe(), feed.subscribe()]
+    for page in pages:
+        messages(page)
+    # When someone acknowledges placebot1's first alert
+    acknowledged = feed.acknowledge(first)
+    # Then both of placebot1's stuck alerts go, on every page, and placebot2's stays
+    assert acknowledged == [first, "vahr~stuck~2"]
+    for page in pages:
+        (told,) = [PAGE.decode(m) for m in page.take(0) or []]
+        assert told == AlertAcknowledgedMessage(ids=[first, "vahr~stuck~2"])
+    assert [a["id"] for a in feed.snapshot()["alerts"]] == ["vahr~offline~1"]
+    # And acknowledging again, or an id never announced, changes nothing
+    assert feed.acknowledge(first) == []
+    assert feed.acknowledge("vahr~nothing~0") == []
+    assert all(messages(page) == [] for page in pages)
+
+
+def test_open_alerts_are_bounded_oldest_first_out(feed: Feed) -> None:
+    for index in range(ALERTS_LIMIT + 3):
+        feed.on_announcement(
+            topics.ASSISTANT_ANNOUNCEMENTS, stuck_announcement(id=f"vahr~stuck~{index}")
+        )
+    alerts = feed.snapshot()["alerts"]
+    assert len(alerts) == ALERTS_LIMIT
+    assert alerts[0]["id"] == "vahr~stuck~3"
+
+
+def test_an_alert_is_acknowledged_through_the_stations_api(fleet: Fleet, feed: Feed) -> None:
+    wire = Wire()
+    desk = Desk(feed, wire.publish)
+    app = StationApp(
+        feed=feed,
+        controls=Controls(fleet, desk, wire.publish),
+        desk=desk,
+        assistant=RecordingAssistant(),
+        push_to_talk=None,
+        synthesize=None,
+    )
+    feed.on_announcement(topics.ASSISTANT_ANNOUNCEMENTS, stuck_announcement())
+    announced = json.loads(stuck_announcement())["id"]
+    # When a page posts the acknowledgment, then the station answers what it acknowledged
+    reply = app.handle_json("POST", "/api/acknowledge", json.dumps({"id": announced}).encode())
+    assert (reply.status, json.loads(reply.body)) == (200, {"acknowledged": [announced]})
+    assert feed.snapshot()["alerts"] == []
+    # And a body without an id is one line naming the field
+    reply = app.handle_json("POST", "/api/acknowledge", b"{}")
+    assert (reply.status, json.loads(reply.body)) == (400, {"error": "id: a string is required"})
+    # And nothing went to the robots
+    assert wire.sent == []

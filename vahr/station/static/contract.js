@@ -23,6 +23,32 @@
  */
 
 /**
+ * Someone acknowledged an alert on a station page: these announcements (the one acknowledged
+ * and any other still open about the same robot and trouble) are no longer shown as alerts.
+ * @typedef {object} AlertAcknowledgedMessage
+ * @property {"alert_acknowledged"} type
+ * @property {Array<string>} ids
+ */
+
+/**
+ * What the assistant told the person unprompted (a robot stuck, failed, offline...), with the
+ * robots it concerns. The page shows it as an alert until someone acknowledges it, and in the
+ * conversation.
+ * @typedef {object} AnnouncementMessage
+ * @property {"announcement"} type
+ * @property {Array<string>} robots
+ * @property {string} id
+ * @property {string} time
+ * @property {string|null} thing
+ * @property {"done"|"failed"|"offline"|"stuck"|"waiting"} kind
+ * @property {number} priority
+ * @property {string} speech
+ * @property {string|null} reason
+ * @property {string} person
+ * @property {string} opened_at
+ */
+
+/**
  * A command seen on a command topic (from the assistant, the console, a robot), to `target` (a
  * thing, or "fleet" for every robot in `robots`); `acks` grows as robots answer. `seen` is when
  * the station saw it (ms since the epoch).
@@ -289,15 +315,16 @@
 
 /**
  * What a page starts from: the fleet, every robot, the conversation so far, the commands seen
- * with their acknowledgments, the session, and the station's clock (ms since the epoch) for the
- * page to correct its own.
+ * with their acknowledgments, the session, the announcements nobody has acknowledged yet
+ * (oldest first), and the station's clock (ms since the epoch) for the page to correct its own.
  * @typedef {object} SnapshotMessage
  * @property {"snapshot"} type
  * @property {FleetView} fleet
  * @property {Record<string, RobotView>} robots
- * @property {Array<TurnMessage|CommandMessage|EventMessage>} conversation
+ * @property {Array<TurnMessage|CommandMessage|EventMessage|AnnouncementMessage>} conversation
  * @property {Record<string, CommandMessage>} commands
  * @property {ExperimentStatus|null} experiment
+ * @property {Array<AnnouncementMessage>} alerts
  * @property {number} server_time
  */
 
@@ -342,9 +369,9 @@
  * @property {string|null} key
  */
 
-/** @typedef {SnapshotMessage|ShadowMessage|PresenceMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage} PageMessage */
+/** @typedef {SnapshotMessage|ShadowMessage|PresenceMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage|AnnouncementMessage|AlertAcknowledgedMessage} PageMessage */
 
-/** @typedef {TurnMessage|CommandMessage|EventMessage} ConversationEntry */
+/** @typedef {TurnMessage|CommandMessage|EventMessage|AnnouncementMessage} ConversationEntry */
 
 /** @typedef {Interaction|PuzzleInput} StationInput */
 

@@ -9,7 +9,7 @@ import { zoneText } from "./map.js";
 import { sourceName } from "./robots.js";
 import { CONVERSATION_LIMIT } from "./contract.js";
 
-/** @import { CommandMessage, ConversationEntry, EventMessage, FleetView, TurnMessage } from "./contract.js" */
+/** @import { AnnouncementMessage, CommandMessage, ConversationEntry, EventMessage, FleetView, TurnMessage } from "./contract.js" */
 
 /** @type {Record<string, string>} */
 const ORIGINS = {
@@ -132,6 +132,7 @@ export class Conversation {
     if (message.type === "turn") item = this.turn(message);
     else if (message.type === "command") item = this.command(message);
     else if (message.type === "event") item = this.exchange(message);
+    else if (message.type === "announcement") item = this.announcement(message);
     if (!item) return;
     item.dataset.robots = (message.robots || []).join(" ");
     item.hidden = !this.visible(item);
@@ -224,6 +225,16 @@ export class Conversation {
     const said = node("div", "said");
     item.appendChild(said);
     this.watch(message.id, () => { said.textContent = this.commandLine(message.id); });
+    return item;
+  }
+
+  // What the assistant said unprompted (the page shows it as an alert too).
+  /** @param {AnnouncementMessage} message */
+  announcement(message) {
+    const item = node("li", "entry announcement");
+    item.dataset.kind = message.kind;
+    item.append(node("span", "who", "The assistant, unprompted"), node("time", "", clock(message.time)));
+    item.appendChild(node("div", "reply", message.speech));
     return item;
   }
 

@@ -53,6 +53,9 @@ function typingIn(target) {
 /** @param {EventTarget | null} target */
 function describe(target) {
   if (!(target instanceof Element)) return "click";
+  // An element that says what a click on it does (an alert's Acknowledge) is named so.
+  const does = target.closest("[data-interaction]")?.getAttribute("data-interaction");
+  if (does) return does;
   const thing = target.closest("[data-thing]")?.getAttribute("data-thing");
   const zone = target.closest("[data-zone]")?.getAttribute("data-zone");
   const labelled = target.closest("button, summary, select, input, [role=button]");

@@ -25,6 +25,8 @@ export const SETTLE_MS = 60; // a click's action starts after the release: time 
  * @property {string | null} [speech]
  * @property {string | null} [intent]
  * @property {string | null} [error]
+ * @property {string} [text] what the interaction did, in words, when the element it began on
+ *   does not say it (a key that acknowledged an alert): its text from then on
  */
 
 /**
@@ -101,6 +103,7 @@ export class Interactions {
       if (outcome.commands?.length) { interaction.commands.push(...outcome.commands); interaction.counts = true; }
       if (outcome.asks) { interaction.asks = true; interaction.counts = true; }
       for (const field of /** @type {const} */ (["speech", "intent", "error"])) if (outcome[field] !== undefined) interaction[field] = outcome[field];
+      if (outcome.text) interaction.text = outcome.text;
     }));
   }
 

@@ -203,6 +203,7 @@ export class MapView {
   drawRobot(robot, index, layers) {
     const group = el("g", { class: "robot", "data-thing": robot.thing, role: "button", "aria-label": robot.name }, layers.robots);
     el("title", {}, group).textContent = robot.name;
+    el("circle", { class: "robot-alert", r: 0.5 }, group);
     el("circle", { class: "robot-ring", r: 0.42 }, group);
     const rotor = el("g", {}, group);
     const body = el("circle", { class: "robot-body", r: 0.28 }, rotor);
@@ -267,6 +268,16 @@ export class MapView {
     const target = driving ? this.zonePose(destinationZone) : null;
     drawn.motion.report(pose, target);
     this.animate();
+  }
+
+  // The robots with an open alert, and about what: each is ringed in its trouble's colour.
+  /** @param {Map<string, string>} troubled */
+  setTroubled(troubled) {
+    for (const [thing, drawn] of this.robots) {
+      const trouble = troubled.get(thing);
+      drawn.group.classList.toggle("alerting", Boolean(trouble));
+      if (trouble) put(drawn.group, "data-trouble", trouble);
+    }
   }
 
   /** @param {boolean | undefined} on */

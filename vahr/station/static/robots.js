@@ -57,6 +57,12 @@ export class RobotsPanel {
     this.rows = new Map();
   }
 
+  // The robots with an open alert: their rows are marked until it is acknowledged.
+  /** @param {Map<string, string>} troubled */
+  setTroubled(troubled) {
+    for (const [thing, { row }] of this.rows) row.classList.toggle("alerting", troubled.has(thing));
+  }
+
   /** @param {FleetView} fleet */
   build(fleet) {
     this.list.replaceChildren();

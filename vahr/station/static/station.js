@@ -2,6 +2,7 @@
 // The station page: one stream of the station's messages (server-sent events, pushed as
 // things happen; the page never polls), one store, and the views that draw it.
 
+import { AlertsView } from "./alerts-view.js";
 import { post, reason, replyVoice, setReplyVoice, speak } from "./api.js";
 import { COMMANDS_LIMIT, DRIVE_ENDS, EXCHANGE_EVENTS } from "./contract.js";
 import { Conversation } from "./conversation.js";
@@ -13,7 +14,7 @@ import { Panel } from "./panel.js";
 import { RobotsPanel } from "./robots.js";
 import { Talk } from "./talk.js";
 
-/** @import { CommandMessage, EventMessage, ExperimentStatus, FleetView, PageMessage, Reported, RobotView, ShadowMessage, SnapshotMessage } from "./contract.js" */
+/** @import { AnnouncementMessage, CommandMessage, EventMessage, ExperimentStatus, FleetView, PageMessage, Reported, RobotView, ShadowMessage, SnapshotMessage } from "./contract.js" */
 /** @import { SayReply } from "./api.js" */
 
 /**
@@ -28,6 +29,7 @@ import { Talk } from "./talk.js";
  */
 
 /** A shadow update on its way to the screen. @typedef {{thing: string, version: number, received: number}} PaintMarker */
+/** An alert on its way to the screen. @typedef {{id: string, thing: string | null, kind: string, received: number}} AlertMarker */
 
 /**
  * What was drawn when, for benchmarks and tests (`?metrics=1`, `window.vahrMetrics`).
@@ -35,12 +37,14 @@ import { Talk } from "./talk.js";
  * @property {Array<PaintMarker & {at: number}>} painted
  * @property {Array<{reply_shown_ms: number, recognizer_ms: number, transcript: string}>} ptt
  * @property {Array<{thing: string, status: string, cargo: boolean, zone: string | null}>} shown
+ * @property {Array<AlertMarker & {at: number}>} alerts each alert when painted
+ * @property {number} beeps
  * @property {number} messages
  */
 
 // Benchmarks and tests read what was drawn when (`?metrics=1`).
 /** @type {Metrics | null} */
-const metrics = new URLSearchParams(location.search).has("metrics") ? { painted: [], ptt: [], shown: [], messages: 0 } : null;
+const metrics = new URLSearchParams(location.search).has("metrics") ? { painted: [], ptt: [], shown: [], alerts: [], beeps: 0, messages: 0 } : null;
 if (metrics) window.vahrMetrics = metrics;
 
 /** @type {Store} */
@@ -63,6 +67,15 @@ const experiment = new ExperimentView({
   verdicts: byId("verdicts", HTMLElement), clock: byId("experiment-clock", HTMLElement), puzzle: byId("puzzle-count", HTMLOutputElement),
   less: byId("puzzle-less", HTMLElement), more: byId("puzzle-more", HTMLElement), names,
   now: () => Date.now() + store.skew,
+});
+const alerts = new AlertsView({
+  box: byId("alerts", HTMLElement), interactions, names,
+  onChange(troubled) {
+    map.setTroubled(troubled);
+    robots.setTroubled(troubled);
+  },
+  onError: (problem) => panel.tell(problem, true),
+  onBeep: () => { if (metrics) metrics.beeps += 1; },
 });
 new Talk({ button: byId("talk", HTMLButtonElement), level: byId("talk-level", HTMLElement), state: byId("talk-state", HTMLElement), interactions, metrics });
 
@@ -111,21 +124,23 @@ function draw() {
   dirty.clear();
   map.updateArms();
   if (metrics && painted.length) {
-    // After this frame is painted: the first task once its rendering has run. A posted
-    // message, not a timer: timers wait behind other queued work (a stream's next batch).
-    afterFrame.push(painted.splice(0));
-    frameDone.port2.postMessage(null);
+    const markers = painted.splice(0);
+    afterPaint((at) => { for (const marker of markers) metrics.painted.push({ ...marker, at }); });
   }
 }
 
-/** @type {PaintMarker[][]} */
+// Call from an animation frame: `then` runs once that frame is painted, with the time. The
+// first task after its rendering: a posted message, not a timer, which would wait behind
+// other queued work (a stream's next batch).
+/** @type {Array<(at: number) => void>} */
 const afterFrame = [];
 const frameDone = new MessageChannel();
-frameDone.port1.onmessage = () => {
-  if (!metrics) return;
-  const at = performance.timeOrigin + performance.now();
-  for (const marker of afterFrame.shift() ?? []) metrics.painted.push({ ...marker, at });
-};
+frameDone.port1.onmessage = () => afterFrame.shift()?.(performance.timeOrigin + performance.now());
+/** @param {(at: number) => void} then */
+function afterPaint(then) {
+  afterFrame.push(then);
+  frameDone.port2.postMessage(null);
+}
 
 // Each robot's status, cargo and zone as drawn, whenever one of them changes (`?metrics=1`).
 /** @type {Record<string, string>} */
@@ -166,7 +181,16 @@ function reset(snapshot) {
     changed(thing);
   }
   onExperiment(snapshot.experiment);
+  alerts.reset(snapshot.alerts, first);
   if (store.selected) select(store.selected);
+}
+
+/** @param {AnnouncementMessage} message */
+function onAnnouncement(message) {
+  conversation.add(message);
+  if (!alerts.add(message) || !metrics) return;
+  const marker = { id: message.id, thing: message.thing, kind: message.kind, received: performance.timeOrigin + performance.now() };
+  requestAnimationFrame(() => afterPaint((at) => metrics.alerts.push({ ...marker, at })));
 }
 
 /** @param {ShadowMessage} message */
@@ -243,6 +267,10 @@ const handlers = {
   experiment(message) {
     onExperiment(message.status);
   },
+  announcement: onAnnouncement,
+  alert_acknowledged(message) {
+    alerts.acknowledged(message.ids);
+  },
 };
 
 function connect() {
@@ -287,4 +315,4 @@ byId("say-form", HTMLFormElement).addEventListener("submit", async (event) => {
 });
 
 connect();
-window.vahrStation = { store, map };
+window.vahrStation = { store, map, alerts };
