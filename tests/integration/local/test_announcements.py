@@ -22,9 +22,12 @@ SPEED = 20
 
 @pytest.fixture(scope="module")
 def up(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Up]:
+    # No station (it is not under test here), and every port free: never the defaults
+    # another `vahr up` on this machine may hold.
     running = start_up(
-        tmp_path_factory.mktemp("up"), "--mqtt-port", "0", "--sim-speed-factor", str(SPEED)
-    )
+        tmp_path_factory.mktemp("up"), "--mqtt-port", "0", "--station-port", "0",
+        "--sim-speed-factor", str(SPEED),
+    )  # fmt: skip
     try:
         yield running
     finally:
