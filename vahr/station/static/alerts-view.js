@@ -109,7 +109,7 @@ export class AlertsView {
     const name = latest.thing ? this.names[latest.thing] || latest.thing : "The fleet";
     const item = node("div", "alert");
     item.setAttribute("role", "alert");
-    item.dataset.kind = latest.kind;
+    item.dataset.trouble = latest.kind;
     item.dataset.key = alert.key;
     if (latest.thing) item.dataset.alertThing = latest.thing;
     item.appendChild(node("span", "alert-icon"));

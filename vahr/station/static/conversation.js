@@ -232,7 +232,7 @@ export class Conversation {
   /** @param {AnnouncementMessage} message */
   announcement(message) {
     const item = node("li", "entry announcement");
-    item.dataset.kind = message.kind;
+    item.dataset.trouble = message.kind;
     item.append(node("span", "who", "The assistant, unprompted"), node("time", "", clock(message.time)));
     item.appendChild(node("div", "reply", message.speech));
     return item;

@@ -203,7 +203,7 @@ export class MapView {
   drawRobot(robot, index, layers) {
     const group = el("g", { class: "robot", "data-thing": robot.thing, role: "button", "aria-label": robot.name }, layers.robots);
     el("title", {}, group).textContent = robot.name;
-    el("circle", { class: "robot-alert", r: 0.5 }, group);
+    el("circle", { class: "robot-alert", r: 0.38 }, group);
     el("circle", { class: "robot-ring", r: 0.42 }, group);
     const rotor = el("g", {}, group);
     const body = el("circle", { class: "robot-body", r: 0.28 }, rotor);

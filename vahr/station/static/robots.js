@@ -60,7 +60,11 @@ export class RobotsPanel {
   // The robots with an open alert: their rows are marked until it is acknowledged.
   /** @param {Map<string, string>} troubled */
   setTroubled(troubled) {
-    for (const [thing, { row }] of this.rows) row.classList.toggle("alerting", troubled.has(thing));
+    for (const [thing, { row }] of this.rows) {
+      const trouble = troubled.get(thing);
+      row.classList.toggle("alerting", Boolean(trouble));
+      if (trouble) row.dataset.trouble = trouble;
+    }
   }
 
   /** @param {FleetView} fleet */
