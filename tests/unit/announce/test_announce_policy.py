@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING
 
 import msgspec
 import pytest
-from conftest import load_event
 
+from tests.conftest import load_event
 from vahr.announce import (
     AnnouncePolicy,
     Dispatched,

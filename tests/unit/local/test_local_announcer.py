@@ -7,8 +7,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 from typing import TYPE_CHECKING
 
-from conftest import load_event
-
+from tests.conftest import load_event
 from vahr.announce import settings_from
 from vahr.local.announcer import Announcer
 from vahr.protocol import encode, topics
