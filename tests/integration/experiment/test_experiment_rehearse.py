@@ -18,8 +18,12 @@ def test_a_small_rehearsal_writes_the_csv_the_report_and_the_paper_beside_it(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "rehearsal"
-    # When a study of two participants, one trial per method, is rehearsed
-    code = main(["rehearse", "--participants", "2", "--trials", "1", "--out", str(out)])
+    # When a study of two participants, one trial per method, is rehearsed (at twice the
+    # default speed: the run waits on simulated time, and nothing here reads its figures)
+    code = main(
+        ["rehearse", "--participants", "2", "--trials", "1", "--speed-factor", "60",
+         "--out", str(out)]
+    )  # fmt: skip
     printed = capsys.readouterr()
     # Then it printed the paper's Table II beside the rehearsal's, labelled simulated
     assert code == 0, printed.err[-2000:]
