@@ -12,6 +12,7 @@ import boto3
 import pytest
 from moto import mock_aws
 
+from tests.faults import wait_until
 from tests.integration.local.shadow_clients import Boto3Shadows, MqttShadows, Shadows, unique_thing
 from vahr.local.mqtt import MqttClient
 from vahr.protocol import topics
@@ -160,7 +161,9 @@ def test_metadata_changes_only_for_keys_an_update_touches(
     moto_gap(request, shadows, "metadata timestamps are re-stamped for every key")
     shadows.update(thing, body({"state": {"reported": {"zone": "A", "cargo": False}}}))
     before = shadows.get(thing).body["metadata"]["reported"]
-    time.sleep(1.05)  # timestamps are whole seconds, as AWS's are
+    # Timestamps are whole seconds, as AWS's are: the next update comes in a later second.
+    stamped = before["cargo"]["timestamp"]
+    wait_until(lambda: time.time() >= stamped + 1, 2)
     shadows.update(thing, body({"state": {"reported": {"cargo": True}}}))
     after = shadows.get(thing).body["metadata"]["reported"]
     assert after["zone"] == before["zone"]
