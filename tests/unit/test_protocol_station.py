@@ -9,8 +9,8 @@ from datetime import UTC, datetime, timedelta
 
 import msgspec
 import pytest
-from conftest import load_event
 
+from tests.conftest import load_event
 from vahr.protocol import EventKind, ProtocolError
 from vahr.protocol.announcements import decode_announcement
 from vahr.protocol.station import (

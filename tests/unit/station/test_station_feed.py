@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 import pytest
-from conftest import load_event
 
+from tests.conftest import load_event
 from tests.support.station import RecordingAssistant, Wire
 from vahr.protocol import Event, EventPose, Presence, encode, new_command, topics, utc_now
 from vahr.protocol.station import (
