@@ -80,7 +80,8 @@ def swarm_fleet(count: int, *, prefix: str = "swarm", base: Fleet | None = None)
         zones=base.zones,
         groups=[Group(id=FLEET_GROUP, spoken=["all robots"], robots=things)],
         experiment_thing=base.experiment_thing,
-        floor=base.floor,
+        # The floor grows to hold the swarm's grid west of it (every start must lie on it).
+        floor=base.floor.covering([robot.start for robot in robots]) if base.floor else None,
     ).validate()
 
 

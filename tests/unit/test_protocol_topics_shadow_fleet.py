@@ -118,11 +118,11 @@ def test_the_default_fleet_is_the_papers(fleet: Fleet) -> None:
         ),
         (
             "robots: [{thing: r, spoken: [x], start: {x: 0, y: 0}}, {thing: r, spoken: [y], start: {x: 0, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\n",
-            "robots",
+            "robots.1.thing",
         ),
         (
             "robots: [{thing: r, spoken: [x], start: {x: 0, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\ngroups: [{id: g, spoken: [g], robots: [q]}]\n",
-            "groups.0.robots",
+            "groups.0.robots.0",
         ),
         (
             "robots: [{thing: r, spoken: [x], start: {x: zero, y: 0}}]\nzones: [{id: LOADING, spoken: [l], pose: {x: 0, y: 0}}]\n",

@@ -59,12 +59,14 @@ def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
         for g in groups
         if g.robots or g.id == FLEET_GROUP
     ]
+    # The robots added start west of the floor the file draws: it grows to hold them.
+    floor = base.floor.covering([robot.start for robot in robots]) if base.floor else None
     return Fleet(
         robots=robots,
         zones=base.zones,
         groups=groups,
         experiment_thing=base.experiment_thing,
-        floor=base.floor,
+        floor=floor,
     ).validate()
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from functools import cached_property
 from typing import Annotated, Literal
 
@@ -78,6 +79,32 @@ class Floor(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     arms: dict[str, Point] = {}
     led: Point | None = None
 
+    def holds(self, point: Pose | Point) -> bool:
+        """Whether `point` lies on the floor's rectangle (its edges included)."""
+        return (
+            self.origin.x <= point.x <= self.origin.x + self.width
+            and self.origin.y <= point.y <= self.origin.y + self.height
+        )
+
+    def extent(self) -> str:
+        """The rectangle in words, for errors: `x 0 to 10.5, y 0 to 8`."""
+        x, y = self.origin.x, self.origin.y
+        return f"x {x:g} to {x + self.width:g}, y {y:g} to {y + self.height:g}"
+
+    def covering(self, points: list[Pose]) -> Floor:
+        """This floor, its rectangle grown to hold `points` with `FLOOR_MARGIN_M` to spare
+        (robots added to a fleet in code park beside the building); itself when it does."""
+        outside = [point for point in points if not self.holds(point)]
+        if not outside:
+            return self
+        left = min([self.origin.x] + [p.x - FLOOR_MARGIN_M for p in outside])
+        bottom = min([self.origin.y] + [p.y - FLOOR_MARGIN_M for p in outside])
+        right = max([self.origin.x + self.width] + [p.x + FLOOR_MARGIN_M for p in outside])
+        top = max([self.origin.y + self.height] + [p.y + FLOOR_MARGIN_M for p in outside])
+        return msgspec.structs.replace(
+            self, origin=Point(left, bottom), width=right - left, height=top - bottom
+        )
+
 
 # A derived floor leaves this much room around the zones and the robots' start poses.
 FLOOR_MARGIN_M = 1.0
@@ -121,7 +148,13 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
     floor: Floor | None = None
 
     def validate(self) -> Fleet:
-        """Check the rules that span fields; return self. `from_yaml` calls this."""
+        """Check the rules that span fields; return self. `from_yaml` calls this.
+
+        Each error names the entry (`robots.2.thing`, `zones.1.spoken.0`) and the reason:
+        thing names valid; things, zone ids, group ids, a group's members and every spoken
+        name used once; a zone LOADING; a group's members robots of the fleet; every pose
+        reachable (`_check_reachable`); the floor's arms at zones with an arm.
+        """
         for index, robot in enumerate(self.robots):
             try:
                 check_thing(robot.thing)
@@ -131,17 +164,15 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
             check_thing(self.experiment_thing)
         except ValueError as err:
             raise ProtocolError("experiment_thing", str(err).split(": ", 1)[1]) from err
-        _require_unique("robots", [robot.thing for robot in self.robots])
-        _require_unique("zones", [zone.id for zone in self.zones])
-        _require_unique("groups", [group.id for group in self.groups])
+        _require_unique([(f"robots.{i}.thing", r.thing) for i, r in enumerate(self.robots)])
+        _require_unique([(f"zones.{i}.id", zone.id) for i, zone in enumerate(self.zones)])
+        _require_unique([(f"groups.{i}.id", group.id) for i, group in enumerate(self.groups)])
         if "LOADING" not in self.zone_ids:
             raise ProtocolError("zones", "a zone with id LOADING is required for deliveries")
         for index, group in enumerate(self.groups):
-            for member in group.robots:
-                if member not in self.robot_things:
-                    raise ProtocolError(
-                        f"groups.{index}.robots", f"{member!r} is not a robot of the fleet"
-                    )
+            self._check_members(f"groups.{index}.robots", group.robots)
+        self._check_spoken_names()
+        _check_reachable(self)
         if self.floor is not None:
             with_arms = {zone.id for zone in self.zones if zone.arm is not None}
             for zone_id in self.floor.arms:
@@ -151,8 +182,43 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
                     )
         return self
 
+    def _check_members(self, field: str, members: list[str]) -> None:
+        _require_unique([(f"{field}.{i}", member) for i, member in enumerate(members)])
+        for index, member in enumerate(members):
+            if member in self.robot_things:
+                continue
+            what = "is a zone, not a robot" if member in self.zone_ids else "is not a robot"
+            raise ProtocolError(
+                f"{field}.{index}",
+                f"{member!r} {what} of the fleet; robots are {_listed(self.robot_things)}",
+            )
+
+    def _check_spoken_names(self) -> None:
+        """One name means one thing, across robots, zones and groups, as people say it
+        (lower-cased, single-spaced); without a group `all`, its default names are taken."""
+        spoken = [
+            *((f"robots.{index}", robot.spoken) for index, robot in enumerate(self.robots)),
+            *((f"zones.{index}", zone.spoken) for index, zone in enumerate(self.zones)),
+            *((f"groups.{index}", group.spoken) for index, group in enumerate(self.groups)),
+        ]
+        named = [
+            (f"{entry}.spoken.{k}", name) for entry, names in spoken for k, name in enumerate(names)
+        ]
+        if not any(group.id == FLEET_GROUP for group in self.groups):
+            default = "the fleet's default names, as no group is `all`"
+            named = [(default, name) for name in FLEET_GROUP_NAMES] + named
+        said = []
+        for field, name in named:
+            words = " ".join(name.lower().split())
+            if not words:
+                raise ProtocolError(field, "is blank")
+            said.append((field, words))
+        _require_unique(said)
+
     @classmethod
     def from_yaml(cls, text: str | bytes) -> Fleet:
+        if not text.strip():
+            raise ProtocolError("fleet", "is empty; a fleet needs robots: and zones:")
         try:
             fleet = msgspec.yaml.decode(text, type=cls)
         except msgspec.ValidationError as err:
@@ -161,7 +227,9 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
             field = "fleet" if error.field == "payload" else error.field
             raise ProtocolError(field, error.reason) from err
         except msgspec.DecodeError as err:
-            raise ProtocolError("fleet", f"is not valid YAML ({err})") from err
+            # PyYAML's message spans lines and names its own input; one line, where it is.
+            reason = re.sub(r' in "<[a-z ]+>",', " at", " ".join(str(err).split()))
+            raise ProtocolError("fleet", f"is not valid YAML ({reason})") from err
         return fleet.validate()
 
     @cached_property
@@ -226,12 +294,78 @@ def _derived_floor(fleet: Fleet) -> Floor:
     )
 
 
-def _require_unique(field: str, values: list[str]) -> None:
-    seen: set[str] = set()
-    for value in values:
-        if value in seen:
-            raise ProtocolError(field, f"{value!r} appears twice")
-        seen.add(value)
+def _require_unique(entries: list[tuple[str, str]]) -> None:
+    """Each (field, value) pair's value once; the second use is the error, naming the first."""
+    first: dict[str, str] = {}
+    for field, value in entries:
+        if value in first:
+            raise ProtocolError(field, f"{value!r} is used twice (also {first[value]})")
+        first[value] = field
+
+
+# An error lists at most this many robots of the fleet.
+LISTED_MAX = 8
+
+
+def _listed(values: tuple[str, ...]) -> str:
+    shown = ", ".join(values[:LISTED_MAX])
+    return shown if len(values) <= LISTED_MAX else f"{shown} and {len(values) - LISTED_MAX} more"
+
+
+def _check_reachable(fleet: Fleet) -> None:
+    """Every pose is one a simulated robot can stand at or drive to.
+
+    The simulator drives in a straight line from anywhere to anywhere (walls are drawn, not
+    driven around), so a pose is unreachable only when it is not a place at all: a
+    coordinate or heading that is not a finite number, or, when the file gives a `floor`,
+    a point outside its rectangle. Without a floor, the one drawn is derived around every
+    pose, which therefore lies on it.
+    """
+    floor = fleet.floor
+    if floor is not None:
+        for field, value in (("floor.width", floor.width), ("floor.height", floor.height)):
+            if not math.isfinite(value):
+                raise ProtocolError(field, "is not a finite number")
+        for field, point in _floor_points(floor):
+            _check_finite(field, point)
+    places = [
+        (f"robots.{index}.start", robot.start, "the robot cannot start there")
+        for index, robot in enumerate(fleet.robots)
+    ]
+    places += [
+        (f"zones.{index}.pose", zone.pose, "no robot can reach it")
+        for index, zone in enumerate(fleet.zones)
+    ]
+    for field, pose, consequence in places:
+        _check_finite(field, pose)
+        if floor is not None and not floor.holds(pose):
+            raise ProtocolError(
+                field,
+                f"({pose.x:g}, {pose.y:g}) is outside the floor ({floor.extent()}), "
+                f"so {consequence}",
+            )
+
+
+def _check_finite(field: str, point: Pose | Point) -> None:
+    for name in point.__struct_fields__:
+        if not math.isfinite(getattr(point, name)):
+            raise ProtocolError(f"{field}.{name}", "is not a finite number")
+
+
+def _floor_points(floor: Floor) -> list[tuple[str, Point]]:
+    points = [("floor.origin", floor.origin)]
+    for index, wall in enumerate(floor.walls):
+        points += [
+            (f"floor.walls.{index}.start", wall.start),
+            (f"floor.walls.{index}.end", wall.end),
+        ]
+    if floor.conveyor is not None:
+        points += [("floor.conveyor.start", floor.conveyor.start)]
+        points += [("floor.conveyor.end", floor.conveyor.end)]
+    points += [(f"floor.arms.{zone_id}", point) for zone_id, point in floor.arms.items()]
+    if floor.led is not None:
+        points.append(("floor.led", floor.led))
+    return points
 
 
 def load_fleet(path: str | os.PathLike[str] | None = None) -> Fleet:

@@ -9,6 +9,7 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 import pytest
 from ask_sdk_core.serialize import DefaultSerializer
 from skill_testkit import speech
@@ -18,7 +19,7 @@ from skill.config import SkillConfig
 from skill.runtime import SkillRuntime
 from skill.vocabulary import FLEET
 from tests.conftest import EVENTS_DIR, load_event
-from vahr.protocol import Fleet
+from vahr.protocol import Fleet, ProtocolError
 from vahr.skill_model import FLEET_ROBOT_ID, ModelError, build_files, build_interaction_model
 from vahr.skill_model.__main__ import main as skill_model_main
 from vahr.skill_model.generator import (
@@ -69,7 +70,7 @@ def test_check_flag_reports_drift_and_exits_non_zero(
     fleet_file.write_text(
         text.replace(
             "\ngroups:",
-            "  - id: E\n    spoken: [zone e, echo]\n    pose: {x: 9.0, y: 9.0}\n\ngroups:",
+            "  - id: E\n    spoken: [zone e, echo]\n    pose: {x: 5.0, y: 7.0}\n\ngroups:",
         )
     )
     out = tmp_path / "checkout"
@@ -259,8 +260,13 @@ def test_generator_refuses_a_sample_with_digits_or_punctuation(fleet: Fleet) -> 
 
 def test_generator_refuses_a_name_given_to_two_zones(fleet: Fleet) -> None:
     text = FLEET_FILE.read_text().replace("[zone b, b,", "[zone b, a,")
+    # The fleet file itself is refused, naming the entry
+    with pytest.raises(ProtocolError, match=r"^zones.2.spoken.1: 'a' is used twice \(also zones"):
+        Fleet.from_yaml(text)
+    # and so is a fleet that was never validated, by the generator
+    unchecked = msgspec.yaml.decode(text, type=Fleet)
     with pytest.raises(ModelError, match="the name 'a' is used by both 'A' and 'B'"):
-        build_interaction_model(Fleet.from_yaml(text), CUSTOM_INTENTS)
+        build_interaction_model(unchecked, CUSTOM_INTENTS)
 
 
 def test_elicitation_answers_never_read_as_another_intent() -> None:
