@@ -18,9 +18,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from vahr.cli_dispatch import add_logging_flag, setup_logging
+from vahr.commands.fleet_flag import add_fleet_flag, read_fleet
 
 if TYPE_CHECKING:
     import argparse
+
+    from vahr.protocol import Fleet
 
 WAIT_TIMEOUT_S = 30.0
 
@@ -35,30 +38,70 @@ class Step:
     voice: bool = False  # needs the room assistant
 
 
+# The paper's scenario. Each name in braces is said as the fleet run says it (`script_for`):
+# {first} and {second} are its first two robots (and, in `until`, their things), {all} and
+# {everyone} the whole fleet, {LOADING}, {A}, {C} and {D} those zones, and {B} a zone to
+# drive to (B when the fleet has one).
 SCRIPT = (
     Step("Alexa, open robot fleet"),
-    Step("send robot one to zone b", until=(("placebot1", "arrived"),)),
-    Step("send all robots to the loading zone", until=(("placebot1", "arrived"),
-                                                       ("placebot2", "arrived"))),
-    Step("where is robot two"),
-    Step("have robot two deliver a package to zone d", until=(("placebot2", "delivered"),)),
+    Step("send {first} to {B}", until=(("first", "arrived"),)),
+    Step("send {all} to {LOADING}", until=(("first", "arrived"), ("second", "arrived"))),
+    Step("where is {second}"),
+    Step("have {second} deliver a package to {D}", until=(("second", "delivered"),)),
     Step(
-        "robot one deliver to zone a then robot two deliver to zone c",
-        until=(("placebot1", "delivered"), ("placebot2", "delivered")),
+        "{first} deliver to {A} then {second} deliver to {C}",
+        until=(("first", "delivered"), ("second", "delivered")),
     ),
-    Step("send everyone to zone b"),
-    Step("emergency stop", until=(("placebot1", "stopped"), ("placebot2", "stopped"))),
+    Step("send {everyone} to {B}"),
+    Step("emergency stop", until=(("first", "stopped"), ("second", "stopped"))),
     Step(
-        "have robot one deliver based on the weather",
-        until=(("placebot1", "delivered"),),
+        "have {first} deliver based on the weather",
+        until=(("first", "delivered"),),
         voice=True,
     ),
     Step("where are the robots"),
     Step("exit"),
 )  # fmt: skip
+# What the script calls each part of the paper's fleet; a fleet without such a name is
+# called by its first spoken name.
+PAPER_NAMES = {
+    "first": "robot one", "second": "robot two", "all": "all robots", "everyone": "everyone",
+    "LOADING": "the loading zone", "A": "zone a", "B": "zone b", "C": "zone c", "D": "zone d",
+}  # fmt: skip
+
+
+def script_for(fleet: Fleet) -> list[Step]:
+    """The scenario in the fleet's names, for a fleet fit for the paper's tasks."""
+    from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
+
+    def said(role: str, spoken: list[str] | tuple[str, ...]) -> str:
+        return PAPER_NAMES[role] if PAPER_NAMES[role] in spoken else spoken[0]
+
+    first, second = fleet.robots[0], fleet.robots[1]
+    group = next((g.spoken for g in fleet.groups if g.id == FLEET_GROUP), FLEET_GROUP_NAMES)
+    elsewhere = [z.id for z in fleet.zones if z.id not in ("LOADING", "A", "C", "D")]
+    zones = {zone_id: fleet.zone(zone_id) for zone_id in ("LOADING", "A", "C", "D")}
+    zones["B"] = fleet.zone("B" if "B" in fleet.zone_ids else (elsewhere or ["A"])[0])
+    names = {
+        "first": said("first", first.spoken),
+        "second": said("second", second.spoken),
+        "all": said("all", group),
+        "everyone": said("everyone", group),
+        **{role: said(role, zone.spoken) for role, zone in zones.items()},
+    }
+    things = {"first": first.thing, "second": second.thing}
+    return [
+        Step(
+            step.utterance.format(**names),
+            tuple((things[role], kind) for role, kind in step.until),
+            step.voice,
+        )
+        for step in SCRIPT
+    ]
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
+    add_fleet_flag(parser)
     parser.add_argument(
         "--sim-speed-factor", type=float, default=20.0, help="simulated time speed-up (20)"
     )
@@ -103,10 +146,15 @@ class _Events:
 
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
+    from vahr.experiment.tasks import require_fit_fleet
     from vahr.local.ports import free_port
     from vahr.local.system import LocalSystem, SystemConfig
 
     setup_logging(args.log_level)
+    fleet = read_fleet(args.fleet)
+    # The script and the experiment use the paper's zones and two robots: checked first.
+    require_fit_fleet(fleet)
+    script = script_for(fleet)
     events = _Events()
     with tempfile.TemporaryDirectory(prefix="vahr-demo-") as state:
         config = SystemConfig(
@@ -115,6 +163,7 @@ def run(args: argparse.Namespace) -> int:
             # The simulated participant's console publishes on the loopback dev listener.
             mqtt_port=free_port(),
             api_port=free_port(),
+            fleet=fleet,
             sim_speed_factor=args.sim_speed_factor,
             voice=not args.no_voice,
             log_level=args.log_level,
@@ -131,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
             assert system.alexa is not None and system.stack.dataplane is not None
             latencies: list[float] = []
             failures: list[str] = []
-            for step in SCRIPT:
+            for step in script:
                 if step.voice and not system.voice_enabled:
                     continue
                 turn = system.alexa.say(step.utterance)

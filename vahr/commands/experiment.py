@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from vahr.commands.broker_flags import add_broker_flags, client_credentials
+from vahr.commands.fleet_flag import add_fleet_flag, fleet_for
 from vahr.errors import VahrError
 
 if TYPE_CHECKING:
@@ -43,7 +44,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         default=DEFAULT_LOG_DIR,
         help=f"where session logs live (default: {DEFAULT_LOG_DIR})",
     )
-    parser.add_argument("--fleet", type=Path, default=None, help="fleet file (default: fleet.yaml)")
+    add_fleet_flag(parser, beside_a_stack=True)
     add_broker_flags(
         parser,
         purpose="to record from and send console commands to",
@@ -92,8 +93,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from vahr.experiment.session import SessionSpec, open_session
-    from vahr.experiment.tasks import default_seed
-    from vahr.protocol import load_fleet
+    from vahr.experiment.tasks import default_seed, require_fit_fleet
 
     if args.speed_factor <= 0 or (args.speed_factor != 1.0 and not args.simulate):
         raise VahrError("--speed-factor must be > 0 and is only for --simulate")
@@ -101,7 +101,9 @@ def run(args: argparse.Namespace) -> int:
         raise VahrError("--task-timeout must be > 0")
     if args.pause < 0:
         raise VahrError("--pause must be >= 0")
-    fleet = load_fleet(args.fleet)
+    fleet = fleet_for(args.fleet, args.api)
+    # Before the session's log is opened: a fleet the tasks cannot run on leaves nothing.
+    require_fit_fleet(fleet)
     seed = (
         args.seed
         if args.seed is not None

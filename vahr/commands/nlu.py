@@ -19,8 +19,16 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "utterance", nargs="?", help='what a person says, e.g. "send robot one to zone b"'
     )
-    parser.add_argument(
+    names = parser.add_mutually_exclusive_group()
+    names.add_argument(
         "--model", type=Path, help="interaction model JSON (default: skill-package en-US)"
+    )
+    names.add_argument(
+        "--fleet",
+        type=Path,
+        metavar="FILE",
+        help="understand the names of this fleet file (its interaction model, generated in "
+        "memory) instead",
     )
     parser.add_argument(
         "--eval",
@@ -35,16 +43,15 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
-    from vahr.local.alexa.nlu import InteractionModel
     from vahr.local.alexa.simulator import strip_invocation
 
     if args.eval is not None:
         if args.utterance:
             raise VahrError("give an utterance or --eval, not both")
-        return _evaluate(InteractionModel.load(args.model), args.eval, args.json)
+        return _evaluate(_model(args), args.eval, args.json)
     if args.utterance is None or not args.utterance.strip():
         raise VahrError("the utterance is empty")
-    model = InteractionModel.load(args.model)
+    model = _model(args)
     understood = model.understand(strip_invocation(model.invocation_name, args.utterance))
     printed = describe(understood)
     if args.json:
@@ -64,6 +71,17 @@ def run(args: argparse.Namespace) -> int:
             how = "" if slot["similarity"] == 100 else f", heard at {slot['similarity']:.0f}%"
             print(f"slot        {name}: {slot['value']!r} -> {slot['id']}{how}")
     return 0
+
+
+def _model(args: argparse.Namespace) -> InteractionModel:
+    from vahr.local.alexa.nlu import InteractionModel
+
+    if args.fleet is None:
+        return InteractionModel.load(args.model)
+    from vahr.commands.fleet_flag import read_fleet
+    from vahr.skill_model.generator import build_interaction_model
+
+    return InteractionModel(build_interaction_model(read_fleet(args.fleet)))
 
 
 def describe(understood: Understanding) -> dict[str, Any]:

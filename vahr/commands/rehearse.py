@@ -24,6 +24,8 @@ from vahr.errors import VahrError
 if TYPE_CHECKING:
     import argparse
 
+    from vahr.protocol import Fleet
+
 DEFAULT_OUT = Path("out") / "rehearsal"
 DEFAULT_SPEED = 30.0
 
@@ -41,6 +43,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--broker", default=None, help="a running `vahr up`'s mqtt:// URL (with --api)"
+    )
+    parser.add_argument(
+        "--fleet",
+        type=Path,
+        metavar="FILE",
+        help="fleet file for the stack it starts (default: fleet.yaml); with --api, the "
+        "running stack's fleet is used",
     )
     parser.add_argument(
         "--speed-factor",
@@ -79,6 +88,11 @@ def _check(args: argparse.Namespace) -> None:
         raise VahrError("--task-timeout must be more than 0")
     if (args.api is None) != (args.broker is None):
         raise VahrError("--api and --broker go together (a running `vahr up`'s endpoints)")
+    if args.api is not None and args.fleet is not None:
+        raise VahrError(
+            "--fleet is for the stack rehearse starts; with --api it rehearses on the running "
+            "stack's fleet (give --fleet to that `vahr up`)"
+        )
 
 
 def speed_factor(api: str | None, asked: float | None) -> float:
@@ -109,11 +123,16 @@ def speed_factor(api: str | None, asked: float | None) -> float:
 
 
 def run(args: argparse.Namespace) -> int:
+    from vahr.commands.fleet_flag import fleet_for
     from vahr.experiment.study import StudySpec, run_study
+    from vahr.experiment.tasks import require_fit_fleet
 
     _check(args)
     setup_logging(args.log_level)
     args.speed_factor = speed_factor(args.api, args.speed_factor)
+    # The running stack's fleet with --api, else the file's: checked before anything starts.
+    fleet = fleet_for(args.fleet, args.api)
+    require_fit_fleet(fleet)
     spec = StudySpec(
         participants=args.participants,
         trials=args.trials,
@@ -129,18 +148,16 @@ def run(args: argparse.Namespace) -> int:
 
     started = time.monotonic()
     if args.api is not None:
-        from vahr.protocol import load_fleet
-
-        report = run_study(
-            spec, load_fleet(), broker_url=args.broker, api_url=args.api, announce=announce
-        )
+        report = run_study(spec, fleet, broker_url=args.broker, api_url=args.api, announce=announce)
     else:
-        report = _on_own_stack(spec, args, announce)
+        report = _on_own_stack(spec, fleet, args, announce)
     _print(report, args, time.monotonic() - started)
     return 0
 
 
-def _on_own_stack(spec: Any, args: argparse.Namespace, announce: Any) -> dict[str, Any]:
+def _on_own_stack(
+    spec: Any, fleet: Fleet, args: argparse.Namespace, announce: Any
+) -> dict[str, Any]:
     from vahr.experiment.study import run_study
     from vahr.local.ports import free_port
     from vahr.local.system import LocalSystem, SystemConfig
@@ -151,6 +168,7 @@ def _on_own_stack(spec: Any, args: argparse.Namespace, announce: Any) -> dict[st
             mqtts_port=free_port(),
             mqtt_port=free_port(),  # the participant's panel publishes on the loopback listener
             api_port=free_port(),
+            fleet=fleet,
             sim_speed_factor=args.speed_factor,
             voice=True,
             log_level=args.log_level,

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 from vahr.cli_dispatch import add_logging_flag, setup_logging
 from vahr.commands.broker_flags import add_broker_flags, client_credentials
+from vahr.commands.fleet_flag import add_fleet_flag, fleet_for
 
 if TYPE_CHECKING:
     import argparse
@@ -31,9 +32,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="the iot-data endpoint: vahr up's api URL, or https://ENDPOINT on AWS "
         "(shadows at start-up, and the assistant for push-to-talk)",
     )
-    parser.add_argument("--fleet", type=Path, help="fleet file (default: fleet.yaml)")
+    add_fleet_flag(parser, beside_a_stack=True)
     parser.add_argument(
-        "--model", type=Path, help="interaction model (default: the skill's en-US model)"
+        "--model", type=Path, help="interaction model (default: the one generated from the fleet)"
     )
     parser.add_argument(
         "--host",
@@ -52,7 +53,6 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
-    from vahr.protocol import load_fleet
     from vahr.station.deployment import Deployment, build_station
     from vahr.station.station import StationConfig
 
@@ -62,7 +62,13 @@ def run(args: argparse.Namespace) -> int:
     if args.token is not None and len(args.token) < 16:
         raise VahrError("--token must be at least 16 characters")
     tls = client_credentials(args)
-    deployment = Deployment(broker=args.broker, fleet=load_fleet(args.fleet), tls=tls, api=args.api)
+    deployment = Deployment(
+        broker=args.broker,
+        fleet=fleet_for(args.fleet, args.api),
+        fleet_file=args.fleet,
+        tls=tls,
+        api=args.api,
+    )
     config = StationConfig(
         port=args.port,
         host=args.host,

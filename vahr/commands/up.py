@@ -10,11 +10,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from vahr.cli_dispatch import add_logging_flag, setup_logging
+from vahr.commands.fleet_flag import add_fleet_flag, read_fleet
 
 if TYPE_CHECKING:
     import argparse
 
-    from vahr.protocol import Event
+    from vahr.protocol import Event, Fleet
 
 DEFAULT_API_PORT = 8180
 DEFAULT_STATION_PORT = 8181
@@ -22,7 +23,10 @@ DEFAULT_STATE_DIR = Path(".state")
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--robots", type=int, help="how many robots (default: fleet.yaml's)")
+    add_fleet_flag(parser)
+    parser.add_argument(
+        "--robots", type=int, help="how many of the fleet's robots (default: all; more adds some)"
+    )
     parser.add_argument(
         "--state-dir", type=Path, default=DEFAULT_STATE_DIR, help="local state (default .state)"
     )
@@ -70,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
         mqtts_port=args.mqtts_port,
         mqtt_port=args.mqtt_port or None,
         api_port=args.api_port,
+        fleet=read_fleet(args.fleet),
         robots=args.robots,
         sim_speed_factor=args.sim_speed_factor,
         ack_timeout_s=args.ack_timeout,
@@ -97,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
         if args.json:
             _emit(json.dumps(endpoints))
         else:
-            _emit(_banner(endpoints, list(system.fleet.robot_things), system.voice_enabled))
+            _emit(_banner(endpoints, system.fleet, system.voice_enabled))
         while not stopping.wait(0.5):
             for line in system.supervise():
                 print(f"vahr up: {line}", file=sys.stderr, flush=True)
@@ -114,7 +119,11 @@ def _emit(line: str) -> None:
     print(line, flush=True)
 
 
-def _banner(endpoints: dict[str, str | None], things: list[str], voice: bool) -> str:
+def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
+    things = fleet.robot_things
+    # An example in the fleet's own words: its first robot to its first zone but LOADING.
+    zone = next((z for z in fleet.zones if z.id != "LOADING"), fleet.zones[0])
+    example = f"send {fleet.robots[0].spoken[0]} to {zone.spoken[0]}"
     lines = [
         "VAHR is up on this machine.",
         f"  data plane  {endpoints['api']}   (AWS_ENDPOINT_URL_IOT_DATA_PLANE)",
@@ -125,7 +134,7 @@ def _banner(endpoints: dict[str, str | None], things: list[str], voice: bool) ->
     lines += [
         f"  station     {endpoints['station'] or '(off)'}   (the operator station page)",
         f"  robots      {', '.join(things)} (sim backend{', room voice' if voice else ''})",
-        '  talk to it: vahr say "send robot one to zone b"   (Ctrl-C stops everything)',
+        f'  talk to it: vahr say "{example}"   (Ctrl-C stops everything)',
     ]
     return "\n".join(lines)
 

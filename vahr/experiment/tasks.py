@@ -18,6 +18,7 @@ import random
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
+from vahr.errors import VahrError
 from vahr.protocol import WEATHER_ZONES, WEATHERS, ExperimentState
 
 if TYPE_CHECKING:
@@ -102,16 +103,41 @@ def delivery_zones(fleet: Fleet) -> list[str]:
     return [zone.id for zone in fleet.zones if zone.arm == "unloader"]
 
 
+# The delivery zones the tasks name: task II's weather zones and task III's.
+NEEDED_ZONES = (*sorted(set(WEATHER_ZONES.values())), SEQUENCE_ZONE)
+
+
+class UnfitFleet(VahrError):
+    """The fleet lacks robots or zones the paper's tasks need."""
+
+
+def require_fit_fleet(fleet: Fleet) -> None:
+    """Raise UnfitFleet, in one line saying what the tasks need and what the fleet lacks,
+    unless it has two robots (task III's first and second) and the delivery zones
+    NEEDED_ZONES (zones with an unloading arm)."""
+    lacking = [zone for zone in NEEDED_ZONES if zone not in delivery_zones(fleet)]
+    missing = (
+        [f"delivery zone{'s' if len(lacking) > 1 else ''} {_words(lacking)}"] if lacking else []
+    )
+    if len(fleet.robots) < 2:
+        missing.append("a second robot")
+    if missing:
+        raise UnfitFleet(
+            f"the paper's tasks need two robots and delivery zones {_words(NEEDED_ZONES)} "
+            f"(zones with arm: unloader); this fleet lacks {' and '.join(missing)}"
+        )
+
+
+def _words(items: tuple[str, ...] | list[str]) -> str:
+    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} and {items[-1]}"
+
+
 def draw_plan(fleet: Fleet, seed: int) -> Plan:
     """Draw the zone assignments (distinct zones when there are enough) and the weather."""
+    require_fit_fleet(fleet)
     rng = random.Random(seed)
     zones = delivery_zones(fleet)
-    for needed in (*WEATHER_ZONES.values(), SEQUENCE_ZONE):
-        if needed not in zones:
-            raise ValueError(f"the experiment needs a delivery zone {needed} in the fleet")
     robots = list(fleet.robot_things)
-    if len(robots) < 2:
-        raise ValueError("the experiment needs at least two robots in the fleet")
     if len(zones) >= len(robots):
         assigned = rng.sample(zones, len(robots))
     else:

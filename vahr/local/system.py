@@ -21,6 +21,8 @@ from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
+import msgspec
+
 from vahr.errors import VahrError
 from vahr.local.announcer import LocalAnnouncer
 from vahr.local.client import SimulatorAssistant
@@ -30,6 +32,7 @@ from vahr.local.robots import ProgressRate, RobotProcesses, fleet_of, write_flee
 from vahr.local.shadow_store import ShadowError
 from vahr.local.stack import LocalStack, StackConfig
 from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
+from vahr.skill_model.generator import build_interaction_model, render
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -53,6 +56,9 @@ class SystemConfig:
     mqtts_port: int
     mqtt_port: int | None
     api_port: int
+    # The fleet to run (`vahr up --fleet FILE`); None is the bundled fleet.yaml. `robots`
+    # then keeps its first N robots, or adds more.
+    fleet: Fleet | None = None
     robots: int | None = None
     sim_speed_factor: float = 1.0
     ack_timeout_s: float | None = None
@@ -106,7 +112,7 @@ class LocalSystem:
         self.config = config
         self.start_station = start_station
         self.on_event = on_event
-        self.fleet: Fleet = fleet_of(config.robots)
+        self.fleet: Fleet = fleet_of(config.robots, config.fleet)
         self.stack = LocalStack(
             StackConfig(
                 state_dir=config.state_dir,
@@ -147,18 +153,28 @@ class LocalSystem:
 
     def start(self) -> LocalSystem:
         cfg = self.config
+        # The simulator understands the names of the fleet it runs: its interaction model is
+        # generated from that fleet (skill-package/ holds the bundled fleet's). First, as a
+        # fleet Alexa would refuse stops the start before anything runs.
+        model = build_interaction_model(self.fleet)
         if cfg.station_port:
             # The data plane's port first: a conflict is named the same with or without a station.
             ensure_free(cfg.api_port, "data-plane API")
             ensure_free(cfg.station_port, "operator station")
         try:
             fleet_file = write_fleet(self.fleet, cfg.state_dir / "fleet.yaml")
+            model_file = cfg.state_dir / "interaction-model.json"
+            model_file.write_text(render(model), encoding="utf-8")
             self.stack.start()
             self.alexa = self.stack.attach_alexa(
-                ack_timeout_s=cfg.ack_timeout_s, fleet_file=fleet_file, log_level=cfg.log_level
+                ack_timeout_s=cfg.ack_timeout_s,
+                model_file=model_file,
+                fleet_file=fleet_file,
+                log_level=cfg.log_level,
             )
             assert self.stack.dataplane is not None and self.stack.ca is not None
             self.stack.dataplane.local_routes[("GET", "/vahr/status")] = self._status
+            self.stack.dataplane.local_routes[("GET", "/vahr/fleet")] = self._fleet_route
             self._watcher = MqttClient(self.stack.service_endpoint()).connect()
             self._watcher.subscribe(topics.ALL_EVENTS, self._on_event)
             self._watcher.subscribe(topics.ALL_PRESENCE, self._on_presence)
@@ -330,6 +346,11 @@ class LocalSystem:
             except ShadowError:  # not reported yet
                 robots[thing] = None
         return 200, {"robots": robots, "online": dict(self._online)}
+
+    def _fleet_route(self, request: dict[str, Any]) -> tuple[int, dict[str, Any]]:
+        """The fleet this system runs, as fleet.yaml's keys: what a command given this
+        stack's `--api` learns the robots, zones and floor from."""
+        return 200, {"fleet": msgspec.to_builtins(self.fleet)}
 
     def stop(self) -> None:
         if self.robots is not None:

@@ -52,6 +52,8 @@ HEALTH_TIMEOUT_S = 3.0
 class Deployment:
     broker: str
     fleet: Fleet
+    # The file `fleet` came from, for the skill run in this process (None: the bundled one).
+    fleet_file: Path | None = None
     tls: ClientCredentials | None = None
     api: str | None = None
     ack_timeout_s: float | None = None
@@ -130,9 +132,17 @@ def _simulator_for(
     # The skill publishes through iot-data; its commands are seen coming back from the broker.
     for topic_filter in (topics.ALL_ROBOT_CMDS, topics.FLEET_CMD):
         link.subscribe(topic_filter, commands.observe)
+    if model_file is None:
+        from vahr.skill_model.generator import build_interaction_model
+
+        # The names of the fleet the station follows, whichever file it came from.
+        model = InteractionModel(build_interaction_model(deployment.fleet))
+    else:
+        model = InteractionModel.load(model_file)
+    fleet_file = str(deployment.fleet_file) if deployment.fleet_file else None
     simulator = AlexaSimulator(
-        InteractionModel.load(model_file),
-        load_skill_handler(api, ack_timeout_s=deployment.ack_timeout_s),
+        model,
+        load_skill_handler(api, ack_timeout_s=deployment.ack_timeout_s, fleet_file=fleet_file),
         command_log=commands.take,
         on_turn=lambda turn: feed.add_turn(turn.to_message()),
     )

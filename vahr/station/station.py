@@ -88,8 +88,8 @@ class Station:
         from vahr.station.vocabulary import command_recognizer
         from vahr.station.voice import PushToTalk
 
-        model_file = self.config.model_file
-        return PushToTalk(assistant, lambda: command_recognizer(model_file))
+        model_file, fleet = self.config.model_file, self.fleet
+        return PushToTalk(assistant, lambda: command_recognizer(model_file, fleet))
 
     @property
     def url(self) -> str:

@@ -22,6 +22,7 @@ from vahr.local.alexa import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases
 from vahr.protocol.text import normalize, spell_numbers
 
 if TYPE_CHECKING:
+    from vahr.protocol import Fleet
     from vahr.speech.lm_stt import LanguageModelRecognizer
 
 _SLOT = re.compile(r"\{([A-Za-z0-9_.]+)\}")
@@ -95,9 +96,15 @@ def load_model(model_file: Path | None = None) -> dict[str, Any]:
     return loaded
 
 
-def command_recognizer(model_file: Path | None = None) -> LanguageModelRecognizer:
-    """The push-to-talk recognizer for the interaction model at `model_file` (default: the
-    one that ships with the package)."""
+def command_recognizer(
+    model_file: Path | None = None, fleet: Fleet | None = None
+) -> LanguageModelRecognizer:
+    """The push-to-talk recognizer for the interaction model at `model_file`; without one,
+    the model generated from `fleet` (in memory), else the one that ships with the package."""
     from vahr.speech.lm_stt import LanguageModelRecognizer
 
+    if model_file is None and fleet is not None:
+        from vahr.skill_model.generator import build_interaction_model
+
+        return LanguageModelRecognizer(sentences(build_interaction_model(fleet)))
     return LanguageModelRecognizer(sentences(load_model(model_file)))
