@@ -10,7 +10,10 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
 SUBCOMMANDS: Subcommands = {
-    "up": ("vahr.commands.up", "run the broker, shadows, data plane, Alexa simulator and robots"),
+    "up": (
+        "vahr.commands.up",
+        "run the broker, shadows, data plane, Alexa simulator and the robots of a fleet file",
+    ),
     "say": ("vahr.commands.say", "say an utterance to the running system as a person to Alexa"),
     "console": ("vahr.commands.console", "talk to the running system interactively"),
     "station": (

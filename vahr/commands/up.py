@@ -25,7 +25,7 @@ DEFAULT_STATE_DIR = Path(".state")
 def configure(parser: argparse.ArgumentParser) -> None:
     add_fleet_flag(parser)
     parser.add_argument(
-        "--robots", type=int, help="how many of the fleet's robots (default: all; more adds some)"
+        "--robots", type=int, help="the fleet's first N robots, or more (default: all of them)"
     )
     parser.add_argument(
         "--state-dir", type=Path, default=DEFAULT_STATE_DIR, help="local state (default .state)"
