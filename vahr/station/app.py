@@ -14,19 +14,25 @@ Routes (all JSON unless said otherwise; errors are `{"error": "one line"}`):
 | `POST /api/interaction`, `POST /api/puzzle` | the participant's input, for the session's log |
 | `POST /api/acknowledge` `{"id"}` | an alert acknowledged: `{"acknowledged": [ids]}` |
 
-The page itself, its files and the event stream are the server's (`server.py`).
+Each JSON body is decoded by msgspec into its route's request type (`json_routes`); an
+empty body is `{}`, unknown fields are ignored, and an error names the field. The page
+itself, its files and the event stream are the server's (`server.py`).
 """
 
 from __future__ import annotations
 
 import json
 import logging
+import re
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Annotated, Any
+
+import msgspec
 
 from vahr.errors import VahrError
 from vahr.experiment.procedures import ProcedureViolation
 from vahr.protocol import ProtocolError
+from vahr.protocol.errors import from_validation_error
 from vahr.speech.errors import SpeechError
 from vahr.station.errors import RequestError
 
@@ -46,7 +52,58 @@ MAX_SPEECH_CHARS = 1_000
 # Who may speak through /api/say: typing in the conversation, the weather button.
 SAY_ORIGINS = frozenset({"station", "station-weather"})
 
-Json = dict[str, Any]
+# msgspec's reason for a string over its length.
+_TOO_LONG = re.compile(r"^expected `str` of length <= (\d+)$")
+
+# The request bodies' fields, with the lengths the routes accept.
+RobotName = Annotated[str, msgspec.Meta(max_length=128)]
+Word = Annotated[str, msgspec.Meta(max_length=32)]
+Utterance = Annotated[str, msgspec.Meta(max_length=MAX_UTTERANCE_CHARS)]
+SpeechText = Annotated[str, msgspec.Meta(max_length=MAX_SPEECH_CHARS)]
+AlertId = Annotated[str, msgspec.Meta(max_length=100)]
+
+
+class CommandRequest(msgspec.Struct, frozen=True):
+    """`POST /api/command`: one order from the panel (`zone` with `navigate`)."""
+
+    robot: RobotName
+    action: Word
+    zone: Word | None = None
+
+
+class StopRequest(msgspec.Struct, frozen=True):
+    """`POST /api/stop`: no fields."""
+
+
+class SayRequest(msgspec.Struct, frozen=True):
+    """`POST /api/say`: a typed request, or the weather button's (`origin`)."""
+
+    utterance: Utterance
+    origin: Word = "station"
+
+
+class SpeechRequest(msgspec.Struct, frozen=True):
+    """`POST /api/speech`: text for espeak-ng to say."""
+
+    text: SpeechText
+
+
+class AcknowledgeRequest(msgspec.Struct, frozen=True):
+    """`POST /api/acknowledge`: the alert acknowledged."""
+
+    id: AlertId
+
+
+# The participant's input: its own message types check it (`Desk.forward`).
+ParticipantRequest = dict[str, Any]
+
+
+@dataclass(frozen=True)
+class JsonRoute:
+    """A POST of JSON: the type its body is decoded into, and what answers it."""
+
+    shape: Any
+    answer: Callable[[Any], Reply]
 
 
 @dataclass(frozen=True)
@@ -65,7 +122,7 @@ def error_reply(status: int, message: str) -> Reply:
 
 
 class StationApp:
-    """The station's routes over its parts; `handle` never raises."""
+    """The station's routes over its parts; `handle_json` and `voice` never raise."""
 
     def __init__(
         self,
@@ -83,29 +140,24 @@ class StationApp:
         self.assistant = assistant
         self.push_to_talk = push_to_talk
         self.synthesize = synthesize
-        self._json_routes: dict[tuple[str, str], Callable[[Json], Reply]] = {
-            ("POST", "/api/command"): self.command,
-            ("POST", "/api/stop"): self.stop_all,
-            ("POST", "/api/say"): self.say,
-            ("POST", "/api/speech"): self.speech,
-            ("POST", "/api/interaction"): lambda body: self.participant("interaction", body),
-            ("POST", "/api/puzzle"): lambda body: self.participant("puzzle", body),
-            ("POST", "/api/acknowledge"): self.acknowledge,
+        # Every POST of JSON the station answers: its path, its body's type, its answer.
+        self.json_routes: dict[str, JsonRoute] = {
+            "/api/command": JsonRoute(CommandRequest, self.command),
+            "/api/stop": JsonRoute(StopRequest, self.stop_all),
+            "/api/say": JsonRoute(SayRequest, self.say),
+            "/api/speech": JsonRoute(SpeechRequest, self.speech),
+            "/api/interaction": JsonRoute(ParticipantRequest, self.interaction),
+            "/api/puzzle": JsonRoute(ParticipantRequest, self.puzzle),
+            "/api/acknowledge": JsonRoute(AcknowledgeRequest, self.acknowledge),
         }
 
-    def is_json_route(self, method: str, path: str) -> bool:
-        return (method, path) in self._json_routes
-
     def handle_json(self, method: str, path: str, body: bytes) -> Reply:
-        """A JSON route: the body must be a JSON object."""
+        """A JSON route: the body decoded into the route's request type, then answered."""
+        route = self.json_routes.get(path) if method == "POST" else None
+        if route is None:
+            return error_reply(404, f"nothing to {method} at {path}")
         try:
-            try:
-                request = json.loads(body or b"{}")
-            except (ValueError, UnicodeDecodeError):
-                raise RequestError(400, "the body is not valid JSON") from None
-            if not isinstance(request, dict):
-                raise RequestError(400, "the body must be a JSON object")
-            return self._json_routes[(method, path)](request)
+            return route.answer(_decode(body, route.shape))
         except RequestError as err:
             return error_reply(err.status, err.message)
         except ProcedureViolation as err:
@@ -120,35 +172,34 @@ class StationApp:
 
     # -- routes -------------------------------------------------------------------------
 
-    def command(self, request: Json) -> Reply:
-        robot = _text(request, "robot", 128)
-        action = _text(request, "action", 32)
-        if action == "navigate":
-            command_id = self.controls.navigate(robot, _text(request, "zone", 32))
-        elif action == "stop":
-            command_id = self.controls.stop(robot)
+    def command(self, request: CommandRequest) -> Reply:
+        if request.action == "navigate":
+            if request.zone is None:
+                raise RequestError(400, "zone: a string is required")
+            command_id = self.controls.navigate(request.robot, request.zone)
+        elif request.action == "stop":
+            command_id = self.controls.stop(request.robot)
         else:
             raise RequestError(
-                400, f"action: {action!r} is not one the panel sends (navigate or stop)"
+                400, f"action: {request.action!r} is not one the panel sends (navigate or stop)"
             )
         return json_reply({"id": command_id})
 
-    def stop_all(self, request: Json) -> Reply:
+    def stop_all(self, request: StopRequest) -> Reply:
         return json_reply({"id": self.controls.stop(None)})
 
-    def say(self, request: Json) -> Reply:
-        utterance = _text(request, "utterance", MAX_UTTERANCE_CHARS).strip()
+    def say(self, request: SayRequest) -> Reply:
+        utterance = request.utterance.strip()
         if not utterance:
             raise RequestError(400, "utterance: say something (it is empty)")
-        origin = request.get("origin", "station")
-        if origin not in SAY_ORIGINS:
+        if request.origin not in SAY_ORIGINS:
             raise RequestError(400, f"origin: one of {', '.join(sorted(SAY_ORIGINS))}")
         if self.assistant is None:
             raise RequestError(503, "no assistant is connected to this station")
-        return json_reply(self.assistant.ask(utterance, origin=origin))
+        return json_reply(self.assistant.ask(utterance, origin=request.origin))
 
-    def speech(self, request: Json) -> Reply:
-        text = _text(request, "text", MAX_SPEECH_CHARS).strip()
+    def speech(self, request: SpeechRequest) -> Reply:
+        text = request.text.strip()
         if not text:
             raise RequestError(400, "text: nothing to say (it is empty)")
         if self.synthesize is None:
@@ -158,13 +209,19 @@ class StationApp:
         except SpeechError as err:
             raise RequestError(503, str(err)) from err
 
-    def participant(self, kind: str, request: Json) -> Reply:
+    def interaction(self, request: ParticipantRequest) -> Reply:
+        return self._participant("interaction", request)
+
+    def puzzle(self, request: ParticipantRequest) -> Reply:
+        return self._participant("puzzle", request)
+
+    def _participant(self, kind: str, request: ParticipantRequest) -> Reply:
         logged = self.desk.forward(kind, request)
         return json_reply({"logged": logged}, 202 if logged else 200)
 
-    def acknowledge(self, request: Json) -> Reply:
+    def acknowledge(self, request: AcknowledgeRequest) -> Reply:
         """An alert acknowledged on a page: no page shows it from now on."""
-        return json_reply({"acknowledged": self.feed.acknowledge(_text(request, "id", 100))})
+        return json_reply({"acknowledged": self.feed.acknowledge(request.id)})
 
     def voice(self, wav: bytes) -> Reply:
         """Push-to-talk: a WAV clip in, what was heard and answered out."""
@@ -181,10 +238,19 @@ class StationApp:
             return error_reply(500, "push-to-talk failed; see the station's log")
 
 
-def _text(request: Json, field: str, limit: int) -> str:
-    value = request.get(field)
-    if not isinstance(value, str):
-        raise RequestError(400, f"{field}: a string is required")
-    if len(value) > limit:
-        raise RequestError(400, f"{field}: at most {limit} characters")
-    return value
+def _decode(body: bytes, shape: Any) -> Any:
+    """The body as `shape` (an empty body is `{}`); an error names the field, in the words
+    the page has always shown (every field of these requests is a string)."""
+    try:
+        return msgspec.json.decode(body or b"{}", type=shape)
+    except msgspec.ValidationError as err:  # before DecodeError, its base class
+        error = from_validation_error(err)
+        if error.field == "payload":
+            raise RequestError(400, "the body must be a JSON object") from None
+        if too_long := _TOO_LONG.match(error.reason):
+            raise RequestError(400, f"{error.field}: at most {too_long[1]} characters") from None
+        if error.reason == "is required but missing" or error.reason.startswith("expected str"):
+            raise RequestError(400, f"{error.field}: a string is required") from None
+        raise error from err
+    except msgspec.DecodeError:
+        raise RequestError(400, "the body is not valid JSON") from None

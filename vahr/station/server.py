@@ -22,6 +22,7 @@ import hmac
 import logging
 import secrets
 import threading
+from collections.abc import Callable
 from http.cookies import CookieError, SimpleCookie
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -36,7 +37,11 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
+# A route's answer: the handler answers the request at a path, with its query.
+Answer = Callable[["_Handler", str, dict[str, str]], None]
+
 STATIC = Path(__file__).with_name("static")
+STATIC_PATH = "/static/"
 MAX_JSON_BYTES = 16 * 1024
 # 16 kHz mono 16-bit is 32 kB a second: a megabyte is half a minute, twice the longest clip.
 MAX_AUDIO_BYTES = 1024 * 1024
@@ -135,63 +140,70 @@ class _Handler(QuietHandler):
             return None
         return self.rfile.read(length) if length else b""
 
-    # -- methods --------------------------------------------------------------------------
+    # -- the routes -----------------------------------------------------------------------
 
     def do_GET(self) -> None:  # noqa: N802
+        self._route("GET")
+
+    # HEAD is answered as GET; `_send` writes no body for it.
+    do_HEAD = do_GET
+
+    def do_POST(self) -> None:  # noqa: N802
+        self._route("POST")
+
+    def _route(self, method: str) -> None:
         checked = self._checked()
         if checked is None:
             return
         path, query = checked
-        station = self.server.station
-        if path == "/api/stream":
-            self._stream()
-            return
-        extra: dict[str, str] = {}
-        if path in ("/", "/index.html"):
-            reply = station.file("index.html")
-            if station.token is not None and query.get("token"):
-                # The page's own later requests (the stream, the API) carry the cookie.
-                extra["Set-Cookie"] = f"{COOKIE}={station.token}; Path=/; HttpOnly; SameSite=Strict"
-        elif path == "/favicon.ico":
-            reply = station.file("favicon.svg")
-        elif path.startswith("/static/"):
-            reply = station.file(path.removeprefix("/static/"))
-        elif path == "/api/health":
-            reply = json_reply({"ok": True})
-        elif path == "/api/snapshot":
-            reply = json_reply(station.app.feed.snapshot())
-        else:
-            reply = error_reply(404, f"nothing at {path}")
-        self._send(reply, extra)
-
-    do_HEAD = do_GET
-
-    def do_POST(self) -> None:  # noqa: N802
-        checked = self._checked()
-        if checked is None:
-            return
-        path, _ = checked
-        app = self.server.station.app
-        kind = self.headers.get("Content-Type", "").split(";")[0].strip().lower()
-        if path == "/api/voice":
-            if kind not in ("audio/wav", "audio/x-wav", "audio/wave"):
-                self.refuse(415, "push-to-talk sends audio/wav")
-                return
-            body = self._body(MAX_AUDIO_BYTES)
-            if body is not None:
-                self._send(app.voice(body))
-            return
-        if not app.is_json_route("POST", path):
+        answer = self.server.station.route(method, path)
+        if answer is not None:
+            answer(self, path, query)
+        elif method == "POST":
             self.refuse(404, f"nothing to POST at {path}")
-            return
-        if kind != "application/json":
+        else:
+            self._send(error_reply(404, f"nothing at {path}"))
+
+    def _page(self, path: str, query: dict[str, str]) -> None:
+        station = self.server.station
+        extra: dict[str, str] = {}
+        if station.token is not None and query.get("token"):
+            # The page's own later requests (the stream, the API) carry the cookie.
+            extra["Set-Cookie"] = f"{COOKIE}={station.token}; Path=/; HttpOnly; SameSite=Strict"
+        self._send(station.file("index.html"), extra)
+
+    def _favicon(self, path: str, query: dict[str, str]) -> None:
+        self._send(self.server.station.file("favicon.svg"))
+
+    def _static(self, path: str, query: dict[str, str]) -> None:
+        self._send(self.server.station.file(path.removeprefix(STATIC_PATH)))
+
+    def _health(self, path: str, query: dict[str, str]) -> None:
+        self._send(json_reply({"ok": True}))
+
+    def _snapshot(self, path: str, query: dict[str, str]) -> None:
+        self._send(json_reply(self.server.station.app.feed.snapshot()))
+
+    def _json(self, path: str, query: dict[str, str]) -> None:
+        if self._kind() != "application/json":
             self.refuse(415, "send application/json")
             return
         body = self._body(MAX_JSON_BYTES)
         if body is not None:
-            self._send(app.handle_json("POST", path, body))
+            self._send(self.server.station.app.handle_json("POST", path, body))
 
-    def _stream(self) -> None:
+    def _voice(self, path: str, query: dict[str, str]) -> None:
+        if self._kind() not in ("audio/wav", "audio/x-wav", "audio/wave"):
+            self.refuse(415, "push-to-talk sends audio/wav")
+            return
+        body = self._body(MAX_AUDIO_BYTES)
+        if body is not None:
+            self._send(self.server.station.app.voice(body))
+
+    def _kind(self) -> str:
+        return self.headers.get("Content-Type", "").split(";")[0].strip().lower()
+
+    def _stream(self, path: str, query: dict[str, str]) -> None:
         station = self.server.station
         if not station.open_stream():
             self.refuse(503, f"at most {MAX_STREAMS} pages at once")
@@ -245,6 +257,19 @@ class StationServer:
         self._files = {p.name: p for p in STATIC.iterdir() if p.suffix in CONTENT_TYPES}
         self._streams = 0
         self._streams_lock = threading.Lock()
+        # Every route the station answers, by method and path (HEAD is GET); the page's
+        # files are the GETs under STATIC_PATH.
+        self.routes: dict[tuple[str, str], Answer] = {
+            ("GET", "/"): _Handler._page,
+            ("GET", "/index.html"): _Handler._page,
+            ("GET", "/favicon.ico"): _Handler._favicon,
+            ("GET", "/api/health"): _Handler._health,
+            ("GET", "/api/snapshot"): _Handler._snapshot,
+            ("GET", "/api/stream"): _Handler._stream,
+            ("POST", "/api/voice"): _Handler._voice,
+            # The JSON API, each route with its body's type (`StationApp.json_routes`).
+            **{("POST", path): _Handler._json for path in app.json_routes},
+        }
         self._serving = ServerThread(_Server, _Handler, host, port)
         self._serving.server.station = self  # type: ignore[attr-defined]
 
@@ -260,6 +285,13 @@ class StationServer:
             shown = f"[{shown}]"
         base = f"http://{shown}:{self.port}/"
         return f"{base}?token={self.token}" if self.token else base
+
+    def route(self, method: str, path: str) -> Answer | None:
+        """What answers `method` on `path`, or None (nothing is there)."""
+        answer = self.routes.get((method, path))
+        if answer is None and method == "GET" and path.startswith(STATIC_PATH):
+            return _Handler._static
+        return answer
 
     def host_allowed(self, host: str) -> bool:
         if self.token is not None:
