@@ -113,6 +113,6 @@ hearing-adaptation: setup
 	$(BIN)/python -m robot_agent.voice.adaptation
 
 # Remake robot_agent/voice/data/answer-sense-heard.yaml, the sense check's training sentences as
-# the robot hears them (docs/voice.md, "The ninth round"; about ten minutes on 2 cores).
+# the robot hears them (docs/history/voice-tuning.md, "The ninth round"; about ten minutes on 2 cores).
 sense-heard: setup
 	$(BIN)/python -m robot_agent.voice.sense_heard

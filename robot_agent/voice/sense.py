@@ -44,7 +44,7 @@ ANSWER, OTHER = "answer", "other"
 RECIPE = "sense 1: words, bigrams, chars 3-5"
 # How likely an answer a reading must be to stand, set on the tuning set only, by the
 # hearing's rule (answers right less three times the unrelated speech accepted), of 0.4,
-# 0.5, 0.55, 0.6, 0.65, 0.7 and 0.8 (docs/voice.md, "The twelfth round").
+# 0.5, 0.55, 0.6, 0.65, 0.7 and 0.8 (docs/history/voice-tuning.md, "The twelfth round").
 ANSWER_AT_LEAST = 0.65
 
 

@@ -61,7 +61,7 @@ SLOT_ANSWER = "vahr.SlotAnswer"
 # An intent is taken only when its calibrated probability reaches this; anything less is the
 # fallback, as a wrong action is worse than asking. Set on the tuning set only, by the rule
 # the hearing's thresholds follow (the most utterances right less three times the wrong
-# ones, of 0.5, 0.55, 0.6, 0.65, 0.7 and 0.75); docs/skill.md has the sweeps.
+# ones, of 0.5, 0.55, 0.6, 0.65, 0.7 and 0.75); docs/history/nlu-tuning.md has the sweeps.
 CONFIDENCE_THRESHOLD = 0.6
 # How long the first utterance may wait for a classifier still training in the background.
 BUILD_TIMEOUT_S = 300.0
