@@ -74,8 +74,8 @@ jstest: setup
 typecheck: setup
 	$(BIN)/mypy
 
-# Two workers, one per core: each test file runs whole on one worker (tests/conftest.py).
-# The 90 s soak is not among them: `make soak-test` runs it.
+# Two workers, one per core: each test file runs whole on one worker, the longest files
+# first (tests/support/scheduling.py). The 90 s soak is not among them: `make soak-test`.
 pytest: setup
 	$(BIN)/pytest -q -n 2 --dist loadgroup -m "not soak"
 
