@@ -10,7 +10,8 @@ still labelled answer or other, to `data/answer-sense-heard.yaml`; `SenseCheck.t
 from them beside the written ones. A heard text that is a sentence of the evaluation or
 tuning sets is left out, so they stay held out.
 
-Chosen on the tuning set (docs/history/voice-tuning.md, "The ninth round"). About ten minutes on 2 cores.
+Chosen on the tuning set (docs/history/voice-tuning.md, "The ninth round"). About ten
+minutes on 2 cores.
 """
 
 from __future__ import annotations
