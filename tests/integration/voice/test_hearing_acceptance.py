@@ -6,71 +6,32 @@ and times it.
 
 The set was written blind and scored once (docs/voice.md, "How well it hears"). What it
 measured is kept as floors, so that nothing gets worse, beside the targets, which it meets
-(a target a set does not meet is held as a strict expected failure).
-
-Each voice is rendered and heard in a process of its own, and the three reports are added
-up: a clip's name, its noise and what the robot hears of it do not depend on the other
-clips (the noise is seeded by the clip, and a hearing keeps nothing from one clip to the
-next), so the report is the one a single pass makes, in about half the time on two cores."""
+(a target a set does not meet is held as a strict expected failure)."""
 
 from __future__ import annotations
 
-import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor
 from typing import TYPE_CHECKING
 
-import msgspec
 import pytest
 
-from robot_agent.voice.evaluation import (
-    EVALUATION_SET,
-    OUTCOMES,
-    Phrasings,
-    Report,
-    render,
-    score,
-)
-from robot_agent.voice.hearing import offline_hearing
-from vahr.speech.scoring import OutcomeTally
+from robot_agent.voice.evaluation import EVALUATION_SET, Phrasings, Report, render, score
 from vahr.speech.tts import EspeakSynthesizer
 
 if TYPE_CHECKING:
-    from pathlib import Path
+    from robot_agent.voice.hearing import Hearing
 
-# Rendering and hearing 1,233 clips takes about three minutes of one core.
+# Rendering and hearing 1,233 clips takes two to three minutes on two cores.
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(420)]
 
 
-def _render_and_hear(phrasings: Phrasings, directory: Path) -> Report:
-    """One voice's clips, rendered as `--make-eval-set` does, then heard by the robot."""
-    render(phrasings, directory, EspeakSynthesizer)
-    return score(directory, offline_hearing().hear, time.perf_counter)
-
-
-def _added_up(reports: list[Report]) -> Report:
-    total = Report()
-    for report in reports:
-        for condition, by_group in report.tallies.items():
-            for group, tally in by_group.items():
-                into = total.tallies.setdefault(condition, {})
-                into.setdefault(group, OutcomeTally(OUTCOMES)).add(tally)
-        total.misses += report.misses
-        total.seconds += report.seconds
-    return total
-
-
 @pytest.fixture(scope="module")
-def report(tmp_path_factory: pytest.TempPathFactory) -> Report:
-    # Given the evaluation set, each voice in a directory of its own
-    every = Phrasings.load(EVALUATION_SET)
-    voices = [msgspec.structs.replace(every, voices=[voice]) for voice in every.voices]
-    directories = [tmp_path_factory.mktemp("evaluation") for _ in voices]
-    # When the robot hears every clip (a fresh process per voice: none inherits this one's
-    # threads or connections)
-    spawn = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=len(voices), mp_context=spawn) as pool:
-        return _added_up(list(pool.map(_render_and_hear, voices, directories)))
+def report(hearing: Hearing, tmp_path_factory: pytest.TempPathFactory) -> Report:
+    # Given the evaluation set, rendered as `--make-eval-set` does
+    directory = tmp_path_factory.mktemp("evaluation")
+    render(Phrasings.load(EVALUATION_SET), directory, EspeakSynthesizer)
+    # When the robot hears every clip
+    return score(directory, hearing.hear, time.perf_counter)
 
 
 CONDITIONS = ("clean", "snr20", "snr10")
