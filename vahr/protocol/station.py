@@ -287,21 +287,28 @@ class SnapshotMessage(msgspec.Struct, kw_only=True, tag="snapshot", tag_field="t
     server_time: float
 
 
-class ShadowMessage(msgspec.Struct, frozen=True, kw_only=True, tag="shadow", tag_field="type"):
-    """A robot's whole reported state after an accepted update, with its version."""
+class RobotChange(msgspec.Struct, kw_only=True, omit_defaults=True):
+    """What changed of one robot since the page last heard of it: a field is present only
+    when it changed. `reported` holds the reported state's top-level fields that changed,
+    with their new values, and `removed` those that are gone: the page merges them into
+    the state it has. `version` is the shadow version that brings it to; `progress` is the
+    drive's latest progress event (None once the drive ended)."""
 
     thing: str
-    reported: ReportedState
-    version: int
-    last_seen: float | None
+    reported: ReportedState | msgspec.UnsetType = msgspec.UNSET
+    removed: list[str] | msgspec.UnsetType = msgspec.UNSET
+    version: int | msgspec.UnsetType = msgspec.UNSET
+    online: bool | msgspec.UnsetType = msgspec.UNSET
+    last_seen: float | None | msgspec.UnsetType = msgspec.UNSET
+    progress: Event | None | msgspec.UnsetType = msgspec.UNSET
 
 
-class PresenceMessage(msgspec.Struct, frozen=True, kw_only=True, tag="presence", tag_field="type"):
-    """A robot came online or went offline."""
+class RobotsMessage(msgspec.Struct, frozen=True, kw_only=True, tag="robots", tag_field="type"):
+    """The robots that changed since the page's last message, each once, with only what
+    changed (shadow updates, presence and drive progress coalesced per robot): at most one
+    of these reaches a page per frame however many robots report."""
 
-    thing: str
-    online: bool
-    last_seen: float | None
+    changes: list[RobotChange]
 
 
 class EventMessage(Event, frozen=True, tag="event", tag_field="type"):
@@ -372,8 +379,7 @@ class AlertAcknowledgedMessage(
 ConversationEntry = TurnMessage | CommandMessage | EventMessage | AnnouncementMessage
 PageMessage = (
     SnapshotMessage
-    | ShadowMessage
-    | PresenceMessage
+    | RobotsMessage
     | EventMessage
     | CommandMessage
     | AckMessage

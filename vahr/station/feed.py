@@ -9,8 +9,9 @@ the typedefs of `static/contract.js`:
 - `snapshot`: the fleet and its floor, every robot (reported shadow, presence, the last
   event, the progress of the drive under way), the conversation so far, the commands seen
   and their acknowledgments, the experiment session;
-- `shadow`: a robot's whole reported state after an accepted update, with its version;
-- `presence`: a robot came online or went offline;
+- `robots`: the robots that changed since the page's last message, each once with only
+  what changed: its reported fields after an accepted shadow update (and the version),
+  presence, the progress of its drive (`RobotChange`; `vahr.station.changes`);
 - `event`: anything a robot did (progress, arrived, said, heard, interpreted...);
 - `command`: a command seen on a command topic (from the assistant, the console, a robot);
 - `ack`: the first answer of a robot to a command, with the time it took from the command
@@ -24,6 +25,11 @@ the typedefs of `static/contract.js`:
 
 Acknowledgments are the station's, not one page's: every page stops showing the alert, and
 a page that reloads does not raise it again.
+
+Robots' changes are coalesced per page: a robot that changes again before the page took
+its last change has the two merged (`Subscriber.push_change`), and the stream writes at
+most one batch a frame (`server.FRAME_S`), so a thousand robots reporting cost the page one
+message a frame, not thousands.
 
 Nothing here waits on a page: a page that falls `SUBSCRIBER_LIMIT` messages behind is
 dropped, and its browser reconnects and starts again from a snapshot.
@@ -65,10 +71,10 @@ from vahr.protocol.station import (
     ExperimentStatus,
     FleetView,
     PageMessage,
-    PresenceMessage,
+    RobotChange,
     RobotEntry,
+    RobotsMessage,
     RobotView,
-    ShadowMessage,
     SnapshotMessage,
     TurnMessage,
     ZoneEntry,
@@ -77,6 +83,7 @@ from vahr.protocol.station import (
     encode_page_message,
     turn_from_message,
 )
+from vahr.station.changes import merge, own, reported_change
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
@@ -106,15 +113,18 @@ def now_ms() -> float:
 class Subscriber:
     """One page's queue of encoded messages.
 
-    A message pushed with a `key` (a robot's progress) replaces the one with the same key
-    that the page has not taken yet: a page that falls behind gets each robot's latest
-    progress rather than every step of it.
+    A message pushed with a `key` replaces the one with the same key that the page has not
+    taken yet. Robots' changes (`push_change`) wait as one `robots` message at the place of
+    the first of them, each robot's merged into one: a page that falls behind gets each
+    robot's latest state rather than every step of it.
     """
 
     def __init__(self, limit: int = SUBSCRIBER_LIMIT) -> None:
         self._limit = limit
-        self._pending: list[bytes] = []
+        # Encoded messages; None marks where the robots' changes go when taken.
+        self._pending: list[bytes | None] = []
         self._keyed: dict[str, int] = {}  # key -> index in _pending
+        self._changes: dict[str, RobotChange] = {}
         self._ready = threading.Condition()
         self.closed = False
         self.overflowed = False
@@ -126,15 +136,39 @@ class Subscriber:
             if key is not None and key in self._keyed:
                 self._pending[self._keyed[key]] = message
                 return
-            if len(self._pending) >= self._limit:
-                self.overflowed = self.closed = True
-                self._pending.clear()
-                self._keyed.clear()
-            else:
-                if key is not None:
-                    self._keyed[key] = len(self._pending)
-                self._pending.append(message)
+            if self._full():
+                return
+            if key is not None:
+                self._keyed[key] = len(self._pending)
+            self._pending.append(message)
             self._ready.notify()
+
+    def push_change(self, change: RobotChange) -> None:
+        """A robot's change: merged into the one of the same robot not taken yet."""
+        with self._ready:
+            if self.closed:
+                return
+            waiting = self._changes.get(change.thing)
+            if waiting is not None:
+                merge(waiting, change)
+                return
+            if not self._changes:
+                if self._full():
+                    return
+                self._pending.append(None)
+            self._changes[change.thing] = own(change)
+            self._ready.notify()
+
+    def _full(self) -> bool:
+        """Close this page's queue if it holds its limit (call with the lock held)."""
+        if len(self._pending) < self._limit:
+            return False
+        self.overflowed = self.closed = True
+        self._pending.clear()
+        self._keyed.clear()
+        self._changes.clear()
+        self._ready.notify()
+        return True
 
     def take(self, timeout_s: float) -> list[bytes] | None:
         """Every message waiting (after up to `timeout_s` for one); None once closed."""
@@ -144,8 +178,12 @@ class Subscriber:
             if self.closed:
                 return None
             taken, self._pending = self._pending, []
+            changes, self._changes = self._changes, {}
             self._keyed.clear()
-            return taken
+        robots = (
+            encode_page_message(RobotsMessage(changes=list(changes.values()))) if changes else b""
+        )
+        return [robots if message is None else message for message in taken]
 
     def close(self) -> None:
         with self._ready:
@@ -265,17 +303,24 @@ class Feed:
         for subscriber in subscribers:
             subscriber.close()
 
+    def _broadcast_change(self, change: RobotChange) -> None:
+        """Send a robot's change to every page (merged with one not taken yet); call with
+        the lock held."""
+        for subscriber in self._subscribers:
+            subscriber.push_change(change)
+        self._drop_overflowed()
+
+    def _drop_overflowed(self) -> None:
+        for subscriber in [s for s in self._subscribers if s.closed]:
+            log.info("a station page fell too far behind; it will reconnect")
+            self._subscribers.remove(subscriber)
+
     def _broadcast(self, message: PageMessage, key: str | None = None) -> None:
         """Send `message` to every page; call with the lock held, so order is kept."""
         encoded = encode_page_message(message)
-        dropped = []
         for subscriber in self._subscribers:
             subscriber.push(encoded, key)
-            if subscriber.closed:
-                dropped.append(subscriber)
-        for subscriber in dropped:
-            log.info("a station page fell too far behind; it will reconnect")
-            self._subscribers.remove(subscriber)
+        self._drop_overflowed()
 
     # -- the broker's messages -------------------------------------------------------------
 
@@ -301,15 +346,13 @@ class Feed:
         if parsed is None or parsed[1] is not None or parsed[0] not in self._things:
             return  # named shadows and things outside the fleet are not drawn
         try:
-            current = json.loads(payload)["current"]
-            reported = current["state"].get("reported") or {}
-            version = int(current["version"])
-        except (ValueError, KeyError, TypeError, AttributeError):
+            # Only `current` is decoded: `previous` is skipped unread, which matters with a
+            # thousand robots reporting.
+            current = _documents_decoder.decode(payload).current
+        except msgspec.MsgspecError:
             log.warning("ignoring an unreadable shadow document on %s", topic)
             return
-        if not isinstance(reported, dict):
-            return
-        self._shadow(parsed[0], reported, version, self._clock())
+        self._shadow(parsed[0], current.state.reported or {}, current.version, self._clock())
 
     def load_shadow(self, thing: str, document: bytes) -> None:
         """A robot's shadow as read at start-up (GetThingShadow's body)."""
@@ -329,17 +372,19 @@ class Feed:
             robot = self._robots[thing]
             if robot.version is not None and version <= robot.version:
                 return  # an older document than one already shown (start-up read raced)
+            changed, removed = reported_change(robot.reported, reported)
+            change = RobotChange(thing=thing, version=version)
+            if changed:
+                change.reported = changed
+            if removed:
+                change.removed = removed
             robot.reported, robot.version = reported, version
-            if seen is not None:
-                robot.last_seen = max(robot.last_seen or 0, seen)
-            if reported.get("status") != "navigating":
-                robot.progress = None
+            if seen is not None and seen > (robot.last_seen or 0):
+                robot.last_seen = change.last_seen = seen
+            if reported.get("status") != "navigating" and robot.progress is not None:
+                robot.progress = change.progress = None
             self._acknowledged_by_shadow(thing, reported)
-            self._broadcast(
-                ShadowMessage(
-                    thing=thing, reported=reported, version=version, last_seen=robot.last_seen
-                )
-            )
+            self._broadcast_change(change)
 
     def on_presence(self, topic: str, payload: bytes) -> None:
         parsed = topics.parse_robot_topic(topic)
@@ -356,8 +401,8 @@ class Feed:
             robot.online = presence.online
             if presence.online:
                 robot.last_seen = max(robot.last_seen or 0, self._clock())
-            self._broadcast(
-                PresenceMessage(thing=thing, online=presence.online, last_seen=robot.last_seen)
+            self._broadcast_change(
+                RobotChange(thing=thing, online=presence.online, last_seen=robot.last_seen)
             )
 
     def on_event(self, topic: str, payload: bytes) -> None:
@@ -387,8 +432,12 @@ class Feed:
                 self._conversation.append(
                     EventMessage(**fields, last_seen=now, robots=[event.thing])
                 )
-            progress = f"progress:{event.thing}" if event.event == "progress" else None
-            self._broadcast(EventMessage(**fields, last_seen=now), progress)
+            if event.event == "progress":
+                # Progress is the robot's state while it drives: coalesced with the rest.
+                change = RobotChange(thing=event.thing, progress=event, last_seen=now)
+                self._broadcast_change(change)
+            else:
+                self._broadcast(EventMessage(**fields, last_seen=now))
 
     def on_command(self, topic: str, payload: bytes) -> None:
         parsed = topics.parse_robot_topic(topic)
@@ -541,6 +590,24 @@ class Feed:
                 return None
             status: Json = msgspec.to_builtins(self._experiment)
             return status
+
+
+class _Reported(msgspec.Struct):
+    reported: Json | None = None
+
+
+class _Document(msgspec.Struct):
+    state: _Reported
+    version: int
+
+
+class _Documents(msgspec.Struct):
+    """The part of an `update/documents` message the station reads."""
+
+    current: _Document
+
+
+_documents_decoder = msgspec.json.Decoder(_Documents)
 
 
 def _timestamps(metadata: object) -> list[float]:

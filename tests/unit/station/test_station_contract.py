@@ -32,7 +32,7 @@ def test_every_page_message_has_a_typedef_tagged_with_its_type() -> None:
     for struct in typing.get_args(PageMessage):
         tag = struct.__struct_config__.tag
         assert f'@property {{"{tag}"}} type' in typedef(text, struct.__name__)
-    assert "@typedef {SnapshotMessage|ShadowMessage|" in text
+    assert "@typedef {SnapshotMessage|RobotsMessage|" in text
 
 
 def test_a_property_is_optional_only_where_the_json_may_lack_it() -> None:
@@ -45,7 +45,9 @@ def test_a_property_is_optional_only_where_the_json_may_lack_it() -> None:
     assert "@property {Array<string>} robots" in typedef(text, "TurnMessage")
     assert "@property {Array<Segment>} walls" in typedef(text, "Floor")
     assert "[status]" in typedef(text, "Reported")
-    assert "@property {Reported} reported" in typedef(text, "ShadowMessage")
+    # A robot's change holds only what changed: every field but the robot may be missing
+    assert "@property {Reported} [reported]" in typedef(text, "RobotChange")
+    assert "@property {string} thing" in typedef(text, "RobotChange")
 
 
 def test_the_page_gets_the_stations_drive_ends() -> None:

@@ -16,7 +16,7 @@ from vahr.protocol.station import (
     AlertAcknowledgedMessage,
     AnnouncementMessage,
     PageMessage,
-    ShadowMessage,
+    RobotsMessage,
     SnapshotMessage,
     TurnMessage,
 )
@@ -89,13 +89,43 @@ def test_shadow_documents_reach_pages_in_order_and_old_versions_are_ignored(feed
     feed.load_shadow(
         "placebot1", json.dumps({"state": {"reported": {"status": "x"}}, "version": 3}).encode()
     )
-    # Then the page is told the two changes, in order, and nothing older
-    told = messages(page)
-    assert [(m["type"], m["version"], m["reported"]["status"]) for m in told] == [
-        ("shadow", 4, "navigating"),
-        ("shadow", 5, "idle"),
-    ]
+    # Then the page, reading once, is told one change of the robot: the latest version,
+    # with the fields as they are now and the one that went away
+    (told,) = messages(page)
+    assert told == {
+        "type": "robots",
+        "changes": [
+            {
+                "thing": "placebot1",
+                "reported": {"status": "idle", "zone": "B"},
+                "removed": ["destination"],
+                "version": 5,
+                "last_seen": 1_000_000.0,
+            }
+        ],
+    }
     assert feed.snapshot()["robots"]["placebot1"]["reported"] == {"status": "idle", "zone": "B"}
+
+
+def test_a_shadow_update_sends_only_the_fields_that_changed(feed: Feed, clock: Clock) -> None:
+    topic = topics.shadow("placebot1", "update/documents")
+    feed.on_shadow_documents(topic, documents({"status": "idle", "zone": "A", "cargo": False}, 1))
+    page = feed.subscribe()
+    messages(page)
+    # When the robot starts to drive: its status changes, a destination appears
+    feed.on_shadow_documents(
+        topic,
+        documents({"status": "navigating", "zone": "A", "cargo": False, "destination": "B"}, 2),
+    )
+    # Then the page is told those two fields and the version, nothing else
+    (told,) = messages(page)
+    assert told["changes"] == [
+        {
+            "thing": "placebot1",
+            "reported": {"status": "navigating", "destination": "B"},
+            "version": 2,
+        }
+    ]
 
 
 def test_things_outside_the_fleet_and_named_shadows_are_not_drawn(feed: Feed) -> None:
@@ -130,7 +160,7 @@ def test_a_command_is_acknowledged_once_per_robot_with_its_latency(
     )
     told = messages(page)
     # Then the page is told the command, one acknowledgment with its latency, the shadow
-    assert [m["type"] for m in told] == ["command", "ack", "event", "shadow"]
+    assert [m["type"] for m in told] == ["command", "ack", "event", "robots"]
     assert told[0]["target"] == "placebot1" and told[0]["source"] == "console"
     assert told[1] == {
         "type": "ack", "id": command.id, "thing": "placebot1", "event": "accepted", "latency_ms": 12.0
@@ -206,8 +236,12 @@ def test_a_page_that_falls_behind_gets_each_robots_latest_progress(feed: Feed) -
     feed.on_event(
         topics.robot_events("placebot2"), event("progress", thing="placebot2", progress=0.1)
     )
-    told = messages(page)
-    assert [(m["thing"], m["progress"]) for m in told] == [("placebot1", 0.8), ("placebot2", 0.1)]
+    (told,) = messages(page)
+    assert [(c["thing"], c["progress"]["progress"]) for c in told["changes"]] == [
+        ("placebot1", 0.8),
+        ("placebot2", 0.1),
+    ]
+    assert told["changes"][0]["progress"]["pose"]["x"] == 5.0
 
 
 def test_a_page_too_far_behind_is_dropped_and_reconnects_from_a_snapshot(feed: Feed) -> None:
@@ -265,12 +299,16 @@ def test_every_message_a_page_is_sent_is_a_page_message_of_the_contract(
     # Then each message the page gets decodes as the contract's struct of its type
     told = [PAGE.decode(message) for message in page.take(0) or []]
     assert [m.__struct_config__.tag for m in told] == [
-        "snapshot", "command", "ack", "event", "shadow", "presence", "turn", "experiment",
+        "snapshot", "command", "ack", "event", "robots", "turn", "experiment",
         "announcement", "alert_acknowledged",
     ]  # fmt: skip
-    # And what the robot reported is passed on whole, fields beyond the contract too
-    shadow = told[4]
-    assert isinstance(shadow, ShadowMessage) and shadow.reported["extra"] == [1]
+    # And what the robot reported is passed on, fields beyond the contract too, beside
+    # the other robot's presence
+    robots = told[4]
+    assert isinstance(robots, RobotsMessage)
+    shadow, presence = robots.changes
+    assert shadow.reported == {"status": "navigating", "destination": "B", "extra": [1]}
+    assert presence.thing == "placebot2" and presence.online is True
     # And a new page's snapshot holds the same, as a page message too
     (snapshot,) = [PAGE.decode(m) for m in feed.subscribe().take(0) or []]
     assert isinstance(snapshot, SnapshotMessage)
@@ -426,3 +464,28 @@ def test_an_alert_is_acknowledged_through_the_stations_api(fleet: Fleet, feed: F
     assert (reply.status, json.loads(reply.body)) == (400, {"error": "id: a string is required"})
     # And nothing went to the robots
     assert wire.sent == []
+
+
+def test_changes_not_taken_yet_merge_into_the_state_the_page_would_reach(feed: Feed) -> None:
+    shadow = topics.shadow("placebot1", "update/documents")
+    feed.on_shadow_documents(shadow, documents({"status": "idle", "zone": "A", "task": "x"}, 1))
+    page = feed.subscribe()
+    (snapshot,) = messages(page)
+    # When the robot drives off (task gone, destination new), goes offline and comes back
+    feed.on_shadow_documents(shadow, documents({"status": "navigating", "zone": "A"}, 2))
+    feed.on_shadow_documents(
+        shadow, documents({"status": "navigating", "zone": None, "destination": "B"}, 3)
+    )
+    presence = topics.robot_presence("placebot1")
+    feed.on_presence(presence, encode(Presence(online=False, at=utc_now())))
+    feed.on_presence(presence, encode(Presence(online=True, at=utc_now())))
+    # Then the one change the page reads takes it from its snapshot to the feed's state
+    (told,) = messages(page)
+    (change,) = told["changes"]
+    robot = snapshot["robots"]["placebot1"]
+    robot["reported"] = {**robot["reported"], **change["reported"]}
+    for key in change["removed"]:
+        del robot["reported"][key]
+    robot.update({k: v for k, v in change.items() if k not in ("thing", "reported", "removed")})
+    assert robot == feed.snapshot()["robots"]["placebot1"]
+    assert change["online"] is True and change["version"] == 3

@@ -235,15 +235,6 @@
  */
 
 /**
- * A robot came online or went offline.
- * @typedef {object} PresenceMessage
- * @property {"presence"} type
- * @property {string} thing
- * @property {boolean} online
- * @property {number|null} last_seen
- */
-
-/**
  * Puzzle pieces the observer counted (a negative count corrects a miscount).
  * @typedef {object} PuzzleInput
  * @property {"puzzle"} kind
@@ -264,6 +255,22 @@
  * @property {string|null} [destination]
  * @property {string|null} [task]
  * @property {ShadowPose|null} [pose]
+ */
+
+/**
+ * What changed of one robot since the page last heard of it: a field is present only when it
+ * changed. `reported` holds the reported state's top-level fields that changed, with their new
+ * values, and `removed` those that are gone: the page merges them into the state it has.
+ * `version` is the shadow version that brings it to; `progress` is the drive's latest progress
+ * event (None once the drive ended).
+ * @typedef {object} RobotChange
+ * @property {string} thing
+ * @property {Reported} [reported]
+ * @property {Array<string>} [removed]
+ * @property {number} [version]
+ * @property {boolean} [online]
+ * @property {number|null} [last_seen]
+ * @property {Event|null} [progress]
  */
 
 /**
@@ -290,20 +297,19 @@
  */
 
 /**
+ * The robots that changed since the page's last message, each once, with only what changed
+ * (shadow updates, presence and drive progress coalesced per robot): at most one of these
+ * reaches a page per frame however many robots report.
+ * @typedef {object} RobotsMessage
+ * @property {"robots"} type
+ * @property {Array<RobotChange>} changes
+ */
+
+/**
  * A straight piece of wall from `start` to `end`.
  * @typedef {object} Segment
  * @property {Point} start
  * @property {Point} end
- */
-
-/**
- * A robot's whole reported state after an accepted update, with its version.
- * @typedef {object} ShadowMessage
- * @property {"shadow"} type
- * @property {string} thing
- * @property {Reported} reported
- * @property {number} version
- * @property {number|null} last_seen
  */
 
 /**
@@ -369,7 +375,7 @@
  * @property {string|null} key
  */
 
-/** @typedef {SnapshotMessage|ShadowMessage|PresenceMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage|AnnouncementMessage|AlertAcknowledgedMessage} PageMessage */
+/** @typedef {SnapshotMessage|RobotsMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage|AnnouncementMessage|AlertAcknowledgedMessage} PageMessage */
 
 /** @typedef {TurnMessage|CommandMessage|EventMessage|AnnouncementMessage} ConversationEntry */
 

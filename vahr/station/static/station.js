@@ -10,11 +10,12 @@ import { byId } from "./dom.js";
 import { ExperimentView, watchInteractions } from "./experiment.js";
 import { Interactions } from "./interactions.js";
 import { MapView, setZoneNames } from "./map.js";
+import { applyChange } from "./changes.js";
 import { Panel } from "./panel.js";
 import { RobotsPanel } from "./robots.js";
 import { Talk } from "./talk.js";
 
-/** @import { AnnouncementMessage, CommandMessage, EventMessage, ExperimentStatus, FleetView, PageMessage, Reported, RobotView, ShadowMessage, SnapshotMessage } from "./contract.js" */
+/** @import { AnnouncementMessage, CommandMessage, EventMessage, ExperimentStatus, FleetView, PageMessage, Reported, RobotChange, RobotView, RobotsMessage, SnapshotMessage } from "./contract.js" */
 /** @import { SayReply } from "./api.js" */
 
 /**
@@ -193,18 +194,25 @@ function onAnnouncement(message) {
   requestAnimationFrame(() => afterPaint((at) => metrics.alerts.push({ ...marker, at })));
 }
 
-/** @param {ShadowMessage} message */
-function onShadow(message) {
-  const robot = store.robots[message.thing];
+/** @param {RobotsMessage} message */
+function onRobots(message) {
+  const received = metrics ? performance.timeOrigin + performance.now() : 0;
+  for (const change of message.changes) onChange(change, received);
+}
+
+/** One robot's change (only what changed is in it). @param {RobotChange} change @param {number} received */
+function onChange(change, received) {
+  const robot = store.robots[change.thing];
   if (!robot) return;
-  robot.reported = message.reported;
-  robot.version = message.version;
-  robot.last_seen = message.last_seen;
-  if (message.reported.status !== "navigating") robot.progress = null;
-  const { status, destination, pose, zone } = message.reported;
-  const driving = status === "navigating" && destination && zone !== destination;
-  map.report(message.thing, pose, destination, Boolean(driving));
-  changed(message.thing, metrics ? { thing: message.thing, version: message.version, received: performance.timeOrigin + performance.now() } : null);
+  applyChange(robot, change);
+  if (change.progress) map.report(change.thing, change.progress.pose, change.progress.zone, true);
+  if (change.reported || change.removed) {
+    const { status, destination, pose, zone } = robot.reported || {};
+    const driving = status === "navigating" && destination && zone !== destination;
+    if (!change.progress) map.report(change.thing, pose, destination, Boolean(driving));
+  }
+  const marker = metrics && change.version !== undefined ? { thing: change.thing, version: change.version, received } : null;
+  changed(change.thing, marker);
 }
 
 /** @param {EventMessage} message */
@@ -237,15 +245,8 @@ function onExperiment(status) {
 /** What the page does with each message, by its type. @type {{[T in PageMessage["type"]]: (message: Extract<PageMessage, {type: T}>) => void}} */
 const handlers = {
   snapshot: reset,
-  shadow: onShadow,
+  robots: onRobots,
   event: onEvent,
-  presence(message) {
-    const robot = store.robots[message.thing];
-    if (!robot) return;
-    robot.online = message.online;
-    robot.last_seen = message.last_seen;
-    changed(message.thing);
-  },
   command(message) {
     store.commands[message.id] = message;
     // Keep as many commands as the station does: a long session must not grow the page.
