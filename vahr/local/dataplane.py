@@ -6,6 +6,9 @@ Publish (to the local broker, QoS and retain honoured), Get/Update/DeleteThingSh
 `x-amzn-ErrorType` names (so boto3 raises `ResourceNotFoundException`, `ConflictException`,
 ...). SigV4 headers are accepted and not checked: it listens on 127.0.0.1 only.
 
+It also answers the IoT control plane's fleet-indexing calls under `/indices`
+(`vahr.local.fleet_index_api`), so boto3's `iot` client pointed here can search the fleet.
+
 Paths under `/vahr/` are the local stack's own (the Alexa simulator's `say`, health and
 the billing meter; `/vahr/dashboard` redirects to the operator station); AWS uses none of
 them.
@@ -19,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
 from vahr.errors import VahrError
+from vahr.local.fleet_index_api import FleetIndexApi
 from vahr.local.ports import LOOPBACK, ensure_free
 from vahr.local.quiet_http import QuietHandler, QuietServer, ServerThread
 from vahr.local.shadow_store import MAX_REQUEST_BYTES, ShadowError
@@ -80,6 +84,20 @@ class DataPlane:
         # What `GET /vahr/health` answers; the system adds what a client must adopt (the
         # robots' `sim_speed_factor`).
         self.health: Json = {"ok": True}
+        # Path prefixes whose routes answer (status, body, AWS error type) themselves: the
+        # IoT control plane's fleet-indexing calls (boto3's `iot` client), whose error
+        # names the status alone does not tell.
+        self.typed_routes: dict[str, Callable[[str, str, bytes], tuple[int, bytes, str | None]]]
+        self.typed_routes = {"/indices": FleetIndexApi(shadows.store.index).respond}
+
+    def respond(self, method: str, raw_path: str, body: bytes) -> tuple[int, bytes, str | None]:
+        """`handle`, and the typed routes: (status, body, error type or None)."""
+        path = urlsplit(raw_path).path
+        for prefix, route in self.typed_routes.items():
+            if path == prefix or path.startswith(prefix + "/"):
+                return route(method, path, body)
+        status, payload = self.handle(method, raw_path, body)
+        return status, payload, None
 
     def handle(self, method: str, raw_path: str, body: bytes) -> tuple[int, bytes]:
         """One request -> (status, response body)."""
@@ -242,18 +260,20 @@ class _Handler(QuietHandler):
             self.end_headers()
             return
         try:
-            status, payload = self.server.dataplane.handle(self.command, self.path, body)
+            answer = self.server.dataplane.respond(self.command, self.path, body)
+            status, payload, error_type = answer
         except Exception:  # the server must answer even when a bug bites
             log.exception("data plane request %s %s failed", self.command, self.path)
-            status, payload = _error(500, "Internal service failure")
-        self._answer(status, payload)
+            status, payload, error_type = (*_error(500, "Internal service failure"), None)
+        self._answer(status, payload, error_type)
 
-    def _answer(self, status: int, payload: bytes) -> None:
+    def _answer(self, status: int, payload: bytes, error_type: str | None = None) -> None:
         self.send_response(status)
         self.send_header("Content-Type", "application/json")
         self.send_header("Content-Length", str(len(payload)))
         if status >= 400:
-            self.send_header("x-amzn-ErrorType", ERROR_TYPES.get(status, "InvalidRequestException"))
+            error_type = error_type or ERROR_TYPES.get(status, "InvalidRequestException")
+            self.send_header("x-amzn-ErrorType", error_type)
         if self.close_connection:
             self.send_header("Connection", "close")
         self.end_headers()

@@ -5,6 +5,9 @@ update (merge, `null` deletes, versions and optimistic locking, per-key metadata
 get, delete and list of named shadows, with AWS's error codes, messages and limits. The
 MQTT adapter (`shadow_service`) and the HTTP data plane (`dataplane`) both call it, so the
 two paths cannot drift. Documents persist in SQLite and survive restarts.
+
+Every change of a classic shadow is also recorded in the store's `FleetIndex` (`index`),
+so fleet queries see what the shadows hold, by either path, at once.
 """
 
 from __future__ import annotations
@@ -18,6 +21,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import msgspec
+
+from vahr.local.fleet_index import FleetIndex
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -76,6 +81,11 @@ class _Stored:
 
 def _view(stored: _Stored) -> Json:
     return {"state": stored.state, "metadata": stored.metadata, "version": stored.version}
+
+
+def _reported(stored: _Stored) -> Json:
+    reported = stored.state.get("reported")
+    return reported if isinstance(reported, dict) else {}
 
 
 def _decode(data: str | bytes) -> Json:
@@ -245,6 +255,11 @@ class ShadowStore:
         }
         # Changed since the last commit, in order of change.
         self._dirty: dict[tuple[str, str], _Stored] = {}
+        self.index = FleetIndex()
+        loaded_at = self.now()
+        for (thing, name), stored in self._cache.items():
+            if not name and stored.exists:
+                self.index.record(thing, _reported(stored), stored.version, loaded_at)
 
     def close(self) -> None:
         with self._commit_lock:
@@ -304,6 +319,9 @@ class ShadowStore:
         key = (thing, name or "")
         self._cache[key] = stored
         self._dirty[key] = stored
+        if not name:
+            reported = _reported(stored) if stored.exists else None
+            self.index.record(thing, reported, stored.version, self.now())
 
     # -- operations -------------------------------------------------------------------
 
