@@ -71,6 +71,10 @@ class QuietServer(ThreadingHTTPServer):
 
     daemon_threads = True
     what = "HTTP"
+    # socketserver's listen backlog is 5: a burst of clients (a station page per operator,
+    # a swarm's status questions, a connection flood) overflows it and each refused SYN
+    # is retried a second later, which reads as a one-second stall.
+    request_queue_size = 128
 
     def handle_error(self, request: object, client_address: object) -> None:
         # A client closing its kept-alive connection is routine, not a server error.
