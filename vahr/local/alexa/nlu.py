@@ -11,7 +11,13 @@ Understanding an utterance takes three steps, each from the same generated model
 3. The intent is held to the values found (`consistency`): an intent that takes no slot is
    not chosen when a robot or zone was named, nor one whose samples never name as many
    values of its types together; either way the answer is the fallback.
-4. The values found are given to the intent's slots by their type and order (`slot_roles`).
+4. The values found are given to the intent's slots by a tagger trained on the same samples
+   with their slots labelled (`roles`); a type the intent takes that is named but given
+   no slot is words that do not fit the intent, and the answer is the fallback.
+
+What the NLU knows of the language beyond the model (the built-in intents' phrases, the
+out-of-domain sentences, the function words around names, the role examples) is the
+locale's `understanding.yaml` (`understanding`).
 
 Slot values resolve as Alexa's entity resolution does (ER_SUCCESS_MATCH with the value's id
 and name, or ER_SUCCESS_NO_MATCH). The trained classifier is cached on disk under a hash
@@ -30,11 +36,13 @@ from typing import Any
 from rapidfuzz import fuzz, process
 
 from vahr.errors import VahrError
+from vahr.local.alexa import roles
 from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
 from vahr.local.alexa.consistency import SlotConsistency
 from vahr.local.alexa.intent_classifier import load_or_train
 from vahr.local.alexa.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize_utterance
 from vahr.local.alexa.slot_roles import assign_slots
+from vahr.local.alexa.understanding import LanguageUnderstanding, load_understanding
 from vahr.local.alexa.weather_rule import states_a_weather_rule
 from vahr.protocol import FLEET_GROUP
 from vahr.skill_model.intents import RAINY_ZONE, ROBOT_TYPE, SUNNY_ZONE
@@ -112,7 +120,10 @@ class InteractionModel:
         cache_dir: Path | None = None,
         background: bool = False,
         use_cache: bool = True,
+        understanding: LanguageUnderstanding | None = None,
     ) -> None:
+        """`understanding` is the locale's data beyond the model (en-US's by default)."""
+        self._understanding = understanding or load_understanding()
         try:
             language = document["interactionModel"]["languageModel"]
             self.invocation_name: str = language["invocationName"]
@@ -147,12 +158,26 @@ class InteractionModel:
             ]
             + [(answer, self.intent_slots[name]) for name, answer in sorted(answers)],
             known,
+            self._understanding.finder,
         )
         robot_values = [
             value for t in self._slot_types if t.name == ROBOT_TYPE for value in t.names.values()
         ]
-        self._robots = {v: name for v, name in robot_values if v != FLEET_GROUP}
-        self._fleet_name = next((n for v, n in robot_values if v == FLEET_GROUP), "all robots")
+        self._fleet = roles.Fleet(
+            {v: name for v, name in robot_values if v != FLEET_GROUP},
+            next((n for v, n in robot_values if v == FLEET_GROUP), "all robots"),
+        )
+        role_sequences = {
+            name: roles.training_sequences(
+                name,
+                slots,
+                [self._normalized_sample(sample) for sample in samples[name]],
+                self._understanding.roles,
+            )
+            for name, slots in self.intent_slots.items()
+            if slots
+        }
+        self._taggers: dict[str, roles.RolesTagger] = {}
         self.training = (texts, labels)
         self.cached: bool | None = None
         self._classifier: TextClassifier | None = None
@@ -162,6 +187,10 @@ class InteractionModel:
 
         def build() -> None:
             try:
+                for name, sequences in role_sequences.items():
+                    self._taggers[name], _ = roles.load_or_train(
+                        name, self.intent_slots[name], sequences, cache
+                    )
                 self._classifier, self.cached = load_or_train(texts, labels, cache)
             except BaseException as err:  # reported to whoever waits for the classifier
                 self._failure = err
@@ -186,7 +215,7 @@ class InteractionModel:
                 self._samples.setdefault(name, []).append((abstracted, sample))
                 texts.append(abstracted)
                 labels.append(name)
-        for name, phrases in built_in_phrases().items():
+        for name, phrases in built_in_phrases(understanding=self._understanding).items():
             if name in self.intent_slots:
                 for phrase in phrases:
                     self._samples.setdefault(name, []).append((phrase, phrase))
@@ -196,7 +225,7 @@ class InteractionModel:
             texts.append(self._abstract_sample(name, answer))
             labels.append(SLOT_ANSWER)
         if FALLBACK in self.intent_slots:
-            background = out_of_domain_phrases()
+            background = out_of_domain_phrases(understanding=self._understanding)
             texts += background
             labels += [FALLBACK] * len(background)
         return texts, labels
@@ -233,16 +262,18 @@ class InteractionModel:
         abstracted = _abstract(words, matches)
         # Outside a dialog there is no question to answer: the answer reading is set aside.
         intent, confidence = classifier.scores(abstracted).without(SLOT_ANSWER).best
+        declared = self.intent_slots.get(intent, {})
+        assigned: dict[str, SlotMatch] | None = {}
+        if intent != FALLBACK and confidence >= CONFIDENCE_THRESHOLD:
+            assigned = self._assign(intent, matches, words)
         if (
             intent == FALLBACK
             or confidence < CONFIDENCE_THRESHOLD
             or not self.consistency.agrees(intent, matches)
-            or not self._rule_said_as_rule(intent, matches, words)
+            or assigned is None
         ):
             guess = None if intent == FALLBACK else intent
             return Understanding(FALLBACK, confidence=confidence, best_guess=guess)
-        declared = self.intent_slots.get(intent, {})
-        assigned = assign_slots(declared, matches, words, self._robots, self._fleet_name)
         slots = {name: _slot_value(name, declared[name], m) for name, m in assigned.items()}
         return Understanding(
             intent,
@@ -251,6 +282,21 @@ class InteractionModel:
             self.nearest_sample(intent, abstracted),
             confidence,
         )
+
+    def _assign(
+        self, intent: str, matches: list[SlotMatch], words: list[str]
+    ) -> dict[str, SlotMatch] | None:
+        """The values given to the intent's slots; None when the words do not fit it."""
+        declared = self.intent_slots.get(intent, {})
+        if self._understanding.english_role_rules:
+            if not self._rule_said_as_rule(intent, matches, words):
+                return None
+            fleet = self._fleet
+            return assign_slots(declared, matches, words, fleet.robots, fleet.name)
+        if intent not in self._taggers:
+            return {}
+        labels = self._taggers[intent].labels(words, matches)
+        return roles.assign(declared, matches, labels, self._fleet)
 
     def _rule_said_as_rule(self, intent: str, matches: list[SlotMatch], words: list[str]) -> bool:
         """A weather delivery that names zones is one only when the words make the weather
@@ -275,9 +321,16 @@ class InteractionModel:
         request = best not in (SLOT_ANSWER, FALLBACK, intent)
         if request and confidence >= CONFIDENCE_THRESHOLD:
             return None
-        # Several values are read as in a request ("robot one and robot two" is the fleet).
-        value = assign_slots({slot: slot_type}, values, words, self._robots, self._fleet_name)
-        return _slot_value(slot, slot_type, value[slot])
+        # Several values are read as the intent's tagger reads them in a request: "robot one
+        # and robot two" listed is the fleet, "robot one or robot two" a choice to ask about.
+        if self._understanding.english_role_rules:
+            fleet = self._fleet
+            value = assign_slots({slot: slot_type}, values, words, fleet.robots, fleet.name)
+            return _slot_value(slot, slot_type, value[slot])
+        tagger = self._taggers.get(intent)
+        labels = tagger.labels(words, values) if tagger else [""] * len(values)
+        modes = [label[:1] if label[:1] in (roles.LISTED, roles.CHOICE) else "" for label in labels]
+        return _slot_value(slot, slot_type, roles.combine(values, modes, self._fleet))
 
     def nearest_sample(self, intent: str, abstracted: str) -> str | None:
         """The intent's sample utterance whose words are closest to `abstracted`."""
@@ -288,6 +341,12 @@ class InteractionModel:
             abstracted, [text for text, _ in samples], scorer=fuzz.token_sort_ratio
         )
         return samples[best[2]][1] if best else None
+
+    @staticmethod
+    def _normalized_sample(sample: str) -> str:
+        """A sample's words as the NLU reads words, its `{slot}` references kept."""
+        words = [w if w.startswith("{") else normalize_utterance(w) for w in sample.split()]
+        return " ".join(word for word in words if word)
 
     def _abstract_sample(self, intent: str, sample: str) -> str:
         types = self.intent_slots.get(intent, {})

@@ -17,12 +17,15 @@ would name another robot or zone. Some spans need more than a name:
   the words cannot say which was meant, so the skill asks rather than take the first;
   but an ordinal right after a robot's name is that robot's turn ("placebot one first,
   placebot two second"), not the start of the next name;
-- a bare number or letter joined to a name by "and" or "or" names the value the name would
-  with that word last ("robot one and two", "zone a or b"), so the second value is not
-  lost: "stop robot one and two" stops both, not robot one alone;
-- "the other robot" (or "the other one") is a robot that does not resolve by its words:
-  which one it is depends on the robot named before it, which `slot_roles` settles where
-  it can (a sequential delivery in a fleet of two).
+- a bare number or letter joined to a name by a joiner ("and", "or") names the value the
+  name would with that word last ("robot one and two", "zone a or b"), so the second value
+  is not lost: "stop robot one and two" stops both, not robot one alone;
+- an `other` phrase followed by a word of a type's names ("the other robot", "the other
+  one") is a value of that type that does not resolve by its words: which one it is
+  depends on the value named before it, which `roles` settles where it can (a fleet of two).
+
+The function words (articles, joiners, turns, the verbs of going, the `other` phrases) are
+the locale's (`understanding.yaml`'s `finder`), not code's.
 """
 
 from __future__ import annotations
@@ -34,10 +37,11 @@ from typing import TYPE_CHECKING
 from rapidfuzz import fuzz, process
 
 from vahr.protocol.text import normalize, spell_numbers
-from vahr.skill_model.intents import ROBOT_TYPE
 
 if TYPE_CHECKING:
     from collections.abc import Iterable, Mapping
+
+    from vahr.local.alexa.understanding import FinderWords
 
 # Misheard words closer than this (rapidfuzz ratio, 0-100) to a word of a slot name are read
 # as that word; below it they stay unknown.
@@ -46,18 +50,6 @@ FUZZY_CUTOFF = 75.0
 # those words into a slot word: a changed number would name another robot or zone.
 SPELLED_BELOW = 21
 NUMBER_WORDS = frozenset(spell_numbers(str(number)) for number in range(SPELLED_BELOW))
-_ARTICLES = frozenset({"the", "a", "an"})
-# Words that join a second value to a name with its shared words left out ("robot one and
-# two"); `slot_roles` reads "and" as a list and "or" as a choice to ask about.
-_JOINERS = frozenset({"and", "or", "plus"})
-# Words that say a robot's turn in a sequence when they follow its name ("placebot one
-# first", "placebot two goes second"); `slot_roles` orders the robots by them.
-TURNS = {"first": 0, "second": 1, "last": 1}
-# The verbs that may stand between a robot and its turn; `slot_roles` reads turns by them too.
-GOING_VERBS = frozenset({"goes", "go", "comes", "delivers", "is", "will", "should"})
-# "the other robot": a robot named by the one named before it.
-OTHER_ROBOT = ("the", "other")
-_OTHER_HEADS = frozenset({"robot", "one", "placebot", "bot"})
 
 
 def normalize_utterance(text: str) -> str:
@@ -78,6 +70,8 @@ class SlotMatch:
     canonical: str | None
     # 100 for an exact name, lower when a misheard word was read as a name's word.
     similarity: float
+    # "the other robot": a value named by the one named before it (`roles` resolves it).
+    refers_to_other: bool = False
 
 
 @dataclass(frozen=True)
@@ -96,9 +90,18 @@ class SlotFinder:
         slot_types: Iterable[SlotTypeValues],
         samples: Iterable[tuple[str, Mapping[str, str]]],
         known_words: Iterable[str],
+        function_words: FinderWords,
     ) -> None:
         """`samples` are (sample text, its slot name -> type); `known_words` are every word
-        the classifier was trained on, which are never corrected into slot words."""
+        the classifier was trained on, which are never corrected into slot words;
+        `function_words` are the locale's (`understanding.yaml`)."""
+        articles = frozenset(function_words.articles)
+        self._joiners = frozenset(function_words.joiners)
+        self._turns = frozenset(function_words.turns)
+        self._going = frozenset(function_words.going)
+        self._other = [tuple(phrase.split()) for phrase in function_words.other]
+        # The words that may follow an `other` phrase: any word of the type's names.
+        self._other_heads: dict[str, str] = {}
         self._names: dict[tuple[str, ...], list[tuple[str, str, str]]] = defaultdict(list)
         self._heads: dict[str, str] = {}
         slot_words: set[str] = set()
@@ -110,10 +113,12 @@ class SlotFinder:
                 slot_words.update(name_words)
                 if len(name_words) > 1:
                     owners[name_words[-2]].add(value_id)
+                for word in name_words:
+                    self._other_heads.setdefault(word, slot_type.name)
             # The word right before what tells values apart ("robot" one, "zone" a), when
             # several values share it, names the type ("drop" of "drop zone a" does not).
             for word, ids in owners.items():
-                if len(ids) > 1 and word not in _ARTICLES:
+                if len(ids) > 1 and word not in articles:
                     self._heads.setdefault(word, slot_type.name)
         self._longest = max((len(words) for words in self._names), default=1)
         self._slot_words = sorted(slot_words)
@@ -162,15 +167,15 @@ class SlotFinder:
             match = (
                 self._name_at(corrected, words, similarity, index)
                 or self._unknown_at(corrected, words, index)
-                or _other_robot_at(words, index)
+                or self._other_at(words, index)
             )
             if match is None:
                 index += 1
                 continue
             if (
                 found
-                and _right_after(found[-1], match.start, words)
-                and words[match.start] in TURNS
+                and self._right_after(found[-1], match.start, words)
+                and words[match.start] in self._turns
             ):
                 # "placebot one first placebot two": the ordinal is the first robot's turn,
                 # not the start of "first placebot" (which names another robot than the
@@ -193,7 +198,7 @@ class SlotFinder:
             return []
         found: list[SlotMatch] = []
         index = match.end
-        while index + 1 < len(corrected) and corrected[index] in _JOINERS:
+        while index + 1 < len(corrected) and corrected[index] in self._joiners:
             word = corrected[index + 1]
             owners = self._names.get((*name[:-1], word), [])
             value = next(((i, c) for t, i, c in owners if t == match.type), None)
@@ -263,6 +268,24 @@ class SlotFinder:
         after_ok = end == len(words) or words[end] in self._after[type_name]
         return before_ok and after_ok
 
+    def _other_at(self, words: list[str], start: int) -> SlotMatch | None:
+        """An `other` phrase and a word of a type's names at `start` ("the other robot"), as
+        a value of that type that does not resolve by its words."""
+        for phrase in self._other:
+            end = start + len(phrase) + 1
+            if tuple(words[start : end - 1]) != phrase or end > len(words):
+                continue
+            type_name = self._other_heads.get(words[end - 1])
+            if type_name is not None:
+                spoken = " ".join(words[start:end])
+                return SlotMatch(type_name, start, end, spoken, None, None, 100.0, True)
+        return None
+
+    def _right_after(self, previous: SlotMatch, start: int, words: list[str]) -> bool:
+        """Whether `start` follows `previous` at once, or after a verb of going ("goes")."""
+        between = words[previous.end : start]
+        return not between or (len(between) == 1 and between[0] in self._going)
+
     def _unknown_at(self, corrected: list[str], words: list[str], start: int) -> SlotMatch | None:
         type_name = self._heads.get(corrected[start])
         if type_name is None or start + 1 >= len(corrected):
@@ -279,20 +302,3 @@ class SlotFinder:
             canonical=None,
             similarity=100.0,
         )
-
-
-def _other_robot_at(words: list[str], start: int) -> SlotMatch | None:
-    """ "the other robot" at `start`, as a robot that does not resolve by its words."""
-    end = start + len(OTHER_ROBOT) + 1
-    if tuple(words[start : end - 1]) != OTHER_ROBOT or words[end - 1 : end] == []:
-        return None
-    if words[end - 1] not in _OTHER_HEADS:
-        return None
-    spoken = " ".join(words[start:end])
-    return SlotMatch(ROBOT_TYPE, start, end, spoken, id=None, canonical=None, similarity=100.0)
-
-
-def _right_after(previous: SlotMatch, start: int, words: list[str]) -> bool:
-    """Whether `start` follows `previous` at once, or after a verb of going ("goes")."""
-    between = words[previous.end : start]
-    return not between or (len(between) == 1 and between[0] in GOING_VERBS)

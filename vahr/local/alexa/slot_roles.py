@@ -26,7 +26,6 @@ from dataclasses import replace
 from itertools import pairwise
 from typing import TYPE_CHECKING
 
-from vahr.local.alexa.slot_finder import GOING_VERBS, OTHER_ROBOT, TURNS
 from vahr.local.alexa.weather_rule import RULE_SLOTS, rule_zones
 from vahr.protocol import FLEET_GROUP
 from vahr.skill_model.intents import ROBOT_TYPE, SUNNY_ZONE
@@ -36,6 +35,14 @@ if TYPE_CHECKING:
 
     from vahr.local.alexa.slot_finder import SlotMatch
 
+# English only: these rules serve en-US until the roles tagger (`roles`) does as well there;
+# every other locale's roles come from the tagger, and from data.
+# Words that say a robot's turn when they follow its name ("placebot one first").
+TURNS = {"first": 0, "second": 1, "last": 1}
+# The verbs that may stand between a robot and its turn.
+GOING_VERBS = frozenset({"goes", "go", "comes", "delivers", "is", "will", "should"})
+# "the other robot": a robot named by the one named before it.
+OTHER_ROBOT = ("the", "other")
 # Words before a robot that make it the one to go first although it is named second.
 _AFTER = frozenset({"after", "once", "until", "till", "for", "behind"})
 # Words right before a value that turn it down: where a robot comes from ("from zone a",

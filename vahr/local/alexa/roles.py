@@ -1,0 +1,373 @@
+"""Giving the slot values found in an utterance to the intent's slots: a tagger learnt from data.
+
+The labelled templates are the training data for slot roles as they are for intents. For
+each intent with slots, a linear-chain CRF (CRFsuite, through python-crfsuite) is trained
+on the intent's sample utterances from the interaction model, where every `{slot}` is a
+value labelled with its slot name, and on the locale's role examples (`understanding.yaml`,
+`roles`), which add what samples never show: a value that takes no slot (`{-ZONE}`: "from
+the loading zone"), one listed with the value before it for the same slot (`{+robot}`:
+"robot one and robot two"), and one offered as a choice (`{?zone}`: "zone a or zone b").
+
+The tagger's sequence is the values found, in order, not the words: each value's features
+are its type, its rank among the values (of its type and of the other types), and the
+words around it (the nearest four on each side, position by position, up to the next
+value; and every word before and after it as a bag), with each word of a weather also read
+as its weather (turned round by a negation just before it, from the language's data).
+The chain's transitions learn the order of the roles ("firstRobot firstZone secondRobot").
+No language's words are in this module: a new language, or a new intent with two robots
+or two zones, is data.
+
+What the labels leave open is settled by what the values are, not by words (`assign`):
+several values for one slot are one value only when listed and together the whole fleet
+(or all the same value), and otherwise a value that does not resolve, so the skill asks;
+"the other robot" of a fleet of two is the robot not named; the fleet in one of two robot
+slots beside one robot is the fleet's other robot; two robot slots never hold one robot
+(the second is asked for); and one value for two slots of its type fills both unless it
+stands between the two values of the other type, where it is the first one's. A type the
+intent takes, named but given no slot at all, means the words do not fit the intent.
+
+Each intent's model is cached on disk under a hash of its training data, as the intent
+classifier is (`vahr.speech.text_classifier`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import os
+import re
+from dataclasses import dataclass, replace
+from importlib.metadata import version
+from typing import TYPE_CHECKING
+
+import pycrfsuite
+
+from vahr.protocol import FLEET_GROUP
+from vahr.protocol.weather import PLAIN_NEGATIONS, WEATHER_WORDS
+from vahr.skill_model.intents import ROBOT_TYPE
+from vahr.skill_model.templates import expand
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping, Sequence
+    from pathlib import Path
+
+    from vahr.local.alexa.slot_finder import SlotMatch
+    from vahr.local.alexa.understanding import RoleExamples
+
+# What the cached models depend on besides their data; change it with the features or the
+# training parameters, and every cache is invalidated.
+RECIPE = "1: type, ranks, words 4 each side, bags, weather; lbfgs c1 0.1 c2 0.1 200 iterations"
+# CRFsuite's L-BFGS with sklearn-crfsuite's tutorial settings (elastic net 0.1 and 0.1), and
+# every transition possible so that an order never seen in training can still be decoded.
+TRAINING_PARAMETERS = {
+    "c1": 0.1,
+    "c2": 0.1,
+    "max_iterations": 200,
+    "feature.possible_transitions": True,
+}
+# A value that takes no slot.
+NO_SLOT = "-"
+LISTED = "+"
+CHOICE = "?"
+WINDOW = 4
+# Label sequences scored one by one at most (a sentence of six values of six labels each).
+MAX_SEQUENCES = 50_000
+_REFERENCE = re.compile(r"^\{([-+?]?)([A-Za-z_.]+)(!?)\}$")
+_WEATHER = {word: weather for weather, words in WEATHER_WORDS.items() for word in words}
+_NEGATIONS = frozenset(PLAIN_NEGATIONS)
+
+# A value in the words: its type, where it starts and ends, and whether it is the fleet.
+Span = tuple[str, int, int, bool]
+Sequence_ = tuple[list[list[str]], list[str]]
+
+
+def weather_of(words: Sequence[str], at: int) -> str | None:
+    """The weather `words[at]` names, turned round by a negation up to two words before it."""
+    weather = _WEATHER.get(words[at])
+    if weather is None:
+        return None
+    if _NEGATIONS & set(words[max(0, at - 2) : at]):
+        return next(other for other in WEATHER_WORDS if other != weather)
+    return weather
+
+
+def value_features(words: Sequence[str], spans: Sequence[Span]) -> list[list[str]]:
+    """The features of each value in `spans` (left to right) of the normalized `words`."""
+    classes = [weather_of(words, at) for at in range(len(words))]
+    types = sorted({span[0] for span in spans})
+    found: list[list[str]] = []
+    for index, (type_name, start, end, _) in enumerate(spans):
+        same = [span for span in spans if span[0] == type_name]
+        rank = same.index(spans[index])
+        features = [
+            f"t={type_name}{'!' if spans[index][3] else ''}",
+            f"rank={min(rank, 2)}",
+            f"of={min(len(same), 3)}",
+            f"at={min(index, 3)}",
+        ]
+        if index == len(spans) - 1:
+            features.append("last")
+        for other in types:
+            before = sum(1 for span in spans[:index] if span[0] == other)
+            features.append(f"before:{other}={min(before, 2)}")
+        previous_end = spans[index - 1][2] if index else 0
+        next_start = spans[index + 1][1] if index + 1 < len(spans) else len(words)
+        for distance in range(1, WINDOW + 1):
+            at = start - distance
+            if at < previous_end:
+                edge = f"<{spans[index - 1][0]}>" if index else "<s>"
+                features.append(f"L{distance}:{edge}")
+                break
+            features.append(f"L{distance}:{words[at]}")
+        for distance in range(1, WINDOW + 1):
+            at = end + distance - 1
+            if at >= next_start:
+                edge = f"<{spans[index + 1][0]}>" if index + 1 < len(spans) else "</s>"
+                features.append(f"R{distance}:{edge}")
+                break
+            features.append(f"R{distance}:{words[at]}")
+        features += [f"l:{word}" for word in words[previous_end:start]]
+        features += [f"r:{word}" for word in words[end:next_start]]
+        nearest_left = next((c for c in reversed(classes[previous_end:start]) if c), None)
+        nearest_right = next((c for c in classes[end:next_start] if c), None)
+        if nearest_left:
+            features.append(f"near-left~{nearest_left}")
+        if nearest_right:
+            features.append(f"near-right~{nearest_right}")
+        features += [f"l~{c}" for c in classes[previous_end:start] if c]
+        features += [f"r~{c}" for c in classes[end:next_start] if c]
+        found.append(features)
+    return found
+
+
+def labelled_sequence(sentence: str, slot_types: Mapping[str, str]) -> Sequence_ | None:
+    """A sample or role example as (features, labels); None when it names no value.
+
+    `{slot}` is a value for the slot; `{-TYPE}` a value of the type for no slot; `{+slot}`
+    and `{?slot}` a value listed with, or offered instead of, the one before it."""
+    words: list[str] = []
+    spans: list[Span] = []
+    labels: list[str] = []
+    for token in sentence.split():
+        reference = _REFERENCE.match(token)
+        if reference is None:
+            words.append(token)
+            continue
+        mode, name, fleet = reference.groups()
+        if mode == NO_SLOT:
+            spans.append((name, len(words), len(words) + 1, bool(fleet)))
+            labels.append(NO_SLOT)
+        elif name in slot_types:
+            spans.append((slot_types[name], len(words), len(words) + 1, bool(fleet)))
+            labels.append(mode + name)
+        else:
+            return None
+        words.append(f"<{spans[-1][0]}>")
+    if not spans:
+        return None
+    return value_features(words, spans), labels
+
+
+class RolesTagger:
+    """One intent's CRF over the values of an utterance, and the slot assignment after it."""
+
+    def __init__(self, intent: str, slot_types: Mapping[str, str], model: bytes) -> None:
+        self.intent = intent
+        self.slot_types = dict(slot_types)
+        # CRFsuite reads the model in place: the bytes must live as long as the tagger.
+        self._model = model
+        self._tagger = pycrfsuite.Tagger()
+        self._tagger.open_inmemory(self._model)
+        # The labels a value of each type may take: its type's slots' (as learnt), or none.
+        known = self._tagger.labels()
+        self._allowed = {
+            slot_type: [
+                label
+                for label in known
+                if label == NO_SLOT or self.slot_types.get(label.lstrip("+?")) == slot_type
+            ]
+            for slot_type in set(self.slot_types.values())
+        }
+
+    def labels(self, words: Sequence[str], matches: Sequence[SlotMatch]) -> list[str]:
+        """A label for each of `matches`: a slot name (marked "+" or "?"), or `NO_SLOT` for
+        a value of a type the intent does not take or one the tagger gives no slot."""
+        taken = [match for match in matches if match.type in self._allowed]
+        if not taken:
+            return [NO_SLOT] * len(matches)
+        # Each value stands as one word of its type, as `{slot}` does in the samples.
+        abstracted: list[str] = []
+        spans: list[Span] = []
+        index = 0
+        for match in taken:
+            abstracted += words[index : match.start]
+            spans.append(
+                (match.type, len(abstracted), len(abstracted) + 1, match.id == FLEET_GROUP)
+            )
+            abstracted.append(f"<{match.type}>")
+            index = match.end
+        abstracted += words[index:]
+        self._tagger.set(value_features(abstracted, spans))
+        best = self._best_sequence([self._allowed[match.type] for match in taken])
+        by_match = {id(match): label for match, label in zip(taken, best, strict=True)}
+        return [by_match.get(id(match), NO_SLOT) for match in matches]
+
+    def _best_sequence(self, allowed: list[list[str]]) -> list[str]:
+        """The most probable labels with each value's label one its type allows (a value of
+        one type never takes another type's slot). The sequences are few (a sentence names
+        two to four values), so each is scored; a longer one is decoded unconstrained."""
+        if math.prod(len(labels) for labels in allowed) > MAX_SEQUENCES:
+            return list(self._tagger.tag())
+        scored = (
+            (self._tagger.probability(list(labels)), labels)
+            for labels in itertools.product(*allowed)
+        )
+        return list(max(scored, key=lambda pair: pair[0])[1])
+
+
+def training_sequences(
+    intent: str,
+    slot_types: Mapping[str, str],
+    samples: Sequence[str],
+    examples: Sequence[RoleExamples],
+) -> list[Sequence_]:
+    """The intent's samples and the locale's role examples for it, labelled."""
+    sentences = list(samples)
+    for group in examples:
+        if intent in group.intents:
+            sentences += [s for template in group.examples for s in expand(template)]
+    found = [labelled_sequence(sentence, slot_types) for sentence in sentences]
+    return [sequence for sequence in found if sequence is not None]
+
+
+def load_or_train(
+    intent: str,
+    slot_types: Mapping[str, str],
+    sequences: list[Sequence_],
+    cache_dir: Path | None,
+) -> tuple[RolesTagger, bool]:
+    """The intent's tagger, from the cache (True) or trained now and cached (False)."""
+    learnt_from = [RECIPE, TRAINING_PARAMETERS, version("python-crfsuite"), intent, sequences]
+    key = hashlib.sha256(json.dumps(learnt_from).encode()).hexdigest()
+    file = cache_dir / f"roles-{intent}-{key[:24]}.crfsuite" if cache_dir else None
+    if file is not None:
+        try:
+            return RolesTagger(intent, slot_types, file.read_bytes()), True
+        except OSError:
+            pass
+    model = _train(sequences)
+    if file is not None:
+        try:
+            file.parent.mkdir(parents=True, exist_ok=True)
+            partial = file.with_suffix(f".{os.getpid()}.tmp")
+            partial.write_bytes(model)
+            partial.replace(file)
+        except OSError:
+            pass
+    return RolesTagger(intent, slot_types, model), False
+
+
+def _train(sequences: list[Sequence_]) -> bytes:
+    import tempfile
+    from pathlib import Path
+
+    trainer = pycrfsuite.Trainer(verbose=False)
+    for features, labels in sequences:
+        trainer.append(features, labels)
+    trainer.set_params(TRAINING_PARAMETERS)
+    with tempfile.TemporaryDirectory(prefix="vahr-roles-") as directory:
+        file = Path(directory) / "model.crfsuite"
+        trainer.train(str(file))
+        return file.read_bytes()
+
+
+@dataclass(frozen=True)
+class Fleet:
+    """The robots of the fleet (id -> name, without the fleet's own id) and its name."""
+
+    robots: Mapping[str, str]
+    name: str
+
+
+def assign(
+    declared: Mapping[str, str],
+    matches: Sequence[SlotMatch],
+    labels: Sequence[str],
+    fleet: Fleet,
+) -> dict[str, SlotMatch] | None:
+    """Slot name -> value for the slots of `declared` (name -> type), from the tagger's
+    labels; None when a type the intent takes is named but given no slot."""
+    given: dict[str, list[tuple[SlotMatch, str]]] = {}
+    for match, label in zip(matches, labels, strict=True):
+        mode, slot = (label[0], label[1:]) if label[:1] in (LISTED, CHOICE) else ("", label)
+        if slot in declared:
+            given.setdefault(slot, []).append((match, mode if slot in given else ""))
+    named_types = {match.type for match in matches}
+    if any(t in named_types and t not in {declared[s] for s in given} for t in declared.values()):
+        return None
+    filled: dict[str, SlotMatch] = {}
+    for slot, values in given.items():
+        filled[slot] = combine([value for value, _ in values], [m for _, m in values], fleet)
+        plain = [value for value, mode in values[1:] if not mode]
+        siblings = [s for s, t in declared.items() if t == declared[slot] and s not in given]
+        if plain and siblings and len(values) == 2:
+            # Two values said alike for one slot, beside an empty one of the same type: the
+            # first is the slot's, the second is heard for the other but not guessed.
+            filled[slot] = values[0][0]
+            filled[siblings[0]] = replace(plain[0], id=None, canonical=None)
+    return _completed(declared, filled, fleet)
+
+
+def combine(values: Sequence[SlotMatch], modes: Sequence[str], fleet: Fleet) -> SlotMatch:
+    """One value standing for the values said for one slot (`modes`: "" for the first or
+    one said apart, "+" listed with the one before, "?" offered as a choice)."""
+    first = values[0]
+    ids = {value.id for value in values}
+    if len(values) == 1 or (len(ids) == 1 and first.id is not None):
+        return first
+    spoken = " and ".join(value.spoken for value in values)
+    listed = all(mode == LISTED for mode in modes[1:])
+    robots = set(fleet.robots)
+    if first.type == ROBOT_TYPE and listed and ids in (robots, {*robots, FLEET_GROUP}):
+        # Robots listed where one is expected are all of them only when they are the fleet.
+        return replace(first, spoken=spoken, id=FLEET_GROUP, canonical=fleet.name)
+    return replace(first, spoken=spoken, id=None, canonical=None)
+
+
+def _completed(
+    declared: Mapping[str, str], filled: dict[str, SlotMatch], fleet: Fleet
+) -> dict[str, SlotMatch]:
+    """What the values are settles what the labels leave open (see the module's notes)."""
+    robot_slots = [slot for slot, t in declared.items() if t == ROBOT_TYPE]
+    robots = [filled[slot] for slot in robot_slots if slot in filled]
+    if len(fleet.robots) == 2:
+        named = {r.id for r in robots if r.id in fleet.robots}
+        for slot in robot_slots:
+            value = filled.get(slot)
+            if value is None or len(named) != 1:
+                continue
+            (other,) = fleet.robots.keys() - named
+            if value.refers_to_other or (value.id == FLEET_GROUP and len(robots) == 2):
+                filled[slot] = replace(value, id=other, canonical=fleet.robots[other])
+    if len(robot_slots) == 2 and all(slot in filled for slot in robot_slots):
+        first, second = (filled[slot] for slot in robot_slots)
+        if first.id is not None and first.id == second.id:
+            filled[robot_slots[1]] = replace(second, id=None, canonical=None)
+    by_type: dict[str, list[str]] = {}
+    for slot, slot_type in declared.items():
+        by_type.setdefault(slot_type, []).append(slot)
+    for slot_type, slots in by_type.items():
+        said = [slot for slot in slots if slot in filled]
+        others = [s for t, ss in by_type.items() if t != slot_type for s in ss]
+        if len(slots) != 2 or len(said) != 1 or len(others) != 2:
+            continue
+        value = filled[said[0]]
+        if said[0] != slots[0] or not all(slot in filled for slot in others):
+            continue
+        before, after = (filled[slot] for slot in others)
+        if before.start < value.start < after.start:
+            continue
+        filled.update(dict.fromkeys(slots, value))
+    return filled
