@@ -1,4 +1,4 @@
-"""`robot-agent`: run a robot, provision its credentials, and use its voice alone."""
+"""`robot-agent`: run a robot or a swarm, provision credentials, and use the voice alone."""
 
 from __future__ import annotations
 
@@ -11,6 +11,10 @@ if TYPE_CHECKING:
 
 SUBCOMMANDS: Subcommands = {
     "run": ("robot_agent.commands.run", "run one robot: receive commands, drive, report state"),
+    "swarm": (
+        "robot_agent.commands.swarm",
+        "run many simulated robots of a fleet in one process, on one connection",
+    ),
     "provision": ("robot_agent.commands.provision", "create a robot's certificate, key and config"),
     "speak": ("robot_agent.commands.speak", "render text to a WAV file with the robot's voice"),
     "hear": (
