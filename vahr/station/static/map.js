@@ -1,12 +1,17 @@
 // @ts-check
 // The floor, top-down, drawn from fleet.yaml, with every robot where it was last reported.
 //
+// Up to `SVG_ROBOTS_UP_TO` robots each is an SVG group, a button with its name for screen
+// readers; more are drawn on one canvas over the floor (robot-layer.js), clustered where
+// they crowd, and found by name in the robots panel's search.
+//
 // Robots report their pose now and then, so between reports the map moves each robot
 // along its path (motion.js): toward its destination zone at the speed its reports imply,
 // easing into a report that disagrees, never jumping or sliding back.
 
 import { clock } from "./dom.js";
 import { Motion, angleDelta, distance } from "./motion.js";
+import { RobotLayer } from "./robot-layer.js";
 
 /** @import { Conveyor, Event, FleetView, Point, Pose, Reported, RobotEntry, RobotView, ZoneEntry } from "./contract.js" */
 /** @import { ReportedPose } from "./motion.js" */
@@ -44,6 +49,9 @@ const SVG = "http://www.w3.org/2000/svg";
 const LABELS_UP_TO = 12; // more robots than this: numbers only, no names under them
 // Frames a second the map moves robots at: smooth for a few, calmer (and cheaper) for many.
 const FRAME_MS_FEW = 0, FRAME_MS_MANY = 50, MANY = 20;
+// More robots than this are drawn on a canvas: SVG's per-element styling and layout cost
+// grows with every robot drawn each frame.
+export const SVG_ROBOTS_UP_TO = 24;
 
 /**
  * @template {keyof SVGElementTagNameMap} K
@@ -95,6 +103,8 @@ export class MapView {
     this.labels = true;
     /** @type {SVGGElement | null} */
     this.led = null;
+    /** Set for a fleet too large for SVG robots. @type {RobotLayer | null} */
+    this.layer = null;
   }
 
   // -- drawing the floor ---------------------------------------------------------------
@@ -103,6 +113,8 @@ export class MapView {
   build(fleet) {
     this.fleet = fleet;
     this.svg.replaceChildren();
+    this.layer?.remove();
+    this.layer = fleet.robots.length > SVG_ROBOTS_UP_TO ? new RobotLayer(this.svg, this.onRobot) : null;
     this.robots.clear();
     this.zones.clear();
     this.arms.clear();
@@ -141,7 +153,13 @@ export class MapView {
     for (const zone of fleet.zones) this.drawZone(zone, layers.zones);
     for (const [zoneId, at] of Object.entries(floor.arms || {})) this.drawArm(zoneId, at, layers.fixtures);
     if (floor.led) this.drawLed(floor.led, layers.fixtures);
-    fleet.robots.forEach((robot, index) => this.drawRobot(robot, index, layers));
+    const layer = this.layer;
+    if (layer) {
+      for (const robot of fleet.robots) layer.add(robot.thing, robot.start);
+      this.animate();
+    } else {
+      fleet.robots.forEach((robot, index) => this.drawRobot(robot, index, layers));
+    }
   }
 
   /** @param {Conveyor} conveyor @param {SVGGElement} parent */
@@ -236,6 +254,10 @@ export class MapView {
   // A robot's whole state changed (shadow, presence, an event): redraw what it shows.
   /** @param {string} thing @param {RobotView} robot */
   update(thing, robot) {
+    if (this.layer) {
+      this.layer.update(thing, robot.online === false ? "offline" : robot.reported?.status || "idle", Boolean(robot.reported?.cargo));
+      return;
+    }
     const drawn = this.robots.get(thing);
     if (!drawn) return;
     /** @type {Reported} */
@@ -263,7 +285,7 @@ export class MapView {
    * @param {boolean} driving
    */
   report(thing, pose, destinationZone, driving) {
-    const drawn = this.robots.get(thing);
+    const drawn = this.layer ? this.layer.robots.get(thing) : this.robots.get(thing);
     if (!drawn || !pose) return;
     const target = driving ? this.zonePose(destinationZone) : null;
     drawn.motion.report(pose, target);
@@ -273,6 +295,11 @@ export class MapView {
   // The robots with an open alert, and about what: each is ringed in its trouble's colour.
   /** @param {Map<string, string>} troubled */
   setTroubled(troubled) {
+    if (this.layer) {
+      this.layer.troubled = troubled;
+      this.layer.dirty = true;
+      this.animate();
+    }
     for (const [thing, drawn] of this.robots) {
       const trouble = troubled.get(thing);
       drawn.group.classList.toggle("alerting", Boolean(trouble));
@@ -288,6 +315,11 @@ export class MapView {
   /** @param {string | null} thing */
   select(thing) {
     this.selected = thing;
+    if (this.layer) {
+      this.layer.selected = thing;
+      this.layer.dirty = true;
+      this.animate();
+    }
     for (const [name, drawn] of this.robots) drawn.group.classList.toggle("selected", name === thing);
     this.svg.classList.toggle("map-armed", Boolean(thing));
   }
@@ -299,6 +331,8 @@ export class MapView {
       const { status, reported } = drawn.state;
       if ((status === "loading" || status === "unloading") && reported?.zone) working.add(reported.zone);
     }
+    // A robot's new status is painted in the frame it arrived in, not the next slow tick.
+    if (this.layer?.dirty) this.layer.draw(now());
     for (const [zoneId, arm] of this.arms) arm.classList.toggle("working", working.has(zoneId));
   }
 
@@ -313,13 +347,17 @@ export class MapView {
   tick() {
     this.frame = null;
     const t = now();
-    const every = this.robots.size > MANY ? FRAME_MS_MANY : FRAME_MS_FEW;
+    const every = this.robots.size > MANY || this.layer ? FRAME_MS_MANY : FRAME_MS_FEW;
     if (t - this.lastFrame < every) {
       this.animate();
       return;
     }
     const dt = Math.min(0.1, (t - this.lastFrame) / 1000);
     this.lastFrame = t;
+    if (this.layer) {
+      if (this.layer.draw(t)) this.animate();
+      return;
+    }
     let busy = false;
     for (const thing of this.robots.keys()) busy = this.place(thing, t, dt) || busy;
     if (busy) this.animate();
@@ -378,7 +416,7 @@ export class MapView {
   // Where a robot is drawn now (tests and benchmarks read it).
   /** @param {string} thing */
   drawnPosition(thing) {
-    const drawn = this.robots.get(thing);
+    const drawn = this.layer ? this.layer.robots.get(thing) : this.robots.get(thing);
     return drawn ? drawn.motion.position(now()) : null;
   }
 }
