@@ -1,0 +1,169 @@
+"""The local stack's fleet task queue: `vahr.protocol.dispatch.TaskStore` over SQLite.
+
+One row per task, in `tasks.sqlite3` in the state directory, so the queue and who holds
+which task survive a restart of `vahr up`. Every conditional change is one SQL statement
+(an UPDATE whose WHERE is the condition) inside one `BEGIN IMMEDIATE` transaction, so two
+dispatchers, in threads or in processes sharing the file, cannot give one task to two
+robots or two tasks to one robot: the loser's UPDATE changes no row and it gets None.
+"""
+
+from __future__ import annotations
+
+import sqlite3
+import threading
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import msgspec
+
+from vahr.protocol.dispatch import Outcome, Task
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+
+FILE_NAME = "tasks.sqlite3"
+
+# `document` is the task as JSON; the columns beside it are what the conditions and the
+# queue's order read. The partial unique index is the rule "one active task per robot"
+# written where SQLite itself enforces it.
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS tasks (
+    id TEXT PRIMARY KEY,
+    status TEXT NOT NULL,
+    thing TEXT,
+    created_at TEXT NOT NULL,
+    document BLOB NOT NULL
+);
+CREATE INDEX IF NOT EXISTS tasks_by_status ON tasks (status, created_at, id);
+CREATE UNIQUE INDEX IF NOT EXISTS one_task_per_robot ON tasks (thing) WHERE status = 'assigned';
+"""
+
+_decoder = msgspec.json.Decoder(Task)
+
+
+class SqliteTaskStore:
+    """Tasks in one SQLite file; safe to share between threads and between processes."""
+
+    def __init__(self, path: Path | str) -> None:
+        self.path = Path(path)
+        # Autocommit mode: each transaction is opened explicitly with BEGIN IMMEDIATE, which
+        # takes the write lock at once, so a check and its update cannot interleave.
+        self._db = sqlite3.connect(
+            self.path, check_same_thread=False, isolation_level=None, timeout=10.0
+        )
+        self._db.execute("PRAGMA journal_mode=WAL")
+        self._db.execute("PRAGMA synchronous=NORMAL")
+        self._db.executescript(_SCHEMA)
+        self._lock = threading.Lock()
+
+    @classmethod
+    def in_state_dir(cls, state_dir: Path) -> SqliteTaskStore:
+        return cls(Path(state_dir) / FILE_NAME)
+
+    def close(self) -> None:
+        with self._lock:
+            self._db.close()
+
+    @contextmanager
+    def _transaction(self) -> Iterator[sqlite3.Connection]:
+        with self._lock:
+            self._db.execute("BEGIN IMMEDIATE")
+            try:
+                yield self._db
+            except BaseException:
+                self._db.execute("ROLLBACK")
+                raise
+            self._db.execute("COMMIT")
+
+    def _load(self, db: sqlite3.Connection, task_id: str) -> Task | None:
+        row = db.execute("SELECT document FROM tasks WHERE id = ?", (task_id,)).fetchone()
+        return None if row is None else _decoder.decode(row[0])
+
+    @staticmethod
+    def _save(db: sqlite3.Connection, task: Task) -> None:
+        db.execute(
+            "UPDATE tasks SET status = ?, thing = ?, document = ? WHERE id = ?",
+            (task.status, task.thing, msgspec.json.encode(task), task.id),
+        )
+
+    # --- the TaskStore port ---------------------------------------------------------------
+
+    def add(self, task: Task) -> None:
+        with self._transaction() as db:
+            db.execute(
+                "INSERT INTO tasks (id, status, thing, created_at, document) VALUES (?,?,?,?,?)",
+                (task.id, task.status, task.thing, task.created_at, msgspec.json.encode(task)),
+            )
+
+    def assign(self, task_id: str, thing: str, *, at: str) -> Task | None:
+        with self._transaction() as db:
+            task = self._load(db, task_id)
+            if task is None or task.status != "queued":
+                return None
+            busy = db.execute(
+                "SELECT 1 FROM tasks WHERE thing = ? AND status = 'assigned'", (thing,)
+            ).fetchone()
+            if busy is not None:
+                return None
+            taken = msgspec.structs.replace(
+                task, status="assigned", thing=thing, assigned_at=at, version=task.version + 1
+            )
+            self._save(db, taken)
+            return taken
+
+    def release(self, task_id: str) -> Task | None:
+        with self._transaction() as db:
+            task = self._load(db, task_id)
+            if task is None or task.status != "assigned":
+                return None
+            back = msgspec.structs.replace(
+                task, status="queued", thing=None, assigned_at=None, version=task.version + 1
+            )
+            self._save(db, back)
+            return back
+
+    def finish(self, task_id: str, *, outcome: Outcome) -> Task | None:
+        with self._transaction() as db:
+            task = self._load(db, task_id)
+            if task is None or task.status != "assigned":
+                return None
+            ended = msgspec.structs.replace(
+                task,
+                status="done" if outcome == "done" else "cancelled",
+                outcome=outcome,
+                version=task.version + 1,
+            )
+            self._save(db, ended)
+            return ended
+
+    def cancel(self, task_id: str) -> Task | None:
+        with self._transaction() as db:
+            task = self._load(db, task_id)
+            if task is None or task.status not in ("queued", "assigned"):
+                return None
+            self._save(
+                db,
+                msgspec.structs.replace(
+                    task, status="cancelled", outcome="cancelled", version=task.version + 1
+                ),
+            )
+            return task
+
+    def get(self, task_id: str) -> Task | None:
+        with self._lock:
+            return self._load(self._db, task_id)
+
+    def pending(self) -> list[Task]:
+        return self._with_status("queued")
+
+    def active(self) -> list[Task]:
+        tasks = self._with_status("assigned")
+        return sorted(tasks, key=lambda task: (task.assigned_at or "", task.id))
+
+    def _with_status(self, status: str) -> list[Task]:
+        with self._lock:
+            rows = self._db.execute(
+                "SELECT document FROM tasks WHERE status = ? ORDER BY created_at, id", (status,)
+            ).fetchall()
+        return [_decoder.decode(row[0]) for row in rows]
