@@ -20,12 +20,23 @@ if TYPE_CHECKING:
 DEFAULT_API_PORT = 8180
 DEFAULT_STATION_PORT = 8181
 DEFAULT_STATE_DIR = Path(".state")
+# The banner names at most this many robots; a swarm's are given as a range.
+BANNER_ROBOTS = 12
+# Robots a swarm builds and brings online per second, at least (measured: docs/local.md).
+SWARM_BUILD_PER_S = 100
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
     add_fleet_flag(parser)
     parser.add_argument(
         "--robots", type=int, help="the fleet's first N robots, or more (default: all of them)"
+    )
+    parser.add_argument(
+        "--swarm",
+        type=int,
+        metavar="N",
+        help="N simulated robots (rover1..) in one process, on a floor sized for them"
+        " (1 to 10,000; the zones are --fleet's)",
     )
     parser.add_argument(
         "--state-dir", type=Path, default=DEFAULT_STATE_DIR, help="local state (default .state)"
@@ -59,6 +70,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
+    from vahr.local.robots import SWARM_MAX
     from vahr.local.system import LocalSystem, SystemConfig
     from vahr.station.deployment import on_local_system
 
@@ -69,6 +81,14 @@ def run(args: argparse.Namespace) -> int:
             raise VahrError(f"--{flag.replace('_', '-')} {value}: not a usable port")
     if args.sim_speed_factor <= 0:
         raise VahrError("--sim-speed-factor must be more than 0")
+    if args.swarm is not None:
+        if args.robots is not None:
+            raise VahrError("give either --robots (a process per robot) or --swarm, not both")
+        if not 1 <= args.swarm <= SWARM_MAX:
+            raise VahrError(
+                f"--swarm {args.swarm}: give 1 to {SWARM_MAX:,} robots (this machine runs"
+                " at most that many in one swarm; see docs/local.md, Large fleets)"
+            )
     config = SystemConfig(
         state_dir=args.state_dir.resolve(),
         mqtts_port=args.mqtts_port,
@@ -76,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
         api_port=args.api_port,
         fleet=read_fleet(args.fleet),
         robots=args.robots,
+        swarm=args.swarm,
         sim_speed_factor=args.sim_speed_factor,
         ack_timeout_s=args.ack_timeout,
         voice=not args.no_voice,
@@ -97,7 +118,8 @@ def run(args: argparse.Namespace) -> int:
         system.start()
         if system.stack.recovered:
             print(f"vahr up: recovered: {system.stack.recovered}", file=sys.stderr, flush=True)
-        system.wait_online()
+        # A swarm's robots come online together once it has built them all.
+        system.wait_online(30.0 + (args.swarm or 0) / SWARM_BUILD_PER_S)
         endpoints = system.endpoints()
         if args.json:
             _emit(json.dumps(endpoints))
@@ -121,6 +143,11 @@ def _emit(line: str) -> None:
 
 def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
     things = fleet.robot_things
+    named = (
+        ", ".join(things)
+        if len(things) <= BANNER_ROBOTS
+        else (f"{things[0]} .. {things[-1]} ({len(things):,} robots)")
+    )
     # An example in the fleet's own words: its first robot to its first zone but LOADING.
     zone = next((z for z in fleet.zones if z.id != "LOADING"), fleet.zones[0])
     example = f"send {fleet.robots[0].spoken[0]} to {zone.spoken[0]}"
@@ -133,7 +160,7 @@ def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
         lines.append(f"  mqtt        {endpoints['mqtt']}   (plaintext, loopback only)")
     lines += [
         f"  station     {endpoints['station'] or '(off)'}   (the operator station page)",
-        f"  robots      {', '.join(things)} (sim backend{', room voice' if voice else ''})",
+        f"  robots      {named} (sim backend{', room voice' if voice else ''})",
         f'  talk to it: vahr say "{example}"   (Ctrl-C stops everything)',
     ]
     return "\n".join(lines)

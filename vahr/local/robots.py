@@ -1,5 +1,7 @@
 """Robot-agent processes for the local stack: one `robot-agent run` per robot, each with
-its own certificate from the local CA, the simulator backend and its own log file.
+its own certificate from the local CA, the simulator backend and its own log file; or, for
+`vahr up --swarm N`, one `robot-agent swarm` process running N robots of a generated
+fleet (`generated_fleet`) on one connection.
 
 A robot runs from the installed package, as it would on a robot: nothing puts a checkout
 on its import path, and it starts in this process's working directory.
@@ -8,6 +10,7 @@ on its import path, and it starts in this process's working directory.
 from __future__ import annotations
 
 import logging
+import math
 import signal
 import subprocess
 import sys
@@ -19,15 +22,26 @@ import msgspec
 from vahr.errors import VahrError
 from vahr.local.lifetime import spawn
 from vahr.protocol import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
+from vahr.protocol.fleet import Conveyor, Floor, Point, Segment
 
 if TYPE_CHECKING:
     from pathlib import Path
 
     from vahr.pki import LocalCA
+    from vahr.protocol.broker import ClientCredentials
 
 log = logging.getLogger(__name__)
 
 STOP_TIMEOUT_S = 8.0
+# `vahr up --swarm N`: the most robots this machine runs in one swarm. Measured resident
+# memory of `robot-agent swarm` (docs/local.md, "Large fleets"): about 60 MB of interpreter and
+# libraries plus about 90 kB per robot, and the CPU, not memory, bounds what runs well:
+# 10,000 robots idle at about a core. The bound is what the local fleet index and the skill's
+# summaries were measured for.
+SWARM_MAX = 10_000
+# The swarm's floor: robots parked on a grid of this spacing, clear of the zones.
+SWARM_SPACING_M = 2.0
+SWARM_ZONE_CLEARANCE_M = 4.0
 
 
 def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
@@ -65,6 +79,60 @@ def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
         robots=robots,
         zones=base.zones,
         groups=groups,
+        experiment_thing=base.experiment_thing,
+        floor=floor,
+    ).validate()
+
+
+def generated_fleet(count: int, base: Fleet | None = None) -> Fleet:
+    """`count` robots `rover1`.. ("rover 17") on a floor sized for them: the zones of `base`
+    (default fleet.yaml) keep their names and arms, the loading zone mid-way along the west
+    wall and the others spread along the east wall; the robots are parked on a square grid
+    between them, `SWARM_SPACING_M` apart, none in a zone."""
+    if not 1 <= count <= SWARM_MAX:
+        raise VahrError(f"--swarm {count}: give 1 to {SWARM_MAX:,} robots")
+    base = base or load_fleet()
+    columns = math.ceil(math.sqrt(count))
+    rows = math.ceil(count / columns)
+    grid_width, grid_height = (columns - 1) * SWARM_SPACING_M, (rows - 1) * SWARM_SPACING_M
+    left = SWARM_ZONE_CLEARANCE_M + 1.5
+    width = left + grid_width + SWARM_ZONE_CLEARANCE_M + 1.5
+    height = max(grid_height + 4.0, 8.0)
+    bottom = (height - grid_height) / 2
+    robots = [
+        Robot(
+            thing=f"rover{index}",
+            spoken=[f"rover {index}"],
+            start=Pose(
+                left + ((index - 1) % columns) * SWARM_SPACING_M,
+                bottom + ((index - 1) // columns) * SWARM_SPACING_M,
+            ),
+        )
+        for index in range(1, count + 1)
+    ]
+    loading = [zone for zone in base.zones if zone.arm == "loader"]
+    delivery = [zone for zone in base.zones if zone.arm != "loader"]
+    zones = [
+        msgspec.structs.replace(zone, pose=Pose(1.5, height / 2, math.pi)) for zone in loading
+    ] + [
+        msgspec.structs.replace(
+            zone, pose=Pose(width - 1.5, height * (len(delivery) - i - 0.5) / len(delivery), 0.0)
+        )
+        for i, zone in enumerate(delivery)
+    ]
+    corners = [Point(0.0, 0.0), Point(width, 0.0), Point(width, height), Point(0.0, height)]
+    floor = Floor(
+        width=width,
+        height=height,
+        walls=[Segment(corners[i], corners[(i + 1) % 4]) for i in range(4)],
+        conveyor=Conveyor(Point(0.0, height / 2), Point(0.9, height / 2)) if loading else None,
+    )
+    everyone = next((g for g in base.groups if g.id == FLEET_GROUP), None)
+    spoken = everyone.spoken if everyone is not None else ["all robots"]
+    return Fleet(
+        robots=robots,
+        zones=zones,
+        groups=[Group(id=FLEET_GROUP, spoken=spoken, robots=[r.thing for r in robots])],
         experiment_thing=base.experiment_thing,
         floor=floor,
     ).validate()
@@ -195,3 +263,95 @@ class RobotProcesses:
                 log.warning("%s did not stop within %s s; killing it", thing, STOP_TIMEOUT_S)
                 process.kill()
                 process.wait(timeout=STOP_TIMEOUT_S)
+
+
+class SwarmProcess:
+    """One `robot-agent swarm` process running every robot of `fleet_file`, watched and
+    stopped like `RobotProcesses` (its one process is named `SWARM`)."""
+
+    SWARM = "swarm"
+
+    def __init__(
+        self,
+        *,
+        fleet_file: Path,
+        count: int,
+        credentials: ClientCredentials,
+        mqtts_port: int,
+        state_dir: Path,
+        sim_speed_factor: float = 1.0,
+        log_level: str = "INFO",
+    ) -> None:
+        self.fleet_file = fleet_file
+        self.count = count
+        self.credentials = credentials
+        self.mqtts_port = mqtts_port
+        self.state_dir = state_dir
+        self.sim_speed_factor = sim_speed_factor
+        self.log_level = log_level
+        self.process: subprocess.Popen[bytes] | None = None
+
+    def log_file(self, _name: str = SWARM) -> Path:
+        return self.state_dir / "swarm.log"
+
+    def command(self) -> list[str]:
+        config = self.state_dir / "agent.yaml"
+        config.write_text(LOCAL_AGENT_CONFIG)
+        credentials = self.credentials
+        return [
+            sys.executable, "-m", "robot_agent.cli", "swarm",
+            "--fleet", str(self.fleet_file),
+            "--count", str(self.count),
+            "--config", str(config),
+            # One connection speaks for every robot: the local services' identity.
+            "--endpoint", "127.0.0.1", "--port", str(self.mqtts_port),
+            "--cert", str(credentials.cert_file),
+            "--key", str(credentials.key_file),
+            "--ca", str(credentials.ca_file),
+            "--client-id", "vahr-swarm",
+            "--sim-speed-factor", f"{self.sim_speed_factor:g}",
+            "--state-dir", str(self.state_dir / "state"),
+            "--log-level", self.log_level,
+        ]  # fmt: skip
+
+    def start(self) -> SwarmProcess:
+        self.restart(self.SWARM)
+        return self
+
+    def restart(self, _name: str = SWARM) -> None:
+        """Start the swarm (again, after it ended); its log file is appended to."""
+        self.state_dir.mkdir(parents=True, exist_ok=True)
+        with self.log_file().open("ab") as log_stream:
+            self.process = spawn(
+                self.command(),
+                started_for=self.state_dir,
+                stdin=subprocess.DEVNULL,
+                stdout=log_stream,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+            )
+
+    def exited(self) -> dict[str, int]:
+        process = self.process
+        if process is None or process.poll() is None:
+            return {}
+        return {self.SWARM: process.returncode}
+
+    def last_log_line(self, _name: str = SWARM) -> str:
+        path = self.log_file()
+        lines = path.read_text(errors="replace").strip().splitlines() if path.exists() else []
+        return lines[-1] if lines else "no output"
+
+    def stop(self) -> None:
+        """SIGTERM, then wait (every robot reports offline); SIGKILL if it outlives that."""
+        process, self.process = self.process, None
+        if process is None:
+            return
+        if process.poll() is None:
+            process.send_signal(signal.SIGTERM)
+        try:
+            process.wait(timeout=STOP_TIMEOUT_S * 2)
+        except subprocess.TimeoutExpired:
+            log.warning("the robot swarm did not stop within %s s; killing it", STOP_TIMEOUT_S * 2)
+            process.kill()
+            process.wait(timeout=STOP_TIMEOUT_S)

@@ -28,7 +28,14 @@ from vahr.local.announcer import LocalAnnouncer
 from vahr.local.client import SimulatorAssistant
 from vahr.local.mqtt import MqttClient
 from vahr.local.ports import ensure_free
-from vahr.local.robots import ProgressRate, RobotProcesses, fleet_of, write_fleet
+from vahr.local.robots import (
+    ProgressRate,
+    RobotProcesses,
+    SwarmProcess,
+    fleet_of,
+    generated_fleet,
+    write_fleet,
+)
 from vahr.local.shadow_store import ShadowError
 from vahr.local.stack import LocalStack, StackConfig
 from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
@@ -60,6 +67,9 @@ class SystemConfig:
     # then keeps its first N robots, or adds more.
     fleet: Fleet | None = None
     robots: int | None = None
+    # `vahr up --swarm N`: N robots of a generated fleet (on `fleet`'s zones) in one
+    # `robot-agent swarm` process instead of a process per robot.
+    swarm: int | None = None
     sim_speed_factor: float = 1.0
     ack_timeout_s: float | None = None
     voice: bool = True
@@ -112,7 +122,10 @@ class LocalSystem:
         self.config = config
         self.start_station = start_station
         self.on_event = on_event
-        self.fleet: Fleet = fleet_of(config.robots, config.fleet)
+        if config.swarm is not None:
+            self.fleet: Fleet = generated_fleet(config.swarm, config.fleet)
+        else:
+            self.fleet = fleet_of(config.robots, config.fleet)
         self.stack = LocalStack(
             StackConfig(
                 state_dir=config.state_dir,
@@ -121,7 +134,7 @@ class LocalSystem:
                 api_port=config.api_port,
             )
         )
-        self.robots: RobotProcesses | None = None
+        self.robots: RobotProcesses | SwarmProcess | None = None
         self.alexa: AlexaSimulator | None = None
         self._watcher: MqttClient | None = None
         self.announcer: LocalAnnouncer | None = None
@@ -183,17 +196,28 @@ class LocalSystem:
                 self._start_room()
             if cfg.station_port is not None:
                 self._start_station(cfg.station_port)
-            self.robots = RobotProcesses(
-                fleet_file=fleet_file,
-                things=list(self.fleet.robot_things),
-                ca=self.stack.ca,
-                mqtts_port=cfg.mqtts_port,
-                state_dir=cfg.state_dir / "robots",
-                sim_speed_factor=cfg.sim_speed_factor,
-                voice=ROOM_VOICE if self.voice_enabled else None,
-                log_level="INFO" if cfg.log_level == "DEBUG" else "WARNING",
-                progress=cfg.progress,
-            ).start()
+            if cfg.swarm is not None:
+                self.robots = SwarmProcess(
+                    fleet_file=fleet_file,
+                    count=cfg.swarm,
+                    credentials=self.stack.ca.service_credentials(),
+                    mqtts_port=cfg.mqtts_port,
+                    state_dir=cfg.state_dir / "swarm",
+                    sim_speed_factor=cfg.sim_speed_factor,
+                    log_level="INFO" if cfg.log_level == "DEBUG" else "WARNING",
+                ).start()
+            else:
+                self.robots = RobotProcesses(
+                    fleet_file=fleet_file,
+                    things=list(self.fleet.robot_things),
+                    ca=self.stack.ca,
+                    mqtts_port=cfg.mqtts_port,
+                    state_dir=cfg.state_dir / "robots",
+                    sim_speed_factor=cfg.sim_speed_factor,
+                    voice=ROOM_VOICE if self.voice_enabled else None,
+                    log_level="INFO" if cfg.log_level == "DEBUG" else "WARNING",
+                    progress=cfg.progress,
+                ).start()
         except BaseException:
             self.stop()
             raise
@@ -263,7 +287,8 @@ class LocalSystem:
                 if not missing:
                     return
                 exited = self.robots.exited() if self.robots else {}
-                for thing in missing:
+                # A robot's own process, or the swarm's, which runs every robot.
+                for thing in [*missing, SwarmProcess.SWARM]:
                     if thing in exited and self.robots is not None:
                         raise VahrError(
                             f"robot {thing} exited with code {exited[thing]}: "
