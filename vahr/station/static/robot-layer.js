@@ -12,9 +12,9 @@ import { Motion } from "./motion.js";
 /** @import { Point } from "./contract.js" */
 
 // A robot's dot, a crowd's smallest mark, and how near a click must be, in CSS pixels.
-const DOT_PX = 4.5, CROWD_PX = 7, REACH_PX = 12;
-// Robots closer than this on the screen are one mark.
-const CELL_PX = 14;
+const DOT_PX = 4.5, CROWD_PX = 6.5, REACH_PX = 12;
+// Robots closer than this on the screen are one mark; a crowd's mark stays inside its square.
+const CELL_PX = 20;
 const COLOURS = ["idle", "navigating", "loading", "waiting", "stopped", "stuck", "error", "offline", "select", "cargo"];
 
 /**
@@ -141,7 +141,7 @@ export class RobotLayer {
     const colour = this.colours[mark.status] || this.colours.idle;
     const single = mark.things.length === 1;
     const thing = mark.things[0];
-    const radius = single ? DOT_PX : CROWD_PX + 2 * Math.log10(mark.things.length);
+    const radius = single ? DOT_PX : Math.min(CELL_PX / 2 - 1, CROWD_PX + 1.5 * Math.log10(mark.things.length));
     const trouble = mark.things.find((t) => this.troubled.has(t));
     if (single && thing === this.selected) {
       const target = this.robots.get(thing)?.motion.target;

@@ -56,7 +56,10 @@ const interactions = new Interactions({ send: (body) => { post("/api/interaction
 watchInteractions(interactions);
 
 const map = new MapView(byId("map", SVGSVGElement), { onRobot: select, onZone: (zone) => panel.navigate(store.selected, zone) });
-const robots = new RobotsPanel(byId("robots", HTMLElement), { onSelect: select });
+const robots = new RobotsPanel(byId("robots", HTMLElement), {
+  onSelect: select,
+  search: { input: byId("robot-search", HTMLInputElement), status: byId("robot-status-filter", HTMLSelectElement), zone: byId("robot-zone-filter", HTMLSelectElement), none: byId("robots-none", HTMLElement), count: byId("robots-count", HTMLElement) },
+});
 const conversation = new Conversation(byId("conversation", HTMLElement), byId("conversation-filters", HTMLElement), { commands: store.commands, names });
 const panel = new Panel({
   robots: byId("robot-buttons", HTMLElement), zones: byId("zone-buttons", HTMLElement), stopAll: byId("stop-all", HTMLButtonElement),
