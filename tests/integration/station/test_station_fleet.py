@@ -35,13 +35,13 @@ from vahr.protocol import encode, new_command, topics
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
-    from playwright.sync_api import Browser, Page
+    from playwright.sync_api import Browser, Page, ViewportSize
 
 pytestmark = pytest.mark.slow
 
 ROBOTS = 300
 IMAGES = ROOT / "docs" / "images"
-VIEWPORT = {"width": 1280, "height": 800}
+VIEWPORT: ViewportSize = {"width": 1280, "height": 800}
 WAIT_S = 60.0
 
 
@@ -55,15 +55,16 @@ class Fleet(msgspec.Struct):
 @pytest.fixture(scope="module")
 def running(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Fleet]:
     state = tmp_path_factory.mktemp("station-fleet")
+    mqtt_port = free_port()
     config = StackConfig(
         state_dir=state / "stack",
         mqtts_port=free_port(),
-        mqtt_port=free_port(),
+        mqtt_port=mqtt_port,
         api_port=free_port(),
     )
     fleet_file = state / "fleet.yaml"
     fleet_file.write_bytes(msgspec.yaml.encode(swarm_fleet(ROBOTS)))
-    broker = f"mqtt://127.0.0.1:{config.mqtt_port}"
+    broker = f"mqtt://127.0.0.1:{mqtt_port}"
     with (
         LocalStack(config),
         SwarmThread(broker=broker, count=ROBOTS, speed_factor=5.0, listen_to_peers=False),
@@ -77,7 +78,7 @@ def running(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Fleet]:
         try:
             assert station.stdout is not None
             url = json.loads(station.stdout.readline())["station"]
-            yield Fleet(station=url, mqtt_port=config.mqtt_port)
+            yield Fleet(station=url, mqtt_port=mqtt_port)
         finally:
             station.send_signal(signal.SIGTERM)
             station.wait(30)
