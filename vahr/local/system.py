@@ -26,6 +26,7 @@ import msgspec
 from vahr.errors import VahrError
 from vahr.local.announcer import LocalAnnouncer
 from vahr.local.client import SimulatorAssistant
+from vahr.local.dispatcher import TASKS_PATH, LocalDispatcher
 from vahr.local.mqtt import MqttClient
 from vahr.local.ports import ensure_free
 from vahr.local.robots import (
@@ -138,6 +139,7 @@ class LocalSystem:
         self.alexa: AlexaSimulator | None = None
         self._watcher: MqttClient | None = None
         self.announcer: LocalAnnouncer | None = None
+        self.dispatcher: LocalDispatcher | None = None
         self._room: Any = None
         self._room_client: MqttClient | None = None
         self._station_client: MqttClient | None = None
@@ -192,6 +194,7 @@ class LocalSystem:
             self._watcher.subscribe(topics.ALL_EVENTS, self._on_event)
             self._watcher.subscribe(topics.ALL_PRESENCE, self._on_presence)
             self._start_announcer()
+            self._start_dispatcher()
             if self.voice_enabled:
                 self._start_room()
             if cfg.station_port is not None:
@@ -236,6 +239,20 @@ class LocalSystem:
             self._watcher, self.fleet
         ).route
         dataplane.health["sim_speed_factor"] = self.config.sim_speed_factor
+
+    def _start_dispatcher(self) -> None:
+        """Fleet dispatch (`/vahr/tasks`): tasks without a robot's name, over the local
+        fleet index, queued in the state directory. Before the robots start, so their
+        first shadow updates already reach it."""
+        dataplane, store = self.stack.dataplane, self.stack.store
+        assert dataplane is not None and store is not None
+        self.dispatcher = LocalDispatcher(
+            fleet=self.fleet,
+            index=store.index,
+            endpoint=self.stack.service_endpoint(),
+            state_dir=self.config.state_dir,
+        ).start()
+        dataplane.typed_routes[TASKS_PATH] = self.dispatcher.api.respond
 
     def _start_room(self) -> None:
         """The assistant robots talk to: a second simulated Echo on the same skill."""
@@ -390,6 +407,9 @@ class LocalSystem:
         if self.announcer is not None:
             self.announcer.stop()
             self.announcer = None
+        if self.dispatcher is not None:
+            self.dispatcher.stop()
+            self.dispatcher = None
         for client in (self._room_client, self._watcher, self._station_client):
             if client is not None:
                 client.stop()

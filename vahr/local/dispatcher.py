@@ -1,0 +1,204 @@
+"""The local stack's fleet dispatcher: the core of `vahr.protocol.dispatch` wired to `vahr up`.
+
+- tasks: `SqliteTaskStore` in the state directory (the queue survives a restart);
+- candidates: the local fleet index the shadow store keeps (`IndexCandidates`), the twin
+  of IoT fleet indexing on AWS;
+- robot freed: every `update/documents` of a classic shadow on the broker (what the IoT
+  rule feeds the dispatcher Lambda on AWS) hands that robot's indexed state to
+  `Dispatcher.observe`, on a worker thread of its own;
+- publish: the command on `vahr/robots/{thing}/cmd`, QoS 1, waiting for the broker's PUBACK.
+
+The data plane serves it (`TasksApi`) under `/vahr/tasks`: `POST` submits an order
+(answers the `Submission`), `GET` lists the tasks robots hold then the queue
+(`{"tasks": [...]}`), `DELETE /vahr/tasks/{id}` cancels one.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+from typing import TYPE_CHECKING
+
+import msgspec
+
+from vahr.local.mqtt import MqttClient
+from vahr.local.task_store import SqliteTaskStore
+from vahr.protocol import Pose, encode, topics
+from vahr.protocol.dispatch import (
+    BUSY_STATUSES,
+    IDLE_STATUSES,
+    Dispatcher,
+    DispatchError,
+    Order,
+    RobotState,
+)
+from vahr.protocol.errors import from_validation_error
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from vahr.local.fleet_index import FleetIndex, IndexedThing
+    from vahr.local.mqtt import MqttEndpoint
+    from vahr.protocol import Command, Fleet
+
+log = logging.getLogger(__name__)
+
+TASKS_PATH = "/vahr/tasks"
+STOP_TIMEOUT_S = 5.0
+
+Answer = tuple[int, bytes, str | None]
+
+
+def robot_state(entry: IndexedThing) -> RobotState:
+    """A fleet index entry as the dispatcher reads it."""
+    last = entry.reported.get("last_command")
+    last_id = last.get("id") if isinstance(last, dict) else None
+    last_result = last.get("result") if isinstance(last, dict) else None
+    pose = entry.pose
+    return RobotState(
+        thing=entry.thing,
+        status=entry.status or "unknown",
+        connected=entry.connected,
+        zone=entry.zone,
+        pose=Pose(pose.x, pose.y, pose.theta) if pose is not None else None,
+        last_command_id=last_id if isinstance(last_id, str) else None,
+        last_result=last_result if isinstance(last_result, str) else None,
+    )
+
+
+class IndexCandidates:
+    """`Candidates` over the local fleet index: only the fleet's robots, only what the index's
+    secondary indexes (by status, by zone) return, so a question costs its answer's size."""
+
+    def __init__(self, index: FleetIndex, fleet: Fleet) -> None:
+        self.index = index
+        self.robots = frozenset(fleet.robot_things)
+
+    def available(self, *, zone: str | None = None) -> list[RobotState]:
+        if zone is not None:
+            entries = self.index.in_zone(zone)
+        else:
+            entries = []
+            for status in sorted(IDLE_STATUSES | BUSY_STATUSES):
+                entries += self.index.with_status(status)
+        robots = self.robots
+        return [
+            robot_state(entry)
+            for entry in entries
+            if entry.connected and entry.thing in robots
+            if entry.status in IDLE_STATUSES or entry.status in BUSY_STATUSES
+        ]
+
+    def state(self, thing: str) -> RobotState | None:
+        entry = self.index.get(thing)
+        return robot_state(entry) if entry is not None and thing in self.robots else None
+
+
+class TasksApi:
+    """`/vahr/tasks` on the data plane, in its typed-route form: (status, body, error type)."""
+
+    def __init__(self, dispatcher: Dispatcher) -> None:
+        self.dispatcher = dispatcher
+
+    def respond(self, method: str, path: str, body: bytes) -> Answer:
+        if path == TASKS_PATH:
+            if method == "GET":
+                return _ok({"tasks": self.dispatcher.tasks()})
+            if method == "POST":
+                return self._submit(body)
+            return _error(405, f"{method} is not allowed on {TASKS_PATH}")
+        task_id = path[len(TASKS_PATH) + 1 :]
+        if "/" in task_id or not task_id:
+            return _error(404, f"No route for {method} {path}")
+        if method != "DELETE":
+            return _error(405, f"{method} is not allowed on a task; DELETE cancels it")
+        cancelled = self.dispatcher.cancel(task_id)
+        if cancelled is None:
+            return _error(404, f"no open task {task_id!r}")
+        return _ok({"task": cancelled})
+
+    def _submit(self, body: bytes) -> Answer:
+        try:
+            order = msgspec.json.decode(body or b"{}", type=Order)
+        except (msgspec.ValidationError, msgspec.DecodeError) as err:
+            return _error(400, str(from_validation_error(err)))
+        try:
+            return _ok(self.dispatcher.submit(order))
+        except DispatchError as err:
+            return _error(400, str(err))
+
+
+def _ok(body: object) -> Answer:
+    return 200, msgspec.json.encode(body), None
+
+
+def _error(status: int, message: str) -> Answer:
+    error_type = {400: "InvalidRequestException", 404: "ResourceNotFoundException"}.get(
+        status, "MethodNotAllowedException"
+    )
+    return status, msgspec.json.encode({"code": status, "message": message}), error_type
+
+
+class LocalDispatcher:
+    """The dispatcher on the local broker: its own client, its shadow subscription and the
+    worker thread that hands robots' updates to the core. A context manager."""
+
+    def __init__(
+        self, *, fleet: Fleet, index: FleetIndex, endpoint: MqttEndpoint, state_dir: Path
+    ) -> None:
+        self.tasks = SqliteTaskStore.in_state_dir(state_dir)
+        self.candidates = IndexCandidates(index, fleet)
+        self._client = MqttClient(endpoint, client_id="vahr-dispatcher-local")
+        self.dispatcher = Dispatcher(
+            fleet=fleet, store=self.tasks, candidates=self.candidates, publish=self._publish
+        )
+        self.api = TasksApi(self.dispatcher)
+        self._updates: queue.SimpleQueue[str | None] = queue.SimpleQueue()
+        self._worker: threading.Thread | None = None
+
+    def _publish(self, thing: str, command: Command) -> None:
+        # Waits for the broker's PUBACK and raises when none comes: the task keeps its place.
+        self._client.publish(topics.robot_cmd(thing), encode(command), qos=1, wait=True)
+
+    def _on_documents(self, topic: str, payload: bytes) -> None:
+        # On paho's network thread: only note which robot changed; the index already holds
+        # its new state (the shadow store records it before the update is announced).
+        parsed = topics.parse_shadow_topic(topic)
+        if parsed is not None and parsed[1] is None:
+            self._updates.put(parsed[0])
+
+    def _serve(self) -> None:
+        while (thing := self._updates.get()) is not None:
+            state = self.candidates.state(thing)
+            if state is None:
+                continue
+            try:
+                self.dispatcher.observe(state)
+            except Exception:  # one failed hand-over must not stop the dispatcher
+                log.exception("dispatching after an update of %s failed", thing)
+
+    def start(self) -> LocalDispatcher:
+        self._client.subscribe(topics.ALL_SHADOW_DOCUMENTS, self._on_documents, retained=False)
+        self._client.connect()
+        self._worker = threading.Thread(target=self._serve, name="vahr-dispatcher", daemon=True)
+        self._worker.start()
+        # What a previous run left: commands assigned but never acknowledged go out again
+        # (same ids: a robot that had one runs it once), then queued tasks to free robots.
+        self.dispatcher.resume()
+        self.dispatcher.drain()
+        return self
+
+    def stop(self) -> None:
+        worker, self._worker = self._worker, None
+        if worker is not None:
+            self._updates.put(None)
+            worker.join(STOP_TIMEOUT_S)
+        self._client.stop()
+        self.tasks.close()
+
+    def __enter__(self) -> LocalDispatcher:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
