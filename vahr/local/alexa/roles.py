@@ -74,7 +74,9 @@ CHOICE = "?"
 WINDOW = 4
 # Label sequences scored one by one at most (a sentence of six values of six labels each).
 MAX_SEQUENCES = 50_000
-_REFERENCE = re.compile(r"^\{([-+?]?)([A-Za-z_.]+)(!?)\}$")
+_REFERENCE = re.compile(r"^\{([-+?]?)([A-Za-z_.&]+)(!?)\}$")
+# Between slot names, a value that fills each of them ("{firstZone&secondZone}").
+BOTH = "&"
 _WEATHER = {word: weather for weather, words in WEATHER_WORDS.items() for word in words}
 _NEGATIONS = frozenset(PLAIN_NEGATIONS)
 
@@ -128,6 +130,11 @@ def value_features(words: Sequence[str], spans: Sequence[Span]) -> list[list[str
                 features.append(f"R{distance}:{edge}")
                 break
             features.append(f"R{distance}:{words[at]}")
+        # What introduces the values of the same type before and after this one ("robot two
+        # delivers to zone d *after* robot one"), which the chain alone would see too late.
+        for side, neighbour in (("p", rank - 1), ("n", rank + 1)):
+            if 0 <= neighbour < len(same) and same[neighbour][1] > 0:
+                features.append(f"{side}L1:{words[same[neighbour][1] - 1]}")
         features += [f"l:{word}" for word in words[previous_end:start]]
         features += [f"r:{word}" for word in words[end:next_start]]
         nearest_left = next((c for c in reversed(classes[previous_end:start]) if c), None)
@@ -159,8 +166,8 @@ def labelled_sequence(sentence: str, slot_types: Mapping[str, str]) -> Sequence_
         if mode == NO_SLOT:
             spans.append((name, len(words), len(words) + 1, bool(fleet)))
             labels.append(NO_SLOT)
-        elif name in slot_types:
-            spans.append((slot_types[name], len(words), len(words) + 1, bool(fleet)))
+        elif len({slot_types.get(slot) for slot in name.split(BOTH)} - {None}) == 1:
+            spans.append((slot_types[name.split(BOTH)[0]], len(words), len(words) + 1, bool(fleet)))
             labels.append(mode + name)
         else:
             return None
@@ -186,7 +193,8 @@ class RolesTagger:
             slot_type: [
                 label
                 for label in known
-                if label == NO_SLOT or self.slot_types.get(label.lstrip("+?")) == slot_type
+                if label == NO_SLOT
+                or self.slot_types.get(label.lstrip("+?").split(BOTH)[0]) == slot_type
             ]
             for slot_type in set(self.slot_types.values())
         }
@@ -301,9 +309,10 @@ def assign(
     labels; None when a type the intent takes is named but given no slot."""
     given: dict[str, list[tuple[SlotMatch, str]]] = {}
     for match, label in zip(matches, labels, strict=True):
-        mode, slot = (label[0], label[1:]) if label[:1] in (LISTED, CHOICE) else ("", label)
-        if slot in declared:
-            given.setdefault(slot, []).append((match, mode if slot in given else ""))
+        mode, slots = (label[0], label[1:]) if label[:1] in (LISTED, CHOICE) else ("", label)
+        for slot in slots.split(BOTH):
+            if slot in declared:
+                given.setdefault(slot, []).append((match, mode if slot in given else ""))
     named_types = {match.type for match in matches}
     if any(t in named_types and t not in {declared[s] for s in given} for t in declared.values()):
         return None
@@ -361,13 +370,19 @@ def _completed(
     for slot_type, slots in by_type.items():
         said = [slot for slot in slots if slot in filled]
         others = [s for t, ss in by_type.items() if t != slot_type for s in ss]
-        if len(slots) != 2 or len(said) != 1 or len(others) != 2:
+        # Two robot slots are two robots; two zones may be one ("both to zone d").
+        if slot_type == ROBOT_TYPE or len(slots) != 2 or len(said) != 1 or len(others) != 2:
             continue
         value = filled[said[0]]
-        if said[0] != slots[0] or not all(slot in filled for slot in others):
-            continue
-        before, after = (filled[slot] for slot in others)
-        if before.start < value.start < after.start:
-            continue
+        pair = [filled[slot] for slot in others if slot in filled]
+        if len(pair) == 2:
+            first, second = pair
+            if first.start < value.start < second.start:
+                # Between the two values of the other type in their order: the first's.
+                continue
+            if second.start < first.start < value.start:
+                # After both, said in the other order ("two waits for one, then to d"):
+                # the one the tagger gave it.
+                continue
         filled.update(dict.fromkeys(slots, value))
     return filled
