@@ -1,0 +1,105 @@
+"""The roles tagger: slot roles learnt from the labelled samples, on the shipped en-US model.
+
+en-US's own understanding keeps the English rules for now (`english_role_rules`); these
+tests build the same model with the tagger instead, as every other locale has it, and hold
+it to what a person meant: the sentence's order of roles, a value kept to its own type's
+slots, listed robots as the fleet, values turned down, and zones without a weather that
+make no rule.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import msgspec
+import pytest
+
+from vahr.local.alexa import roles
+from vahr.local.alexa.nlu import FALLBACK, InteractionModel
+from vahr.local.alexa.understanding import load_understanding
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from vahr.local.alexa.nlu import Understanding
+
+
+@pytest.fixture(scope="module")
+def model(tmp_path_factory: pytest.TempPathFactory) -> InteractionModel:
+    understanding = msgspec.structs.replace(load_understanding(), english_role_rules=False)
+    cache = tmp_path_factory.mktemp("cache")
+    return InteractionModel.load(cache_dir=cache, understanding=understanding)
+
+
+def ids(understood: Understanding) -> dict[str, str | None]:
+    return {name: value.id for name, value in understood.slots.items()}
+
+
+@pytest.mark.parametrize(
+    ("utterance", "intent", "slots"),
+    [
+        ("send robot one and robot two to the loading zone", "NavigateIntent",
+         {"robot": "all", "zone": "LOADING"}),
+        ("move robot one from the loading zone to zone c", "NavigateIntent",
+         {"robot": "placebot1", "zone": "C"}),
+        ("have robot two deliver to zone d after robot one delivers to zone a",
+         "SequentialDeliveryIntent",
+         {"firstRobot": "placebot1", "firstZone": "A", "secondRobot": "placebot2",
+          "secondZone": "D"}),
+        ("robot one delivers to zone c then robot two", "SequentialDeliveryIntent",
+         {"firstRobot": "placebot1", "firstZone": "C", "secondRobot": "placebot2"}),
+        ("placebot one delivers to zone d and then the other robot delivers to zone c",
+         "SequentialDeliveryIntent",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "C"}),
+        ("robot two if it's raining go to zone c and if it's sunny go to zone a",
+         "WeatherDeliveryIntent", {"robot": "placebot2", "sunnyZone": "A", "rainyZone": "C"}),
+        ("robot one if it's not sunny go to zone b otherwise zone d", "WeatherDeliveryIntent",
+         {"robot": "placebot1", "sunnyZone": "D", "rainyZone": "B"}),
+    ],
+)  # fmt: skip
+def test_roles_follow_the_sentence(
+    model: InteractionModel, utterance: str, intent: str, slots: dict[str, str]
+) -> None:
+    understood = model.understand(utterance)
+    assert (understood.intent, ids(understood)) == (intent, slots)
+
+
+def test_a_weather_report_before_a_zone_makes_no_rule(model: InteractionModel) -> None:
+    # "it's raining, go to zone c" says where to go, and why: no rule for the robot to follow
+    assert model.understand("it is raining robot two go to zone c").intent != (
+        "WeatherDeliveryIntent"
+    )
+
+
+def test_robots_offered_as_a_choice_are_asked_about(model: InteractionModel) -> None:
+    robot = model.understand("send robot one or robot two to zone a").slots["robot"]
+    assert (robot.spoken, robot.id) == ("robot one and robot two", None)
+
+
+def test_a_value_never_takes_another_types_slot(model: InteractionModel) -> None:
+    # Given a sequential delivery naming two robots and two zones
+    words, matches = model.find_slots("robot one to zone a and robot two to zone b")
+    # When the tagger labels them
+    labels = model._taggers["SequentialDeliveryIntent"].labels(words, matches)
+    # Then each robot takes a robot slot and each zone a zone slot
+    kinds = {"ROBOT": {"firstRobot", "secondRobot"}, "ZONE": {"firstZone", "secondZone"}}
+    for match, label in zip(matches, labels, strict=True):
+        assert label.lstrip("+?").split("&")[0] in kinds[match.type] | {roles.NO_SLOT}
+
+
+def test_the_tagger_is_cached_by_its_data(tmp_path: Path) -> None:
+    understanding = msgspec.structs.replace(load_understanding(), english_role_rules=False)
+    first = InteractionModel.load(cache_dir=tmp_path, understanding=understanding)
+    written = {path.name: path.stat().st_mtime_ns for path in tmp_path.glob("roles-*.crfsuite")}
+    # One model per intent with slots
+    assert len(written) == len([i for i, slots in first.intent_slots.items() if slots])
+    again = InteractionModel.load(cache_dir=tmp_path, understanding=understanding)
+    said = "have robot two deliver to zone d after robot one delivers to zone a"
+    assert ids(again.understand(said)) == ids(first.understand(said))
+    # Read from the cache, not trained and written again
+    assert {p.name: p.stat().st_mtime_ns for p in tmp_path.glob("roles-*.crfsuite")} == written
+
+
+def test_nothing_understood_is_nothing_assigned(model: InteractionModel) -> None:
+    assert model.understand("play some jazz").intent == FALLBACK
