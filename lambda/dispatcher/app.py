@@ -1,0 +1,122 @@
+"""The dispatcher's Lambda handler. Thin: parse the event, run the core, answer.
+
+Two callers (see `dispatcher.requests`): the skill, synchronously, and the topic rule on
+the robots' shadow documents. Errors are mapped here and nowhere else: a request that
+cannot be carried out (a bad order, an unknown task) is answered with its one line, and
+the skill speaks it; an AWS failure raises, so a rule's event is retried by Lambda and
+then kept in the dead-letter queue, and the skill hears that the dispatcher failed.
+"""
+
+from __future__ import annotations
+
+import logging
+from datetime import UTC, datetime
+from functools import cache
+from typing import Any
+
+import msgspec
+
+from dispatcher.command_channel import CommandChannel
+from dispatcher.config import DispatcherConfig
+from dispatcher.errors import BadRequest, DispatcherError
+from dispatcher.fleet_search import FleetSearch, robot_state
+from dispatcher.requests import (
+    OPERATIONS,
+    Answer,
+    Cancel,
+    ListPending,
+    ListTasks,
+    RobotUpdate,
+    SkillRequest,
+    Submit,
+    is_robot_update,
+)
+from dispatcher.robot_updates import robot_freed
+from dispatcher.task_table import TaskTable
+from vahr.protocol import load_fleet
+from vahr.protocol.dispatch import Dispatcher, DispatchError
+from vahr.protocol.errors import from_validation_error
+
+log = logging.getLogger("dispatcher")
+
+
+@cache
+def runtime() -> Dispatcher:
+    """Built once per cold start: configuration, fleet, adapters, the core."""
+    config = DispatcherConfig.from_env()
+    log.setLevel(config.log_level)
+    return Dispatcher(
+        fleet=load_fleet(config.fleet_file),
+        store=TaskTable(config.table, closed_task_days=config.closed_task_days),
+        candidates=FleetSearch(index_name=config.index_name),
+        publish=CommandChannel(config.iot_data_endpoint),
+    )
+
+
+def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
+    try:
+        return handle(event, runtime())
+    except DispatcherError as err:
+        log.error("dispatcher failed: %s", err)
+        raise
+    except Exception as err:  # a bug: still one line in the log, still retried
+        log.exception("dispatcher failed")
+        raise DispatcherError(f"dispatcher failed: {type(err).__name__}: {err}") from err
+
+
+def handle(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, Any]:
+    """One invocation: a robot's update (from the rule) or a skill's request."""
+    if is_robot_update(event):
+        return on_robot_update(event, dispatcher)
+    try:
+        answer = on_request(_request(event), dispatcher)
+    except BadRequest as err:
+        answer = Answer(err.status, {"code": err.status, "message": str(err)})
+    return msgspec.to_builtins(answer)  # type: ignore[no-any-return]
+
+
+def on_robot_update(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, Any]:
+    """A robot's update the rule selected: it may have finished its task and be free."""
+    try:
+        update = msgspec.convert(event, RobotUpdate, strict=False)
+    except msgspec.ValidationError as err:
+        # Retrying cannot mend a malformed event: logged and dropped.
+        log.warning("ignoring a malformed robot update: %s", err)
+        return {"took": None}
+    state = robot_state(update.thing, update.reported)
+    if state is None or update.thing not in dispatcher.fleet.robot_things:
+        log.warning("ignoring an update of %s, which is not a robot of the fleet", update.thing)
+        return {"took": None}
+    taken = robot_freed(dispatcher, state, now=datetime.now(UTC))
+    if taken is not None:
+        log.info("task %s (%s to %s) given to %s", taken.id, taken.kind, taken.zone, taken.thing)
+    return {"took": taken.id if taken is not None else None}
+
+
+def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
+    if isinstance(request, Submit):
+        try:
+            return Answer(200, dispatcher.submit(request.order))
+        except DispatchError as err:
+            raise BadRequest(str(err)) from err
+    if isinstance(request, ListTasks):
+        return Answer(200, {"tasks": dispatcher.tasks()})
+    if isinstance(request, ListPending):
+        return Answer(200, {"tasks": dispatcher.pending()})
+    assert isinstance(request, Cancel)
+    cancelled = dispatcher.cancel(request.task_id)
+    if cancelled is None:
+        raise BadRequest(f"no open task {request.task_id!r}", status=404)
+    return Answer(200, {"task": cancelled})
+
+
+def _request(event: dict[str, Any]) -> SkillRequest:
+    operation = event.get("operation")
+    if operation not in OPERATIONS:
+        raise BadRequest(
+            f"operation: {str(operation)[:40]!r} is not one of {', '.join(OPERATIONS)}"
+        )
+    try:
+        return msgspec.convert(event, SkillRequest)  # type: ignore[arg-type]
+    except msgspec.ValidationError as err:
+        raise BadRequest(str(from_validation_error(err))) from err

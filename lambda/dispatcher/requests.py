@@ -1,0 +1,68 @@
+"""What the dispatcher function is invoked with, typed: the skill's requests and the
+robots' shadow updates from the topic rule.
+
+The skill invokes it synchronously (`lambda:InvokeFunction`, RequestResponse) with one of
+
+| payload | answer `body` (status 200) |
+| --- | --- |
+| `{"operation": "submit", "order": {Order}}` | the `Submission`: tasks assigned and queued |
+| `{"operation": "tasks"}` | `{"tasks": [...]}`: the tasks robots hold, then the queue |
+| `{"operation": "pending"}` | `{"tasks": [...]}`: the queue, next first |
+| `{"operation": "cancel", "task_id": "..."}` | `{"task": Task}` as it was before it was cancelled |
+
+and gets `{"status": N, "body": ...}` back: the status and body the local data plane
+answers `POST`, `GET` and `DELETE {api}/vahr/tasks` with, so the skill's two `TaskDesk`
+adapters read one shape. A request that cannot be carried out is `{"status": 400 or 404,
+"body": {"code": N, "message": "one line"}}` and changes nothing.
+
+The topic rule (infra/constructs/dispatcher.py) sends `{"thing", "reported", "timestamp"}`:
+the robot's whole reported state after an update that left it idle or stopped.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import msgspec
+
+# msgspec reads the annotations at run time: Order is needed outside TYPE_CHECKING.
+from vahr.protocol.dispatch import Order  # noqa: TC001
+
+
+class Submit(msgspec.Struct, frozen=True, tag_field="operation", tag="submit"):
+    order: Order
+
+
+class ListTasks(msgspec.Struct, frozen=True, tag_field="operation", tag="tasks"):
+    pass
+
+
+class ListPending(msgspec.Struct, frozen=True, tag_field="operation", tag="pending"):
+    pass
+
+
+class Cancel(msgspec.Struct, frozen=True, tag_field="operation", tag="cancel"):
+    task_id: str
+
+
+SkillRequest = Submit | ListTasks | ListPending | Cancel
+OPERATIONS = ("submit", "tasks", "pending", "cancel")
+
+
+class RobotUpdate(msgspec.Struct, frozen=True, kw_only=True):
+    """One robot's reported state after an update, as the topic rule selects it.
+    `timestamp` is the shadow document's (seconds since the epoch)."""
+
+    thing: str
+    reported: dict[str, Any]
+    timestamp: float | None = None
+
+
+class Answer(msgspec.Struct, frozen=True):
+    status: int
+    body: Any
+
+
+def is_robot_update(event: dict[str, Any]) -> bool:
+    """The rule's events carry `thing` and `reported`; the skill's carry `operation`."""
+    return "operation" not in event and "thing" in event and "reported" in event

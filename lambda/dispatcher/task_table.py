@@ -1,0 +1,290 @@
+"""The task queue in DynamoDB: `vahr.protocol.dispatch.TaskStore` with conditional writes.
+
+One table, keyed by `section` (partition) and `id` (sort):
+
+| section | id | holds |
+| --- | --- | --- |
+| `open` | task id | a queued or assigned task: `task` (its JSON), `status`, `version` |
+| `closed` | task id | a done or cancelled task, kept until `expires_at` (the table's TTL) |
+| `robot` | thing | the robot's claim on its one assigned task: `task_id` |
+
+Every open task lives in one partition, so the queue is one strongly consistent Query
+(a fleet's queue is tens of tasks, far below a partition's 3,000 reads a second), and a
+finished task leaves that partition, so the Query never reads the history.
+
+`assign` is one transaction of two conditional writes: the task's item is rewritten only
+if its `version` is the one read and it is still `queued`, and the robot's claim is
+created only if the robot has none. Either condition failing cancels both: two robots
+never take one task, one robot never takes two. Every other change is conditional on the
+version read too, and is retried on a lost race a bounded number of times.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING, Any
+
+import boto3
+import msgspec
+from botocore.config import Config
+from botocore.exceptions import BotoCoreError, ClientError
+
+from dispatcher.errors import StoreError
+from vahr.protocol.dispatch import Task
+
+if TYPE_CHECKING:
+    from vahr.protocol.dispatch import Outcome
+
+CLIENT_CONFIG = Config(
+    connect_timeout=2.0, read_timeout=3.0, retries={"mode": "standard", "total_max_attempts": 3}
+)
+OPEN, CLOSED, ROBOT = "open", "closed", "robot"
+# A change that lost a race to another writer reads the task again and decides anew; a
+# task is written by a handful of invocations at most, so a few rounds settle it.
+ATTEMPTS = 4
+_LOST_RACE = ("ConditionalCheckFailed", "TransactionConflict")
+
+
+class _Conflict(Exception):
+    """A conditional write found the item changed since it was read."""
+
+
+class TaskTable:
+    """The dispatcher's TaskStore on one DynamoDB table (see the module docstring)."""
+
+    def __init__(self, table: str, *, closed_task_days: int = 30, client: Any = None) -> None:
+        self._table = table
+        self._keep_closed_s = closed_task_days * 86_400
+        self._client = client or boto3.client("dynamodb", config=CLIENT_CONFIG)
+        self._encoder = msgspec.json.Encoder()
+        self._decoder = msgspec.json.Decoder(Task)
+        # DynamoDB's own page limit (1 MB) unless set; tests set it to read in small pages.
+        self._page_limit: int | None = None
+
+    # --- TaskStore ------------------------------------------------------------------------
+
+    def add(self, task: Task) -> None:
+        try:
+            self._client.put_item(
+                TableName=self._table,
+                Item=self._task_item(OPEN, task),
+                ConditionExpression="attribute_not_exists(id)",
+            )
+        except ClientError as err:
+            if _code(err) == "ConditionalCheckFailedException":
+                raise StoreError(f"task {task.id} exists already") from err
+            raise StoreError(f"cannot add task {task.id}: {_message(err)}") from err
+        except BotoCoreError as err:
+            raise StoreError(f"cannot add task {task.id}: {err}") from err
+
+    def assign(self, task_id: str, thing: str, *, at: str) -> Task | None:
+        task = self._open(task_id)
+        if task is None or task.status != "queued":
+            return None
+        taken = msgspec.structs.replace(
+            task, status="assigned", thing=thing, assigned_at=at, version=task.version + 1
+        )
+        try:
+            self._transact(
+                self._rewrite(taken, seen=task, status="queued"),
+                {
+                    "Put": {
+                        "TableName": self._table,
+                        "Item": {
+                            "section": {"S": ROBOT},
+                            "id": {"S": thing},
+                            "task_id": {"S": task_id},
+                        },
+                        "ConditionExpression": "attribute_not_exists(id)",
+                    }
+                },
+            )
+        except _Conflict:
+            return None
+        return taken
+
+    def release(self, task_id: str) -> Task | None:
+        for _ in range(ATTEMPTS):
+            task = self._open(task_id)
+            if task is None or task.status != "assigned" or task.thing is None:
+                return None
+            back = msgspec.structs.replace(
+                task, status="queued", thing=None, assigned_at=None, version=task.version + 1
+            )
+            try:
+                self._transact(
+                    self._rewrite(back, seen=task), self._drop_claim(task.thing, task_id)
+                )
+            except _Conflict:
+                continue
+            return back
+        return None
+
+    def finish(self, task_id: str, *, outcome: Outcome) -> Task | None:
+        for _ in range(ATTEMPTS):
+            task = self._open(task_id)
+            if task is None or task.status != "assigned" or task.thing is None:
+                return None
+            ended = msgspec.structs.replace(
+                task,
+                status="done" if outcome == "done" else "cancelled",
+                outcome=outcome,
+                version=task.version + 1,
+            )
+            try:
+                self._close(task, ended)
+            except _Conflict:
+                continue
+            return ended
+        return None
+
+    def cancel(self, task_id: str) -> Task | None:
+        for _ in range(ATTEMPTS):
+            task = self._open(task_id)
+            if task is None or task.status not in ("queued", "assigned"):
+                return None
+            ended = msgspec.structs.replace(
+                task, status="cancelled", outcome="cancelled", version=task.version + 1
+            )
+            try:
+                self._close(task, ended)
+            except _Conflict:
+                continue
+            return task
+        return None
+
+    def get(self, task_id: str) -> Task | None:
+        return self._open(task_id) or self._read(CLOSED, task_id)
+
+    def pending(self) -> list[Task]:
+        queued = [task for task in self._all_open() if task.status == "queued"]
+        return sorted(queued, key=lambda task: task.order_key)
+
+    def active(self) -> list[Task]:
+        assigned = [task for task in self._all_open() if task.status == "assigned"]
+        return sorted(assigned, key=lambda task: (task.assigned_at or "", task.id))
+
+    # --- inside ---------------------------------------------------------------------------
+
+    def _task_item(self, section: str, task: Task) -> dict[str, Any]:
+        item: dict[str, Any] = {
+            "section": {"S": section},
+            "id": {"S": task.id},
+            "task": {"S": self._encoder.encode(task).decode()},
+            "status": {"S": task.status},
+            "version": {"N": str(task.version)},
+        }
+        if section == CLOSED:
+            item["expires_at"] = {"N": str(int(time.time()) + self._keep_closed_s)}
+        return item
+
+    def _rewrite(self, task: Task, *, seen: Task, status: str | None = None) -> dict[str, Any]:
+        """Put the open item, only over the version read (and the status, when given)."""
+        condition = "version = :seen"
+        values: dict[str, Any] = {":seen": {"N": str(seen.version)}}
+        if status is not None:
+            condition += " AND #status = :status"
+            values[":status"] = {"S": status}
+        put: dict[str, Any] = {
+            "TableName": self._table,
+            "Item": self._task_item(OPEN, task),
+            "ConditionExpression": condition,
+            "ExpressionAttributeValues": values,
+        }
+        if status is not None:
+            put["ExpressionAttributeNames"] = {"#status": "status"}
+        return {"Put": put}
+
+    def _drop_claim(self, thing: str, task_id: str) -> dict[str, Any]:
+        return {
+            "Delete": {
+                "TableName": self._table,
+                "Key": {"section": {"S": ROBOT}, "id": {"S": thing}},
+                "ConditionExpression": "task_id = :task",
+                "ExpressionAttributeValues": {":task": {"S": task_id}},
+            }
+        }
+
+    def _close(self, before: Task, ended: Task) -> None:
+        """Move a task from the open partition to the closed one (and free its robot)."""
+        writes = [
+            {
+                "Delete": {
+                    "TableName": self._table,
+                    "Key": {"section": {"S": OPEN}, "id": {"S": before.id}},
+                    "ConditionExpression": "version = :seen",
+                    "ExpressionAttributeValues": {":seen": {"N": str(before.version)}},
+                }
+            },
+            {"Put": {"TableName": self._table, "Item": self._task_item(CLOSED, ended)}},
+        ]
+        if before.status == "assigned" and before.thing is not None:
+            writes.append(self._drop_claim(before.thing, before.id))
+        self._transact(*writes)
+
+    def _transact(self, *writes: dict[str, Any]) -> None:
+        try:
+            self._client.transact_write_items(TransactItems=list(writes))
+        except ClientError as err:
+            if _code(err) == "TransactionCanceledException":
+                reasons = err.response.get("CancellationReasons") or []
+                codes = {reason.get("Code") for reason in reasons}
+                if not reasons or codes & set(_LOST_RACE):
+                    raise _Conflict from err
+            if _code(err) == "TransactionConflictException":
+                raise _Conflict from err
+            raise StoreError(f"cannot write the task table: {_message(err)}") from err
+        except BotoCoreError as err:
+            raise StoreError(f"cannot write the task table: {err}") from err
+
+    def _open(self, task_id: str) -> Task | None:
+        return self._read(OPEN, task_id)
+
+    def _read(self, section: str, task_id: str) -> Task | None:
+        try:
+            item = self._client.get_item(
+                TableName=self._table,
+                Key={"section": {"S": section}, "id": {"S": task_id}},
+                ConsistentRead=True,
+            ).get("Item")
+        except (ClientError, BotoCoreError) as err:
+            raise StoreError(f"cannot read task {task_id}: {_message(err)}") from err
+        return None if item is None else self._decode(item)
+
+    def _all_open(self) -> list[Task]:
+        tasks: list[Task] = []
+        query: dict[str, Any] = {
+            "TableName": self._table,
+            "KeyConditionExpression": "#section = :open",
+            "ExpressionAttributeNames": {"#section": "section"},
+            "ExpressionAttributeValues": {":open": {"S": OPEN}},
+            "ConsistentRead": True,
+        }
+        if self._page_limit is not None:
+            query["Limit"] = self._page_limit
+        while True:
+            try:
+                page = self._client.query(**query)
+            except (ClientError, BotoCoreError) as err:
+                raise StoreError(f"cannot read the task queue: {_message(err)}") from err
+            tasks.extend(self._decode(item) for item in page.get("Items", []))
+            if "LastEvaluatedKey" not in page:
+                return tasks
+            query["ExclusiveStartKey"] = page["LastEvaluatedKey"]
+
+    def _decode(self, item: dict[str, Any]) -> Task:
+        try:
+            task: Task = self._decoder.decode(item["task"]["S"])
+        except (KeyError, msgspec.DecodeError) as err:
+            raise StoreError(f"task {item.get('id', {}).get('S')} is unreadable: {err}") from err
+        return task
+
+
+def _code(err: ClientError) -> str:
+    return str(err.response.get("Error", {}).get("Code", ""))
+
+
+def _message(err: Exception) -> str:
+    if isinstance(err, ClientError):
+        return f"{_code(err)}: {err.response.get('Error', {}).get('Message', '')}"
+    return str(err)
