@@ -132,3 +132,13 @@ def test_a_locale_without_understanding_data_is_one_line() -> None:
     expected = r"no understanding data for the locale 'yy-YY' \(have: xx-XX\)"
     with pytest.raises(VahrError, match=expected):
         load_understanding("yy-YY", directory=LOCALES)
+
+
+def test_a_role_example_naming_no_slot_is_one_line(document: dict[str, Any]) -> None:
+    # Given the locale's data with a misspelt slot in a role example
+    understanding = load_understanding(LOCALE, directory=LOCALES)
+    typo = msgspec.structs.replace(understanding.roles[0], examples=["zub {robot} ka {zon}"])
+    broken = msgspec.structs.replace(understanding, roles=[typo])
+    # When the NLU is built from it, Then one line names the intent and the reference
+    with pytest.raises(VahrError, match=r"role examples of NavigateIntent: \{zon\} in 'zub"):
+        InteractionModel(document, use_cache=False, understanding=broken)

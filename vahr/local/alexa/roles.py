@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING
 
 import pycrfsuite
 
+from vahr.errors import VahrError
 from vahr.protocol import FLEET_GROUP
 from vahr.protocol.weather import PLAIN_NEGATIONS, WEATHER_WORDS
 from vahr.skill_model.intents import ROBOT_TYPE
@@ -153,7 +154,8 @@ def labelled_sequence(sentence: str, slot_types: Mapping[str, str]) -> Sequence_
     """A sample or role example as (features, labels); None when it names no value.
 
     `{slot}` is a value for the slot; `{-TYPE}` a value of the type for no slot; `{+slot}`
-    and `{?slot}` a value listed with, or offered instead of, the one before it."""
+    and `{?slot}` a value listed with, or offered instead of, the one before it; `{a&b}` a
+    value for both slots. A reference to anything else is a `VahrError` naming it."""
     words: list[str] = []
     spans: list[Span] = []
     labels: list[str] = []
@@ -163,14 +165,16 @@ def labelled_sequence(sentence: str, slot_types: Mapping[str, str]) -> Sequence_
             words.append(token)
             continue
         mode, name, fleet = reference.groups()
-        if mode == NO_SLOT:
+        kinds = {slot_types.get(slot) for slot in name.split(BOTH)}
+        if mode == NO_SLOT and name in slot_types.values():
             spans.append((name, len(words), len(words) + 1, bool(fleet)))
             labels.append(NO_SLOT)
-        elif len({slot_types.get(slot) for slot in name.split(BOTH)} - {None}) == 1:
-            spans.append((slot_types[name.split(BOTH)[0]], len(words), len(words) + 1, bool(fleet)))
+        elif mode != NO_SLOT and len(kinds) == 1 and None not in kinds:
+            spans.append((kinds.pop() or "", len(words), len(words) + 1, bool(fleet)))
             labels.append(mode + name)
         else:
-            return None
+            known = ", ".join([*slot_types, *sorted(set(slot_types.values()))])
+            raise VahrError(f"{token} in {sentence!r} is no slot or type of its intent ({known})")
         words.append(f"<{spans[-1][0]}>")
     if not spans:
         return None
@@ -241,12 +245,16 @@ def training_sequences(
     samples: Sequence[str],
     examples: Sequence[RoleExamples],
 ) -> list[Sequence_]:
-    """The intent's samples and the locale's role examples for it, labelled."""
+    """The intent's samples and the locale's role examples for it, labelled; a role example
+    naming what the intent lacks is a `VahrError` naming the intent."""
     sentences = list(samples)
     for group in examples:
         if intent in group.intents:
             sentences += [s for template in group.examples for s in expand(template)]
-    found = [labelled_sequence(sentence, slot_types) for sentence in sentences]
+    try:
+        found = [labelled_sequence(sentence, slot_types) for sentence in sentences]
+    except VahrError as err:
+        raise VahrError(f"role examples of {intent}: {err}") from err
     return [sequence for sequence in found if sequence is not None]
 
 
