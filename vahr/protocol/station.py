@@ -272,11 +272,35 @@ class CommandParams(msgspec.Struct, frozen=True, omit_defaults=True):
     after: str | None | msgspec.UnsetType = msgspec.UNSET
 
 
+TaskStatusWord = Literal["queued", "assigned", "done", "cancelled"]
+
+
+class FleetTask(msgspec.Struct, frozen=True, kw_only=True):
+    """One task of the fleet's queue as the dispatcher serves it (`GET {api}/vahr/tasks`):
+    what is to be done where, its state, and the robot that took it (None while queued).
+    Fields the dispatcher adds beyond these are not passed on."""
+
+    id: ShortText
+    kind: ShortText
+    zone: ShortText | None = None
+    status: TaskStatusWord
+    thing: ShortText | None = None
+    created_at: ShortText | None = None
+
+
+class TasksMessage(msgspec.Struct, frozen=True, kw_only=True, tag="tasks", tag_field="type"):
+    """The fleet's task queue, sent when it changed: every task the dispatcher lists, in
+    its order; `available` is False when the deployment has no dispatcher to ask."""
+
+    tasks: list[FleetTask]
+    available: bool
+
+
 class SnapshotMessage(msgspec.Struct, kw_only=True, tag="snapshot", tag_field="type"):
     """What a page starts from: the fleet, every robot, the conversation so far, the
     commands seen with their acknowledgments, the session, the announcements nobody has
-    acknowledged yet (oldest first), and the station's clock (ms since the epoch) for the
-    page to correct its own."""
+    acknowledged yet (oldest first), the station's clock (ms since the epoch) for the
+    page to correct its own, and the fleet's task queue when the station has read it."""
 
     fleet: FleetView
     robots: dict[str, RobotView]
@@ -285,6 +309,7 @@ class SnapshotMessage(msgspec.Struct, kw_only=True, tag="snapshot", tag_field="t
     experiment: ExperimentStatus | None
     alerts: list[AnnouncementMessage]
     server_time: float
+    tasks: TasksMessage | None = None
 
 
 class RobotChange(msgspec.Struct, kw_only=True, omit_defaults=True):
@@ -387,6 +412,7 @@ PageMessage = (
     | ExperimentMessage
     | AnnouncementMessage
     | AlertAcknowledgedMessage
+    | TasksMessage
 )
 
 _page_encoder = msgspec.json.Encoder()

@@ -18,6 +18,7 @@ assistant and its shadow store (the local stack does not import the station).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import urllib.error
@@ -89,6 +90,9 @@ def build_station(config: StationConfig, deployment: Deployment) -> Station:
     assistant: Assistant | None = None
     if api is not None and local:
         assistant = HttpAssistant(api)
+        if config.tasks_url is None:
+            # The local stack's dispatcher serves the fleet's task queue beside its data plane.
+            config = dataclasses.replace(config, tasks_url=f"{api.rstrip('/')}/vahr/tasks")
     elif api is not None:
         assistant = _simulator_for(api, config.model_file, deployment, feed, link)
     link.connect()
@@ -114,11 +118,16 @@ def on_local_system(
     link: MqttClient,
     assistant: Assistant,
     read_shadow: Callable[[str], bytes | None],
+    tasks_url: str | None = None,
 ) -> Station:
     """`vahr up`'s station, started: on the stack's broker, the simulator in-process, shadows
-    read from the store, every turn seen on the broker."""
+    read from the store, every turn seen on the broker, the task queue from `tasks_url`."""
     return Station(
-        StationConfig(port=port), fleet, link=link, assistant=assistant, read_shadow=read_shadow
+        StationConfig(port=port, tasks_url=tasks_url),
+        fleet,
+        link=link,
+        assistant=assistant,
+        read_shadow=read_shadow,
     ).start()
 
 

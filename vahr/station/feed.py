@@ -21,7 +21,9 @@ the typedefs of `static/contract.js`:
 - `announcement`: what the assistant told the person unprompted (a robot stuck, failed,
   offline; `topics.ASSISTANT_ANNOUNCEMENTS`), shown as an alert until acknowledged;
 - `alert_acknowledged`: someone acknowledged an alert on a page (`acknowledge`): the
-  announcement and any other still open about the same robot and trouble.
+  announcement and any other still open about the same robot and trouble;
+- `tasks`: the fleet's task queue and who took which task, when it changed (`set_tasks`,
+  fed by `vahr.station.tasks.TaskPoller` from the dispatcher's `GET {api}/vahr/tasks`).
 
 Acknowledgments are the station's, not one page's: every page stops showing the alert, and
 a page that reloads does not raise it again.
@@ -76,6 +78,7 @@ from vahr.protocol.station import (
     RobotsMessage,
     RobotView,
     SnapshotMessage,
+    TasksMessage,
     TurnMessage,
     ZoneEntry,
     decode_experiment_status,
@@ -250,6 +253,7 @@ class Feed:
         self._experiment: ExperimentStatus | None = None
         self._alerts: OrderedDict[str, AnnouncementMessage] = OrderedDict()
         self._announced: OrderedDict[str, None] = OrderedDict()
+        self._tasks: TasksMessage | None = None
         self.closed = False
 
     # -- pages ----------------------------------------------------------------------------
@@ -293,6 +297,7 @@ class Feed:
             experiment=self._experiment,
             alerts=list(self._alerts.values()),
             server_time=self._clock(),
+            tasks=self._tasks,
         )
 
     def close(self) -> None:
@@ -302,6 +307,14 @@ class Feed:
             subscribers, self._subscribers = self._subscribers, []
         for subscriber in subscribers:
             subscriber.close()
+
+    def set_tasks(self, tasks: TasksMessage) -> None:
+        """The fleet's task queue as just read: sent to the pages if it changed."""
+        with self._lock:
+            if tasks == self._tasks:
+                return
+            self._tasks = tasks
+            self._broadcast(tasks, "tasks")
 
     def _broadcast_change(self, change: RobotChange) -> None:
         """Send a robot's change to every page (merged with one not taken yet); call with

@@ -23,6 +23,7 @@ from vahr.station.controls import Controls
 from vahr.station.desk import Desk
 from vahr.station.feed import Feed
 from vahr.station.server import StationServer
+from vahr.station.tasks import TaskPoller
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -44,6 +45,8 @@ class StationConfig:
     # Push-to-talk needs the recognizer (pocketsphinx) and the interaction model.
     voice: bool = True
     model_file: Path | None = None
+    # The dispatcher's task queue (`GET {api}/vahr/tasks`), relayed to the pages; None: not shown.
+    tasks_url: str | None = None
 
 
 class Station:
@@ -80,6 +83,7 @@ class Station:
         self.server = StationServer(
             self.app, host=config.host, port=config.port, token=config.token
         )
+        self.tasks = TaskPoller(config.tasks_url, self.feed) if config.tasks_url else None
 
     def _publish(self, topic: str, payload: bytes) -> None:
         self.link.publish(topic, payload, qos=1)
@@ -107,12 +111,16 @@ class Station:
             if self.push_to_talk is not None:
                 self.push_to_talk.warm_up()
             self.server.start()
+            if self.tasks is not None:
+                self.tasks.start()
         except BaseException:
-            self.server.stop()
+            self.stop()
             raise
         return self
 
     def stop(self) -> None:
+        if self.tasks is not None:
+            self.tasks.stop()
         self.server.stop()
 
     def __enter__(self) -> Station:

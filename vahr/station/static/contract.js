@@ -158,6 +158,19 @@
  */
 
 /**
+ * One task of the fleet's queue as the dispatcher serves it (`GET {api}/vahr/tasks`): what is
+ * to be done where, its state, and the robot that took it (None while queued). Fields the
+ * dispatcher adds beyond these are not passed on.
+ * @typedef {object} FleetTask
+ * @property {string} id
+ * @property {string} kind
+ * @property {string|null} zone
+ * @property {"assigned"|"cancelled"|"done"|"queued"} status
+ * @property {string|null} thing
+ * @property {string|null} created_at
+ */
+
+/**
  * The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`).
  * @typedef {object} FleetView
  * @property {Array<RobotEntry>} robots
@@ -322,7 +335,8 @@
 /**
  * What a page starts from: the fleet, every robot, the conversation so far, the commands seen
  * with their acknowledgments, the session, the announcements nobody has acknowledged yet
- * (oldest first), and the station's clock (ms since the epoch) for the page to correct its own.
+ * (oldest first), the station's clock (ms since the epoch) for the page to correct its own, and
+ * the fleet's task queue when the station has read it.
  * @typedef {object} SnapshotMessage
  * @property {"snapshot"} type
  * @property {FleetView} fleet
@@ -332,6 +346,7 @@
  * @property {ExperimentStatus|null} experiment
  * @property {Array<AnnouncementMessage>} alerts
  * @property {number} server_time
+ * @property {TasksMessage|null} tasks
  */
 
 /**
@@ -343,6 +358,15 @@
  * @property {string} [title]
  * @property {string|null} [started_at]
  * @property {string|null} [ended_at]
+ */
+
+/**
+ * The fleet's task queue, sent when it changed: every task the dispatcher lists, in its order;
+ * `available` is False when the deployment has no dispatcher to ask.
+ * @typedef {object} TasksMessage
+ * @property {"tasks"} type
+ * @property {Array<FleetTask>} tasks
+ * @property {boolean} available
  */
 
 /**
@@ -375,7 +399,7 @@
  * @property {string|null} key
  */
 
-/** @typedef {SnapshotMessage|RobotsMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage|AnnouncementMessage|AlertAcknowledgedMessage} PageMessage */
+/** @typedef {SnapshotMessage|RobotsMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage|AnnouncementMessage|AlertAcknowledgedMessage|TasksMessage} PageMessage */
 
 /** @typedef {TurnMessage|CommandMessage|EventMessage|AnnouncementMessage} ConversationEntry */
 

@@ -2,7 +2,9 @@
 // The keyboard-and-mouse panel: the paper's baseline method. Select a robot (a click on the
 // map or here, or keys 1-9), then a zone (a click, or its key: A-D, L) to send it there; the
 // arms load and unload on arrival. Esc stops every robot. "Ask the weather" asks the
-// assistant, as the paper's keyboard participants did.
+// assistant, as the paper's keyboard participants did. "Any robot" (key 0), then a zone,
+// asks the assistant to send a robot there, as a person would say it: the fleet's dispatcher
+// picks the robot, or queues the task when none is free.
 
 import { post, reason } from "./api.js";
 import { statusColour, zoneText } from "./map.js";
@@ -26,6 +28,17 @@ import { typing } from "./talk.js";
  * @property {Record<string, string>} names the robots' spoken names
  * @property {Record<string, CommandMessage>} commands the commands seen, by id
  */
+
+// The words the panel sends and shows for "any robot" (one place, for translation).
+const ANY = {
+  label: "Any robot",
+  key: "0",
+  /** @param {string} zone the zone as spoken ("zone c", "loading zone") */
+  utterance: (zone) => `send a robot to ${zone}`,
+  /** @param {string} zone */
+  title: (zone) => `Send any free robot to ${zone}`,
+  select: "Any robot selected: click a zone (or press its key) to send the free robot nearest it.",
+};
 
 /** @param {string | undefined} label @param {string} [className] */
 function button(label, className = "btn") {
@@ -56,6 +69,10 @@ export class Panel {
     this.names = names;
     /** @type {string | null} */
     this.selected = null;
+    // "Any robot" chosen: a zone sends whichever robot the dispatcher picks.
+    this.anyRobot = false;
+    /** @type {HTMLButtonElement | null} */
+    this.anyButton = null;
     this.ordersAllowed = true;
     /** Per command id, what the status line says about it. @type {Map<string, string>} */
     this.pending = new Map();
@@ -90,6 +107,13 @@ export class Panel {
       this.robotsBox.appendChild(made);
       this.robotButtons.set(robot.thing, { made, dot });
     }
+    const any = button(undefined);
+    any.append(key(ANY.key), document.createTextNode(ANY.label));
+    any.dataset.any = "true";
+    any.setAttribute("aria-pressed", "false");
+    any.addEventListener("click", () => this.chooseAny());
+    this.robotsBox.appendChild(any);
+    this.anyButton = any;
     if (fleet.robots.length > this.robotButtons.size) {
       const select = document.createElement("select");
       select.className = "robot-select";
@@ -120,9 +144,23 @@ export class Panel {
     if (parts) parts.dot.style.background = `var(--${statusColour(status)})`;
   }
 
+  // "Any robot" on (or off again); a robot selected is let go.
+  chooseAny() {
+    const on = !this.anyRobot;
+    if (this.selected) this.onSelect(this.selected);
+    this.anyRobot = on;
+    this.anyButton?.setAttribute("aria-pressed", String(on));
+    if (on) this.tell(ANY.select);
+    this.refresh();
+  }
+
   /** @param {string | null} thing */
   select(thing) {
     this.selected = thing;
+    if (thing && this.anyRobot) {
+      this.anyRobot = false;
+      this.anyButton?.setAttribute("aria-pressed", "false");
+    }
     for (const [name, { made }] of this.robotButtons) made.setAttribute("aria-pressed", String(name === thing));
     this.refresh();
   }
@@ -138,9 +176,9 @@ export class Panel {
 
   refresh() {
     for (const made of this.zoneButtons?.values() ?? []) {
-      made.disabled = !this.selected || !this.ordersAllowed;
+      made.disabled = !(this.selected || this.anyRobot) || !this.ordersAllowed;
       const zone = made.dataset.zone;
-      made.title = this.selected ? `Send ${this.names[this.selected]} to ${zone}` : `Zone ${zone}: select a robot first`;
+      made.title = this.selected ? `Send ${this.names[this.selected]} to ${zone}` : this.anyRobot ? ANY.title(String(zone)) : `Zone ${zone}: select a robot first`;
     }
   }
 
@@ -174,12 +212,32 @@ export class Panel {
 
   /** @param {string | null} thing @param {string} zone */
   navigate(thing, zone) {
+    if (!thing && this.anyRobot) return this.ordersAllowed ? this.sendAny(zone) : undefined;
     if (!thing) {
       this.tell("Select a robot first: click it on the map, or press its number.", true);
       return;
     }
     if (!this.ordersAllowed) return;
     return this.order({ robot: thing, action: "navigate", zone }, `${this.names[thing]} to ${zoneText(zone)}`);
+  }
+
+  // Ask the assistant to send a robot to `zone`, as a person would say it.
+  /** @param {string} zone */
+  async sendAny(zone) {
+    const spoken = this.fleet?.zones.find((z) => z.id === zone)?.name ?? `zone ${zone}`;
+    /** @type {Promise<SayReply>} */
+    const sent = post("/api/say", { utterance: ANY.utterance(spoken), origin: "station" });
+    this.interactions.attach(sent.then(
+      (turn) => ({ speech: turn.speech, intent: turn.intent, commands: turn.commands || [] }),
+      (err) => ({ error: err.message }),
+    ));
+    this.tell(`${ANY.label} to ${zoneText(zone)}…`);
+    try {
+      const turn = await sent;
+      this.tell(`The assistant: “${turn.speech}”`);
+    } catch (err) {
+      this.tell(reason(err), true);
+    }
   }
 
   async stopAll() {
@@ -232,6 +290,11 @@ export class Panel {
     if (event.key === "Escape") {
       event.preventDefault();
       this.stopAll();
+      return;
+    }
+    if (event.key === ANY.key) {
+      event.preventDefault();
+      this.chooseAny();
       return;
     }
     const robot = this.fleet?.robots.find((r) => r.key && r.key === event.key);

@@ -9,11 +9,12 @@ import { Conversation } from "./conversation.js";
 import { byId } from "./dom.js";
 import { ExperimentView, watchInteractions } from "./experiment.js";
 import { Interactions } from "./interactions.js";
-import { MapView, setZoneNames } from "./map.js";
+import { MapView, setZoneNames, zoneText } from "./map.js";
 import { applyChange } from "./changes.js";
 import { Panel } from "./panel.js";
 import { RobotsPanel } from "./robots.js";
 import { Talk } from "./talk.js";
+import { TasksView } from "./tasks-view.js";
 
 /** @import { AnnouncementMessage, CommandMessage, EventMessage, ExperimentStatus, FleetView, PageMessage, Reported, RobotChange, RobotView, RobotsMessage, SnapshotMessage } from "./contract.js" */
 /** @import { SayReply } from "./api.js" */
@@ -81,6 +82,10 @@ const alerts = new AlertsView({
   onError: (problem) => panel.tell(problem, true),
   onBeep: () => { if (metrics) metrics.beeps += 1; },
 });
+const tasks = new TasksView(
+  { card: byId("tasks", HTMLElement), list: byId("task-list", HTMLElement), count: byId("task-count", HTMLElement) },
+  { nameOf: (thing) => names[thing] || thing, zoneOf: (zone) => (zone.length <= 2 ? `zone ${zone}` : zoneText(zone)) },
+);
 new Talk({ button: byId("talk", HTMLButtonElement), level: byId("talk-level", HTMLElement), state: byId("talk-state", HTMLElement), interactions, metrics });
 
 const voice = byId("reply-voice", HTMLSelectElement);
@@ -185,6 +190,7 @@ function reset(snapshot) {
     changed(thing);
   }
   onExperiment(snapshot.experiment);
+  tasks.update(snapshot.tasks);
   alerts.reset(snapshot.alerts, first);
   if (store.selected) select(store.selected);
 }
@@ -274,6 +280,9 @@ const handlers = {
   announcement: onAnnouncement,
   alert_acknowledged(message) {
     alerts.acknowledged(message.ids);
+  },
+  tasks(message) {
+    tasks.update(message);
   },
 };
 

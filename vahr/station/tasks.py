@@ -1,0 +1,92 @@
+"""The fleet's task queue for the station: read from the dispatcher and relayed to the pages.
+
+The dispatcher serves the queue at `GET {api}/vahr/tasks` (`{"tasks": [...]}`). A
+`TaskPoller` reads it every `EVERY_S` on its own thread and hands it to the feed, which
+sends it to the pages only when it changed (`Feed.set_tasks`): the page never polls, and
+however many pages are open the dispatcher is asked once a period. A deployment without a
+dispatcher (a 404) shows the queue as not available; an unreachable or unreadable answer
+is logged once and the last queue stays shown.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import urllib.error
+import urllib.request
+from typing import TYPE_CHECKING
+
+import msgspec
+
+from vahr.protocol.station import FleetTask, TasksMessage
+
+if TYPE_CHECKING:
+    from vahr.station.feed import Feed
+
+log = logging.getLogger(__name__)
+
+EVERY_S = 1.0
+TIMEOUT_S = 2.0
+# A queue longer than this is cut to its first tasks (queued and assigned ones come first
+# in the dispatcher's order, which is the line).
+TASKS_SHOWN = 200
+
+
+class _Tasks(msgspec.Struct):
+    tasks: list[FleetTask]
+
+
+_decoder = msgspec.json.Decoder(_Tasks)
+
+
+def read_tasks(url: str, timeout_s: float = TIMEOUT_S) -> TasksMessage:
+    """The queue at `url`; not available when nothing answers there (HTTP 404).
+    Raises `OSError` or `msgspec.MsgspecError` when it cannot be read."""
+    try:
+        with urllib.request.urlopen(url, timeout=timeout_s) as answer:  # noqa: S310 (http only)
+            body = answer.read()
+    except urllib.error.HTTPError as err:
+        if err.code == 404:
+            return TasksMessage(tasks=[], available=False)
+        raise
+    return TasksMessage(tasks=_decoder.decode(body).tasks[:TASKS_SHOWN], available=True)
+
+
+class TaskPoller:
+    """Read `url` every `every_s` into `feed` until `stop()`."""
+
+    def __init__(self, url: str, feed: Feed, *, every_s: float = EVERY_S) -> None:
+        if not url.startswith(("http://", "https://")):
+            raise ValueError(f"tasks URL must be http(s): {url}")
+        self.url = url
+        self.feed = feed
+        self.every_s = every_s
+        self._stopped = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="vahr-station-tasks", daemon=True)
+        self._failing = False
+
+    def start(self) -> TaskPoller:
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        self._stopped.set()
+        if self._thread.is_alive():
+            self._thread.join(TIMEOUT_S + 1)
+
+    def poll(self) -> None:
+        """Read once and hand the queue to the feed."""
+        try:
+            tasks = read_tasks(self.url)
+        except (OSError, msgspec.MsgspecError) as err:
+            if not self._failing:
+                log.warning("cannot read the task queue at %s: %s", self.url, err)
+            self._failing = True
+            return
+        self._failing = False
+        self.feed.set_tasks(tasks)
+
+    def _run(self) -> None:
+        while not self._stopped.is_set():
+            self.poll()
+            self._stopped.wait(self.every_s)
