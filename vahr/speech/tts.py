@@ -1,14 +1,24 @@
-"""Text-to-speech: espeak-ng offline (the default), Amazon Polly and gTTS optional.
+"""Text-to-speech: espeak-ng, flite and festival offline, Amazon Polly and gTTS optional.
 
 Every synthesizer returns `Audio` at 16 kHz mono, the rate the recognizers and the room
-channel use. espeak-ng and sox run as subprocesses; boto3 and gTTS are imported only
-when their synthesizer is built, so the default path needs neither.
+channel use. espeak-ng (the default), flite, festival and sox run as subprocesses; boto3
+and gTTS are imported only when their synthesizer is built, so the default path needs
+neither.
+
+A voice has one name, `ENGINE:VOICE`, wherever voices are listed (the hearing's
+evaluations speak with many): `espeak-ng:en-us+f2`, `flite:slt` (also `rms`, `awb`,
+`kal`), `festival:cmu_us_slt_arctic_hts`. flite's and festival's voices are diphone and
+HMM voices built from recordings of people, so they sound far more like a person than
+espeak-ng's formant synthesis, and a recognizer trained on people hears them better;
+a hearing measured on espeak-ng alone says little about people.
 """
 
 from __future__ import annotations
 
 import shutil
 import subprocess
+import tempfile
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from vahr.speech.audio import SAMPLE_RATE, Audio, convert_to_pcm16k
@@ -20,7 +30,13 @@ if TYPE_CHECKING:
 DEFAULT_VOICE = "en-us+f2"
 DEFAULT_WORDS_PER_MINUTE = 150
 ESPEAK_TIMEOUT_S = 10.0
+# festival starts a Scheme interpreter and loads its voice for every sentence: about 2 s.
+FESTIVAL_TIMEOUT_S = 30.0
 MAX_TEXT_CHARS = 1_000
+FLITE_VOICES = ("slt", "rms", "awb", "kal")
+FESTIVAL_VOICES = ("cmu_us_slt_arctic_hts",)
+# Voices spoken in the hearing's evaluations, engine by engine (see `voice_names`).
+ESPEAK_VOICES = ("en-us+f2", "en-us+m3", "en-us+f4", "en+m1", "en-gb+f3")
 
 
 class Synthesizer(Protocol):
@@ -128,13 +144,107 @@ class GttsSynthesizer:
         return Audio(convert_to_pcm16k(buffer.getvalue(), "mp3"))
 
 
+class FliteSynthesizer:
+    """flite (`-voice NAME -o FILE.wav`): CMU's small synthesizer, 16 kHz already."""
+
+    def __init__(self, voice: str = "slt") -> None:
+        executable = shutil.which("flite")
+        if executable is None:
+            raise SpeechError("flite is not installed (Debian: apt-get install flite)")
+        if voice not in FLITE_VOICES:
+            raise SpeechError(f"flite voice {voice!r}: use one of {', '.join(FLITE_VOICES)}")
+        self.executable = executable
+        self.voice = voice
+
+    def synthesize(self, text: str) -> Audio:
+        text = _check_text(text)
+        with tempfile.TemporaryDirectory() as folder:
+            out = Path(folder) / "speech.wav"
+            # The text is read from a file: flite's -t would take a leading "-" as an option.
+            source = Path(folder) / "text.txt"
+            source.write_text(text, encoding="utf-8")
+            command = [self.executable, "-voice", self.voice, "-f", str(source), "-o", str(out)]
+            return _run_to_wav(command, out, "flite", ESPEAK_TIMEOUT_S, text=None)
+
+
+class FestivalSynthesizer:
+    """festival's `text2wave` with an installed voice (Debian: festvox-us-slt-hts for
+    `cmu_us_slt_arctic_hts`), resampled from its 32 kHz (HTS) to 16 kHz by sox."""
+
+    def __init__(self, voice: str = "cmu_us_slt_arctic_hts") -> None:
+        executable = shutil.which("text2wave")
+        if executable is None:
+            raise SpeechError(
+                "festival is not installed (Debian: apt-get install festival festvox-us-slt-hts)"
+            )
+        # A voice name goes into a Scheme expression: only a plain name may.
+        if not voice.replace("_", "").isalnum():
+            raise SpeechError(f"festival voice {voice!r} is not a voice name")
+        self.executable = executable
+        self.voice = voice
+
+    def synthesize(self, text: str) -> Audio:
+        text = _check_text(text)
+        with tempfile.TemporaryDirectory() as folder:
+            out = Path(folder) / "speech.wav"
+            command = [
+                self.executable, "-eval", f"(voice_{self.voice})", "-o", str(out),
+            ]  # fmt: skip
+            # The text goes in on stdin, read as text (not as Scheme).
+            return _run_to_wav(command, out, "festival", FESTIVAL_TIMEOUT_S, text=text)
+
+
+def _run_to_wav(
+    command: list[str], out: Path, engine: str, timeout_s: float, *, text: str | None
+) -> Audio:
+    try:
+        done = subprocess.run(
+            command,
+            input=text.encode() if text is not None else None,
+            capture_output=True,
+            timeout=timeout_s,
+            check=False,
+        )
+    except subprocess.TimeoutExpired as err:
+        raise SpeechError(f"{engine} did not finish within {timeout_s:g} s") from err
+    message = done.stderr.decode(errors="replace").strip()
+    # festival says "SIOD ERROR" and may still exit 0 when a voice is missing.
+    if done.returncode != 0 or not out.is_file() or out.stat().st_size <= 44 or "ERROR" in message:
+        reason = message.splitlines()[-1] if message else "no audio produced"
+        raise SpeechError(f"{engine} could not speak: {reason}")
+    return Audio.from_wav(out.read_bytes())
+
+
+def voice_names() -> dict[str, tuple[str, ...]]:
+    """Every offline voice by engine, as `make_synthesizer` names them."""
+    return {
+        "espeak-ng": tuple(f"espeak-ng:{v}" for v in ESPEAK_VOICES),
+        "flite": tuple(f"flite:{v}" for v in FLITE_VOICES),
+        "festival": tuple(f"festival:{v}" for v in FESTIVAL_VOICES),
+    }
+
+
+def engine_of(spec: str) -> str:
+    """The engine of a voice name: `flite:slt` -> `flite`; `espeak` is `espeak-ng`."""
+    kind = spec.partition(":")[0]
+    return "espeak-ng" if kind in ("", "espeak") else kind
+
+
 def make_synthesizer(spec: str) -> Synthesizer:
-    """`espeak[:VOICE]` (default), `polly[:VOICE]` or `gtts[:LANG]`."""
+    """`espeak-ng[:VOICE]` (or `espeak[:VOICE]`, the default), `flite[:VOICE]`,
+    `festival[:VOICE]`, `polly[:VOICE]` or `gtts[:LANG]`."""
     kind, _, option = spec.partition(":")
     if kind in ("", "espeak", "espeak-ng"):
         return EspeakSynthesizer(option or DEFAULT_VOICE)
+    if kind == "flite":
+        return FliteSynthesizer(option or "slt")
+    if kind == "festival":
+        return FestivalSynthesizer(option or FESTIVAL_VOICES[0])
     if kind == "polly":
         return PollySynthesizer(option or "Joanna")
     if kind == "gtts":
         return GttsSynthesizer(option or "en")
-    raise SpeechError(f"unknown synthesizer {spec!r}: use espeak[:VOICE], polly[:VOICE], gtts")
+    raise SpeechError(
+        f"unknown synthesizer {spec!r}: use espeak-ng[:VOICE], flite[:VOICE], "
+        "festival[:VOICE], polly[:VOICE], gtts"
+    )
