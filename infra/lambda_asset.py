@@ -62,6 +62,7 @@ SKILL_DIR = "lambda/skill"
 CODE_ROOTS = {"skill": SKILL_DIR, "announcer": "lambda/announcer"}
 # Where `vahr.protocol.fleet` looks for the bundled fleet definition.
 FLEET_IN_BUNDLE = "vahr/protocol/fleet.yaml"
+LOCALES_IN_BUNDLE = "vahr/protocol/locales"
 _IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".mypy_cache", ".pytest_cache")
 _REQUIREMENT = re.compile(r"^\s*([A-Za-z0-9][A-Za-z0-9._-]*)\s*==\s*([^\s;#]+)")
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
@@ -123,6 +124,9 @@ def _source_files(fleet_file: Path) -> list[tuple[Path, str]]:
         for path in sorted((REPO_ROOT / package).rglob("*.py")):
             if "__pycache__" not in path.parts:
                 pairs.append((path, path.relative_to(REPO_ROOT).as_posix()))
+    # Each locale's words and message catalog (vahr.protocol.locale reads them).
+    for path in sorted((REPO_ROOT / LOCALES_IN_BUNDLE).rglob("*.yaml")):
+        pairs.append((path, path.relative_to(REPO_ROOT).as_posix()))
     pairs.append((fleet_file, FLEET_IN_BUNDLE))
     return pairs
 
