@@ -1,10 +1,11 @@
 """The CDK app: `npx cdk synth|deploy` runs `python -m infra.app` (see cdk.json).
 
 Context flags (cdk.json or `-c key=value`): `skill=true` adds the Alexa skill, `lex=true`
-the Lex bot and the robots' role alias; `skillId`, `vendorId`, `lwaSecretName`,
-`architecture`, `fleetFile`, `logRetentionDays`, `ackTimeoutS`, `logLevel`, `stackName`,
-`robotPolicyName`, `operatorPolicyName`, `roleAliasName`, `weatherAnswersFile`
-(docs/deploy.md lists them all).
+the Lex bot and the robots' role alias, `announcer=true` the announcer, `dispatcher=true`
+the fleet dispatcher with fleet indexing (`taskTableDeletionProtection`); `skillId`,
+`vendorId`, `lwaSecretName`, `architecture`, `fleetFile`, `logRetentionDays`, `ackTimeoutS`,
+`logLevel`, `stackName`, `robotPolicyName`, `operatorPolicyName`, `roleAliasName`,
+`weatherAnswersFile` (docs/deploy.md lists them all).
 cdk-nag's AwsSolutions checks run on the whole app; synth fails on any finding that the
 stack has not acknowledged with a reason.
 """

@@ -70,6 +70,13 @@ class InfraConfig:
     announcer_stage: str = "development"
     # vahr.announce.AnnounceSettings as JSON, checked at synth.
     announce_settings: str = "{}"
+    # The fleet dispatcher (infra/constructs/dispatcher.py): the task table, the dispatcher
+    # function, its rule on the robots' shadows, and fleet indexing, which is the account's
+    # one thing-indexing configuration in the region (so it is off unless asked for).
+    dispatcher: bool = False
+    dispatcher_rule_name: str = "vahr_dispatcher_robot_freed"
+    # On: the table survives `cdk destroy` and cannot be deleted by accident.
+    task_table_deletion_protection: bool = False
 
     @classmethod
     def from_context(cls, get: Callable[[str], Any]) -> InfraConfig:
@@ -124,6 +131,8 @@ class InfraConfig:
             alexa_region=(_text(get, "alexaRegion") or defaults.alexa_region).upper(),
             announcer_stage=_text(get, "announcerStage") or defaults.announcer_stage,
             announce_settings=_announce_settings(get("announce")),
+            dispatcher=_flag(get, "dispatcher"),
+            task_table_deletion_protection=_flag(get, "taskTableDeletionProtection"),
         )
         if config.alexa_region not in ("NA", "EU", "FE"):
             raise VahrError(f"alexaRegion: {config.alexa_region!r} must be NA, EU or FE")

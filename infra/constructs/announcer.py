@@ -30,11 +30,10 @@ from aws_cdk import aws_events_targets as targets
 from aws_cdk import aws_iam as iam
 from aws_cdk import aws_iot as iot
 from aws_cdk import aws_lambda as lambda_
-from aws_cdk import aws_logs as logs
 from aws_cdk import aws_sqs as sqs
 from constructs import Construct
 
-from infra.config import LOG_RETENTION_NAMES
+from infra.constructs.python_function import python_function
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
@@ -99,12 +98,6 @@ class Announcer(Construct):
             enforce_ssl=True,
             retention_period=cdk.Duration.days(14),
         )
-        self.log_group = logs.LogGroup(
-            self,
-            "Logs",
-            retention=logs.RetentionDays[LOG_RETENTION_NAMES[config.log_retention_days]],
-            removal_policy=cdk.RemovalPolicy.DESTROY,
-        )
         self.role = iam.Role(
             self,
             "Role",
@@ -142,22 +135,15 @@ class Announcer(Construct):
                 sid="PublishAnnouncements", actions=["iot:Publish"], resources=[self.topic_arn]
             )
         )
-        self.function = lambda_.Function(
+        self.function, self.log_group = python_function(
             self,
-            "Function",
-            description="VAHR announcer: robots' troubles to Alexa notifications",
-            runtime=lambda_.Runtime.PYTHON_3_12,
-            architecture=(
-                lambda_.Architecture.ARM_64
-                if config.architecture == "arm64"
-                else lambda_.Architecture.X86_64
-            ),
-            handler=HANDLER,
+            config=config,
             code=code,
-            memory_size=MEMORY_MB,
-            timeout=TIMEOUT,
+            handler=HANDLER,
+            description="VAHR announcer: robots' troubles to Alexa notifications",
             role=self.role,
-            log_group=self.log_group,
+            memory_mb=MEMORY_MB,
+            timeout=TIMEOUT,
             dead_letter_queue=self.dead_letters,
             retry_attempts=2,
             max_event_age=cdk.Duration.hours(1),
@@ -170,7 +156,6 @@ class Announcer(Construct):
                 "VAHR_LOG_LEVEL": config.log_level,
             },
         )
-        self.log_group.grant_write(self.role)
         self.rule_role = iam.Role(
             self,
             "RuleRole",

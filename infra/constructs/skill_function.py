@@ -15,11 +15,10 @@ import aws_cdk as cdk
 import jsii
 from aws_cdk import aws_iam as iam
 from aws_cdk import aws_lambda as lambda_
-from aws_cdk import aws_logs as logs
 from constructs import Construct
 
 from infra import lambda_asset
-from infra.config import LOG_RETENTION_NAMES
+from infra.constructs.python_function import python_function
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
@@ -91,12 +90,6 @@ class SkillFunction(Construct):
     ) -> None:
         super().__init__(scope, construct_id)
         stack = cdk.Stack.of(self)
-        self.log_group = logs.LogGroup(
-            self,
-            "Logs",
-            retention=logs.RetentionDays[LOG_RETENTION_NAMES[config.log_retention_days]],
-            removal_policy=cdk.RemovalPolicy.DESTROY,
-        )
         self.role = iam.Role(
             self,
             "Role",
@@ -112,25 +105,17 @@ class SkillFunction(Construct):
         }
         if config.skill_id:
             environment["VAHR_SKILL_ID"] = config.skill_id
-        self.function = lambda_.Function(
+        self.function, self.log_group = python_function(
             self,
-            "Function",
-            description="VAHR Alexa skill: voice commands to the robot fleet over AWS IoT",
-            runtime=lambda_.Runtime.PYTHON_3_12,
-            architecture=(
-                lambda_.Architecture.ARM_64
-                if config.architecture == "arm64"
-                else lambda_.Architecture.X86_64
-            ),
-            handler=HANDLER,
+            config=config,
             code=code or skill_code(config),
-            memory_size=MEMORY_MB,
-            timeout=TIMEOUT,
+            handler=HANDLER,
+            description="VAHR Alexa skill: voice commands to the robot fleet over AWS IoT",
             role=self.role,
-            log_group=self.log_group,
+            memory_mb=MEMORY_MB,
+            timeout=TIMEOUT,
             environment=environment,
         )
-        self.log_group.grant_write(self.role)
         # Without a skill id (the skill does not exist before its endpoint does) any skill
         # could call the function; the handler then checks nothing, so set skillId once
         # `ask deploy` has printed it and deploy again.

@@ -10,6 +10,8 @@ from aws_cdk import aws_logs as logs
 from announcer.config import events_url
 from infra.constructs.alexa_skill import AlexaSkill
 from infra.constructs.announcer import Announcer
+from infra.constructs.dispatcher import Dispatcher
+from infra.constructs.fleet_indexing import FleetIndexing
 from infra.constructs.iot_endpoint import IotEndpoint
 from infra.constructs.iot_fleet import IotFleet
 from infra.constructs.operator_policy import OperatorPolicy
@@ -17,6 +19,7 @@ from infra.constructs.presence_rule import PresenceRule
 from infra.constructs.robot_policy import RobotPolicy
 from infra.constructs.skill_function import SkillFunction
 from infra.constructs.skill_function import skill_code as bundled_code
+from infra.constructs.task_table import TaskTable
 from infra.constructs.weather_bot import WeatherBot
 
 if TYPE_CHECKING:
@@ -29,7 +32,7 @@ if TYPE_CHECKING:
 
 class VahrStack(cdk.Stack):
     """IoT fleet, robot and operator policies, presence rule, skill function; optionally the
-    Alexa skill and the Lex bot."""
+    Alexa skill, the Lex bot, the announcer and the fleet dispatcher."""
 
     def __init__(
         self,
@@ -86,7 +89,7 @@ class VahrStack(cdk.Stack):
         self.data_endpoint = IotEndpoint(
             self, "DataEndpoint", endpoint_type="iot:Data-ATS", provider_logs=provider_logs
         )
-        # One bundle holds both functions' code roots (infra/lambda_asset.py): built once.
+        # One bundle holds every function's code root (infra/lambda_asset.py): built once.
         code = skill_code or bundled_code(config)
         self.skill_function = SkillFunction(
             self,
@@ -108,6 +111,25 @@ class VahrStack(cdk.Stack):
             if config.announcer
             else None
         )
+        self.fleet_indexing: FleetIndexing | None = None
+        self.task_table: TaskTable | None = None
+        self.dispatcher: Dispatcher | None = None
+        if config.dispatcher:
+            self.fleet_indexing = FleetIndexing(self, "FleetIndexing", provider_logs=provider_logs)
+            self.task_table = TaskTable(
+                self, "Tasks", deletion_protection=config.task_table_deletion_protection
+            )
+            self.dispatcher = Dispatcher(
+                self,
+                "Dispatcher",
+                config=config,
+                fleet=fleet,
+                code=code,
+                table=self.task_table.table,
+                index_arn=self.fleet_indexing.index_arn,
+                data_endpoint=self.data_endpoint.address,
+            )
+            self.dispatcher.admit_skill(self.skill_function.function, self.skill_function.role)
         self.credentials_endpoint = (
             IotEndpoint(
                 self,
@@ -178,6 +200,26 @@ class VahrStack(cdk.Stack):
                 "This queue is itself the dead-letter queue of the announcer function and its "
                 "rules' error action; a dead-letter queue of its own would hold nothing.",
             )
+        if self.dispatcher is not None and self.fleet_indexing is not None:
+            acknowledge(
+                self.dispatcher.function,
+                "L1",
+                "Pinned to python3.12 with the skill function: it runs from the same bundle, "
+                "whose compiled wheels are cross-built for cp312.",
+            )
+            acknowledge(
+                self.dispatcher.dead_letters,
+                "SQS3",
+                "This queue is itself the dead-letter queue of the dispatcher function and its "
+                "rule's error action; a dead-letter queue of its own would hold nothing.",
+            )
+            acknowledge(
+                self.fleet_indexing,
+                "IAM5[Resource::*]",
+                "iot:UpdateIndexingConfiguration has no resource type in IAM (the indexing "
+                "configuration is the account's), so its only valid resource is '*'; the "
+                "statement allows that one action.",
+            )
         acknowledge(
             self.skill_function,
             "L1",
@@ -217,5 +259,12 @@ class VahrStack(cdk.Stack):
             output("RoleAlias", self.weather_bot.role_alias_name, "IoT role alias for Lex")
             output("BotId", self.weather_bot.bot_id, "Lex V2 bot id (weather answers)")
             output("BotAliasId", self.weather_bot.alias_id, "Lex V2 bot alias id")
+        if self.dispatcher is not None and self.task_table is not None:
+            output(
+                "DispatcherFunctionName",
+                self.dispatcher.function.function_name,
+                "The fleet dispatcher (the skill's VAHR_DISPATCHER_FUNCTION)",
+            )
+            output("TaskTableName", self.task_table.table.table_name, "The fleet's task queue")
         if self.alexa_skill is not None:
             output("SkillId", self.alexa_skill.skill_id, "The Alexa skill id (set -c skillId=)")
