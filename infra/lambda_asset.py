@@ -1,20 +1,21 @@
-"""Build the Lambda code bundle (the skill and the announcer): the one build used by CDK and by
-the ASK CLI path.
+"""Build the Lambda code bundle (the skill, the announcer and the dispatcher): the one build
+used by CDK and by the ASK CLI path.
 
     python -m infra.lambda_asset OUT_DIR [--architecture x86_64|arm64] [--zip FILE]
 
-The bundle holds two functions' code roots: `skill/` (from `lambda/skill`, handler
-`skill.app.lambda_handler`) and `announcer/` (from `lambda/announcer`, handler
-`announcer.app.lambda_handler`); the parts of `vahr` they import (`vahr/__init__.py`,
+The bundle holds three functions' code roots: `skill/` (from `lambda/skill`, handler
+`skill.app.lambda_handler`), `announcer/` (from `lambda/announcer`, handler
+`announcer.app.lambda_handler`) and `dispatcher/` (from `lambda/dispatcher`, handler
+`dispatcher.app.lambda_handler`); the parts of `vahr` they import (`vahr/__init__.py`,
 `vahr/errors.py`, `vahr/protocol`, and `vahr/announce` for the announcer), `fleet.yaml` as
 `vahr/protocol/fleet.yaml` (where `vahr.protocol.fleet` looks for it), and the runtime
 dependencies installed from wheels built for the Lambda runtime (CPython 3.12 on Amazon
 Linux), so no Docker is needed. boto3 comes from the Lambda runtime and awscrt must stay
 out: botocore imports awscrt whenever it is present, which costs cold start.
 
-One bundle serves both functions: a cold start pays for the modules a handler imports, not
-for the files it leaves alone (the announcer imports no ASK SDK), and one build, one asset
-hash and one upload stay simpler than two.
+One bundle serves every function: a cold start pays for the modules a handler imports, not
+for the files it leaves alone (the announcer and the dispatcher import no ASK SDK), and one
+build, one asset hash and one upload stay simpler than three.
 
 Installed dependencies are cached under `.cache/lambda-deps/<key>`, keyed by the pins and
 the target platform, so a rebuild copies files instead of running pip.
@@ -59,7 +60,11 @@ VAHR_FILES = ("vahr/__init__.py", "vahr/errors.py")
 VAHR_PACKAGES = ("vahr/protocol", "vahr/announce")
 SKILL_DIR = "lambda/skill"
 # Each function's code root: its package name in the bundle, and where it lives here.
-CODE_ROOTS = {"skill": SKILL_DIR, "announcer": "lambda/announcer"}
+CODE_ROOTS = {
+    "skill": SKILL_DIR,
+    "announcer": "lambda/announcer",
+    "dispatcher": "lambda/dispatcher",
+}
 # Where `vahr.protocol.fleet` looks for the bundled fleet definition.
 FLEET_IN_BUNDLE = "vahr/protocol/fleet.yaml"
 LOCALES_IN_BUNDLE = "vahr/protocol/locales"
