@@ -51,12 +51,22 @@ export class RobotLayer {
     /** @type {Record<string, string>} */
     this.colours = {};
     this.dirty = true;
+    // Where the floor is on the screen, read again only when it may have moved: reading it
+    // each frame would make the browser lay out the page each time a robot's line changed.
+    /** @type {{box: DOMRect, matrix: DOMMatrix} | null} */
+    this.frame = null;
+    this.moved = () => { this.frame = null; this.dirty = true; };
+    this.resized = new ResizeObserver(this.moved);
+    this.resized.observe(svg);
+    window.addEventListener("scroll", this.moved, { passive: true, capture: true });
     this.onClick = (/** @type {MouseEvent} */ event) => this.click(event);
     // Capture: the robot under the pointer wins over the zone it stands in.
     svg.addEventListener("click", this.onClick, true);
   }
 
   remove() {
+    this.resized.disconnect();
+    window.removeEventListener("scroll", this.moved, { capture: true });
     this.svg.removeEventListener("click", this.onClick, true);
     this.canvas.remove();
   }
@@ -96,7 +106,12 @@ export class RobotLayer {
   /** @param {number} t */
   draw(t) {
     this.dirty = false;
-    const box = this.svg.getBoundingClientRect();
+    if (!this.frame) {
+      const matrix = this.svg.getScreenCTM();
+      if (!matrix) return false;
+      this.frame = { box: this.svg.getBoundingClientRect(), matrix };
+    }
+    const { box, matrix } = this.frame;
     const ratio = window.devicePixelRatio || 1;
     const width = Math.round(box.width * ratio), height = Math.round(box.height * ratio);
     if (this.canvas.width !== width || this.canvas.height !== height) {
@@ -108,8 +123,6 @@ export class RobotLayer {
       const style = getComputedStyle(this.svg);
       for (const name of COLOURS) this.colours[name] = style.getPropertyValue(`--${name}`).trim() || "#64748b";
     }
-    const matrix = this.svg.getScreenCTM();
-    if (!matrix) return false;
     // SVG user units (y drawn as -y) to the canvas's CSS pixels.
     const toScreen = (/** @type {Point} */ at) => ({
       x: matrix.a * at.x - matrix.c * at.y + matrix.e - box.left,

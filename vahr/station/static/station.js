@@ -156,11 +156,11 @@ function afterPaint(then) {
 const lastShown = {};
 /** @param {Metrics} metrics @param {string} thing @param {string} status @param {Reported} reported */
 function record(metrics, thing, status, reported) {
-  const shown = { thing, status, cargo: Boolean(reported.cargo), zone: reported.zone ?? null };
-  const key = JSON.stringify(shown);
+  const cargo = Boolean(reported.cargo), zone = reported.zone ?? null;
+  const key = `${status}|${cargo}|${zone}`;
   if (lastShown[thing] === key) return;
   lastShown[thing] = key;
-  metrics.shown.push(shown);
+  metrics.shown.push({ thing, status, cargo, zone });
 }
 
 // -- the stream --------------------------------------------------------------------------
