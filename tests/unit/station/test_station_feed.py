@@ -15,9 +15,11 @@ from vahr.protocol import Event, EventPose, Presence, encode, new_command, topic
 from vahr.protocol.station import (
     AlertAcknowledgedMessage,
     AnnouncementMessage,
+    FleetTask,
     PageMessage,
     RobotsMessage,
     SnapshotMessage,
+    TasksMessage,
     TurnMessage,
 )
 from vahr.station.app import StationApp
@@ -489,3 +491,22 @@ def test_changes_not_taken_yet_merge_into_the_state_the_page_would_reach(feed: F
     robot.update({k: v for k, v in change.items() if k not in ("thing", "reported", "removed")})
     assert robot == feed.snapshot()["robots"]["placebot1"]
     assert change["online"] is True and change["version"] == 3
+
+
+def test_the_task_queue_reaches_pages_when_it_changed_and_new_pages_start_with_it(
+    feed: Feed,
+) -> None:
+    page = feed.subscribe()
+    messages(page)
+    queued = FleetTask(id="t1", kind="deliver", zone="C", status="queued")
+    # When the dispatcher's queue is read three times, changing once in between
+    feed.set_tasks(TasksMessage(tasks=[queued], available=True))
+    feed.set_tasks(TasksMessage(tasks=[queued], available=True))
+    taken = msgspec.structs.replace(queued, status="assigned", thing="placebot2")
+    feed.set_tasks(TasksMessage(tasks=[taken], available=True))
+    # Then the page, reading once, is told the latest queue once
+    (told,) = messages(page)
+    assert told["type"] == "tasks"
+    assert [(t["status"], t["thing"]) for t in told["tasks"]] == [("assigned", "placebot2")]
+    # And a page opened now starts from it
+    assert feed.snapshot()["tasks"]["tasks"][0]["thing"] == "placebot2"
