@@ -31,7 +31,7 @@ from skill.handlers.deliver import DeliverIntentHandler
 from skill.handlers.emergency_stop import EmergencyStopIntentHandler
 from skill.handlers.navigate import NavigateIntentHandler
 from skill.handlers.sequential_delivery import SequentialDeliveryIntentHandler
-from skill.handlers.status import StatusIntentHandler
+from skill.handlers.status import ProblemRobotsIntentHandler, StatusIntentHandler
 from skill.handlers.weather import WeatherIntentHandler
 from skill.handlers.weather_delivery import WeatherDeliveryIntentHandler
 from skill.interceptors import (
@@ -63,6 +63,7 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
         WeatherDeliveryIntentHandler(runtime),
         SequentialDeliveryIntentHandler(runtime),
         StatusIntentHandler(runtime),
+        ProblemRobotsIntentHandler(runtime),
         EmergencyStopIntentHandler(runtime),
         WeatherIntentHandler(runtime),
         LaunchRequestHandler(runtime),

@@ -6,6 +6,7 @@ Every setting has a default, so the handler runs with only a region configured:
 | --- | --- | --- |
 | `AWS_ENDPOINT_URL_IOT_DATA_PLANE` | unset | iot-data endpoint URL (boto3's own variable) |
 | `VAHR_IOT_DATA_ENDPOINT` | unset | iot-data endpoint set by the CDK stack (URL or host name) |
+| `AWS_ENDPOINT_URL_IOT` | unset | IoT control plane for fleet indexing (see `index_endpoint`) |
 | `VAHR_SKILL_ID` | unset | when set, requests for any other skill id are refused |
 | `VAHR_ACK_TIMEOUT_S` | 2.5 | how long to wait for robots to acknowledge a command (0-6 s) |
 | `VAHR_FLEET_FILE` | bundled fleet.yaml | the fleet definition |
@@ -41,6 +42,20 @@ class SkillConfig(msgspec.Struct, frozen=True):
     log_level: str = DEFAULT_LOG_LEVEL
     # Where boto3 finds no region (a local endpoint needs none), sign for this one.
     fallback_region: str = "us-east-1"
+    # The fleet dispatcher's function name on AWS (skill.tasks.task_desk).
+    dispatcher_function: str | None = None
+    # The IoT control plane's URL for fleet indexing, when not boto3's default.
+    control_endpoint: str | None = None
+
+    @property
+    def index_endpoint(self) -> str | None:
+        """Where fleet-indexing calls go: the configured control plane; else the data
+        endpoint when it is a local `http://` one (the local data plane answers both);
+        else None, boto3's default (AWS)."""
+        if self.control_endpoint:
+            return self.control_endpoint
+        local = self.data_endpoint is not None and self.data_endpoint.startswith("http://")
+        return self.data_endpoint if local else None
 
     @classmethod
     def from_env(cls, environ: Mapping[str, str] | None = None) -> SkillConfig:
@@ -54,6 +69,7 @@ class SkillConfig(msgspec.Struct, frozen=True):
             ack_timeout_s=_ack_timeout(env.get("VAHR_ACK_TIMEOUT_S")),
             fleet_file=_blank_to_none(env.get("VAHR_FLEET_FILE")),
             log_level=_log_level(env.get("VAHR_LOG_LEVEL")),
+            control_endpoint=_blank_to_none(env.get("AWS_ENDPOINT_URL_IOT")),
         )
 
 

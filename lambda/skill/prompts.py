@@ -117,6 +117,36 @@ STATUS_ERROR_REASON = "{robot} has a problem: {reason}."
 STATUS_ERROR = "{robot} has a problem."
 STATUS_UNREADABLE = "I could not read the state of {robot}."
 
+# Status of a large fleet (skill.speech.fleet_summary): the counts by status, then the
+# robots that need attention by name and place. Each count as (one robot, several robots).
+SUMMARY_OPENING = "Of {total} robots, {counts}"
+SUMMARY_COUNTS = {
+    "idle": ("{n} is idle", "{n} are idle"),
+    "navigating": ("{n} is driving", "{n} are driving"),
+    "loading": ("{n} is being loaded", "{n} are being loaded"),
+    "unloading": ("{n} is being unloaded", "{n} are being unloaded"),
+    "waiting": ("{n} is waiting", "{n} are waiting"),
+    "stopped": ("{n} is stopped", "{n} are stopped"),
+    "stuck": ("{n} is stuck", "{n} are stuck"),
+    "error": ("{n} has failed", "{n} have failed"),
+    "offline": ("{n} is offline", "{n} are offline"),
+    "unreported": ("{n} has not reported", "{n} have not reported"),
+}
+SUMMARY_IN = "{robot} in {zone}"
+SUMMARY_NEAR = "{robot} near {zone}"
+SUMMARY_MORE = "{n} more"
+# Before the named robots when a trouble is not the last count of the opening.
+SUMMARY_LABELS = {"stuck": "Stuck", "error": "Failed", "offline": "Offline"}
+# "Which robots are stuck?": each trouble as (one robot, several robots).
+PROBLEMS = {
+    "stuck": ("{n} robot is stuck", "{n} robots are stuck"),
+    "error": ("{n} robot has failed", "{n} robots have failed"),
+    "offline": ("{n} robot is offline", "{n} robots are offline"),
+}
+PROBLEMS_NONE = "No robot is stuck, failed or offline."
+INDEX_UNAVAILABLE = "Sorry, I could not count the robots just now. Please try again in a moment."
+FLEET_PROBLEMS_MORE = "and {n} more did not confirm"
+
 # The experiment's weather. The robots recognise these exact openings.
 WEATHER = {weather: f"The weather is {weather}." for weather in WEATHERS}
 

@@ -15,6 +15,8 @@ if TYPE_CHECKING:
 
     from skill.acknowledgment import RobotAnswer
     from skill.commands import Dispatch
+    from skill.fleet_index import IndexedRobot
+    from skill.fleet_status import FleetState
     from skill.robots import ShadowRead
     from skill.vocabulary import Vocabulary
     from vahr.protocol import Reported
@@ -53,16 +55,23 @@ def command_report(
     confirmed = [answer for answer in mine if answer.confirmed]
     if len(confirmed) == len(mine):
         robots = (
-            prompts.BOTH_ROBOTS if len(mine) == 2 else prompts.ALL_ROBOTS.format(count=len(mine))
+            prompts.BOTH_ROBOTS
+            if len(mine) == 2
+            else prompts.ALL_ROBOTS.format(count=f"{len(mine):,}")
         )
         return prompts.FLEET_ACKNOWLEDGED[action].format(robots=robots, zone=zone_name)
-    problems = "; ".join(
+    unconfirmed = [answer for answer in mine if not answer.confirmed]
+    # A fleet of a thousand cannot hear every missing robot: the first few by name.
+    named = [
         _problem(vocabulary.robot(answer.thing), answer, _FLEET_PROBLEMS)
-        for answer in mine
-        if not answer.confirmed
-    )
+        for answer in unconfirmed[:FLEET_PROBLEMS_NAMED]
+    ]
+    if len(unconfirmed) > FLEET_PROBLEMS_NAMED:
+        named.append(prompts.FLEET_PROBLEMS_MORE.format(n=len(unconfirmed) - FLEET_PROBLEMS_NAMED))
     template = prompts.FLEET_PARTIAL if confirmed else prompts.FLEET_NONE
-    return template.format(confirmed=len(confirmed), count=len(mine), problems=problems)
+    return template.format(
+        confirmed=f"{len(confirmed):,}", count=f"{len(mine):,}", problems="; ".join(named)
+    )
 
 
 def sequential_report(
@@ -171,3 +180,135 @@ def _moving(robot: str, state: Reported, there: str | None) -> str:
     if there:
         return prompts.STATUS_MOVING_TO.format(robot=robot, zone=there)
     return prompts.STATUS_MOVING.format(robot=robot)
+
+
+# -- status of a large fleet ------------------------------------------------------------
+
+# A spoken answer about the fleet stays within this many words (about 20 s of speech).
+MAX_WORDS = 60
+# Statuses that are not trouble, in the order a tie is spoken.
+_CALM = ("idle", "navigating", "loading", "unloading", "waiting", "stopped")
+# Troubles go last in the opening, so that the first one named can follow it after a colon.
+_TROUBLE_CLAUSES = ("error", "stuck")
+# Unconfirmed robots a fleet command's reply names before "and N more".
+FLEET_PROBLEMS_NAMED = 3
+
+
+def words(text: str) -> int:
+    return len(text.split())
+
+
+def _counted(template: tuple[str, str], n: int) -> str:
+    return template[0 if n == 1 else 1].format(n=f"{n:,}")
+
+
+def _joined(parts: Sequence[str]) -> str:
+    if len(parts) <= 1:
+        return "".join(parts)
+    return ", ".join(parts[:-1]) + " and " + parts[-1]
+
+
+def _place(vocabulary: Vocabulary, robot: IndexedRobot) -> str:
+    """'rover 17 in zone C', 'rover 230 near zone A' (by its pose), or just 'rover 5'."""
+    name = vocabulary.robot(robot.thing)
+    state = robot.reported
+    if state.zone:
+        return prompts.SUMMARY_IN.format(robot=name, zone=vocabulary.zone(state.zone))
+    zones = vocabulary.fleet.zones
+    if state.pose is not None and zones:
+        pose = state.pose
+        nearest = min(zones, key=lambda z: (z.pose.x - pose.x) ** 2 + (z.pose.y - pose.y) ** 2)
+        return prompts.SUMMARY_NEAR.format(robot=name, zone=vocabulary.zone(nearest.id))
+    return name
+
+
+def _names(
+    vocabulary: Vocabulary, robots: Sequence[IndexedRobot], count: int, budget: int
+) -> str | None:
+    """As many of `robots` (of `count` in all) as fit in `budget` words, then 'N more';
+    None when not even one fits."""
+    places = [_place(vocabulary, robot) for robot in robots]
+    for shown in range(len(places), 0, -1):
+        rest = count - shown
+        parts = places[:shown] + ([prompts.SUMMARY_MORE.format(n=f"{rest:,}")] if rest else [])
+        text = _joined(parts)
+        if words(text) <= budget:
+            return text
+    return None
+
+
+def _count_wording(status: str) -> tuple[str, str]:
+    # A status newer than this skill is still counted, in its own word.
+    return prompts.SUMMARY_COUNTS.get(status, ("{n} is " + status, "{n} are " + status))
+
+
+def fleet_summary(vocabulary: Vocabulary, state: FleetState) -> str:
+    """'Of 1,000 robots, 990 are idle, 8 are driving and 2 are stuck: rover 17 in zone C and
+    rover 230 near zone A.' Counts by status, then the robots in trouble, stuck first, in
+    at most `MAX_WORDS` words (the offline count is said even when no name fits)."""
+    calm = sorted(
+        (status for status, n in state.counts.items() if n and status not in _TROUBLE_CLAUSES),
+        key=lambda status: (
+            -state.counts[status],
+            _CALM.index(status) if status in _CALM else len(_CALM),
+        ),
+    )
+    clauses = [_counted(_count_wording(status), state.counts[status]) for status in calm]
+    if state.unreported:
+        clauses.append(_counted(prompts.SUMMARY_COUNTS["unreported"], state.unreported))
+    troubles = [status for status in _TROUBLE_CLAUSES if state.counts.get(status)]
+    clauses += [_counted(prompts.SUMMARY_COUNTS[s], state.counts[s]) for s in troubles]
+    text = prompts.SUMMARY_OPENING.format(total=f"{state.total:,}", counts=_joined(clauses))
+    # The trouble named right after the counts (after a colon), and the sentences after it.
+    attached = troubles[-1] if troubles else None
+    leads: dict[str, str] = {}
+    for kind in ("stuck", "error", "offline"):
+        if kind == attached or not state.trouble_count(kind):
+            continue
+        if kind == "offline":
+            leads[kind] = _capitalised(_counted(prompts.SUMMARY_COUNTS["offline"], state.offline))
+        elif state.troubled.get(kind):
+            leads[kind] = prompts.SUMMARY_LABELS[kind]
+    order = [kind for kind in ("stuck", "error", "offline") if kind == attached or kind in leads]
+    for position, kind in enumerate(order):
+        later = sum(words(leads[k]) for k in order[position + 1 :] if k == "offline")
+        lead = "" if kind == attached else leads[kind]
+        budget = MAX_WORDS - words(text) - words(lead) - later
+        names = _names(vocabulary, state.troubled.get(kind, []), state.trouble_count(kind), budget)
+        if kind == attached:
+            text += f": {names}" if names else ""
+        elif names:
+            text += f". {lead}: {names}"
+        elif kind == "offline":
+            text += f". {lead}"
+    return text + "."
+
+
+def _capitalised(text: str) -> str:
+    return text[:1].upper() + text[1:]
+
+
+def problem_report(vocabulary: Vocabulary, state: FleetState) -> str:
+    """'2 robots are stuck: rover 17 in zone C and rover 230 near zone A. 1 robot has
+    failed: rover 5 in zone B.' Stuck, failed, then offline, in at most `MAX_WORDS` words;
+    every count is said, names as far as the bound allows."""
+    leads = {
+        kind: _counted(prompts.PROBLEMS[kind], state.trouble_count(kind))
+        for kind in ("stuck", "error", "offline")
+        if state.trouble_count(kind)
+    }
+    if not leads:
+        return prompts.PROBLEMS_NONE
+    sentences: list[str] = []
+    kinds = list(leads)
+    for position, kind in enumerate(kinds):
+        used = sum(words(sentence) for sentence in sentences)
+        reserved = sum(words(leads[k]) for k in kinds[position:])
+        names = _names(
+            vocabulary,
+            state.troubled.get(kind, []),
+            state.trouble_count(kind),
+            MAX_WORDS - used - reserved,
+        )
+        sentences.append(f"{leads[kind]}: {names}." if names else f"{leads[kind]}.")
+    return " ".join(sentences)

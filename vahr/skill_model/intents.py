@@ -347,6 +347,33 @@ STATUS = IntentSpec(
     ),
 )
 
+# The follow-up to a large fleet's status summary: the robots in trouble by name
+# (lambda/skill/handlers/status.py).
+PROBLEM_ROBOTS = IntentSpec(
+    name="ProblemRobotsIntent",
+    essentials=(
+        "which robots are stuck",
+        "which robots have failed",
+        "which robots are offline",
+        "are any robots stuck",
+    ),
+    templates=(
+        "[so|um|okay] (which|what) (robots|bots|ones) (are|got) (stuck|in trouble|offline|down|"
+        "broken|having problems|having trouble) [right now|now]",
+        "[so|um|okay] (which|what) (robots|bots|ones) (have failed|failed|need help|need attention|"
+        "have problems|have a problem|are not working|aren't working)",
+        "are (any|some) (robots|bots|of the robots|of them) (stuck|offline|down|broken|in trouble|"
+        "having problems) [right now|now]",
+        "is (any robot|any of the robots|any of them) (stuck|offline|down|broken|in trouble)",
+        "(have any robots|have any of the robots|has any robot|did any robot) failed",
+        "[<ask>] (tell me|list|name) the (stuck|failed|offline|broken) robots",
+        "(which robot is|which one is|which ones are) (stuck|offline|broken)",
+        "(any|are there any) (problems|trouble|issues) with the robots [right now]",
+        "(any|are there any) (stuck|failed|offline|broken) robots [right now]",
+        "(which|what) robots (need|still need) (help|attention|rescuing) [right now|now]",
+    ),
+)
+
 EMERGENCY_STOP = IntentSpec(
     name="EmergencyStopIntent",
     slots=(ROBOT,),
@@ -407,6 +434,7 @@ CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     WEATHER_DELIVERY,
     SEQUENTIAL_DELIVERY,
     STATUS,
+    PROBLEM_ROBOTS,
     EMERGENCY_STOP,
     WEATHER,
 )
