@@ -36,7 +36,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         type=int,
         metavar="N",
         help="N simulated robots (rover1..) in one process, on a floor sized for them"
-        " (1 to 10,000; the zones are --fleet's)",
+        " (1 to 5,000; the zones are --fleet's)",
     )
     parser.add_argument(
         "--state-dir", type=Path, default=DEFAULT_STATE_DIR, help="local state (default .state)"
@@ -86,8 +86,8 @@ def run(args: argparse.Namespace) -> int:
             raise VahrError("give either --robots (a process per robot) or --swarm, not both")
         if not 1 <= args.swarm <= SWARM_MAX:
             raise VahrError(
-                f"--swarm {args.swarm}: give 1 to {SWARM_MAX:,} robots (this machine runs"
-                " at most that many in one swarm; see docs/local.md, Large fleets)"
+                f"--swarm {args.swarm}: give 1 to {SWARM_MAX:,} robots (the most whose names"
+                " fit in one Alexa interaction model; see docs/local.md, Large fleets)"
             )
     config = SystemConfig(
         state_dir=args.state_dir.resolve(),

@@ -33,12 +33,12 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 STOP_TIMEOUT_S = 8.0
-# `vahr up --swarm N`: the most robots this machine runs in one swarm. Measured resident
-# memory of `robot-agent swarm` (docs/local.md, "Large fleets"): about 60 MB of interpreter and
-# libraries plus about 90 kB per robot, and the CPU, not memory, bounds what runs well:
-# 10,000 robots idle at about a core. The bound is what the local fleet index and the skill's
-# summaries were measured for.
-SWARM_MAX = 10_000
+# `vahr up --swarm N`: the most robots one swarm runs here. Memory does not bind: the swarm
+# process measured 34.5 MB at 100 robots, 47.7 MB at 1,000 and 92 MB at 5,000 (11 to 15 kB
+# a robot; bench/swarm_startup.py, docs/local.md "Large fleets"). What binds is Alexa's limit of
+# 1,000,000 characters on an interaction model, whose ROBOT slot type names every robot:
+# 5,000 rovers fit, 6,000 do not.
+SWARM_MAX = 5_000
 # The swarm's floor: robots parked on a grid of this spacing, clear of the zones.
 SWARM_SPACING_M = 2.0
 SWARM_ZONE_CLEARANCE_M = 4.0
