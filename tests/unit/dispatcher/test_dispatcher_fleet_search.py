@@ -1,0 +1,100 @@
+"""The Candidates adapter on fleet indexing's SearchIndex, against a fleet index that answers
+boto3's `iot` client with AWS's shapes and pagination (the local data plane's).
+
+moto's own `search_index` cannot stand in here: it matches only thing names, types, groups
+and attributes (a `shadow.reported.*` term matches nothing), ignores `maxResults` and never
+pages. What neither can show is AWS's indexing delay (seconds) and its exact query parser;
+the adapter sends only field:value terms, OR and AND, which both document.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING, Any
+
+import boto3
+import pytest
+
+from dispatcher.errors import SearchError
+from dispatcher.fleet_search import FleetSearch, available_query
+from vahr.local.dataplane import DataPlane, DataPlaneServer
+from vahr.local.meter import Meter
+from vahr.local.shadow_service import ShadowService
+from vahr.local.shadow_store import ShadowStore
+from vahr.protocol.fleet import Pose
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+
+
+@pytest.fixture
+def fleet_index(aws_credentials: None) -> Iterator[tuple[ShadowStore, Any]]:
+    store = ShadowStore(None)
+    shadows = ShadowService(store, publish=lambda _topic, _payload: None)
+    with DataPlaneServer(DataPlane(shadows, publish=lambda *_: None, meter=Meter()), 0) as server:
+        yield store, boto3.client("iot", endpoint_url=server.url)
+
+
+def report(store: ShadowStore, thing: str, **reported: Any) -> None:
+    store.update(thing, None, json.dumps({"state": {"reported": reported}}).encode())
+
+
+def test_every_free_robot_is_found_across_pages_with_its_pose(
+    fleet_index: tuple[ShadowStore, Any],
+) -> None:
+    store, iot = fleet_index
+    # Given 230 robots that may take a task (three pages of 100) and 20 that may not
+    for n in range(230):
+        status = "idle" if n % 2 else "navigating"
+        report(store, f"rover{n}", status=status, zone="A" if n < 30 else "B",
+               connected=True, pose={"x": n, "y": 1.0})  # fmt: skip
+    for n in range(230, 240):
+        report(store, f"rover{n}", status="stuck", zone="A", connected=True)
+    for n in range(240, 250):
+        report(store, f"rover{n}", status="idle", zone="A", connected=False)
+    calls: list[str] = []
+    iot.meta.events.register("before-call.iot.SearchIndex", lambda **_: calls.append("search"))
+    found = FleetSearch(client=iot).available()
+    # Then all 230 come back, each with its reported state, in three SearchIndex calls
+    assert len(found) == 230 and len(calls) == 3
+    rover7 = next(robot for robot in found if robot.thing == "rover7")
+    assert (rover7.status, rover7.zone, rover7.pose, rover7.idle) == (
+        "idle",
+        "A",
+        Pose(7, 1.0),
+        True,
+    )
+    # And a zone narrows the search itself
+    in_a = FleetSearch(client=iot).available(zone="A")
+    assert sorted(robot.thing for robot in in_a) == sorted(f"rover{n}" for n in range(30))
+
+
+def test_one_robots_state_and_an_unknown_one(fleet_index: tuple[ShadowStore, Any]) -> None:
+    store, iot = fleet_index
+    report(store, "placebot1", status="idle", zone="C", connected=True,
+           last_command={"id": "abc", "action": "navigate", "result": "done"})  # fmt: skip
+    report(store, "placebot10", status="stuck", connected=True)
+    search = FleetSearch(client=iot)
+    state = search.state("placebot1")
+    assert state is not None
+    assert (state.last_command_id, state.last_result, state.available) == ("abc", "done", True)
+    assert search.state("placebot9") is None
+
+
+def test_the_query_names_every_status_that_may_take_a_task() -> None:
+    assert available_query("C") == (
+        "(shadow.reported.status:idle OR shadow.reported.status:loading OR "
+        "shadow.reported.status:navigating OR shadow.reported.status:stopped OR "
+        "shadow.reported.status:unloading OR shadow.reported.status:waiting) "
+        "AND shadow.reported.zone:C"
+    )
+    with pytest.raises(SearchError, match="cannot be searched for"):
+        available_query("C OR thingName:*")
+
+
+def test_an_index_that_does_not_answer_is_one_line(fleet_index: tuple[ShadowStore, Any]) -> None:
+    _, iot = fleet_index
+    with pytest.raises(
+        SearchError, match=r"ResourceNotFoundException: Index AWS_Nope does not exist"
+    ):
+        FleetSearch(index_name="AWS_Nope", client=iot).available()

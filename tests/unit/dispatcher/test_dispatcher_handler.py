@@ -1,0 +1,262 @@
+"""The dispatcher's handler as the skill and the topic rule invoke it: tasks in moto's
+DynamoDB, commands through moto's iot-data, candidates from a fleet index answering boto3's
+`iot` client (the local data plane's, the same wire as AWS's SearchIndex). What a user
+would observe: which robot's command topic got which command, the answer the skill reads,
+the queue, and one-line errors that change nothing."""
+
+from __future__ import annotations
+
+import json
+from datetime import UTC, datetime, timedelta
+from typing import TYPE_CHECKING, Any
+
+import boto3
+import msgspec
+import pytest
+from conftest import REGION, load_event
+from moto.core import DEFAULT_ACCOUNT_ID
+from moto.iotdata.models import iotdata_backends
+
+from dispatcher import app
+from dispatcher.command_channel import CommandChannel
+from dispatcher.config import DispatcherConfig
+from dispatcher.errors import ConfigError
+from dispatcher.fleet_search import FleetSearch
+from vahr.local.dataplane import DataPlane, DataPlaneServer
+from vahr.local.meter import Meter
+from vahr.local.shadow_service import ShadowService
+from vahr.local.shadow_store import ShadowStore
+from vahr.protocol import load_fleet, topics
+from vahr.protocol.dispatch import Dispatcher, Task, timestamp
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+
+    from dispatcher.task_table import TaskTable
+
+LONG_AGO = datetime(2026, 11, 26, 22, 0, tzinfo=UTC)
+
+
+class Index:
+    """A fleet index served over HTTP as boto3's `iot` client expects it."""
+
+    def __init__(self) -> None:
+        self.store = ShadowStore(None)
+        shadows = ShadowService(self.store, publish=lambda _topic, _payload: None)
+        self.server = DataPlaneServer(
+            DataPlane(shadows, publish=lambda *_: None, meter=Meter()), 0
+        ).start()
+
+    def report(self, thing: str, **reported: Any) -> None:
+        body = {"state": {"reported": {"connected": True, **reported}}}
+        self.store.update(thing, None, json.dumps(body).encode())
+
+
+@pytest.fixture
+def index() -> Iterator[Index]:
+    served = Index()
+    yield served
+    served.server.stop()
+
+
+@pytest.fixture
+def published(dynamodb: Any) -> list[tuple[str, dict[str, Any]]]:
+    """Every command published through moto's iot-data, decoded, in order (a live view)."""
+    backend = iotdata_backends[DEFAULT_ACCOUNT_ID][REGION]
+    backend.published_payloads.clear()
+
+    class View(list[tuple[str, dict[str, Any]]]):
+        def __iter__(self):  # type: ignore[no-untyped-def]
+            return iter([(t, json.loads(p)) for t, p in backend.published_payloads])
+
+        def __len__(self) -> int:
+            return len(backend.published_payloads)
+
+    return View()
+
+
+def make_dispatcher(
+    table: TaskTable, index: Index, *, clock: Any = lambda: datetime.now(UTC)
+) -> Dispatcher:
+    return Dispatcher(
+        fleet=load_fleet(),
+        store=table,
+        candidates=FleetSearch(client=boto3.client("iot", endpoint_url=index.server.url)),
+        publish=CommandChannel(client=boto3.client("iot-data", region_name=REGION)),
+        clock=clock,
+    )
+
+
+@pytest.fixture
+def dispatcher(table: TaskTable, index: Index) -> Dispatcher:
+    # placebot1 by zone C's door, placebot2 at the loading zone: both idle.
+    index.report("placebot1", status="idle", zone="C", pose={"x": 9.0, "y": 4.5})
+    index.report("placebot2", status="idle", zone="LOADING", pose={"x": 1.5, "y": 4.0})
+    return make_dispatcher(table, index)
+
+
+def submit(dispatcher: Dispatcher, **order: Any) -> dict[str, Any]:
+    return app.handle({"operation": "submit", "order": order}, dispatcher)
+
+
+def test_a_delivery_goes_to_the_nearest_free_robot_and_the_skill_hears_which(
+    dispatcher: Dispatcher, published: list[tuple[str, dict[str, Any]]]
+) -> None:
+    # When the skill submits "deliver a package to zone C"
+    answer = submit(dispatcher, kind="deliver", zone="C")
+    # Then placebot2, already at the loading zone, takes it (pickup there, then C)
+    assert answer["status"] == 200
+    [task] = answer["body"]["assigned"]
+    assert (task["thing"], task["kind"], task["zone"], task["pickup"]) == (
+        "placebot2", "deliver", "C", "LOADING",
+    )  # fmt: skip
+    assert answer["body"]["queued"] == []
+    # And the command went to placebot2's topic only, carrying the task's id
+    [(topic, command)] = list(published)
+    assert topic == topics.robot_cmd("placebot2")
+    assert (command["id"], command["action"], command["params"]) == (
+        task["id"], "deliver", {"zone": "C"},
+    )  # fmt: skip
+
+
+def test_with_every_robot_taken_the_task_is_queued_and_its_place_said(
+    dispatcher: Dispatcher, published: list[tuple[str, dict[str, Any]]]
+) -> None:
+    submit(dispatcher, zone="A", count=2)
+    answer = submit(dispatcher, kind="deliver", zone="B")
+    assert answer["status"] == 200
+    assert answer["body"]["assigned"] == []
+    [queued] = answer["body"]["queued"]
+    # (a queued task's status is the model's default, which the JSON leaves out)
+    assert (queued.get("status", "queued"), queued["zone"], queued.get("thing")) == (
+        "queued", "B", None,
+    )  # fmt: skip
+    assert answer["body"]["positions"] == [1]
+    assert len(published) == 2  # nothing more was sent
+    listed = app.handle({"operation": "pending"}, dispatcher)
+    assert [t["id"] for t in listed["body"]["tasks"]] == [queued["id"]]
+    everything = app.handle({"operation": "tasks"}, dispatcher)
+    statuses = [t.get("status", "queued") for t in everything["body"]["tasks"]]
+    assert statuses == ["assigned", "assigned", "queued"]
+
+
+def test_a_robot_that_finishes_its_task_takes_the_next_in_line(
+    table: TaskTable, index: Index, published: list[tuple[str, dict[str, Any]]]
+) -> None:
+    # Given placebot1 alone, holding task T (the fixture's id), and a delivery queued
+    rule_event = load_event("iot_rule_robot_freed")
+    task_id = rule_event["reported"]["last_command"]["id"]
+    index.report("placebot1", status="navigating", zone="B", pose={"x": 9.0, "y": 5.0})
+    dispatcher = make_dispatcher(table, index)
+    created = timestamp(datetime.now(UTC) - timedelta(minutes=1))
+    table.add(Task(id=task_id, request="r", kind="navigate", zone="C", created_at=created))
+    assert table.assign(task_id, "placebot1", at=timestamp(datetime.now(UTC))) is not None
+    queued = submit(dispatcher, kind="deliver", zone="D")["body"]["queued"][0]
+    # When the rule reports placebot1 idle with T done
+    index.report("placebot1", **rule_event["reported"])
+    answer = app.handle(rule_event, dispatcher)
+    # Then T is done and placebot1 took the delivery
+    assert answer == {"took": queued["id"]}
+    done = table.get(task_id)
+    assert done is not None and (done.status, done.outcome) == ("done", "done")
+    topic, command = list(published)[-1]
+    assert (topic, command["id"], command["action"]) == (
+        topics.robot_cmd("placebot1"), queued["id"], "deliver",
+    )  # fmt: skip
+    assert app.handle({"operation": "pending"}, dispatcher)["body"]["tasks"] == []
+
+
+def test_a_task_lost_to_a_command_by_name_is_closed_after_the_grace(
+    table: TaskTable, index: Index, published: list[tuple[str, dict[str, Any]]]
+) -> None:
+    # Given placebot1 was given a task long ago, and a delivery waits
+    index.report("placebot1", status="idle", zone="B", pose={"x": 9.0, "y": 5.0})
+    held = submit(make_dispatcher(table, index, clock=lambda: LONG_AGO), zone="C")
+    held_id = held["body"]["assigned"][0]["id"]
+    dispatcher = make_dispatcher(table, index)
+    queued = submit(dispatcher, zone="D")["body"]["queued"][0]
+    # When it reports free after finishing another command (given by name)
+    other = load_event("shadow_documents_other_command_done")["current"]["state"]["reported"]
+    answer = app.handle({"thing": "placebot1", "reported": other}, dispatcher)
+    # Then its task ended preempted and it took the next one
+    ended = table.get(held_id)
+    assert ended is not None and ended.outcome == "preempted"
+    assert answer == {"took": queued["id"]}
+
+
+def test_a_robot_free_on_another_command_just_after_assignment_keeps_its_task(
+    dispatcher: Dispatcher, table: TaskTable, published: list[tuple[str, dict[str, Any]]]
+) -> None:
+    """Its task's command may still be on the way: nothing is changed."""
+    held = submit(dispatcher, zone="C", count=2)["body"]["assigned"]
+    other = load_event("shadow_documents_other_command_done")["current"]["state"]["reported"]
+    answer = app.handle({"thing": "placebot1", "reported": other}, dispatcher)
+    assert answer == {"took": None}
+    assert {t.thing for t in table.active()} == {"placebot1", "placebot2"}
+    assert len(published) == len(held)
+
+
+def test_cancel_stops_the_robot_and_frees_it(
+    dispatcher: Dispatcher, table: TaskTable, published: list[tuple[str, dict[str, Any]]]
+) -> None:
+    task = submit(dispatcher, zone="A")["body"]["assigned"][0]
+    answer = app.handle({"operation": "cancel", "task_id": task["id"]}, dispatcher)
+    assert answer["status"] == 200 and answer["body"]["task"]["id"] == task["id"]
+    topic, command = list(published)[-1]
+    assert (topic, command["action"]) == (topics.robot_cmd(task["thing"]), "stop")
+    assert table.active() == []
+
+
+@pytest.mark.parametrize(
+    ("request_body", "status", "message"),
+    [
+        ({"operation": "submit", "order": {"zone": "Z"}}, 400,
+         "there is no zone 'Z'; zones are LOADING, A, B, C, D"),
+        ({"operation": "submit", "order": {"zone": "A", "count": 5}}, 400,
+         "the fleet has 2 robots; 5 cannot go"),
+        ({"operation": "submit", "order": {"zone": "A", "colour": "red"}}, 400,
+         "order.colour: is not a known field"),
+        ({"operation": "submit"}, 400, "order: is required but missing"),
+        ({"operation": "cancel", "task_id": "nope"}, 404, "no open task 'nope'"),
+        ({"operation": "launch"}, 400,
+         "operation: 'launch' is not one of submit, tasks, pending, cancel"),
+        ({}, 400, "operation: 'None' is not one of submit, tasks, pending, cancel"),
+    ],
+)  # fmt: skip
+def test_a_request_that_cannot_be_done_is_one_line_and_changes_nothing(
+    dispatcher: Dispatcher,
+    table: TaskTable,
+    published: list[tuple[str, dict[str, Any]]],
+    request_body: dict[str, Any],
+    status: int,
+    message: str,
+) -> None:
+    answer = app.handle(request_body, dispatcher)
+    assert answer == {"status": status, "body": {"code": status, "message": message}}
+    assert table.pending() == [] and table.active() == [] and len(published) == 0
+
+
+def test_a_malformed_rule_event_or_a_stranger_is_dropped(
+    dispatcher: Dispatcher, table: TaskTable
+) -> None:
+    assert app.handle({"thing": 7, "reported": "idle"}, dispatcher) == {"took": None}
+    idle = {"status": "idle", "connected": True}
+    assert app.handle({"thing": "intruder", "reported": idle}, dispatcher) == {"took": None}
+    assert table.pending() == [] and table.active() == []
+
+
+def test_the_configuration_is_read_once_and_refuses_a_missing_table() -> None:
+    with pytest.raises(ConfigError, match=r"^VAHR_TASK_TABLE: not set \(the CDK stack sets it\)$"):
+        DispatcherConfig.from_env({})
+    config = DispatcherConfig.from_env(
+        {"VAHR_TASK_TABLE": "t", "VAHR_IOT_DATA_ENDPOINT": "abc-ats.iot.us-east-1.amazonaws.com"}
+    )
+    assert config.iot_data_endpoint == "https://abc-ats.iot.us-east-1.amazonaws.com"
+    assert (config.index_name, config.closed_task_days) == ("AWS_Things", 30)
+    with pytest.raises(ConfigError, match=r"^VAHR_CLOSED_TASK_DAYS: 0 must be 1 to 365$"):
+        DispatcherConfig.from_env({"VAHR_TASK_TABLE": "t", "VAHR_CLOSED_TASK_DAYS": "0"})
+
+
+def test_the_answer_is_plain_json(dispatcher: Dispatcher) -> None:
+    answer = submit(dispatcher, zone="B")
+    assert msgspec.json.decode(msgspec.json.encode(answer)) == answer
