@@ -136,6 +136,34 @@ def test_the_announcer_loads_from_the_same_bundle_without_the_skills_sdk(
     assert seen["loaded"] == ["vahr.announce", "vahr.protocol"]
 
 
+def test_the_dispatcher_loads_from_the_same_bundle_and_answers_in_one_line(
+    bundle: lambda_asset.BuildResult,
+) -> None:
+    # When a clean 3.12 runs the dispatcher's handler from the bundle with a request it
+    # cannot carry out (so no AWS service is needed: moto's server needs Flask)
+    script = (
+        "import json, sys, dispatcher.app\n"
+        "answer = dispatcher.app.lambda_handler({'operation': 'launch'}, None)\n"
+        "print(json.dumps({'answer': answer, 'file': dispatcher.app.__file__,"
+        " 'loaded': sorted(m for m in ('skill', 'ask_sdk_core', 'announcer', 'awscrt',"
+        " 'vahr.announce', 'vahr.protocol.dispatch') if m in sys.modules)}))"
+    )
+    result = run_in_lambda_python(bundle.out_dir, script, VAHR_TASK_TABLE="vahr-tasks")
+    assert result.returncode == 0, result.stderr
+    seen = json.loads(result.stdout)
+    # Then it comes from the bundle, reads its configuration and fleet, and answers the
+    # skill's way; its cold start loads none of the skill's or the announcer's modules
+    assert seen["file"] == str(bundle.out_dir / "dispatcher" / "app.py")
+    assert seen["answer"] == {
+        "status": 400,
+        "body": {
+            "code": 400,
+            "message": "operation: 'launch' is not one of submit, tasks, pending, cancel",
+        },
+    }
+    assert seen["loaded"] == ["vahr.protocol.dispatch"]
+
+
 class IotDataRecorder(BaseHTTPRequestHandler):
     """The two iot-data calls the navigate path makes, as AWS answers them for robots that
     never reported: Publish is accepted and recorded; GetThingShadow is 404. (moto's
