@@ -7,6 +7,7 @@ derived from its zones and robots (`Fleet.layout`).
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import re
@@ -28,6 +29,10 @@ DEFAULT_FLEET_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "f
 FLEET_GROUP = "all"
 # What people call every robot when fleet.yaml names no such group.
 FLEET_GROUP_NAMES = ("all robots", "every robot", "everyone")
+# The locale of `spoken`; other locales' names are `spoken_by_locale` (`spoken_in`).
+SPOKEN_LOCALE = "en-US"
+_WARNED_LOCALES: set[str] = set()
+_log = logging.getLogger(__name__)
 
 SpokenNames = Annotated[
     list[Annotated[str, msgspec.Meta(min_length=1)]], msgspec.Meta(min_length=1)
@@ -118,6 +123,8 @@ class Robot(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     thing: str
     spoken: SpokenNames
     start: Pose
+    # Names in other languages than en-US's `spoken`, by locale ("de-DE": [...]).
+    spoken_by_locale: dict[str, SpokenNames] = {}
 
 
 class Zone(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -128,6 +135,7 @@ class Zone(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     pose: Pose
     arm: Literal["loader", "unloader"] | None = None
     radius: Annotated[float, msgspec.Meta(gt=0)] = 0.5
+    spoken_by_locale: dict[str, SpokenNames] = {}
 
 
 class Group(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -136,6 +144,7 @@ class Group(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     id: str
     spoken: SpokenNames
     robots: list[str]
+    spoken_by_locale: dict[str, SpokenNames] = {}
 
 
 class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
@@ -273,9 +282,28 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
                 )
         return msgspec.structs.replace(floor, arms=arms)
 
-    def spoken_name(self, thing: str) -> str:
+    def spoken_name(self, thing: str, locale: str = SPOKEN_LOCALE) -> str:
         """The name a person would use for a robot: the first of its spoken names."""
-        return self.robot(thing).spoken[0]
+        return spoken_in(self.robot(thing), locale)[0]
+
+
+def spoken_in(entry: Robot | Zone | Group, locale: str = SPOKEN_LOCALE) -> list[str]:
+    """What people call a robot, zone or group in `locale`: `spoken` in en-US, else its
+    `spoken_by_locale` names; a fleet file without them falls back to the en-US names
+    and says so once per locale."""
+    if locale == SPOKEN_LOCALE:
+        return entry.spoken
+    names = entry.spoken_by_locale.get(locale)
+    if names:
+        return names
+    if locale not in _WARNED_LOCALES:
+        _WARNED_LOCALES.add(locale)
+        _log.warning(
+            "fleet: no %s names for %r (spoken_by_locale); using its en-US names",
+            locale,
+            getattr(entry, "thing", None) or getattr(entry, "id", ""),
+        )
+    return entry.spoken
 
 
 def _derived_floor(fleet: Fleet) -> Floor:

@@ -18,7 +18,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m vahr.skill_model",
         description=(
-            "Write skill-package/ (skill.json, the en-US interaction model) and "
+            "Write skill-package/ (skill.json, the interaction model of en-US and of each "
+            "locale with templates) and "
             "lambda/skill/fleet.json from fleet.yaml and the skill's intent definitions."
         ),
     )

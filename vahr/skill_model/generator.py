@@ -17,6 +17,9 @@ from typing import TYPE_CHECKING, Any
 from vahr.errors import VahrError
 from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
 from vahr.protocol.assistant import INVOCATION_NAME
+from vahr.protocol.fleet import spoken_in
+from vahr.protocol.locale import load_language
+from vahr.protocol.text import number_variants, spell_numbers
 from vahr.skill_model.intents import (
     BUILT_IN_INTENTS,
     CUSTOM_INTENTS,
@@ -25,6 +28,7 @@ from vahr.skill_model.intents import (
     ZONE_TYPE,
     IntentSpec,
 )
+from vahr.skill_model.locale_templates import locale_intents, template_locales
 from vahr.skill_model.manifest import build_manifest
 
 if TYPE_CHECKING:
@@ -42,7 +46,7 @@ FLEET_TWIN_PATH = Path("lambda") / "skill" / "fleet.json"
 
 # Alexa's rules for sample utterances: lower-case words (apostrophes allowed, numbers spelled
 # out) and slot references, separated by single spaces.
-_WORD_OR_SLOT = r"(?:[a-z']+|\{[A-Za-z]+\})"
+_WORD_OR_SLOT = r"(?:[a-zäöüß']+|\{[A-Za-z]+\})"
 _SAMPLE = re.compile(rf"^{_WORD_OR_SLOT}(?: {_WORD_OR_SLOT})*$")
 _SLOT_REF = re.compile(r"\{([A-Za-z]+)\}")
 
@@ -71,11 +75,14 @@ def build_files(
     when fleet.yaml changed after the twin was written and read the YAML instead.
     `endpoint` is a deployed skill endpoint to keep in skill.json.
     """
-    return {
+    files = {
         MANIFEST_PATH: render(build_manifest(endpoint)),
         MODEL_PATH: render(build_interaction_model(fleet)),
         FLEET_TWIN_PATH: render(fleet_twin(fleet, source)),
     }
+    for locale in template_locales():
+        files[model_path(locale)] = render(build_locale_model(fleet, locale))
+    return files
 
 
 def fleet_twin(fleet: Fleet, source: bytes) -> dict[str, Any]:
@@ -280,3 +287,44 @@ def write(root: Path, fleet: Fleet, source: bytes) -> list[Path]:
 def drift(root: Path, fleet: Fleet, source: bytes) -> list[Path]:
     """The generated files under `root` that differ from what the generator would write."""
     return list(_stale(root, fleet, source))
+
+
+# The slot type that counts robots (`intents.COUNT_TYPE`), said in the locale's numbers.
+COUNT_TYPE_NAME = "COUNT"
+
+
+def model_path(locale: str) -> Path:
+    """Where the interaction model of `locale` is written, from the repository root."""
+    return PACKAGE_DIR / "interactionModels" / "custom" / f"{locale}.json"
+
+
+def in_locale(fleet: Fleet, locale: str) -> Fleet:
+    """`fleet` with every robot's, zone's and group's `spoken` names those of `locale`
+    (its `spoken_by_locale` names, else the en-US ones)."""
+    import msgspec
+
+    return msgspec.structs.replace(
+        fleet,
+        robots=[msgspec.structs.replace(r, spoken=spoken_in(r, locale)) for r in fleet.robots],
+        zones=[msgspec.structs.replace(z, spoken=spoken_in(z, locale)) for z in fleet.zones],
+        groups=[msgspec.structs.replace(g, spoken=spoken_in(g, locale)) for g in fleet.groups],
+    )
+
+
+def build_locale_model(fleet: Fleet, locale: str) -> dict[str, Any]:
+    """The interaction model of a locale with templates (`locale_templates`): its intents,
+    its invocation name, the fleet's names in it, and counts in its number words."""
+    model = build_interaction_model(in_locale(fleet, locale), locale_intents(locale))
+    language = model["interactionModel"]["languageModel"]
+    language["invocationName"] = load_language(locale).invocation_name
+    for slot_type in language["types"]:
+        if slot_type["name"] != COUNT_TYPE_NAME:
+            continue
+        for value in slot_type["values"]:
+            number = int(value["id"])
+            value["name"] = {
+                "value": spell_numbers(str(number), locale=locale),
+                "synonyms": number_variants(number, locale),
+            }
+    check_limits(model)
+    return model

@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import Any
 
 from vahr.protocol.assistant import INVOCATION_NAME
+from vahr.protocol.locale import load_language
 from vahr.skill_model.intents import LOCALE
 
 SKILL_NAME = "VAHR Robot Fleet"
@@ -19,6 +20,29 @@ SKILL_NAME = "VAHR Robot Fleet"
 # publishes.
 NOTIFICATIONS_PERMISSION = "alexa::devices:all:notifications:write"
 PUBLISHED_EVENTS = ("AMAZON.MessageAlert.Activated",)
+
+
+GERMAN = "de-DE"
+
+
+def german_publishing() -> dict[str, Any]:
+    """The skill's store entry in German: what the German templates let people say."""
+    name = load_language(GERMAN).invocation_name
+    return {
+        "name": "VAHR Roboterflotte",
+        "summary": "Steuere eine Flotte von Lagerrobotern mit der Stimme.",
+        "description": (
+            "Schicke Roboter in Zonen, lass sie Pakete liefern (auch je nach Wetter oder "
+            "nacheinander), frag, wo sie sind, und halte sie sofort an. Die Befehle laufen "
+            "über AWS IoT Core; der Skill bestätigt, dass jeder Roboter sie angenommen hat."
+        ),
+        "examplePhrases": [
+            f"Alexa, öffne {name}",
+            f"Alexa, sage {name}, schicke placebot eins in zone a",
+            f"Alexa, frage {name}, wo sind die roboter",
+        ],
+        "keywords": ["roboter", "flotte", "lager", "lieferung", "forschung"],
+    }
 
 
 def build_manifest(endpoint: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -46,10 +70,11 @@ def build_manifest(endpoint: dict[str, Any] | None = None) -> dict[str, Any]:
                             f"Alexa, ask {INVOCATION_NAME} where are the robots",
                         ],
                         "keywords": ["robots", "fleet", "warehouse", "delivery", "research"],
-                    }
+                    },
+                    GERMAN: german_publishing(),
                 },
                 "isAvailableWorldwide": False,
-                "distributionCountries": ["US"],
+                "distributionCountries": ["US", "DE"],
                 "testingInstructions": (
                     "Run the robots (robot-agent) or the local stack (vahr up), then say "
                     "'send placebot one to zone a' and 'where are the robots'."
@@ -65,7 +90,7 @@ def build_manifest(endpoint: dict[str, Any] | None = None) -> dict[str, Any]:
                 "isChildDirected": False,
                 "isExportCompliant": True,
                 "containsAds": False,
-                "locales": {LOCALE: {}},
+                "locales": {LOCALE: {}, GERMAN: {}},
             },
         }
     }
