@@ -2,10 +2,13 @@
 
 There is no CloudFormation resource for it: a custom resource calls
 `iot:UpdateIndexingConfiguration` at deploy time, turning on thing indexing with the
-registry and the classic shadow (REGISTRY_AND_SHADOW) and two custom fields,
-`shadow.reported.status` and `shadow.reported.zone`, which `SearchIndex` matches exactly and
-`GetBucketsAggregation` can count by. Connectivity indexing stays off: the robots' shadows
-report `connected` themselves (the presence rule keeps it true to the MQTT session).
+registry and the classic shadow (REGISTRY_AND_SHADOW) and three custom fields,
+`shadow.reported.status` and `shadow.reported.zone` (String) and `shadow.reported.connected`
+(Boolean), which `SearchIndex` matches exactly and `GetBucketsAggregation` and
+`GetStatistics` can count by (the dispatcher searches by status and zone; the skill's
+status summary counts by status and connection). Connectivity indexing stays off: the
+robots' shadows report `connected` themselves (the presence rule keeps it true to the MQTT
+session).
 
 The configuration belongs to the account and region, not to the stack: deploying sets it
 (replacing any other), destroying the stack turns thing indexing off again. The index
@@ -25,7 +28,11 @@ if TYPE_CHECKING:
     from aws_cdk import aws_logs as logs
 
 INDEX_NAME = "AWS_Things"
-CUSTOM_FIELDS = ("shadow.reported.status", "shadow.reported.zone")
+CUSTOM_FIELDS = (
+    ("shadow.reported.status", "String"),
+    ("shadow.reported.zone", "String"),
+    ("shadow.reported.connected", "Boolean"),
+)
 
 
 def indexing_configuration(mode: str = "REGISTRY_AND_SHADOW") -> dict[str, Any]:

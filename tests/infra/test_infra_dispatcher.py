@@ -85,6 +85,7 @@ def test_fleet_indexing_indexes_shadows_with_status_and_zone_and_is_off_after_de
             "customFields": [
                 {"name": "shadow.reported.status", "type": "String"},
                 {"name": "shadow.reported.zone", "type": "String"},
+                {"name": "shadow.reported.connected", "type": "Boolean"},
             ],
         }
     }
