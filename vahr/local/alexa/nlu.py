@@ -41,11 +41,9 @@ from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
 from vahr.local.alexa.consistency import SlotConsistency
 from vahr.local.alexa.intent_classifier import load_or_train
 from vahr.local.alexa.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize_utterance
-from vahr.local.alexa.slot_roles import assign_slots
 from vahr.local.alexa.understanding import LanguageUnderstanding, load_understanding
-from vahr.local.alexa.weather_rule import states_a_weather_rule
 from vahr.protocol import FLEET_GROUP
-from vahr.skill_model.intents import RAINY_ZONE, ROBOT_TYPE, SUNNY_ZONE
+from vahr.skill_model.intents import ROBOT_TYPE
 from vahr.speech.text_classifier import TextClassifier, default_cache_dir
 
 __all__ = [
@@ -167,12 +165,14 @@ class InteractionModel:
             {v: name for v, name in robot_values if v != FLEET_GROUP},
             next((n for v, n in robot_values if v == FLEET_GROUP), "all robots"),
         )
+        lexicon = roles.WeatherLexicon.of_locale(self._understanding.locale)
         role_sequences = {
             name: roles.training_sequences(
                 name,
                 slots,
                 [self._normalized_sample(sample) for sample in samples[name]],
                 self._understanding.roles,
+                lexicon,
             )
             for name, slots in self.intent_slots.items()
             if slots
@@ -189,7 +189,7 @@ class InteractionModel:
             try:
                 for name, sequences in role_sequences.items():
                     self._taggers[name], _ = roles.load_or_train(
-                        name, self.intent_slots[name], sequences, cache
+                        name, self.intent_slots[name], sequences, cache, lexicon
                     )
                 self._classifier, self.cached = load_or_train(texts, labels, cache)
             except BaseException as err:  # reported to whoever waits for the classifier
@@ -288,24 +288,10 @@ class InteractionModel:
     ) -> dict[str, SlotMatch] | None:
         """The values given to the intent's slots; None when the words do not fit it."""
         declared = self.intent_slots.get(intent, {})
-        if self._understanding.english_role_rules:
-            if not self._rule_said_as_rule(intent, matches, words):
-                return None
-            fleet = self._fleet
-            return assign_slots(declared, matches, words, fleet.robots, fleet.name)
         if intent not in self._taggers:
             return {}
         labels = self._taggers[intent].labels(words, matches)
         return roles.assign(declared, matches, labels, self._fleet)
-
-    def _rule_said_as_rule(self, intent: str, matches: list[SlotMatch], words: list[str]) -> bool:
-        """A weather delivery that names zones is one only when the words make the weather
-        a condition ("to zone a if it's sunny"): "it's raining, go to zone c" is not."""
-        declared = self.intent_slots.get(intent, {})
-        if not {SUNNY_ZONE.name, RAINY_ZONE.name} <= declared.keys():
-            return True
-        zone_type = declared[SUNNY_ZONE.name]
-        return not any(m.type == zone_type for m in matches) or states_a_weather_rule(words)
 
     def answer(self, utterance: str, intent: str, slot: str) -> SlotValue | None:
         """`utterance` read as the answer to a question for `slot` of `intent` ("which
@@ -323,10 +309,6 @@ class InteractionModel:
             return None
         # Several values are read as the intent's tagger reads them in a request: "robot one
         # and robot two" listed is the fleet, "robot one or robot two" a choice to ask about.
-        if self._understanding.english_role_rules:
-            fleet = self._fleet
-            value = assign_slots({slot: slot_type}, values, words, fleet.robots, fleet.name)
-            return _slot_value(slot, slot_type, value[slot])
         tagger = self._taggers.get(intent)
         labels = tagger.labels(words, values) if tagger else [""] * len(values)
         modes = [label[:1] if label[:1] in (roles.LISTED, roles.CHOICE) else "" for label in labels]
