@@ -1,17 +1,15 @@
 """The roles tagger: slot roles learnt from the labelled samples, on the shipped en-US model.
 
-en-US's own understanding keeps the English rules for now (`english_role_rules`); these
-tests build the same model with the tagger instead, as every other locale has it, and hold
-it to what a person meant: the sentence's order of roles, a value kept to its own type's
-slots, listed robots as the fleet, values turned down, and zones without a weather that
-make no rule.
+Every locale, en-US among them, takes its slot roles from the tagger. These tests hold it to
+what a person meant: the sentence's order of roles, a value kept to its own type's slots,
+listed robots as the fleet, values turned down, zones without a weather that make no rule,
+and the weather words read from the locale's language data.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import msgspec
 import pytest
 
 from vahr.local.alexa import roles
@@ -26,9 +24,8 @@ if TYPE_CHECKING:
 
 @pytest.fixture(scope="module")
 def model(tmp_path_factory: pytest.TempPathFactory) -> InteractionModel:
-    understanding = msgspec.structs.replace(load_understanding(), english_role_rules=False)
     cache = tmp_path_factory.mktemp("cache")
-    return InteractionModel.load(cache_dir=cache, understanding=understanding)
+    return InteractionModel.load(cache_dir=cache)
 
 
 def ids(understood: Understanding) -> dict[str, str | None]:
@@ -89,7 +86,7 @@ def test_a_value_never_takes_another_types_slot(model: InteractionModel) -> None
 
 
 def test_the_tagger_is_cached_by_its_data(tmp_path: Path) -> None:
-    understanding = msgspec.structs.replace(load_understanding(), english_role_rules=False)
+    understanding = load_understanding()
     first = InteractionModel.load(cache_dir=tmp_path, understanding=understanding)
     written = {path.name: path.stat().st_mtime_ns for path in tmp_path.glob("roles-*.crfsuite")}
     # One model per intent with slots
@@ -103,3 +100,19 @@ def test_the_tagger_is_cached_by_its_data(tmp_path: Path) -> None:
 
 def test_nothing_understood_is_nothing_assigned(model: InteractionModel) -> None:
     assert model.understand("play some jazz").intent == FALLBACK
+
+
+def test_the_weather_words_are_the_locales() -> None:
+    # Given English's language data: "sunny" names a weather, "not" turns it round
+    english = roles.WeatherLexicon.of_locale("en-US")
+    words = "if it is not sunny go to zone b".split()
+    assert english.weather_of(words, words.index("sunny")) == "rainy"
+    # A locale with no language data gives the tagger no weather to read
+    assert roles.WeatherLexicon.of_locale("xx-XX").weather_of(words, 4) is None
+
+
+def test_the_shipped_english_understanding_has_no_hand_rules() -> None:
+    # The English rules are gone: en-US is understood as every other locale is
+    understanding = load_understanding()
+    assert understanding.locale == "en-US"
+    assert not hasattr(understanding, "english_role_rules")

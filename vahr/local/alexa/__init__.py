@@ -19,7 +19,10 @@ from vahr.local.alexa.commands_seen import CommandLog
 from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel
 from vahr.local.alexa.simulator import AlexaSimulator, Turn
 from vahr.local.alexa.skill import load_skill_handler
-from vahr.local.alexa.weather_rule import RULE_SLOTS
+from vahr.skill_model.intents import RAINY_ZONE, SUNNY_ZONE
+
+# The weather delivery's rule: the slot that holds the zone for each weather.
+RULE_SLOTS = {"sunny": SUNNY_ZONE.name, "rainy": RAINY_ZONE.name}
 
 __all__ = [
     "DEFAULT_MODEL",

@@ -10,7 +10,7 @@ the classifier's side of it (a wrong action is worse than a question):
   sample utterances hold together: no sequential-delivery sample names one robot and one
   zone, so "go to zone b with robot two" is not a sequential delivery, whatever its words.
   A type's count is capped at the intent's slots of that type, since extra values are
-  `slot_roles`' to sort out ("robot one and robot two" for one robot slot is the fleet).
+  the roles tagger's to sort out ("robot one and robot two" for one robot slot is the fleet).
 """
 
 from __future__ import annotations

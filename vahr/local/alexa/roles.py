@@ -12,7 +12,9 @@ The tagger's sequence is the values found, in order, not the words: each value's
 are its type, its rank among the values (of its type and of the other types), and the
 words around it (the nearest four on each side, position by position, up to the next
 value; and every word before and after it as a bag), with each word of a weather also read
-as its weather (turned round by a negation just before it, from the language's data).
+as its weather (turned round by a negation just before it): the weather words and the
+negations are the language's (`vahr.protocol.locale`, its `language.yaml`), and a locale
+without them gives no weather features.
 The chain's transitions learn the order of the roles ("firstRobot firstZone secondRobot").
 No language's words are in this module: a new language, or a new intent with two robots
 or two zones, is data.
@@ -46,7 +48,8 @@ import pycrfsuite
 
 from vahr.errors import VahrError
 from vahr.protocol import FLEET_GROUP
-from vahr.protocol.weather import PLAIN_NEGATIONS, WEATHER_WORDS
+from vahr.protocol.locale import LocaleError
+from vahr.protocol.weather import plain_negations, weather_words
 from vahr.skill_model.intents import ROBOT_TYPE
 from vahr.skill_model.templates import expand
 
@@ -78,27 +81,47 @@ MAX_SEQUENCES = 50_000
 _REFERENCE = re.compile(r"^\{([-+?]?)([A-Za-z_.&]+)(!?)\}$")
 # Between slot names, a value that fills each of them ("{firstZone&secondZone}").
 BOTH = "&"
-_WEATHER = {word: weather for weather, words in WEATHER_WORDS.items() for word in words}
-_NEGATIONS = frozenset(PLAIN_NEGATIONS)
 
 # A value in the words: its type, where it starts and ends, and whether it is the fleet.
 Span = tuple[str, int, int, bool]
 Sequence_ = tuple[list[list[str]], list[str]]
 
 
-def weather_of(words: Sequence[str], at: int) -> str | None:
-    """The weather `words[at]` names, turned round by a negation up to two words before it."""
-    weather = _WEATHER.get(words[at])
-    if weather is None:
-        return None
-    if _NEGATIONS & set(words[max(0, at - 2) : at]):
-        return next(other for other in WEATHER_WORDS if other != weather)
-    return weather
+@dataclass(frozen=True)
+class WeatherLexicon:
+    """One language's words for each weather and the negations that turn one into the other
+    ("if it's not sunny"), as the tagger reads them."""
+
+    weathers: Mapping[str, str]
+    negations: frozenset[str]
+
+    @classmethod
+    def of_locale(cls, locale: str) -> WeatherLexicon:
+        """The locale's weather words from its `language.yaml`; none for a locale without."""
+        try:
+            named = weather_words(locale)
+            negations = plain_negations(locale)
+        except LocaleError:
+            return cls({}, frozenset())
+        weathers = {word: weather for weather, words in named.items() for word in words}
+        return cls(weathers, frozenset(negations))
+
+    def weather_of(self, words: Sequence[str], at: int) -> str | None:
+        """The weather `words[at]` names, turned round by a negation up to two words before."""
+        weather = self.weathers.get(words[at])
+        if weather is None:
+            return None
+        if self.negations & set(words[max(0, at - 2) : at]):
+            others = {w for w in self.weathers.values() if w != weather}
+            return others.pop() if len(others) == 1 else None
+        return weather
 
 
-def value_features(words: Sequence[str], spans: Sequence[Span]) -> list[list[str]]:
+def value_features(
+    words: Sequence[str], spans: Sequence[Span], lexicon: WeatherLexicon
+) -> list[list[str]]:
     """The features of each value in `spans` (left to right) of the normalized `words`."""
-    classes = [weather_of(words, at) for at in range(len(words))]
+    classes = [lexicon.weather_of(words, at) for at in range(len(words))]
     types = sorted({span[0] for span in spans})
     found: list[list[str]] = []
     for index, (type_name, start, end, _) in enumerate(spans):
@@ -150,7 +173,9 @@ def value_features(words: Sequence[str], spans: Sequence[Span]) -> list[list[str
     return found
 
 
-def labelled_sequence(sentence: str, slot_types: Mapping[str, str]) -> Sequence_ | None:
+def labelled_sequence(
+    sentence: str, slot_types: Mapping[str, str], lexicon: WeatherLexicon
+) -> Sequence_ | None:
     """A sample or role example as (features, labels); None when it names no value.
 
     `{slot}` is a value for the slot; `{-TYPE}` a value of the type for no slot; `{+slot}`
@@ -178,15 +203,18 @@ def labelled_sequence(sentence: str, slot_types: Mapping[str, str]) -> Sequence_
         words.append(f"<{spans[-1][0]}>")
     if not spans:
         return None
-    return value_features(words, spans), labels
+    return value_features(words, spans, lexicon), labels
 
 
 class RolesTagger:
     """One intent's CRF over the values of an utterance, and the slot assignment after it."""
 
-    def __init__(self, intent: str, slot_types: Mapping[str, str], model: bytes) -> None:
+    def __init__(
+        self, intent: str, slot_types: Mapping[str, str], model: bytes, lexicon: WeatherLexicon
+    ) -> None:
         self.intent = intent
         self.slot_types = dict(slot_types)
+        self.lexicon = lexicon
         # CRFsuite reads the model in place: the bytes must live as long as the tagger.
         self._model = model
         self._tagger = pycrfsuite.Tagger()
@@ -221,7 +249,7 @@ class RolesTagger:
             abstracted.append(f"<{match.type}>")
             index = match.end
         abstracted += words[index:]
-        self._tagger.set(value_features(abstracted, spans))
+        self._tagger.set(value_features(abstracted, spans, self.lexicon))
         best = self._best_sequence([self._allowed[match.type] for match in taken])
         by_match = {id(match): label for match, label in zip(taken, best, strict=True)}
         return [by_match.get(id(match), NO_SLOT) for match in matches]
@@ -244,6 +272,7 @@ def training_sequences(
     slot_types: Mapping[str, str],
     samples: Sequence[str],
     examples: Sequence[RoleExamples],
+    lexicon: WeatherLexicon,
 ) -> list[Sequence_]:
     """The intent's samples and the locale's role examples for it, labelled; a role example
     naming what the intent lacks is a `VahrError` naming the intent."""
@@ -252,7 +281,7 @@ def training_sequences(
         if intent in group.intents:
             sentences += [s for template in group.examples for s in expand(template)]
     try:
-        found = [labelled_sequence(sentence, slot_types) for sentence in sentences]
+        found = [labelled_sequence(sentence, slot_types, lexicon) for sentence in sentences]
     except VahrError as err:
         raise VahrError(f"role examples of {intent}: {err}") from err
     return [sequence for sequence in found if sequence is not None]
@@ -263,6 +292,7 @@ def load_or_train(
     slot_types: Mapping[str, str],
     sequences: list[Sequence_],
     cache_dir: Path | None,
+    lexicon: WeatherLexicon,
 ) -> tuple[RolesTagger, bool]:
     """The intent's tagger, from the cache (True) or trained now and cached (False)."""
     learnt_from = [RECIPE, TRAINING_PARAMETERS, version("python-crfsuite"), intent, sequences]
@@ -270,7 +300,7 @@ def load_or_train(
     file = cache_dir / f"roles-{intent}-{key[:24]}.crfsuite" if cache_dir else None
     if file is not None:
         try:
-            return RolesTagger(intent, slot_types, file.read_bytes()), True
+            return RolesTagger(intent, slot_types, file.read_bytes(), lexicon), True
         except OSError:
             pass
     model = _train(sequences)
@@ -282,7 +312,7 @@ def load_or_train(
             partial.replace(file)
         except OSError:
             pass
-    return RolesTagger(intent, slot_types, model), False
+    return RolesTagger(intent, slot_types, model, lexicon), False
 
 
 def _train(sequences: list[Sequence_]) -> bytes:

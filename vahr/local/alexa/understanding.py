@@ -54,9 +54,9 @@ class LanguageUnderstanding(msgspec.Struct, frozen=True, forbid_unknown_fields=T
     out_of_domain: list[str] = []
     finder: FinderWords = FinderWords()
     roles: list[RoleExamples] = []
-    # en-US only, for now: its roles are given by the English hand rules (`slot_roles`,
-    # `weather_rule`), which the tagger does not yet match there (docs/skill.md).
-    english_role_rules: bool = False
+    # The locale the file is for (set by `load_understanding`, not written in the file): the
+    # roles tagger reads the locale's weather words from its `language.yaml`.
+    locale: str = DEFAULT_LOCALE
 
 
 def understanding_file(locale: str, directory: Path | None = None) -> Path:
@@ -74,8 +74,9 @@ def load_understanding(
             f"no understanding data for the locale {locale!r} (have: {', '.join(shipped)})"
         )
     try:
-        return msgspec.yaml.decode(file.read_bytes(), type=LanguageUnderstanding)
+        understanding = msgspec.yaml.decode(file.read_bytes(), type=LanguageUnderstanding)
     except msgspec.ValidationError as err:
         raise VahrError(f"{file}: {err}") from err
     except msgspec.DecodeError as err:
         raise VahrError(f"{file} is not valid YAML: {err}") from err
+    return msgspec.structs.replace(understanding, locale=locale)
