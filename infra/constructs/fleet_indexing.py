@@ -40,7 +40,9 @@ def indexing_configuration(mode: str = "REGISTRY_AND_SHADOW") -> dict[str, Any]:
     configuration: dict[str, Any] = {"thingIndexingMode": mode}
     if mode != "OFF":
         configuration["thingConnectivityIndexingMode"] = "OFF"
-        configuration["customFields"] = [{"name": name, "type": "String"} for name in CUSTOM_FIELDS]
+        configuration["customFields"] = [
+            {"name": name, "type": kind} for name, kind in CUSTOM_FIELDS
+        ]
     return {"thingIndexingConfiguration": configuration}
 
 
