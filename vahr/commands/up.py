@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
         if not 1 <= args.swarm <= SWARM_MAX:
             raise VahrError(
                 f"--swarm {args.swarm}: give 1 to {SWARM_MAX:,} robots (the most whose names"
-                " fit in one Alexa interaction model; see docs/local.md, Large fleets)"
+                " fit in one Alexa interaction model; see docs/large-fleets.md)"
             )
     config = SystemConfig(
         state_dir=args.state_dir.resolve(),

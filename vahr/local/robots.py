@@ -35,7 +35,7 @@ log = logging.getLogger(__name__)
 STOP_TIMEOUT_S = 8.0
 # `vahr up --swarm N`: the most robots one swarm runs here. Memory does not bind: the swarm
 # process measured 34.5 MB at 100 robots, 47.7 MB at 1,000 and 92 MB at 5,000 (11 to 15 kB
-# a robot; bench/swarm_startup.py, docs/local.md "Large fleets"). What binds is Alexa's limit of
+# a robot; bench/swarm_startup.py, docs/large-fleets.md). What binds is Alexa's limit of
 # 1,000,000 characters on an interaction model, whose ROBOT slot type names every robot:
 # 5,000 rovers fit, 6,000 do not.
 SWARM_MAX = 5_000
