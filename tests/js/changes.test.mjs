@@ -28,13 +28,18 @@ test("presence alone leaves the reported state as it was", () => {
   assert.equal(shown.last_seen, 99);
 });
 
-test("progress is the drive's, and null ends it", () => {
+test("the latest event is kept, and progress is the drive's state after it", () => {
   const shown = robot();
   const progress = { event: "progress", thing: "r1", progress: 0.4, pose: { x: 1, y: 2, theta: 0 } };
-  applyChange(shown, { thing: "r1", progress });
+  const accepted = { event: "accepted", thing: "r1" };
+  applyChange(shown, { thing: "r1", last_event: accepted, progress });
   assert.equal(shown.progress, progress);
-  assert.equal(shown.last_event, progress);
-  applyChange(shown, { thing: "r1", progress: null });
+  assert.equal(shown.last_event, accepted);
+  const arrived = { event: "arrived", thing: "r1", zone: "B" };
+  applyChange(shown, { thing: "r1", last_event: arrived, progress: null });
   assert.equal(shown.progress, null);
-  assert.equal(shown.last_event, progress);
+  assert.equal(shown.last_event, arrived);
+  // A change without either leaves both
+  applyChange(shown, { thing: "r1", online: true });
+  assert.equal(shown.last_event, arrived);
 });

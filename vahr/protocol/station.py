@@ -316,8 +316,11 @@ class RobotChange(msgspec.Struct, kw_only=True, omit_defaults=True):
     """What changed of one robot since the page last heard of it: a field is present only
     when it changed. `reported` holds the reported state's top-level fields that changed,
     with their new values, and `removed` those that are gone: the page merges them into
-    the state it has. `version` is the shadow version that brings it to; `progress` is the
-    drive's latest progress event (None once the drive ended)."""
+    the state it has. `version` is the shadow version that brings it to; `last_event` the
+    robot's latest event other than progress (an exchange with the assistant is sent as an
+    `EventMessage` instead); `progress` the drive's latest progress event (None once the
+    drive ended). A page applies `last_event` before `progress`: `progress` is always the
+    state after both."""
 
     thing: str
     reported: ReportedState | msgspec.UnsetType = msgspec.UNSET
@@ -326,6 +329,7 @@ class RobotChange(msgspec.Struct, kw_only=True, omit_defaults=True):
     online: bool | msgspec.UnsetType = msgspec.UNSET
     last_seen: float | None | msgspec.UnsetType = msgspec.UNSET
     progress: Event | None | msgspec.UnsetType = msgspec.UNSET
+    last_event: Event | msgspec.UnsetType = msgspec.UNSET
 
 
 class RobotsMessage(msgspec.Struct, frozen=True, kw_only=True, tag="robots", tag_field="type"):
@@ -337,8 +341,8 @@ class RobotsMessage(msgspec.Struct, frozen=True, kw_only=True, tag="robots", tag
 
 
 class EventMessage(Event, frozen=True, tag="event", tag_field="type"):
-    """Anything a robot did (progress, arrived, said, heard, interpreted...), with when the
-    station last heard from it; in the conversation, with the robots it concerns."""
+    """What a robot said, heard or understood (`EXCHANGE_EVENTS`), with when the station
+    last heard from it; in the conversation, with the robots it concerns."""
 
     last_seen: float
     robots: list[str] = []

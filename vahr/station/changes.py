@@ -48,7 +48,7 @@ def merge(earlier: RobotChange, later: RobotChange) -> None:
         earlier.removed = gone + [key for key in later.removed if key not in gone]
     if isinstance(earlier.removed, list) and not earlier.removed:
         earlier.removed = msgspec.UNSET
-    for name in ("version", "online", "last_seen", "progress"):
+    for name in ("version", "online", "last_seen", "progress", "last_event"):
         value = getattr(later, name)
         if not isinstance(value, msgspec.UnsetType):
             setattr(earlier, name, value)

@@ -11,8 +11,11 @@ the typedefs of `static/contract.js`:
   and their acknowledgments, the experiment session;
 - `robots`: the robots that changed since the page's last message, each once with only
   what changed: its reported fields after an accepted shadow update (and the version),
-  presence, the progress of its drive (`RobotChange`; `vahr.station.changes`);
-- `event`: anything a robot did (progress, arrived, said, heard, interpreted...);
+  presence, its latest event and the progress of its drive (`RobotChange`;
+  `vahr.station.changes`);
+- `event`: what a robot said, heard or understood (`EXCHANGE_EVENTS`, the conversation's);
+  anything else a robot did (accepted, progress, arrived...) is part of its change in
+  `robots`;
 - `command`: a command seen on a command topic (from the assistant, the console, a robot);
 - `ack`: the first answer of a robot to a command, with the time it took from the command
   being seen here (the acknowledgment latency the conversation shows);
@@ -440,17 +443,22 @@ class Feed:
                 robot.progress = None
             if event.command_id is not None:
                 self._acknowledged(event.command_id, event.thing, event.event, now)
-            fields = msgspec.structs.asdict(event)
             if event.event in EXCHANGE_EVENTS:
+                # What a robot said, heard, understood: the conversation shows each one.
+                fields = msgspec.structs.asdict(event)
                 self._conversation.append(
                     EventMessage(**fields, last_seen=now, robots=[event.thing])
                 )
-            if event.event == "progress":
-                # Progress is the robot's state while it drives: coalesced with the rest.
-                change = RobotChange(thing=event.thing, progress=event, last_seen=now)
-                self._broadcast_change(change)
-            else:
                 self._broadcast(EventMessage(**fields, last_seen=now))
+                return
+            # Anything else is the robot's state: its latest event and drive, coalesced with
+            # the rest of its change (a fleet command's thousand answers are one message).
+            change = RobotChange(thing=event.thing, last_seen=now)
+            if event.event == "progress" or event.event in DRIVE_ENDS:
+                change.progress = robot.progress
+            if event.event != "progress":
+                change.last_event = event
+            self._broadcast_change(change)
 
     def on_command(self, topic: str, payload: bytes) -> None:
         parsed = topics.parse_robot_topic(topic)

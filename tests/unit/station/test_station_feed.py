@@ -162,7 +162,9 @@ def test_a_command_is_acknowledged_once_per_robot_with_its_latency(
     )
     told = messages(page)
     # Then the page is told the command, one acknowledgment with its latency, the shadow
-    assert [m["type"] for m in told] == ["command", "ack", "event", "robots"]
+    assert [m["type"] for m in told] == ["command", "ack", "robots"]
+    (change,) = told[2]["changes"]
+    assert change["last_event"]["event"] == "accepted" and change["version"] == 9
     assert told[0]["target"] == "placebot1" and told[0]["source"] == "console"
     assert told[1] == {
         "type": "ack", "id": command.id, "thing": "placebot1", "event": "accepted", "latency_ms": 12.0
@@ -247,9 +249,10 @@ def test_a_page_that_falls_behind_gets_each_robots_latest_progress(feed: Feed) -
 
 
 def test_a_page_too_far_behind_is_dropped_and_reconnects_from_a_snapshot(feed: Feed) -> None:
+    # (what robots say to the assistant is never merged: each line is the conversation's)
     page = feed.subscribe(limit=3)
     for _ in range(5):
-        feed.on_event(topics.robot_events("placebot1"), event("arrived", zone="B"))
+        feed.on_event(topics.robot_events("placebot1"), event("said", text="Alexa, hello"))
     assert page.overflowed and page.take(0) is None
     assert feed.subscribers == 0
 
@@ -301,12 +304,12 @@ def test_every_message_a_page_is_sent_is_a_page_message_of_the_contract(
     # Then each message the page gets decodes as the contract's struct of its type
     told = [PAGE.decode(message) for message in page.take(0) or []]
     assert [m.__struct_config__.tag for m in told] == [
-        "snapshot", "command", "ack", "event", "robots", "turn", "experiment",
+        "snapshot", "command", "ack", "robots", "turn", "experiment",
         "announcement", "alert_acknowledged",
     ]  # fmt: skip
     # And what the robot reported is passed on, fields beyond the contract too, beside
     # the other robot's presence
-    robots = told[4]
+    robots = told[3]
     assert isinstance(robots, RobotsMessage)
     shadow, presence = robots.changes
     assert shadow.reported == {"status": "navigating", "destination": "B", "extra": [1]}
@@ -510,3 +513,22 @@ def test_the_task_queue_reaches_pages_when_it_changed_and_new_pages_start_with_i
     assert [(t["status"], t["thing"]) for t in told["tasks"]] == [("assigned", "placebot2")]
     # And a page opened now starts from it
     assert feed.snapshot()["tasks"]["tasks"][0]["thing"] == "placebot2"
+
+
+def test_a_fleet_commands_answers_reach_a_page_as_one_message(feed: Feed) -> None:
+    page = feed.subscribe()
+    messages(page)
+    # When both robots accept a command, drive, and one arrives, all before the page reads
+    for thing in ("placebot1", "placebot2"):
+        feed.on_event(topics.robot_events(thing), event("accepted", thing=thing))
+        pose = EventPose(2.0, 3.0)
+        feed.on_event(
+            topics.robot_events(thing), event("progress", thing=thing, progress=0.5, pose=pose)
+        )
+    feed.on_event(topics.robot_events("placebot1"), event("arrived", zone="B"))
+    # Then the page gets one message: per robot its latest event, and the drive's state
+    # after it (over for placebot one, half way for placebot two)
+    (told,) = messages(page)
+    one, two = told["changes"]
+    assert (one["last_event"]["event"], one["progress"]) == ("arrived", None)
+    assert (two["last_event"]["event"], two["progress"]["progress"]) == ("accepted", 0.5)

@@ -19,8 +19,7 @@ export function applyChange(robot, change) {
   if (change.version !== undefined) robot.version = change.version;
   if (change.online !== undefined) robot.online = change.online;
   if (change.last_seen !== undefined) robot.last_seen = change.last_seen;
-  if (change.progress !== undefined) {
-    robot.progress = change.progress;
-    if (change.progress) robot.last_event = change.progress;
-  }
+  // The latest event first: `progress` is the drive's state after both.
+  if (change.last_event !== undefined) robot.last_event = change.last_event;
+  if (change.progress !== undefined) robot.progress = change.progress;
 }

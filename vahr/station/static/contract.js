@@ -101,8 +101,8 @@
  */
 
 /**
- * Anything a robot did (progress, arrived, said, heard, interpreted...), with when the station
- * last heard from it; in the conversation, with the robots it concerns.
+ * What a robot said, heard or understood (`EXCHANGE_EVENTS`), with when the station last heard
+ * from it; in the conversation, with the robots it concerns.
  * @typedef {object} EventMessage
  * @property {"event"} type
  * @property {number} last_seen
@@ -274,8 +274,10 @@
  * What changed of one robot since the page last heard of it: a field is present only when it
  * changed. `reported` holds the reported state's top-level fields that changed, with their new
  * values, and `removed` those that are gone: the page merges them into the state it has.
- * `version` is the shadow version that brings it to; `progress` is the drive's latest progress
- * event (None once the drive ended).
+ * `version` is the shadow version that brings it to; `last_event` the robot's latest event
+ * other than progress (an exchange with the assistant is sent as an `EventMessage` instead);
+ * `progress` the drive's latest progress event (None once the drive ended). A page applies
+ * `last_event` before `progress`: `progress` is always the state after both.
  * @typedef {object} RobotChange
  * @property {string} thing
  * @property {Reported} [reported]
@@ -284,6 +286,7 @@
  * @property {boolean} [online]
  * @property {number|null} [last_seen]
  * @property {Event|null} [progress]
+ * @property {Event} [last_event]
  */
 
 /**

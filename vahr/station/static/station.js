@@ -214,6 +214,8 @@ function onChange(change, received) {
   const robot = store.robots[change.thing];
   if (!robot) return;
   applyChange(robot, change);
+  const ended = change.last_event && DRIVE_ENDS.includes(change.last_event.event) ? change.last_event : null;
+  if (ended?.pose) map.report(change.thing, ended.pose, null, false);
   if (change.progress) map.report(change.thing, change.progress.pose, change.progress.zone, true);
   if (change.reported || change.removed) {
     const { status, destination, pose, zone } = robot.reported || {};
@@ -224,19 +226,13 @@ function onChange(change, received) {
   changed(change.thing, marker);
 }
 
+// What a robot said, heard or understood (the rest of what robots do comes as changes).
 /** @param {EventMessage} message */
 function onEvent(message) {
   const robot = store.robots[message.thing];
   if (!robot) return;
   robot.last_event = message;
   robot.last_seen = message.last_seen;
-  if (message.event === "progress") {
-    robot.progress = message;
-    map.report(message.thing, message.pose, message.zone, true);
-  } else if (DRIVE_ENDS.includes(message.event)) {
-    robot.progress = null;
-    if (message.pose) map.report(message.thing, message.pose, null, false);
-  }
   if (EXCHANGE_EVENTS.includes(message.event)) conversation.add({ ...message, robots: [message.thing] });
   changed(message.thing);
 }
