@@ -40,12 +40,14 @@ def machine() -> str:
     return f"{python}, {os.cpu_count()} cores, {platform.machine()}"
 
 
-def write_section(name: str, title: str, body: str) -> None:
-    """Replace (or append) the section `name` in docs/benchmarks.md and print it."""
+def write_section(name: str, title: str, body: str, *, script: str | None = None) -> None:
+    """Replace (or append) the section `name` in docs/benchmarks.md and print it; `script`
+    names the script when it is not `bench/{name}.py` (one script writing two sections)."""
     stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
     section = (
         f"<!-- bench:{name} -->\n## {title}\n\n"
-        f"`bench/{name}.py`, {stamp}, {machine()}.\n\n{body.strip()}\n<!-- /bench:{name} -->"
+        f"`bench/{script or name}.py`, {stamp}, {machine()}.\n\n{body.strip()}\n"
+        f"<!-- /bench:{name} -->"
     )
     text = RESULTS_FILE.read_text() if RESULTS_FILE.exists() else HEADER
     start, end = f"<!-- bench:{name} -->", f"<!-- /bench:{name} -->"

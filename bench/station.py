@@ -133,6 +133,10 @@ def main() -> int:
         help="smaller fleets measured first in the same run (default: 100)",
     )  # fmt: skip
     parser.add_argument("--presses", type=int, default=5)
+    parser.add_argument(
+        "--section", default="station",
+        help="the section of docs/benchmarks.md to write (a long memory run keeps its own)",
+    )  # fmt: skip
     args = parser.parse_args()
     if args.robots < 1 or any(size < 1 for size in args.beside):
         parser.error("--robots and --beside take whole numbers of at least 1")
@@ -373,7 +377,10 @@ versions are counted.
 
 {chr(10).join(rows)}
 {talk}"""
-    write_section("station", "Operator station: a fleet on the map, push-to-talk", body)
+    title = "Operator station: a fleet on the map, push-to-talk"
+    if args.section != "station":
+        title = f"Operator station: {args.robots:,} robots for {args.minutes:g} minutes"
+    write_section(args.section, title, body, script="station")
 
 
 if __name__ == "__main__":
