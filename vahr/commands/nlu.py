@@ -36,23 +36,36 @@ def configure(parser: argparse.ArgumentParser) -> None:
         nargs="?",
         const=DEVELOPMENT_SET,
         metavar="FILE",
-        help="score a labelled set (YAML) instead; without FILE, the shipped development set",
+        help="score a labelled set (YAML) instead; without FILE, the shipped development set "
+        "of the locale",
+    )
+    parser.add_argument(
+        "--locale",
+        default="en-US",
+        help="the language understood: en-US (default) or de-DE; its interaction model and "
+        "understanding data",
     )
     parser.add_argument("--json", action="store_true", help="print JSON")
 
 
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
-    from vahr.local.alexa.simulator import strip_invocation
+    from vahr.local.alexa.evaluation import DEVELOPMENT_SET
+    from vahr.local.alexa.localized import strip_invocation, supported
 
+    supported(args.locale)
     if args.eval is not None:
         if args.utterance:
             raise VahrError("give an utterance or --eval, not both")
-        return _evaluate(_model(args), args.eval, args.json)
+        labelled = args.eval
+        if labelled == DEVELOPMENT_SET and args.locale != "en-US":
+            labelled = DEVELOPMENT_SET.with_name(f"devset-{args.locale}.yaml")
+        return _evaluate(_model(args), labelled, args.json)
     if args.utterance is None or not args.utterance.strip():
         raise VahrError("the utterance is empty")
     model = _model(args)
-    understood = model.understand(strip_invocation(model.invocation_name, args.utterance))
+    said = strip_invocation(model.invocation_name, args.utterance, args.locale)
+    understood = model.understand(said)
     printed = describe(understood)
     if args.json:
         print(json.dumps(printed))
@@ -74,14 +87,20 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _model(args: argparse.Namespace) -> InteractionModel:
+    from vahr.local.alexa.localized import load_model
     from vahr.local.alexa.nlu import InteractionModel
+    from vahr.local.alexa.understanding import load_understanding
 
     if args.fleet is None:
-        return InteractionModel.load(args.model)
+        return load_model(args.locale, args.model)
     from vahr.commands.fleet_flag import read_fleet
-    from vahr.skill_model.generator import build_interaction_model
+    from vahr.skill_model.generator import build_interaction_model, build_locale_model
 
-    return InteractionModel(build_interaction_model(read_fleet(args.fleet)))
+    fleet = read_fleet(args.fleet)
+    if args.locale == "en-US":
+        return InteractionModel(build_interaction_model(fleet))
+    document = build_locale_model(fleet, args.locale)
+    return InteractionModel(document, understanding=load_understanding(args.locale))
 
 
 def describe(understood: Understanding) -> dict[str, Any]:

@@ -67,12 +67,14 @@ class Invocation(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """How a request names the skill: "Alexa, ask robot fleet to ...", "Alexa, sage
     roboterflotte, ...". `ask` are the verbs before the invocation name with a request
     after it, `joiners` the words that may follow the name before the request, `open` the
-    verbs that only open the skill, and `trailing` the words before a name said last
+    verbs that only open the skill (`open_joiners` join a request to them: "open robot fleet
+    and ..."), and `trailing` the words before a name said last
     ("... using robot fleet")."""
 
     ask: list[str]
     joiners: list[str] = []
     open: list[str] = []
+    open_joiners: list[str] = []
     trailing: list[str] = []
 
 

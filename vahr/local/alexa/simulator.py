@@ -19,6 +19,7 @@ from datetime import UTC, datetime
 from typing import TYPE_CHECKING, Any
 
 from vahr.local.alexa import envelope
+from vahr.local.alexa.localized import invocation_patterns
 from vahr.local.alexa.nlu import Understanding, normalize_utterance
 
 if TYPE_CHECKING:
@@ -126,6 +127,7 @@ class AlexaSimulator:
         identity: envelope.Identity | None = None,
         command_log: Callable[[], list[str]] | None = None,
         on_turn: Callable[[Turn], None] | None = None,
+        locale: str = "en-US",
     ) -> None:
         self.model = model
         self.handler = handler
@@ -134,14 +136,9 @@ class AlexaSimulator:
         self.on_turn = on_turn
         self._session: _Session | None = None
         self._lock = threading.Lock()
-        invocation = re.escape(normalize_utterance(model.invocation_name))
-        self._one_shot = re.compile(
-            rf"^(?:alexa\s+)?(?:ask|tell)\s+{invocation}(?:\s+(?:to|for|about|if|whether))?"
-            rf"(?:\s+(?P<rest>.*))?$"
-        )
-        self._open = re.compile(
-            rf"^(?:alexa\s+)?(?:open|launch|start|begin|talk to|use)\s+{invocation}$"
-        )
+        # The language spoken: the request's locale, and how the skill is addressed in it.
+        self.locale = locale
+        self._one_shot, self._open = invocation_patterns(model.invocation_name, locale)
 
     @property
     def session_open(self) -> bool:
@@ -233,6 +230,7 @@ class AlexaSimulator:
             new=session.turns == 0,
             attributes=session.attributes,
         )
+        event["request"]["locale"] = self.locale
         self._command_log()  # forget commands published outside this turn
         started = time.perf_counter()
         response = self.handler(event, None)
