@@ -24,11 +24,17 @@ A phone-loop likelihood ratio, as `GrammarRecognizer` uses, was measured here to
 dropped: with a back-off model, answers and unrelated speech scored alike (tuning set,
 docs/voice.md), and it doubled the time. Silence never reaches the decoder (energy
 detection first).
+
+Beside the best transcript the recognizer gives its N best (`Recognition.hypotheses`,
+from the decoder's word lattice, each distinct transcript once with its best path score),
+so a caller can weigh what each reading would mean: "zone b" and "zone d" a few points
+apart is a question to ask, not an action.
 """
 
 from __future__ import annotations
 
 import io
+import itertools
 import tempfile
 import threading
 from pathlib import Path
@@ -37,7 +43,14 @@ from typing import TYPE_CHECKING
 from vahr.speech.audio import SAMPLE_RATE, SpeechDetector
 from vahr.speech.errors import SpeechError
 from vahr.speech.pronounce import guesses
-from vahr.speech.stt import NOTHING_HEARD, HeardWord, Recognition, adapted_to, utterance
+from vahr.speech.stt import (
+    NOTHING_HEARD,
+    HeardWord,
+    Hypothesis,
+    Recognition,
+    adapted_to,
+    utterance,
+)
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -46,6 +59,10 @@ if TYPE_CHECKING:
 
 # How much of the probability mass an ARPA back-off keeps for unseen word sequences.
 DISCOUNT_MASS = 0.5
+# The lattice paths read for the N best: many differ only in a filler or a pronunciation,
+# so 40 paths give about 10 distinct transcripts.
+NBEST_PATHS = 40
+MAX_HYPOTHESES = 10
 _FILLERS = frozenset({"<s>", "</s>", "<sil>", "[NOISE]", "[SPEECH]", "[BREATH]", "[COUGH]"})
 
 
@@ -118,11 +135,34 @@ class LanguageModelRecognizer:
             with utterance(decoder):
                 decoder.process_raw(audio.pcm, full_utt=True)
             words = self._words() if decoder.hyp() is not None else ()
+            hypotheses = self._nbest() if words else ()
         if not words:
             return Recognition("", 0.0, False, reason="nothing recognizable")
         text = " ".join(word.text for word in words)
         # The confidence of the whole is that of its least certain word.
-        return Recognition(text, min(word.posterior for word in words), True, words)
+        confidence = min(word.posterior for word in words)
+        return Recognition(text, confidence, True, words, hypotheses=hypotheses)
+
+    def _nbest(self) -> tuple[Hypothesis, ...]:
+        """The distinct transcripts among the lattice's best paths, best first; the best
+        path's own transcript leads even when the A* search scores it lower."""
+        decoder = self._decoder
+        logmath = decoder.get_logmath()
+        best: dict[str, float] = {}
+        best_text = _clean(decoder.hyp().hypstr)
+        for found in itertools.islice(decoder.nbest(), NBEST_PATHS):
+            if found.score <= 0.0:
+                continue
+            text = _clean(found.hypstr)
+            # The binding hands the score back exponentiated; take the log again.
+            score = float(logmath.log(found.score))
+            if text and score > best.get(text, float("-inf")):
+                best[text] = score
+        ranked = sorted(best.items(), key=lambda item: -item[1])
+        if best_text and best_text not in best:
+            top = ranked[0][1] if ranked else 0.0
+            ranked.insert(0, (best_text, top))
+        return tuple(Hypothesis(text, score) for text, score in ranked[:MAX_HYPOTHESES])
 
     def _words(self) -> tuple[HeardWord, ...]:
         found = []
@@ -132,6 +172,15 @@ class LanguageModelRecognizer:
             # An alternative pronunciation is reported as `word(2)`.
             found.append(HeardWord(segment.word.split("(")[0], round(float(segment.prob), 3)))
         return tuple(found)
+
+
+def _clean(transcript: str) -> str:
+    """A transcript without fillers and pronunciation marks (`word(2)`)."""
+    return " ".join(
+        word.split("(")[0]
+        for word in transcript.split()
+        if word not in _FILLERS and not word.startswith("[")
+    )
 
 
 def dictionary_entries() -> list[tuple[str, str]]:

@@ -69,9 +69,19 @@ class HeardWord:
 
 
 @dataclass(frozen=True)
+class Hypothesis:
+    """One of the recognizer's N best transcripts and its path score: the log-likelihood in
+    the decoder's log units (base 1.0001), comparable only between hypotheses of one clip."""
+
+    text: str
+    score: float
+
+
+@dataclass(frozen=True)
 class Recognition:
     """What was heard: `text` is the best guess, `accepted` says whether to trust it,
-    `words` are its words with their posteriors (when the recognizer knows them) and
+    `words` are its words with their posteriors (when the recognizer knows them),
+    `hypotheses` the N best transcripts, best first (when the recognizer gives them), and
     `reason` says why it was not accepted."""
 
     text: str
@@ -79,6 +89,7 @@ class Recognition:
     accepted: bool
     words: tuple[HeardWord, ...] = ()
     reason: str = ""
+    hypotheses: tuple[Hypothesis, ...] = ()
 
 
 NOTHING_HEARD = Recognition("", 0.0, False, reason="no speech")

@@ -1,12 +1,20 @@
 """Push-to-talk: a WAV clip from the page in; what was heard and what the assistant answered out.
 
 The page records while the button (or the space bar) is held and uploads 16 kHz mono
-16-bit WAV. The clip is checked (a WAV, at most `MAX_CLIP_S` long), transcribed offline by
-a recognizer whose vocabulary comes from the skill's interaction model (`vocabulary.py`),
-and a transcript whose least certain word is at least `MIN_CONFIDENCE` goes to the
-assistant as a request (origin `station-voice`), with what the recognizer heard alongside.
-A clip with no speech, a transcript the recognizer is not sure of, or one the assistant
-does not understand (its fallback intent) changes nothing and gets `SORRY`.
+16-bit WAV. The clip is checked (a WAV, at most `MAX_CLIP_S` long) and transcribed offline
+by a recognizer whose vocabulary comes from the skill's interaction model
+(`vocabulary.py`). Its N best transcripts are each understood by the simulator's NLU and
+weighed into one understanding (`vahr.local.alexa.nbest`): an intent heard with too little of the
+weight is not acted on, and a robot or zone the hearing is unsure of is asked about
+("Zone B or zone D?") instead of acted on. The understanding goes to the assistant with
+the best transcript (origin `station-voice`) and what the recognizer heard alongside.
+
+A clip with no speech, or speech understood as nothing the skill does (out of domain,
+music, noise, a ramble) changes nothing and gets `SORRY`, which says so.
+
+With the simulator in this process (`vahr up`) the weighed understanding is handed to it
+as is. An assistant reached over HTTP re-reads words, so it gets the best transcript only
+when the hearing is sure of every robot and zone; otherwise the station asks itself.
 """
 
 from __future__ import annotations
@@ -17,22 +25,21 @@ import time
 import wave
 from typing import TYPE_CHECKING, Any
 
+from vahr.local.alexa import Weighed, weigh_recognition
+from vahr.local.client import SimulatorAssistant
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio
 from vahr.station.errors import RequestError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from vahr.local.alexa import InteractionModel
     from vahr.local.client import Assistant
-    from vahr.speech.stt import Recognizer
+    from vahr.speech.stt import Recognition, Recognizer
 
-SORRY = "Sorry, I didn't catch that."
+SORRY = "Sorry, I didn't catch that. I sent nothing to the robots."
+# A clip may be up to 20 s long: the page's recorder stops there.
 MAX_CLIP_S = 20.0
-# The least word posterior of a transcript passed to the assistant. Chosen by
-# bench/station_hearing.py on the NLU's tuning set spoken by espeak-ng: the most requests
-# understood as meant among the thresholds that act on at most 10% of out-of-domain
-# sentences (docs/benchmarks.md, "Push-to-talk: spoken requests understood").
-MIN_CONFIDENCE = 0.15
 ORIGIN = "station-voice"
 FALLBACK = "AMAZON.FallbackIntent"
 
@@ -64,17 +71,32 @@ def read_clip(data: bytes) -> Audio:
     return audio
 
 
+def ask_back(weighed: Weighed) -> str | None:
+    """The station's own question when a remote assistant cannot be given the weighed
+    understanding: which value of an unsure robot or zone slot was meant; None when sure."""
+    for value in weighed.understanding.slots.values():
+        if value.alternatives and value.canonical:
+            options = [value.canonical, *(name for _, name in value.alternatives)]
+            return f"Did you say {' or '.join(options)}? Please say it again."
+        if not value.resolved and value.name in weighed.slot_confidence:
+            return f"I'm not sure which {value.type.lower()} you said. Please say it again."
+    return None
+
+
 class PushToTalk:
-    """Recognize a clip and pass what was heard to the assistant.
+    """Recognize a clip, weigh its readings, and pass the understanding to the assistant.
 
     The recognizer is built on first use, or ahead of it in the background with `warm_up`
-    (building one takes a moment; the first press should not wait for it).
+    (building one takes a moment; the first press should not wait for it). The NLU is the
+    simulator's when the assistant is the simulator in this process, else the one that
+    ships with the package (built on first use).
     """
 
     def __init__(self, assistant: Assistant, recognizer: Callable[[], Recognizer]) -> None:
         self.assistant = assistant
         self._make = recognizer
         self._recognizer: Recognizer | None = None
+        self._model: InteractionModel | None = None
         self._lock = threading.Lock()
 
     def warm_up(self) -> threading.Thread:
@@ -88,16 +110,29 @@ class PushToTalk:
                 self._recognizer = self._make()
             return self._recognizer
 
+    def model(self) -> InteractionModel:
+        if isinstance(self.assistant, SimulatorAssistant):
+            return self.assistant.simulator.model
+        with self._lock:
+            if self._model is None:
+                from vahr.local.alexa import InteractionModel
+
+                self._model = InteractionModel.load()
+            return self._model
+
+    def weigh(self, recognition: Recognition) -> Weighed:
+        """The understanding of a recognition's N best (its transcript alone without)."""
+        return weigh_recognition(self.model(), recognition)
+
     def handle(self, wav: bytes) -> dict[str, Any]:
         audio = read_clip(wav)
         started = time.perf_counter()
         recognition = self.recognizer().recognize(audio)
         recognizer_ms = round((time.perf_counter() - started) * 1000, 1)
-        accepted = recognition.accepted and recognition.confidence >= MIN_CONFIDENCE
-        heard = {
+        heard: dict[str, Any] = {
             "transcript": recognition.text,
             "confidence": round(recognition.confidence, 3),
-            "accepted": accepted,
+            "accepted": False,
             "seconds": round(audio.seconds, 2),
         }
         result: dict[str, Any] = {
@@ -107,10 +142,31 @@ class PushToTalk:
             "speech": SORRY,
             "turn": None,
         }
-        if not accepted or not recognition.text:
+        if not recognition.accepted or not recognition.text:
             return result
-        turn = self.assistant.ask(recognition.text, origin=ORIGIN, heard=heard)
+        weighed = self.weigh(recognition)
+        heard["weighed"] = weighed.to_json()
+        understanding = weighed.understanding
+        if understanding.intent == FALLBACK:
+            return result
+        heard["accepted"] = True
+        turn = self._ask(recognition.text, heard, weighed)
         result["turn"] = turn
         if turn.get("intent") not in (None, FALLBACK):
             result.update(understood=True, speech=turn.get("speech") or "")
         return result
+
+    def _ask(self, text: str, heard: dict[str, Any], weighed: Weighed) -> dict[str, Any]:
+        if isinstance(self.assistant, SimulatorAssistant):
+            simulator = self.assistant.simulator
+            if simulator.pending is None:
+                turn = simulator.say(
+                    text, origin=ORIGIN, heard=heard, understanding=weighed.understanding
+                )
+                return {**turn.to_json(), "utterance": text}
+            # An answer to the skill's question is read against the question: the words go.
+            return self.assistant.ask(text, origin=ORIGIN, heard=heard)
+        question = ask_back(weighed)
+        if question is not None:
+            return {"speech": question, "intent": None, "utterance": text}
+        return self.assistant.ask(text, origin=ORIGIN, heard=heard)

@@ -47,7 +47,7 @@ class Assistant:
         self.asked: list[tuple[str, str, dict[str, Any] | None]] = []
 
     def ask(
-        self, utterance: str, *, origin: str, heard: dict[str, Any] | None = None
+        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
     ) -> dict[str, Any]:
         self.asked.append((utterance, origin, heard))
         return {
@@ -85,12 +85,17 @@ def test_speech_heard_goes_to_the_assistant_with_what_was_heard() -> None:
     assert result["speech"] == "Placebot two is on its way to zone C."
     ((utterance, origin, sent),) = assistant.asked
     assert (utterance, origin) == ("send placebot two to zone c", "station-voice")
+    assert sent is not None
+    weighed = sent.pop("weighed")
     assert sent == {
         "transcript": "send placebot two to zone c",
         "confidence": 0.81,
         "accepted": True,
         "seconds": 1.0,
     }
+    # One reading, understood by the NLU: the robot and the zone are sure.
+    assert weighed["intent"] == "NavigateIntent"
+    assert weighed["slots"] == {"robot": 1.0, "zone": 1.0}
 
 
 @pytest.mark.parametrize(
@@ -98,7 +103,8 @@ def test_speech_heard_goes_to_the_assistant_with_what_was_heard() -> None:
     [
         (NOTHING_HEARD, "NavigateIntent", False),  # silence
         (Recognition("what tell every d", 0.02, False), "NavigateIntent", False),  # unsure
-        (Recognition("to loading", 0.6, True), "AMAZON.FallbackIntent", True),  # not understood
+        # understood by the NLU as nothing the skill does: not even sent
+        (Recognition("play some music please", 0.6, True), "NavigateIntent", False),
     ],
 )
 def test_silence_and_what_is_not_understood_get_sorry(

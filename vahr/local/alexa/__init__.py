@@ -11,11 +11,14 @@ experiment out of them (pyproject.toml, docs/architecture.md):
   in-process) and `CommandLog` (the commands the skill published during a turn): what a
   simulator is built from;
 - `built_in_phrases` (what the simulator knows Alexa's built-in intents by) and
-  `RULE_SLOTS` (the weather rule's slots): what a vocabulary of the model is made from.
+  `RULE_SLOTS` (the weather rule's slots): what a vocabulary of the model is made from;
+- `weigh_recognition`, `Weighed` and `Weighing` (`nbest`): a recognizer's N best weighed
+  into one understanding, unsure robots and zones asked about.
 """
 
 from vahr.local.alexa.background import built_in_phrases
 from vahr.local.alexa.commands_seen import CommandLog
+from vahr.local.alexa.nbest import Weighed, Weighing, weigh_recognition
 from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel
 from vahr.local.alexa.simulator import AlexaSimulator, Turn
 from vahr.local.alexa.skill import load_skill_handler
@@ -31,6 +34,9 @@ __all__ = [
     "CommandLog",
     "InteractionModel",
     "Turn",
+    "Weighed",
+    "Weighing",
     "built_in_phrases",
     "load_skill_handler",
+    "weigh_recognition",
 ]

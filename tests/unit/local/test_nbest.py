@@ -1,0 +1,89 @@
+"""Weighing push-to-talk's N best with the shipped NLU: a reading that dominates is acted
+on, a zone split between readings is asked about, and speech that is nothing the skill
+does moves nothing."""
+
+from __future__ import annotations
+
+import pytest
+
+from vahr.local.alexa.nbest import Weighing, posteriors, weigh
+from vahr.local.alexa.nlu import FALLBACK, InteractionModel, Understanding
+from vahr.speech.stt import Hypothesis
+
+
+@pytest.fixture(scope="module")
+def understand() -> object:
+    model = InteractionModel.load()
+
+    def read(text: str) -> Understanding:
+        return model.understand(text)
+
+    return read
+
+
+def test_posteriors_follow_the_scores_and_add_up_to_one() -> None:
+    weights = posteriors([Hypothesis("a", -100.0), Hypothesis("b", -300.0)], 1 / 200)
+    assert weights[0] > weights[1] and sum(weights) == pytest.approx(1.0)
+    # 200 decoder units at sharpness 1/200 is a factor e between the two.
+    assert weights[0] / weights[1] == pytest.approx(2.718, rel=1e-3)
+
+
+def test_a_reading_that_dominates_is_acted_on(understand: object) -> None:
+    weighed = weigh(
+        [
+            Hypothesis("send placebot one to zone c", 0.0),
+            Hypothesis("send placebot one into zone c", -150.0),
+            Hypothesis("send placebot one to zone d", -2000.0),
+        ],
+        understand,  # type: ignore[arg-type]
+    )
+    slots = weighed.understanding.slots
+    assert weighed.understanding.intent == "NavigateIntent"
+    assert (slots["robot"].id, slots["zone"].id) == ("placebot1", "C")
+    assert not slots["zone"].alternatives
+    assert weighed.slot_confidence["zone"] > 0.99
+
+
+def test_a_zone_split_between_readings_is_asked_about(understand: object) -> None:
+    weighed = weigh(
+        [
+            Hypothesis("send placebot two to zone d", 0.0),
+            Hypothesis("send placebot two to zone b", -100.0),
+            Hypothesis("send placebot to to zone d", -200.0),
+        ],
+        understand,  # type: ignore[arg-type]
+    )
+    zone = weighed.understanding.slots["zone"]
+    assert zone.id == "D" and zone.alternatives == (("B", "zone b"),)
+    assert weighed.slot_confidence["robot"] == pytest.approx(1.0, abs=0.3)
+    assert weighed.slot_confidence["zone"] < 0.7
+
+
+def test_with_higher_thresholds_a_split_robot_is_asked_about(understand: object) -> None:
+    weighed = weigh(
+        [
+            Hypothesis("send placebot one to zone a", 0.0),
+            Hypothesis("send placebot two to zone a", -60.0),
+        ],
+        understand,  # type: ignore[arg-type]
+        Weighing(min_slot_confidence=0.9),
+    )
+    robot = weighed.understanding.slots["robot"]
+    assert robot.id == "placebot1" and [v for v, _ in robot.alternatives] == ["placebot2"]
+
+
+@pytest.mark.parametrize(
+    "readings",
+    [
+        ["play some music", "place some music", "play sunny music"],
+        ["what is the capital of france", "what is the capital of the france"],
+    ],
+)
+def test_speech_about_something_else_moves_nothing(understand: object, readings: list[str]) -> None:
+    hypotheses = [Hypothesis(text, -50.0 * n) for n, text in enumerate(readings)]
+    weighed = weigh(hypotheses, understand)  # type: ignore[arg-type]
+    assert weighed.understanding.intent == FALLBACK
+
+
+def test_no_reading_at_all_is_the_fallback(understand: object) -> None:
+    assert weigh([], understand).understanding.intent == FALLBACK  # type: ignore[arg-type]

@@ -1,0 +1,180 @@
+"""How sure a hearing is of what moves a robot: the recognizer's N best, each understood
+by the NLU, weighed into one understanding with a confidence per slot value (the
+operator station's push-to-talk uses it).
+
+Each distinct transcript i of the N best gets a posterior from its path score,
+`w_i ∝ exp(SHARPNESS * (score_i - score_best))` (a softmax whose one constant, how many
+decoder log units make a factor e, is fitted on the tuning voices by the likelihood of
+the right zone and robot: temperature scaling). Each transcript is understood by the NLU,
+whose calibrated intent probability c_i splits w_i between its intent (w_i * c_i) and
+the fallback. Then:
+
+- the intent is the one with the most weight; below `MIN_INTENT_CONFIDENCE` of the whole,
+  or the fallback, nothing is acted on;
+- each robot or zone slot of the leading reading gets P(value) = the weight of the
+  readings of that intent giving the slot that value, over all readings of that intent. A
+  value below `MIN_SLOT_CONFIDENCE` is not acted on: with rival values heard, the slot
+  carries them as alternatives and the skill asks ("Zone B or zone D?"); with none (the
+  other readings lack the slot) the slot is left empty and the skill asks for it.
+
+The three constants are chosen on the tuning voices only (`bench/station_hearing.py`,
+docs/voice.md "Push-to-talk: asking when unsure").
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+from vahr.local.alexa.nlu import FALLBACK, SlotValue, Understanding
+from vahr.skill_model.intents import ROBOT_TYPE, ZONE_TYPE
+from vahr.speech.stt import Hypothesis
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+
+    from vahr.local.alexa.nlu import InteractionModel
+    from vahr.speech.stt import Recognition
+
+# Decoder log units (base 1.0001) per factor e between two transcripts' posteriors.
+# Fitted on the tuning voices (bench/station_hearing.py): the sharpness of the softmax
+# that gives the right zone and robot the highest likelihood.
+SHARPNESS = 1 / 200
+# Chosen on the tuning voices by one rule: the most requests right less ten times the
+# wrong actions (a robot sent where nobody asked costs far more than a question).
+MIN_SLOT_CONFIDENCE = 0.7
+MIN_INTENT_CONFIDENCE = 0.5
+# Slot types whose value moves a robot somewhere: never acted on when unsure.
+MOVING_TYPES = frozenset({ROBOT_TYPE, ZONE_TYPE})
+# A rival value is offered in the question only when it holds this share of the weight.
+MIN_RIVAL_SHARE = 0.1
+
+
+@dataclass(frozen=True)
+class Weighed:
+    """The understanding to act on, and how sure of it the hearing is."""
+
+    understanding: Understanding
+    intent_confidence: float
+    # Slot name -> P(the value acted on or asked about), for the robot and zone slots.
+    slot_confidence: dict[str, float]
+    readings: int
+
+    def to_json(self) -> dict[str, object]:
+        return {
+            "intent": self.understanding.intent,
+            "intent_confidence": round(self.intent_confidence, 3),
+            "slots": {name: round(p, 3) for name, p in self.slot_confidence.items()},
+            "readings": self.readings,
+        }
+
+
+@dataclass(frozen=True)
+class Weighing:
+    """The constants of the combination (defaults: those chosen on the tuning voices)."""
+
+    sharpness: float = SHARPNESS
+    min_slot_confidence: float = MIN_SLOT_CONFIDENCE
+    min_intent_confidence: float = MIN_INTENT_CONFIDENCE
+
+
+def posteriors(hypotheses: Sequence[Hypothesis], sharpness: float) -> list[float]:
+    """Each hypothesis's share of the weight: a softmax of its score times `sharpness`."""
+    if not hypotheses:
+        return []
+    top = max(h.score for h in hypotheses)
+    raw = [math.exp(sharpness * (h.score - top)) for h in hypotheses]
+    total = sum(raw)
+    return [r / total for r in raw]
+
+
+def weigh(
+    hypotheses: Sequence[Hypothesis],
+    understand: Callable[[str], Understanding],
+    weighing: Weighing = Weighing(),
+) -> Weighed:
+    """The understanding push-to-talk acts on, from the N best (best first)."""
+    if not hypotheses:
+        return Weighed(Understanding(FALLBACK, confidence=1.0), 1.0, {}, 0)
+    weights = posteriors(hypotheses, weighing.sharpness)
+    readings = [understand(h.text) for h in hypotheses]
+    mass: dict[str, float] = defaultdict(float)
+    for weight, reading in zip(weights, readings, strict=True):
+        share = reading.confidence if reading.intent != FALLBACK else 1.0
+        mass[reading.intent] += weight * share
+        mass[FALLBACK] += weight * (1.0 - share)
+    intent = max(mass, key=lambda name: (mass[name], name != FALLBACK))
+    intent_confidence = mass[intent]
+    if intent == FALLBACK or intent_confidence < weighing.min_intent_confidence:
+        guess = intent if intent != FALLBACK else None
+        fallback = Understanding(FALLBACK, confidence=intent_confidence, best_guess=guess)
+        return Weighed(fallback, intent_confidence, {}, len(readings))
+    agreeing = [
+        (weight * reading.confidence, reading)
+        for weight, reading in zip(weights, readings, strict=True)
+        if reading.intent == intent
+    ]
+    lead = agreeing[0][1]  # the best-scored reading of that intent
+    slots = dict(lead.slots)
+    confidence: dict[str, float] = {}
+    for name, value in lead.slots.items():
+        if value.type not in MOVING_TYPES:
+            continue
+        shares, names = _value_shares(name, agreeing)
+        confidence[name] = shares.get(value.id, 0.0)
+        # A value the NLU already asks about stays a question, with its own rivals.
+        if confidence[name] < weighing.min_slot_confidence and not value.alternatives:
+            slots[name] = _unsure(value, shares, names)
+    return Weighed(replace(lead, slots=slots), intent_confidence, confidence, len(readings))
+
+
+def weigh_recognition(
+    model: InteractionModel, recognition: Recognition, weighing: Weighing = Weighing()
+) -> Weighed:
+    """`weigh` over a recognition's N best (its transcript alone when it has none), each
+    read by `model` as the simulator reads a request (the invocation taken off)."""
+    from vahr.local.alexa.simulator import strip_invocation
+
+    def understand(text: str) -> Understanding:
+        return model.understand(strip_invocation(model.invocation_name, text))
+
+    hypotheses = recognition.hypotheses or (Hypothesis(recognition.text, 0.0),)
+    return weigh(hypotheses, understand, weighing)
+
+
+def _value_shares(
+    name: str, agreeing: list[tuple[float, Understanding]]
+) -> tuple[dict[str | None, float], dict[str, str]]:
+    """P(value id) of slot `name` among the readings of one intent (None: left empty),
+    and each value's canonical name."""
+    shares: dict[str | None, float] = defaultdict(float)
+    names: dict[str, str] = {}
+    total = sum(weight for weight, _ in agreeing)
+    for weight, reading in agreeing:
+        value = reading.slots.get(name)
+        if value is None or value.id is None:
+            shares[None] += weight
+            continue
+        names[value.id] = value.canonical or value.id
+        names.update(value.alternatives)
+        if value.alternatives:
+            # A reading that already asks counts for none of its values.
+            shares[None] += weight
+        else:
+            shares[value.id] += weight
+    return ({key: share / total for key, share in shares.items()} if total else {}), names
+
+
+def _unsure(value: SlotValue, shares: dict[str | None, float], names: dict[str, str]) -> SlotValue:
+    """`value` not to be acted on: with the rival values heard as alternatives (asked
+    about), or emptied (asked for) when no rival value was heard."""
+    rivals = tuple(
+        (value_id, names.get(value_id, value_id))
+        for value_id, share in sorted(shares.items(), key=lambda item: -item[1])
+        if value_id is not None and value_id != value.id and share >= MIN_RIVAL_SHARE
+    )
+    if rivals:
+        return replace(value, alternatives=rivals)
+    return replace(value, id=None, canonical=None, alternatives=())
