@@ -24,7 +24,9 @@ PRICES_AS_OF = "2026-11-22"
 # https://aws.amazon.com/iot-core/pricing/ (connectivity, messaging, Device Shadow and
 # registry, rules engine; metering in 5 KB message and 1 KB shadow units),
 # https://aws.amazon.com/lambda/pricing/, https://aws.amazon.com/lex/pricing/,
-# https://aws.amazon.com/cloudwatch/pricing/, https://aws.amazon.com/secrets-manager/pricing/.
+# https://aws.amazon.com/cloudwatch/pricing/, https://aws.amazon.com/secrets-manager/pricing/,
+# https://aws.amazon.com/iot-device-management/pricing/ (fleet indexing: index updates
+# metered in 1 KB increments, search queries).
 
 
 @dataclass(frozen=True)
@@ -45,6 +47,10 @@ class Prices:
     # DynamoDB on demand (https://aws.amazon.com/dynamodb/pricing/on-demand/).
     dynamodb_read: float = 0.125 / 1e6  # per read request unit (4 KB, strongly consistent)
     dynamodb_write: float = 0.625 / 1e6  # per write request unit (1 KB)
+    # AWS IoT Device Management fleet indexing: an index update per 1 KB of a registry or
+    # shadow change, a query per SearchIndex call (each page) or aggregation call.
+    fleet_index_update: float = 2.25 / 1e6
+    fleet_index_query: float = 0.05 / 10_000
 
 
 @dataclass(frozen=True)
@@ -207,6 +213,138 @@ def announcer_ticks_cost(prices: Prices, ticks: AnnouncerTicks = AnnouncerTicks(
         + ticks.log_bytes / 1e9 * prices.log_ingestion_gb
     )
     return ticks.per_month * per_tick
+
+
+# -- fleet dispatch and status questions at scale (infra/constructs/dispatcher.py) ------
+
+
+@dataclass(frozen=True)
+class Billable:
+    """The billable operations of one action on AWS, by kind."""
+
+    index_queries: float = 0.0  # fleet indexing queries
+    index_updates: float = 0.0  # fleet indexing updates (1 KB)
+    shadow_operations: float = 0.0  # Device Shadow operations (1 KB)
+    dynamodb_reads: float = 0.0  # read request units
+    dynamodb_writes: float = 0.0  # write request units
+    lambda_requests: float = 0.0
+    rules_triggered: float = 0.0
+    rule_actions: float = 0.0
+    messages: float = 0.0  # IoT Core messages (5 KB)
+
+    def operations(self) -> float:
+        return math.fsum(getattr(self, field) for field in self.__dataclass_fields__)
+
+    def cost(self, prices: Prices) -> float:
+        return math.fsum(
+            (
+                self.index_queries * prices.fleet_index_query,
+                self.index_updates * prices.fleet_index_update,
+                self.shadow_operations * prices.shadow_operation,
+                self.dynamodb_reads * prices.dynamodb_read,
+                self.dynamodb_writes * prices.dynamodb_write,
+                self.lambda_requests * prices.lambda_request,
+                self.rules_triggered * prices.rule_triggered,
+                self.rule_actions * prices.rule_action,
+                self.messages * prices.message,
+            )
+        )
+
+
+@dataclass(frozen=True)
+class DispatchUsage:
+    """One dispatched task on AWS: the skill invokes the dispatcher to submit it, the
+    dispatcher finds candidates and assigns it in the task table, publishes the command,
+    and the robot's shadow updates while it works reach the dispatcher's rule, the last of
+    them (idle, task done) the function, which closes the task."""
+
+    # Task-table request units of a submit and of the robot-freed event that closes the
+    # task, measured on the handler under moto (tests/support/dispatch_meter.py; checked by
+    # tests/unit/dispatcher/test_dispatcher_costs.py). The submit: the task's PutItem (1
+    # write), the assignment's transaction of two items (4: transactions bill twice), two
+    # consistent Queries of the open tasks and a GetItem (3 reads); the robot-freed event:
+    # the closing transaction of three items (6 writes), three Queries and a GetItem (4).
+    table_reads: float = 7.0
+    table_writes: float = 11.0
+    # The robot's shadow updates while it does one task (LabUsage: a delivery sends 9).
+    # Each is a rule triggered (the rule's topic filter matches every classic shadow's
+    # documents; counted whether or not WHERE selects it) and an index update (a robot's
+    # reported state is under 1 KB).
+    shadow_updates: int = 9
+    # SearchIndex's page (AWS: maxResults "cannot exceed 100").
+    search_page: int = 100
+    # Share of the fleet that may take a task (idle or busy, connected) when it is
+    # submitted; every one of them is a candidate the index returns.
+    free_share: float = 1.0
+    # Reading a robot's shadow instead (GetThingShadow): a document with metadata, 1-2 KB.
+    shadow_units_per_read: int = 2
+    # The command: in once, out to its robot at QoS 1 (the PUBLISH and the PUBACK).
+    command_messages: int = 3
+
+
+def dispatch_billable(
+    robots: int, *, index: bool, usage: DispatchUsage = DispatchUsage()
+) -> Billable:
+    """One dispatched task among `robots`: candidates from fleet indexing (`index`) or by
+    reading every robot's shadow."""
+    common = {
+        "dynamodb_reads": usage.table_reads,
+        "dynamodb_writes": usage.table_writes,
+        "lambda_requests": 2.0,  # the skill's submit, the robot-freed event
+        "rules_triggered": float(usage.shadow_updates),
+        "rule_actions": 1.0,
+        "messages": float(usage.command_messages),
+    }
+    if not index:
+        return Billable(shadow_operations=robots * usage.shadow_units_per_read, **common)
+    candidates = math.ceil(robots * usage.free_share)
+    return Billable(
+        index_queries=max(1, math.ceil(candidates / usage.search_page)),
+        index_updates=float(usage.shadow_updates),
+        **common,
+    )
+
+
+# The skill's status summary on fleet indexing (lambda/skill/fleet_index.py): counts by
+# status (GetBucketsAggregation), robots offline (GetStatistics) and one page of the robots
+# it names (SearchIndex).
+STATUS_INDEX_QUERIES = 3
+
+
+def status_billable(
+    robots: int, *, index: bool, usage: DispatchUsage = DispatchUsage()
+) -> Billable:
+    """One status question about `robots`: by fleet indexing, or by reading every shadow.
+    (Keeping the index costs its updates, counted with the tasks that cause them.)"""
+    if index:
+        return Billable(index_queries=STATUS_INDEX_QUERIES, lambda_requests=1.0)
+    return Billable(shadow_operations=robots * usage.shadow_units_per_read, lambda_requests=1.0)
+
+
+def dynamodb_units(operation: str, request: dict[str, object]) -> tuple[float, float]:
+    """(read, write) request units an on-demand table bills for one call, by DynamoDB's
+    metering: a write 1 unit per KB of the item, twice in a transaction; a strongly
+    consistent read 1 unit per 4 KB (a Query over the sum of what it returns; at least
+    one). For reads the size comes from the response, passed as `request["_returned"]`."""
+
+    def size(item: object) -> int:
+        import json
+
+        return len(json.dumps(item, separators=(",", ":")).encode())
+
+    if operation in ("PutItem", "DeleteItem", "UpdateItem"):
+        item = request.get("Item") or request.get("Key")
+        return 0.0, float(max(1, math.ceil(size(item) / 1024)))
+    if operation == "TransactWriteItems":
+        writes = 0
+        for entry in request.get("TransactItems", []):  # type: ignore[attr-defined]
+            body = next(iter(entry.values()))
+            writes += 2 * max(1, math.ceil(size(body.get("Item") or body.get("Key")) / 1024))
+        return 0.0, float(writes)
+    if operation in ("GetItem", "Query"):
+        returned = request.get("_returned", [])
+        return float(max(1, math.ceil(size(returned) / 4096))), 0.0
+    return 0.0, 0.0
 
 
 # -- cost of measured operations (bench/billable_operations.py) ---------------------------

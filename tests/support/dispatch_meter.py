@@ -1,0 +1,142 @@
+"""What one dispatched task costs on AWS, counted on the real code: the dispatcher's handler
+runs a submit and then the robot-freed event that closes the task, with its task table in
+moto's DynamoDB, its commands through moto's iot-data and its candidates from a fleet index
+on boto3's `iot` wire (the local data plane's, with AWS's pagination), and every AWS call
+it makes is counted, with the DynamoDB request units each bills
+(`infra.cost_estimate.dynamodb_units`).
+
+Used by tests/unit/dispatcher/test_dispatcher_costs.py and bench/billable_operations.py.
+Call it inside `moto.mock_aws()` with fake credentials set.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import Counter
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from typing import Any
+
+import boto3
+
+from dispatcher import app
+from dispatcher.command_channel import CommandChannel
+from dispatcher.fleet_search import FleetSearch
+from dispatcher.task_table import TaskTable
+from infra.cost_estimate import dynamodb_units
+from vahr.local.dataplane import DataPlane, DataPlaneServer
+from vahr.local.meter import Meter
+from vahr.local.shadow_service import ShadowService
+from vahr.local.shadow_store import ShadowStore
+from vahr.protocol import load_fleet
+from vahr.protocol.dispatch import Dispatcher
+
+REGION = "us-east-1"
+TABLE = "vahr-tasks"
+
+
+@dataclass
+class CallMeter:
+    """AWS calls by operation, and the DynamoDB request units they bill."""
+
+    calls: Counter[str] = field(default_factory=Counter)
+    reads: float = 0.0
+    writes: float = 0.0
+
+    def watch(self, client: Any) -> Any:
+        client.meta.events.register("provide-client-params.*.*", self._remember)
+        client.meta.events.register("after-call.*.*", self._count)
+        return client
+
+    def _remember(self, params: dict[str, Any], context: dict[str, Any], **_: Any) -> None:
+        context["vahr_params"] = dict(params)
+
+    def _count(self, parsed: dict[str, Any], model: Any, context: dict[str, Any], **_: Any) -> None:
+        operation = model.name
+        self.calls[operation] += 1
+        if model.service_model.service_name != "dynamodb":
+            return
+        request = dict(context.get("vahr_params", {}))
+        if operation in ("GetItem", "Query"):
+            request["_returned"] = parsed.get("Item") or parsed.get("Items") or []
+        reads, writes = dynamodb_units(operation, request)
+        self.reads += reads
+        self.writes += writes
+
+
+@dataclass(frozen=True)
+class DispatchMeasure:
+    """The calls and units of one task: its submit and the event that closed it."""
+
+    robots: int
+    submit: CallMeter
+    freed: CallMeter
+    assigned_to: str
+
+
+def _create_table(client: Any) -> None:
+    client.create_table(
+        TableName=TABLE,
+        KeySchema=[
+            {"AttributeName": "section", "KeyType": "HASH"},
+            {"AttributeName": "id", "KeyType": "RANGE"},
+        ],
+        AttributeDefinitions=[
+            {"AttributeName": "section", "AttributeType": "S"},
+            {"AttributeName": "id", "AttributeType": "S"},
+        ],
+        BillingMode="PAY_PER_REQUEST",
+    )
+
+
+def measure_dispatch(robots: int) -> DispatchMeasure:
+    """A delivery to zone C submitted to a fleet of `robots` idle, connected robots (the
+    fleet file's two and `rover3`...), then the robot that took it reports it done."""
+    store = ShadowStore(None)
+    shadows = ShadowService(store, publish=lambda _topic, _payload: None)
+    server = DataPlaneServer(DataPlane(shadows, publish=lambda *_: None, meter=Meter()), 0)
+    fleet = load_fleet()
+    names = [*fleet.robot_things, *(f"rover{n}" for n in range(3, robots + 1))][:robots]
+    for n, thing in enumerate(names):
+        robot = fleet.robots[n] if n < len(fleet.robots) else None
+        pose = robot.start if robot is not None else None
+        reported = {
+            "status": "idle",
+            "zone": "A",
+            "connected": True,
+            "pose": {"x": pose.x, "y": pose.y} if pose else {"x": 20.0 + n % 100, "y": 20.0},
+        }
+        store.update(thing, None, json.dumps({"state": {"reported": reported}}).encode())
+    dynamodb = boto3.client("dynamodb", region_name=REGION)
+    _create_table(dynamodb)
+    with server:
+        submit_meter, freed_meter = CallMeter(), CallMeter()
+
+        def dispatcher(meter: CallMeter) -> Dispatcher:
+            return Dispatcher(
+                fleet=fleet,
+                store=TaskTable(
+                    TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION))
+                ),
+                candidates=FleetSearch(
+                    client=meter.watch(boto3.client("iot", endpoint_url=server.url))
+                ),
+                publish=CommandChannel(
+                    client=meter.watch(boto3.client("iot-data", region_name=REGION))
+                ),
+                clock=lambda: datetime.now(UTC),
+            )
+
+        answer = app.handle(
+            {"operation": "submit", "order": {"kind": "deliver", "zone": "C"}},
+            dispatcher(submit_meter),
+        )
+        [task] = answer["body"]["assigned"]
+        done = {
+            "status": "idle",
+            "zone": "C",
+            "connected": True,
+            "last_command": {"id": task["id"], "action": "deliver", "result": "done"},
+        }
+        app.handle({"thing": task["thing"], "reported": done}, dispatcher(freed_meter))
+    return DispatchMeasure(robots, submit_meter, freed_meter, task["thing"])
