@@ -8,6 +8,7 @@ more than a spoken summary can name within its word bound.
 
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING
 
 import msgspec
@@ -19,6 +20,20 @@ if TYPE_CHECKING:
 
     from skill.fleet_index import FleetIndex
     from skill.robots import ShadowRead
+
+_NUMBERS = re.compile(r"(\d+)")
+
+
+def spoken_order(robots: Sequence[IndexedRobot]) -> list[IndexedRobot]:
+    """Robots in the order a person counts them: rover 99 before rover 101 before rover 1000
+    (the index returns them by thing name as text, or in an order of its own on AWS)."""
+
+    def key(robot: IndexedRobot) -> list[tuple[int, int | str]]:
+        parts = _NUMBERS.split(robot.thing)
+        return [(1, int(part)) if part.isdigit() else (0, part) for part in parts]
+
+    return sorted(robots, key=key)
+
 
 # The troubles a summary names robots for, most urgent first. "error" is the status a
 # robot reports when a task failed.
@@ -56,7 +71,7 @@ def from_index(index: FleetIndex, total: int) -> FleetState:
                 if kind == "offline"
                 else f"shadow.reported.status:{kind}"
             )
-            troubled[kind] = index.search(query, NAMED_MAX)
+            troubled[kind] = spoken_order(index.search(query, NAMED_MAX))
     return FleetState(total=total, counts=counts, offline=offline, troubled=troubled)
 
 
@@ -70,10 +85,10 @@ def from_shadows(reads: Sequence[ShadowRead]) -> FleetState:
         counts[robot.reported.status] = counts.get(robot.reported.status, 0) + 1
     offline = [robot for robot in robots if not robot.reported.connected]
     troubled = {
-        kind: [robot for robot in robots if robot.reported.status == kind][:NAMED_MAX]
+        kind: spoken_order([robot for robot in robots if robot.reported.status == kind])[:NAMED_MAX]
         for kind in ("stuck", "error")
     }
-    troubled["offline"] = offline[:NAMED_MAX]
+    troubled["offline"] = spoken_order(offline)[:NAMED_MAX]
     return FleetState(
         total=len(reads),
         counts=counts,

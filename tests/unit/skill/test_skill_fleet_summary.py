@@ -235,3 +235,11 @@ def test_every_mix_of_troubles_stays_within_the_word_bound(
         assert f"{stuck} {'is' if stuck == 1 else 'are'} stuck: rover 100 in zone C" in summary
     if offline:
         assert f"{offline} {'is' if offline == 1 else 'are'} offline" in summary
+
+
+def test_robots_are_named_in_the_order_a_person_counts_them() -> None:
+    from skill.fleet_index import IndexedRobot
+    from skill.fleet_status import spoken_order
+
+    robots = [IndexedRobot(thing, Reported()) for thing in ("rover1000", "rover101", "rover99")]
+    assert [robot.thing for robot in spoken_order(robots)] == ["rover99", "rover101", "rover1000"]
