@@ -116,3 +116,28 @@ def test_the_shipped_english_understanding_has_no_hand_rules() -> None:
     understanding = load_understanding()
     assert understanding.locale == "en-US"
     assert not hasattr(understanding, "english_role_rules")
+
+
+@pytest.mark.parametrize(
+    ("utterance", "slots"),
+    [
+        # A robot's turn said after its name ("goes second"): the tagger does not always
+        # give the turn or the shared zone, and then the skill asks; it never sends a robot
+        # in the other order or to another zone.
+        ("placebot two goes second placebot one goes first both deliver to zone d",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "D"}),
+        ("placebot two second and placebot one first deliver to zone d",
+         {"firstRobot": "placebot1", "firstZone": "D", "secondRobot": "placebot2",
+          "secondZone": "D"}),
+    ],
+)  # fmt: skip
+def test_turns_after_the_names_are_right_or_asked_about(
+    model: InteractionModel, utterance: str, slots: dict[str, str]
+) -> None:
+    understood = model.understand(utterance)
+    assert understood.intent == "SequentialDeliveryIntent"
+    # Each slot is what was said, or empty or unresolved (so the skill asks for it)
+    assert all(ids(understood).get(name) in (None, value) for name, value in slots.items())
+    # and the first robot is always the one said to go first
+    assert ids(understood).get("firstRobot") in (None, "placebot1")
