@@ -98,15 +98,20 @@ def _hear_file(args: argparse.Namespace) -> int:
 
 
 def _make_eval_set(args: argparse.Namespace) -> int:
-    from robot_agent.voice.evaluation import EVALUATION_SET, Phrasings, manifest_json, render
-    from vahr.speech.tts import EspeakSynthesizer
+    from robot_agent.voice.evaluation import (
+        EVALUATION_SET,
+        Phrasings,
+        manifest_json,
+        render,
+        synthesizer_for_voice,
+    )
 
     source: Path = args.phrasings or EVALUATION_SET
     phrasings = Phrasings.load(source)
     directory: Path = args.make_eval_set
     try:
         directory.mkdir(parents=True, exist_ok=True)
-        manifest = render(phrasings, directory, EspeakSynthesizer, source=source.name)
+        manifest = render(phrasings, directory, synthesizer_for_voice, source=source.name)
     except SpeechError as err:
         raise VahrError(str(err)) from err
     except OSError as err:

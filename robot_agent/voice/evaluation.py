@@ -1,10 +1,12 @@
 """The spoken evaluation of the robot's hearing: render a set of answers, score a hearing.
 
-A phrasings file (`data/hearing-eval.yaml`, `data/hearing-tuning.yaml`) names espeak-ng
-voices, noise levels, a seed, the answers per intent and unrelated sentences. `render`
+A phrasings file (`data/hearing-eval.yaml`, `data/hearing-tuning.yaml`) names voices
+(`ENGINE:VOICE` as `vahr.speech.tts.make_synthesizer` reads them, `flite:slt`,
+`festival:cmu_us_slt_arctic_hts`; a bare name is an espeak-ng voice), noise levels, a seed,
+the answers per intent and unrelated sentences. `render`
 speaks every sentence in every voice, clean and with white noise at each SNR, into a
 directory with a `manifest.json`; the same file gives byte-identical audio on every run
-(espeak-ng is deterministic, and each clip's noise comes from a generator seeded by the
+(the synthesizers are deterministic, and each clip's noise comes from a generator seeded by the
 set's seed and the clip's name, not by the order of rendering). `score` hears every clip
 of such a directory and counts, per condition and expected intent, what came back:
 
@@ -87,6 +89,14 @@ class Manifest(msgspec.Struct, frozen=True):
         """One fingerprint of all the audio: equal digests mean identical sets."""
         joined = "".join(f"{clip.file}:{clip.sha256}\n" for clip in self.clips)
         return hashlib.sha256(joined.encode()).hexdigest()
+
+
+def synthesizer_for_voice(voice: str) -> Any:
+    """The synthesizer of a phrasings file's voice: `ENGINE:VOICE`, or a bare espeak-ng
+    voice name (`en-us+f4`) as the older sets list them."""
+    from vahr.speech.tts import make_synthesizer
+
+    return make_synthesizer(voice if ":" in voice else f"espeak-ng:{voice}")
 
 
 def condition_name(snr_db: float | None) -> str:

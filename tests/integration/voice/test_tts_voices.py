@@ -3,10 +3,16 @@ and a voice that does not exist is refused in one line."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import pytest
 
+from robot_agent.voice.evaluation import Phrasings, render, synthesizer_for_voice
 from vahr.speech.errors import SpeechError
 from vahr.speech.tts import engine_of, make_synthesizer, voice_names
+
+if TYPE_CHECKING:
+    from pathlib import Path
 
 
 @pytest.mark.parametrize(
@@ -39,3 +45,18 @@ def test_an_unknown_voice_is_refused_in_one_line(voice: str, says: str) -> None:
         make_synthesizer(voice).synthesize("zone b")
     assert says in str(caught.value)
     assert "\n" not in str(caught.value)
+
+
+def test_the_robots_evaluation_sets_name_voices_of_any_engine(tmp_path: Path) -> None:
+    phrasings = Phrasings(
+        voices=["en-us+f4", "flite:kal"],
+        snr_db=[],
+        seed=1,
+        answers={"sunny": ["it is sunny"]},
+        unrelated=["open the door"],
+    )
+    manifest = render(phrasings, tmp_path, synthesizer_for_voice)
+    assert sorted({clip.voice for clip in manifest.clips}) == ["en-us+f4", "flite:kal"]
+    # The same file renders the same audio again, whichever engine spoke it.
+    again = render(phrasings, tmp_path / "again", synthesizer_for_voice)
+    assert again.digest() == manifest.digest()
