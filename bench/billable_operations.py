@@ -11,6 +11,12 @@ counts for a 5-minute session with 2 robots: polling costs the same whether anyt
 happens or not, so nothing needs to sleep for 5 minutes. Costs in USD come from
 `infra/cost_estimate.py` (its list prices and metering rules).
 Run: `.venv/bin/python bench/billable_operations.py`.
+
+`--fleet` measures instead what one dispatched task and one status question cost on AWS for
+10, 1,000 and 10,000 robots, with fleet indexing beside reading every robot's shadow: the
+dispatcher's handler runs a submit and the event that closes the task under moto, against
+a fleet index on boto3's `iot` wire holding that many idle robots, and every AWS call it
+makes is counted (tests/support/dispatch_meter.py); the prices are `infra/cost_estimate.py`'s.
 """
 
 from __future__ import annotations
@@ -222,5 +228,113 @@ average; an idle hour is {ROBOTS} robots connected (and polling). Months: {LAB.n
     return 0
 
 
+FLEET_SIZES = (10, 1_000, 10_000)
+TASK_COLUMNS = (
+    "robots", "SearchIndex calls (measured)", "table reads / writes (measured)", "commands",
+    "operations, index", "µUSD, index", "shadow operations instead", "operations, shadows",
+    "µUSD, shadows", "shadows / index",
+)  # fmt: skip
+STATUS_COLUMNS = (
+    "robots", "index queries", "µUSD, index", "shadow operations instead", "µUSD, shadows",
+    "shadows / index",
+)  # fmt: skip
+
+
+def table_head(columns: tuple[str, ...]) -> str:
+    """A Markdown table's header and its right-aligned rule."""
+    return f"| {' | '.join(columns)} |\n|{' ---: |' * len(columns)}"
+
+
+def fleet_main() -> int:
+    """Billable operations per dispatched task and per status question, by fleet size."""
+    from moto import mock_aws
+
+    from infra.cost_estimate import DispatchUsage, dispatch_billable, status_billable
+    from tests.support.dispatch_meter import measure_dispatch
+
+    for name in ("AWS_ACCESS_KEY_ID", "AWS_SECRET_ACCESS_KEY"):
+        os.environ.setdefault(name, "bench")
+    os.environ.setdefault("AWS_DEFAULT_REGION", "us-east-1")
+    load = Path("/proc/loadavg").read_text().split()[0]
+    usage = DispatchUsage()
+    task_rows, status_rows = [], []
+    for robots in FLEET_SIZES:
+        with mock_aws():
+            measured = measure_dispatch(robots)
+        calls = measured.submit.calls + measured.freed.calls
+        reads = measured.submit.reads + measured.freed.reads
+        writes = measured.submit.writes + measured.freed.writes
+        if (reads, writes) != (usage.table_reads, usage.table_writes):
+            model = f"{usage.table_reads:g}/{usage.table_writes:g}"
+            raise SystemExit(f"measured {reads:g}/{writes:g} table units, modelled {model}")
+        by_index = dispatch_billable(robots, index=True)
+        by_shadows = dispatch_billable(robots, index=False)
+        if calls["SearchIndex"] != by_index.index_queries:
+            raise SystemExit(f"{calls['SearchIndex']} SearchIndex calls, modelled "
+                             f"{by_index.index_queries:g}")  # fmt: skip
+        index_usd, shadows_usd = by_index.cost(PRICES), by_shadows.cost(PRICES)
+        task_rows.append(
+            f"| {robots:,} | {calls['SearchIndex']} | {reads:g} / {writes:g} | "
+            f"{calls['Publish']} | {by_index.operations():,.0f} | {index_usd * 1e6:,.1f} | "
+            f"{by_shadows.shadow_operations:,.0f} | {by_shadows.operations():,.0f} | "
+            f"{shadows_usd * 1e6:,.1f} | {shadows_usd / index_usd:,.1f}x |"
+        )
+        asked = status_billable(robots, index=True)
+        read_all = status_billable(robots, index=False)
+        status_rows.append(
+            f"| {robots:,} | {asked.index_queries:g} | {asked.cost(PRICES) * 1e6:,.1f} | "
+            f"{read_all.shadow_operations:,.0f} | {read_all.cost(PRICES) * 1e6:,.1f} | "
+            f"{read_all.cost(PRICES) / asked.cost(PRICES):,.1f}x |"
+        )
+    body = f"""
+What one dispatched task and one status question cost on AWS, by fleet size, with fleet
+indexing (VAHR with `-c dispatcher=true`) beside reading every robot's shadow. Counted on
+the dispatcher's own handler (`bench/billable_operations.py --fleet`): a delivery submitted
+to a fleet of idle, connected robots, then the event that closes it when the robot reports
+it done, with the task table in moto's DynamoDB and the candidates from a fleet index
+answering boto3's `iot` client with AWS's 100-thing pages; every AWS call and the DynamoDB
+request units it bills were counted. Load average {load} when it ran.
+
+Per dispatched task. Both designs share the measured table units, two Lambda requests (the
+skill's submit, the robot-freed event), the command (3 messages) and the dispatcher rule
+({usage.shadow_updates} shadow updates of the robot matched by its topic filter, one
+action). Fleet indexing adds its queries (one per 100 candidates) and an index update per
+shadow update ({usage.shadow_updates}); reading shadows adds two shadow operations (a 1-2 KB
+document) per robot instead. Every robot is a candidate here (all idle), the most the index
+can return.
+
+{table_head(TASK_COLUMNS)}
+{chr(10).join(task_rows)}
+
+Per status question ("where are the robots"): the skill's summary on fleet indexing asks
+three queries (counts by status, robots offline, one page of the robots it names) whatever
+the fleet's size, against a shadow read per robot; both count the skill's one Lambda
+request. Keeping the index costs an update per shadow update (USD 2.25 per million),
+counted above with the tasks that cause them.
+
+{table_head(STATUS_COLUMNS)}
+{chr(10).join(status_rows)}
+
+Prices: AWS list prices of {PRICES_AS_OF} in us-east-1 (`infra/cost_estimate.py`; fleet
+indexing from aws.amazon.com/iot-device-management/pricing: USD 0.05 per 10,000 queries,
+USD 2.25 per million 1 KB index updates). At 10 robots the two designs cost about the same
+per task (the index's updates weigh as much as ten shadow reads); from a few hundred robots
+on, reading every shadow costs more per task and per question, and its latency grows with
+the fleet (one GetThingShadow per robot) where the index's grows by a page per 100 robots.
+"""
+    write_section(
+        "billable_operations_fleet",
+        "Billable AWS operations per dispatched task and per status question, by fleet size",
+        body,
+        script="billable_operations",
+    )
+    return 0
+
+
 if __name__ == "__main__":
+    if sys.argv[1:] == ["--fleet"]:
+        raise SystemExit(fleet_main())
+    if sys.argv[1:]:
+        print("usage: bench/billable_operations.py [--fleet]", file=sys.stderr)
+        raise SystemExit(2)
     raise SystemExit(main())
