@@ -11,6 +11,8 @@ quoted ("zone C"). The fields are the ones VAHR's robots report and the skill as
 | `shadow.reported.status` | the robot's status (`idle`, `navigating`, `stuck`, ...) |
 | `shadow.reported.zone` | the zone the robot reports being in |
 | `connectivity.connected` / `shadow.reported.connected` | `true` or `false` |
+| `shadow.reported.last_command.id` | the id of the last command the robot saw |
+| `shadow.reported.last_command.result` | what became of it (`accepted`, `done`, `rejected`, ...) |
 
 Anything else is a `QueryError` whose message is one line, which the data plane returns
 as AWS's `InvalidQueryException`. Parsing is pure: `parse` gives a tree of `Term`, `Not`,
@@ -28,7 +30,11 @@ ZONE = "shadow.reported.zone"
 CONNECTED = "connectivity.connected"
 # The robots' own report of the same flag (the local presence rule writes it).
 REPORTED_CONNECTED = "shadow.reported.connected"
-FIELDS = (THING_NAME, STATUS, ZONE, CONNECTED, REPORTED_CONNECTED)
+# Which robots acknowledged a command, without reading every shadow (the skill's fleet
+# commands).
+COMMAND_ID = "shadow.reported.last_command.id"
+COMMAND_RESULT = "shadow.reported.last_command.result"
+FIELDS = (THING_NAME, STATUS, ZONE, CONNECTED, REPORTED_CONNECTED, COMMAND_ID, COMMAND_RESULT)
 # AWS's limit on a query string's length.
 MAX_QUERY_CHARS = 1000
 

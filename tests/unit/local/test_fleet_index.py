@@ -116,3 +116,23 @@ def test_a_bad_query_is_one_line_naming_the_problem(query: str, message: str) ->
 def test_an_aggregation_over_a_field_not_kept_is_refused(store: ShadowStore) -> None:
     with pytest.raises(AggregationError, match="Unsupported aggregation field 'thingName'"):
         store.index.buckets("thingName:*", "thingName")
+
+
+def test_who_acknowledged_a_command_is_a_query_not_a_read_per_robot(store: ShadowStore) -> None:
+    _report(store, "rover1", last_command={"id": "c-7", "action": "navigate", "result": "accepted"})
+    _report(store, "rover2", last_command={"id": "c-7", "action": "navigate", "result": "rejected"})
+    _report(store, "rover10", last_command={"id": "c-6", "action": "navigate", "result": "done"})
+    index = store.index
+    assert names(index.search("shadow.reported.last_command.id:c-7")) == ["rover1", "rover2"]
+    silent = "thingName:rover* AND NOT shadow.reported.last_command.id:c-7"
+    assert names(index.search(silent)) == ["rover10"]
+    total, buckets = index.buckets(
+        "shadow.reported.last_command.id:c-7", "shadow.reported.last_command.result"
+    )
+    assert (total, buckets) == (2, [("accepted", 1), ("rejected", 1)])
+    # A robot's next command moves it from one id to the other.
+    _report(
+        store, "rover10", last_command={"id": "c-7", "action": "navigate", "result": "accepted"}
+    )
+    assert index.statistics("shadow.reported.last_command.id:c-7") == 3
+    assert index.statistics("shadow.reported.last_command.id:c-6") == 0
