@@ -1,6 +1,7 @@
 """The monthly AWS cost of a VAHR lab, computed from billable operation counts.
 
     python -m infra.cost_estimate [--lex] [--skill]
+    python -m infra.cost_estimate --fleet
 
 Every count comes from what the code does on the wire (DESIGN.md's loop, the robot's
 events and shadow updates, the skill's publish-then-poll), multiplied out for the usage
@@ -430,11 +431,40 @@ def markdown(lines: list[Line]) -> str:
     return "\n".join(rows)
 
 
+FLEET_SIZES = (10, 1_000, 10_000)
+
+
+def fleet_markdown(prices: Prices, usage: DispatchUsage = DispatchUsage()) -> str:
+    """USD per dispatched task and per status question by fleet size, fleet indexing beside
+    reading every shadow, as a Markdown table."""
+    rows = [
+        "| robots | task, index (µUSD) | task, reading shadows (µUSD) | "
+        "status question, index (µUSD) | status question, reading shadows (µUSD) |",
+        "| ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for robots in FLEET_SIZES:
+        figures = (
+            dispatch_billable(robots, index=True, usage=usage),
+            dispatch_billable(robots, index=False, usage=usage),
+            status_billable(robots, index=True, usage=usage),
+            status_billable(robots, index=False, usage=usage),
+        )
+        cells = " | ".join(f"{billable.cost(prices) * 1e6:,.1f}" for billable in figures)
+        rows.append(f"| {robots:,} | {cells} |")
+    return "\n".join(rows)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m infra.cost_estimate", description=__doc__)
     parser.add_argument("--lex", action="store_true", help="robots interpret answers with Lex")
     parser.add_argument("--skill", action="store_true", help="the skill is deployed by CDK")
+    parser.add_argument(
+        "--fleet", action="store_true", help="per task and status question, by fleet size"
+    )
     args = parser.parse_args(argv)
+    if args.fleet:
+        print(fleet_markdown(Prices()))
+        return 0
     print(markdown(estimate(LabUsage(), Prices(), lex=args.lex, skill=args.skill)))
     return 0
 

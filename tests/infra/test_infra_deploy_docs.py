@@ -8,7 +8,7 @@ from dataclasses import replace
 import pytest
 from template_tools import REPO_ROOT
 
-from infra.cost_estimate import LabUsage, Prices, estimate, markdown
+from infra.cost_estimate import LabUsage, Prices, estimate, fleet_markdown, markdown
 
 DEPLOY_DOC = REPO_ROOT / "docs" / "deploy.md"
 
@@ -20,6 +20,12 @@ def test_the_cost_tables_in_the_deploy_guide_are_the_estimates_output(
     table = markdown(estimate(LabUsage(), Prices(), lex=lex, skill=skill))
     assert table in DEPLOY_DOC.read_text(), (
         "run `python -m infra.cost_estimate` and update docs/deploy.md"
+    )
+
+
+def test_the_fleet_dispatch_table_in_the_deploy_guide_is_the_models_output() -> None:
+    assert fleet_markdown(Prices()) in DEPLOY_DOC.read_text(), (
+        "run `python -m infra.cost_estimate --fleet` and update docs/deploy.md"
     )
 
 
