@@ -18,7 +18,7 @@ import msgspec
 
 from dispatcher.command_channel import CommandChannel
 from dispatcher.config import DispatcherConfig
-from dispatcher.errors import BadRequest, DispatcherError
+from dispatcher.errors import BadRequest, ConfigError, DispatcherError
 from dispatcher.fleet_search import FleetSearch, robot_state
 from dispatcher.requests import (
     OPERATIONS,
@@ -35,7 +35,7 @@ from dispatcher.robot_updates import robot_freed
 from dispatcher.task_table import TaskTable
 from vahr.protocol import load_fleet
 from vahr.protocol.dispatch import Dispatcher, DispatchError
-from vahr.protocol.errors import from_validation_error
+from vahr.protocol.errors import ProtocolError, from_validation_error
 
 log = logging.getLogger("dispatcher")
 
@@ -45,8 +45,12 @@ def runtime() -> Dispatcher:
     """Built once per cold start: configuration, fleet, adapters, the core."""
     config = DispatcherConfig.from_env()
     log.setLevel(config.log_level)
+    try:
+        fleet = load_fleet(config.fleet_file)
+    except ProtocolError as err:
+        raise ConfigError(f"the fleet file {config.fleet_file or '(bundled)'}: {err}") from err
     return Dispatcher(
-        fleet=load_fleet(config.fleet_file),
+        fleet=fleet,
         store=TaskTable(config.table, closed_task_days=config.closed_task_days),
         candidates=FleetSearch(index_name=config.index_name),
         publish=CommandChannel(config.iot_data_endpoint),

@@ -20,7 +20,7 @@ from moto.iotdata.models import iotdata_backends
 from dispatcher import app
 from dispatcher.command_channel import CommandChannel
 from dispatcher.config import DispatcherConfig
-from dispatcher.errors import ConfigError
+from dispatcher.errors import ConfigError, DispatcherError
 from dispatcher.fleet_search import FleetSearch
 from vahr.local.dataplane import DataPlane, DataPlaneServer
 from vahr.local.meter import Meter
@@ -260,3 +260,31 @@ def test_the_configuration_is_read_once_and_refuses_a_missing_table() -> None:
 def test_the_answer_is_plain_json(dispatcher: Dispatcher) -> None:
     answer = submit(dispatcher, zone="B")
     assert msgspec.json.decode(msgspec.json.encode(answer)) == answer
+
+
+def test_the_lambda_entry_point_builds_its_adapters_from_the_environment(
+    dynamodb: Any,
+    index: Index,
+    published: list[tuple[str, dict[str, Any]]],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # Given the environment the CDK stack sets (the index reached through boto3's own
+    # variable for the IoT control plane)
+    index.report("placebot2", status="idle", zone="B", pose={"x": 9.0, "y": 5.0})
+    monkeypatch.setenv("VAHR_TASK_TABLE", "vahr-tasks")
+    monkeypatch.setenv("AWS_ENDPOINT_URL_IOT", index.server.url)
+    app.runtime.cache_clear()
+    try:
+        # When the skill invokes the function
+        answer = app.lambda_handler({"operation": "submit", "order": {"zone": "A"}}, None)
+        # Then the task is placebot2's and its command is on placebot2's topic
+        [task] = answer["body"]["assigned"]
+        assert task["thing"] == "placebot2"
+        assert [topic for topic, _ in published] == [topics.robot_cmd("placebot2")]
+        # And a missing table is a failed invocation with one line, not an answer
+        monkeypatch.setenv("VAHR_TASK_TABLE", "no-such-table")
+        app.runtime.cache_clear()
+        with pytest.raises(DispatcherError, match=r"^cannot add task \w+: ResourceNotFound"):
+            app.lambda_handler({"operation": "submit", "order": {"zone": "A"}}, None)
+    finally:
+        app.runtime.cache_clear()
