@@ -103,6 +103,52 @@ def swarm_process(broker: str, size: int, ready: Any, stop: Any) -> None:
         stop.wait(7200)
 
 
+def feed_cost(robots: int, rounds: int = 5) -> dict[str, float]:
+    """The station's own cost per robot update, apart from the machine's other work: a feed
+    with one page takes `rounds` shadow documents and progress events of every robot (as
+    the broker hands them over), and the page takes them once per round. Microseconds per
+    document and per event, on one core; the best of three, as the least disturbed."""
+    from vahr.protocol import Event, EventPose, utc_now
+    from vahr.station.feed import Feed
+
+    fleet = swarm_fleet(robots)
+    documents, events = [], []
+    for version in range(2, 2 + rounds):
+        for index, thing in enumerate(fleet.robot_things):
+            reported = {
+                "status": "navigating", "zone": None, "cargo": False, "destination": "A",
+                "pose": {"x": index + version * 0.1, "y": 2.0, "theta": 0.1}, "connected": True,
+                "last_command": {"id": "c" * 32, "action": "navigate", "result": "accepted"},
+            }  # fmt: skip
+            state = {"state": {"reported": reported}, "metadata": {}}
+            document = {
+                "previous": {**state, "version": version - 1},
+                "current": {**state, "version": version},
+                "timestamp": version,
+            }
+            documents.append((topics.shadow(thing, "update/documents"), json.dumps(document)))
+            event = Event(event="progress", thing=thing, at=utc_now(), progress=0.5,
+                          pose=EventPose(1.0, 2.0))  # fmt: skip
+            events.append((topics.robot_events(thing), encode(event)))
+    best = {"document_us": float("inf"), "event_us": float("inf")}
+    for _ in range(3):
+        feed = Feed(fleet)
+        page = feed.subscribe()
+        page.take(0)
+        started = time.perf_counter()
+        for topic, payload in documents:
+            feed.on_shadow_documents(topic, payload.encode())
+        page.take(0)
+        middle = time.perf_counter()
+        for topic, event_payload in events:
+            feed.on_event(topic, event_payload)
+        page.take(0)
+        ended = time.perf_counter()
+        best["document_us"] = min(best["document_us"], (middle - started) / len(documents) * 1e6)
+        best["event_us"] = min(best["event_us"], (ended - middle) / len(events) * 1e6)
+    return {key: round(value, 1) for key, value in best.items()}
+
+
 def heap_mb(cdp: Any) -> float:
     metrics = {m["name"]: m["value"] for m in cdp.send("Performance.getMetrics")["metrics"]}
     return float(metrics["JSHeapUsedSize"]) / 1e6
@@ -148,6 +194,7 @@ def main() -> int:
             run_args.presses = 0
         latencies, result = measure(run_args)
         runs.append(figures(size, latencies, result, load_before))
+        runs[-1]["feed"] = feed_cost(size)
         print(json.dumps(runs[-1]), flush=True)
     report(args, runs)
     main_run = runs[-1]
@@ -349,6 +396,9 @@ def report(args: argparse.Namespace, runs: list[dict[str, Any]]) -> None:
         row("of which the broker to the page's receipt, p95", "received_p95_ms"),
         row("shadow updates painted", "updates_painted", ""),
         row("messages the page received", "page_messages", ""),
+        "| the station's feed alone, per shadow document / per progress event (one core) | "
+        + " | ".join(f"{run['feed']['document_us']} / {run['feed']['event_us']} µs" for run in runs)
+        + " |",
         row("page JS heap after warm-up", "heap_start_mb", "MB"),
         row(f"page JS heap after {args.minutes:g} minutes (after garbage collection)",
             "heap_end_mb", "MB"),
