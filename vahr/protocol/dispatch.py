@@ -250,24 +250,35 @@ def rank(
 ) -> list[RobotState]:
     """The robots allowed to take `task`, best first: idle before busy, then by cost, then
     by thing name. With `limit`, only the best `limit` (a partial sort: 10,000 robots are
-    ranked without sorting them all)."""
-    keyed = (
-        (
-            0 if robot.idle else 1,
-            task_cost(fleet, robot_pose(fleet, robot), task, path_length),
-            robot.thing,
-            robot,
-        )
-        for robot in robots
-        if task.allows(robot.thing)
-    )
+    ranked without sorting them all).
+
+    The cost is `task_cost`, computed here with the pickup and drop looked up once: the
+    leg from the pickup to the drop is the same for every robot.
+    """
+    drop = fleet.zone(task.zone).pose
+    pickup = fleet.zone(task.pickup).pose if task.pickup is not None else None
+    first = pickup or drop
+    rest = path_length(pickup, drop) if pickup is not None else 0.0
+    allowed = frozenset(task.robots)
+    hypot, fx, fy = math.hypot, first.x, first.y
+    straight = path_length is straight_line
+    keyed: list[tuple[bool, float, str, RobotState]] = []
+    for robot in robots:
+        if allowed and robot.thing not in allowed:
+            continue
+        pose = robot.pose if robot.pose is not None else robot_pose(fleet, robot)
+        to_first = hypot(pose.x - fx, pose.y - fy) if straight else path_length(pose, first)
+        # False sorts before True: idle robots first.
+        keyed.append((robot.status not in IDLE_STATUSES, to_first + rest, robot.thing, robot))
+    # Tuples compare field by field and thing names are unique, so the states themselves
+    # are never compared.
     if limit is None:
-        return [entry[3] for entry in sorted(keyed, key=_rank_key)]
-    return [entry[3] for entry in heapq.nsmallest(limit, keyed, key=_rank_key)]
-
-
-def _rank_key(entry: tuple[int, float, str, RobotState]) -> tuple[int, float, str]:
-    return entry[0], entry[1], entry[2]
+        keyed.sort()
+    elif limit == 1:
+        keyed = [min(keyed)] if keyed else []
+    else:
+        keyed = heapq.nsmallest(limit, keyed)
+    return [entry[3] for entry in keyed]
 
 
 def timestamp(moment: datetime) -> str:
@@ -438,7 +449,8 @@ class Dispatcher:
                 self._check_count(order.count, len(group), f"the group {order.group}")
                 members = [list(group)] * order.count
         elif order.origin is not None or order.idle:
-            members = [[robot.thing] for robot in self._free(zone=order.origin, idle=order.idle)]
+            free = self._free(zone=order.origin, idle=order.idle)
+            members = [[thing] for thing in sorted(robot.thing for robot in free)]
         else:
             count = 1 if order.count is None else order.count
             self._check_count(count, len(fleet.robots), "the fleet")
@@ -480,17 +492,14 @@ class Dispatcher:
             raise DispatchError(f"{what} has {most} {robots}; {count} cannot go")
 
     def _free(self, *, zone: str | None = None, idle: bool = False) -> list[RobotState]:
-        """Available robots that hold no task, in name order."""
+        """Available robots that hold no task (in the candidates' order)."""
         holding = {task.thing for task in self.store.active()}
         robots = self.candidates.available(zone=zone)
-        return sorted(
-            (
-                robot
-                for robot in robots
-                if robot.available and robot.thing not in holding and (robot.idle or not idle)
-            ),
-            key=lambda robot: robot.thing,
-        )
+        return [
+            robot
+            for robot in robots
+            if robot.available and robot.thing not in holding and (robot.idle or not idle)
+        ]
 
     def _give(self, task: Task) -> Task | None:
         """Assign `task` to the best free robot that will take it, trying the next when a
