@@ -36,6 +36,7 @@ from skill.handlers.weather import WeatherIntentHandler
 from skill.handlers.weather_delivery import WeatherDeliveryIntentHandler
 from skill.interceptors import (
     CorrelationIdInterceptor,
+    LocaleInterceptor,
     RequestLogInterceptor,
     ResponseLogInterceptor,
 )
@@ -83,6 +84,8 @@ def build_skill_builder(runtime: SkillRuntime) -> SkillBuilder:
     for handler in request_handlers(runtime):
         builder.add_request_handler(handler)
     # The correlation id is set before anything is logged.
+    # First: every reply of the request, errors included, is in the request's locale.
+    builder.add_global_request_interceptor(LocaleInterceptor())
     builder.add_global_request_interceptor(CorrelationIdInterceptor())
     builder.add_global_request_interceptor(RequestLogInterceptor())
     builder.add_global_response_interceptor(ResponseLogInterceptor())

@@ -6,6 +6,9 @@ Robot names come from fleet.yaml (their first spoken name) and zone names from
 
 from __future__ import annotations
 
+import sys
+
+from skill.catalog import localise
 from vahr.protocol.assistant import INVOCATION_NAME
 from vahr.protocol.weather import WEATHERS
 
@@ -154,3 +157,10 @@ WEATHER = {weather: f"The weather is {weather}." for weather in WEATHERS}
 GATEWAY_ERROR = "Sorry, I could not reach the robots just now. Please try again in a moment."
 GENERIC_ERROR = "Sorry, something went wrong on my side. Please try again."
 ERROR_REPROMPT = "What would you like the robots to do?"
+
+# The word before the last of several choices ("zone a, zone b, or zone c").
+OR = "or"
+
+# Every other locale's sentences are vahr/protocol/locales/<locale>/replies.yaml, under these
+# names; the request's locale chooses (skill.catalog).
+localise(sys.modules[__name__])
