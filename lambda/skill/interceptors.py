@@ -1,4 +1,5 @@
-"""Request and response interceptors: the per-request correlation id and the log lines."""
+"""Request and response interceptors: the request's language, the per-request correlation
+id and the log lines."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from ask_sdk_core.dispatch_components import (
     AbstractResponseInterceptor,
 )
 
+from skill.catalog import use_locale
 from skill.logs import correlation_id, log_event
 
 if TYPE_CHECKING:
@@ -19,6 +21,15 @@ if TYPE_CHECKING:
 
 CORRELATION_ID = "correlation_id"
 STARTED = "started"
+
+
+class LocaleInterceptor(AbstractRequestInterceptor):
+    """Answer in the request's locale (`request.locale`, "de-DE"), English when the skill has
+    no catalog for it: every `prompts.NAME` of this request is then that locale's message."""
+
+    def process(self, handler_input: HandlerInput) -> None:
+        request = handler_input.request_envelope.request
+        use_locale(getattr(request, "locale", None))
 
 
 class CorrelationIdInterceptor(AbstractRequestInterceptor):

@@ -2,18 +2,24 @@
 
 Everything comes from fleet.yaml: a robot is called by its first spoken name ("placebot
 one"), a zone by the spoken name that reads well in a sentence ("zone A", "the loading
-zone"), and the whole fleet by the `all` group's names.
+zone"), and the whole fleet by the `all` group's names. In another locale than en-US the
+names are those of `spoken_by_locale` (`vahr.protocol.fleet.spoken_in`), read for the
+request's locale (`skill.catalog`): "placebot eins", "Zone A", "Ladezone". Names heard are
+looked up in every language the fleet file gives.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from skill import prompts
+from skill.catalog import current_locale
 from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
+from vahr.protocol.fleet import SPOKEN_LOCALE, spoken_in
 from vahr.protocol.text import normalize
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet, Zone
+    from vahr.protocol import Fleet, Group, Robot, Zone
 
 # The ROBOT slot value (and target) that means every robot; it matches the generator's id.
 FLEET = FLEET_GROUP
@@ -44,10 +50,20 @@ def capitalise(sentence: str) -> str:
 
 
 def join_choices(names: list[str]) -> str:
-    """'a', 'a or b', 'a, b, or c'."""
+    """'a', 'a or b', 'a, b, or c' (in German 'a, b oder c')."""
+    word = prompts.OR
     if len(names) <= 2:
-        return " or ".join(names)
-    return ", ".join(names[:-1]) + ", or " + names[-1]
+        return f" {word} ".join(names)
+    serial = "," if current_locale() == SPOKEN_LOCALE else ""
+    return ", ".join(names[:-1]) + f"{serial} {word} " + names[-1]
+
+
+def _named_in_locale(names: list[str]) -> str:
+    # Outside English a zone is called by its first name, its nouns capitalised as written
+    # ("zone a" -> "Zone A", "ladezone" -> "Ladezone"): sentences need no article for it.
+    return " ".join(
+        word.upper() if len(word) == 1 else word.capitalize() for word in names[0].split()
+    )
 
 
 class Vocabulary:
@@ -60,16 +76,20 @@ class Vocabulary:
         self._robot_ids: dict[str, str] = {FLEET: FLEET}
         for name in self.fleet_names:
             self._robot_ids[normalize(name)] = FLEET
+        self._group = group
         for robot in fleet.robots:
             self._robot_ids[robot.thing.lower()] = robot.thing
-            for name in robot.spoken:
-                self._robot_ids[normalize(name)] = robot.thing
+            for name in _every_name(robot):
+                self._robot_ids.setdefault(normalize(name), robot.thing)
+        if group is not None:
+            for name in _every_name(group):
+                self._robot_ids.setdefault(normalize(name), FLEET)
         self._zone_ids: dict[str, str] = {}
         self._zone_names: dict[str, str] = {}
         for zone in fleet.zones:
             self._zone_ids[zone.id.lower()] = zone.id
-            for name in zone.spoken:
-                self._zone_ids[normalize(name)] = zone.id
+            for name in _every_name(zone):
+                self._zone_ids.setdefault(normalize(name), zone.id)
             self._zone_names[zone.id] = zone_phrase(zone)
 
     @property
@@ -79,11 +99,18 @@ class Vocabulary:
 
     def robot(self, thing: str) -> str:
         """What to call a robot (or the fleet) in speech, in lower case."""
+        locale = current_locale()
         if thing == FLEET:
+            if locale != SPOKEN_LOCALE and self._group is not None:
+                return normalize(spoken_in(self._group, locale)[0])
             return normalize(self.fleet_names[0])
-        return normalize(self.fleet.spoken_name(thing))
+        return normalize(self.fleet.spoken_name(thing, locale))
 
     def zone(self, zone_id: str) -> str:
+        locale = current_locale()
+        if locale != SPOKEN_LOCALE and zone_id in self.fleet.zone_ids:
+            zone = next(zone for zone in self.fleet.zones if zone.id == zone_id)
+            return _named_in_locale(spoken_in(zone, locale))
         return self._zone_names.get(zone_id, f"zone {zone_id}")
 
     def robot_id(self, heard: str) -> str | None:
@@ -116,3 +143,8 @@ class Vocabulary:
             "zone": self.zone(zones[0]),
             "other_zone": self.zone(zones[1 % len(zones)]),
         }
+
+
+def _every_name(entry: Robot | Zone | Group) -> list[str]:
+    """A robot's, zone's or group's names in every language the fleet file gives."""
+    return [*entry.spoken, *(name for names in entry.spoken_by_locale.values() for name in names)]

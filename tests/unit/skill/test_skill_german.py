@@ -1,0 +1,78 @@
+"""The skill answers in the request's locale: a German request gets German sentences from
+the de-DE catalog, an English one the English sentences, and the German catalog has every
+message of the English one with the same placeholders."""
+
+from __future__ import annotations
+
+import string
+from typing import Any
+
+import pytest
+from skill_testkit import RobotDoubles, speech
+
+from skill import catalog, prompts
+from tests.conftest import load_event
+
+
+def _messages() -> dict[str, Any]:
+    """The en-US catalog: every upper-case name of skill.prompts that is a message."""
+    catalog.use_locale("en-US")
+    return {
+        name: getattr(prompts, name)
+        for name in dir(prompts)
+        if name.isupper() and name not in ("INVOCATION_NAME", "WEATHERS")
+    }
+
+
+def _fields(message: Any) -> Any:
+    """The placeholders of a message, in its shape (a dict's by key, a tuple's in order)."""
+    if isinstance(message, dict):
+        return {key: _fields(value) for key, value in message.items()}
+    if isinstance(message, (tuple, list)):
+        return [_fields(value) for value in message]
+    return sorted({field for _, field, _, _ in string.Formatter().parse(message) if field})
+
+
+def test_every_english_message_has_a_german_translation_with_its_placeholders() -> None:
+    german = catalog.replies("de-DE")
+    for name, english in _messages().items():
+        assert name in german, f"de-DE replies.yaml lacks {name}"
+        if name == "ORDINALS":
+            assert len(german[name]) == len(english)
+            continue
+        # The same placeholders; MEMBERS_BUSY's English {verb} ("is"/"are") has no use in
+        # the German sentence, which is built so that it needs none.
+        expected = _fields(english)
+        if name == "MEMBERS_BUSY":
+            expected.remove("verb")
+        assert _fields(german[name]) == expected, name
+
+
+def test_the_robots_weather_sentence_stays_english_in_german() -> None:
+    # The robots hear the weather with an English recognizer.
+    assert catalog.replies("de-DE")["WEATHER"] == {k: v for k, v in _messages()["WEATHER"].items()}
+
+
+@pytest.mark.usefixtures("aws")
+def test_a_german_launch_is_welcomed_in_german_and_an_english_one_in_english(skill: Any) -> None:
+    assert speech(skill(load_event("alexa_launch_de"), None)).startswith(
+        "Willkommen bei Roboterflotte."
+    )
+    assert speech(skill(load_event("alexa_launch"), None)).startswith("Welcome to robot fleet.")
+
+
+def test_a_german_command_moves_the_robot_and_is_confirmed_in_german(
+    skill: Any, robots: RobotDoubles
+) -> None:
+    # Given robots that acknowledge, when a German request sends placebot eins to zone a
+    response = skill(load_event("alexa_navigate_de"), None)
+    # Then the robot got the command and the answer names it in German
+    assert [thing for thing, _, _ in robots.answered] == ["placebot1"]
+    assert speech(response) == "Placebot eins ist unterwegs Richtung Zone A."
+
+
+@pytest.mark.usefixtures("aws")
+def test_a_locale_without_a_catalog_is_answered_in_english(skill: Any) -> None:
+    event = load_event("alexa_launch")
+    event["request"]["locale"] = "fr-FR"
+    assert speech(skill(event, None)).startswith("Welcome to robot fleet.")
