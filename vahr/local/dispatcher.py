@@ -91,12 +91,15 @@ class IndexCandidates:
             entries = []
             for status in sorted(IDLE_STATUSES | BUSY_STATUSES):
                 entries += self.index.with_status(status)
-        robots, takes = self.robots, IDLE_STATUSES | BUSY_STATUSES
-        return [
-            self._state(entry)
-            for entry in entries
-            if entry.connected and entry.status in takes and entry.thing in robots
-        ]
+        robots, takes, read = self.robots, IDLE_STATUSES | BUSY_STATUSES, self._read
+        states = []
+        for entry in entries:
+            if not (entry.connected and entry.status in takes and entry.thing in robots):
+                continue
+            known = read.get(entry.thing)
+            fresh = known is not None and known[0] is entry
+            states.append(known[1] if fresh else self._state(entry))  # type: ignore[index]
+        return states
 
     def state(self, thing: str) -> RobotState | None:
         entry = self.index.get(thing)

@@ -495,10 +495,12 @@ class Dispatcher:
         """Available robots that hold no task (in the candidates' order)."""
         holding = {task.thing for task in self.store.active()}
         robots = self.candidates.available(zone=zone)
+        # `RobotState.available` and `.idle` spelled out: this runs for every robot.
+        takes = IDLE_STATUSES if idle else IDLE_STATUSES | BUSY_STATUSES
         return [
             robot
             for robot in robots
-            if robot.available and robot.thing not in holding and (robot.idle or not idle)
+            if robot.connected and robot.status in takes and robot.thing not in holding
         ]
 
     def _give(self, task: Task) -> Task | None:
