@@ -5,7 +5,7 @@ The station runs in-process on a real mosquitto, its task queue read from a disp
 dispatcher would), and its assistant records what it is asked. The page shows the queue and
 who took which task as the dispatcher's answer changes, hides the card when there is no
 dispatcher, and the keyboard-and-mouse panel's "Any robot" then a zone asks the assistant
-to send a robot there.
+to send a robot there. The first test writes docs/images/station-tasks.png.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from playwright.sync_api import sync_playwright
 
 from tests.support.browser import Watch, launch
 from tests.support.station import RecordingAssistant
+from tests.support.vahr_up import ROOT
 from vahr.local.mqtt import MqttClient, MqttEndpoint
 from vahr.local.ports import LOOPBACK, free_port
 from vahr.station.station import Station, StationConfig
@@ -35,6 +36,7 @@ if TYPE_CHECKING:
 
 pytestmark = pytest.mark.slow
 
+IMAGES = ROOT / "docs" / "images"
 VIEWPORT: ViewportSize = {"width": 1280, "height": 800}
 WAIT_MS = 15_000
 
@@ -143,6 +145,8 @@ def test_the_queue_and_who_took_which_task_follow_the_dispatcher(
         "two tasks in line",
     )  # fmt: skip
     assert page.locator("#task-count").inner_text() == "2 queued · 0 under way"
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    page.locator("#tasks").screenshot(path=str(IMAGES / "station-tasks.png"), animations="disabled")
     # When placebot one takes the first, and the second is cancelled
     dispatcher.tasks = [task("t1", "assigned", "placebot1"), task("t2", "cancelled", zone="B")]
     eventually(
