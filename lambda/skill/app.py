@@ -27,6 +27,8 @@ from skill.handlers.built_in import (
     StopIntentHandler,
 )
 from skill.handlers.catch_all import CatchAllExceptionHandler
+from skill.handlers.confirmation import DeniedIntentHandler
+from skill.handlers.correction import CorrectionIntentHandler, UndoIntentHandler
 from skill.handlers.deliver import DeliverIntentHandler
 from skill.handlers.emergency_stop import EmergencyStopIntentHandler
 from skill.handlers.navigate import NavigateIntentHandler
@@ -59,6 +61,8 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
     least frequent; SessionEndedRequest comes last as it never speaks.
     """
     return [
+        # A denied intent is answered before its own handler could act on it.
+        DeniedIntentHandler(),
         NavigateIntentHandler(runtime),
         DeliverIntentHandler(runtime),
         WeatherDeliveryIntentHandler(runtime),
@@ -67,6 +71,8 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
         ProblemRobotsIntentHandler(runtime),
         EmergencyStopIntentHandler(runtime),
         WeatherIntentHandler(runtime),
+        CorrectionIntentHandler(runtime),
+        UndoIntentHandler(runtime),
         LaunchRequestHandler(runtime),
         HelpIntentHandler(runtime),
         CancelIntentHandler(),

@@ -1,4 +1,8 @@
-"""Reading ROBOT and ZONE slots against the fleet, and asking again when they fall short."""
+"""Reading ROBOT and ZONE slots against the fleet, and asking again when they fall short.
+
+A value the words fit several ways ("zone b" heard as B or D) is asked about by name
+("Zone B or zone D?") rather than acted on; the answer fills the slot afresh.
+"""
 
 from __future__ import annotations
 
@@ -7,7 +11,7 @@ from typing import TYPE_CHECKING
 from skill import prompts
 from skill.responses import answer, elicit, may_ask_again
 from skill.slots import read_slot
-from skill.vocabulary import LOADING
+from skill.vocabulary import LOADING, capitalise, join_choices
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
@@ -45,6 +49,9 @@ def ask_robot(
     preface: str = "",
 ) -> Response:
     """Elicit a robot, listing the choices; say first when the last answer was unknown."""
+    if reading.choices:
+        names = [runtime.vocabulary.robot(thing) for thing in reading.choices]
+        return _ask(handler_input, runtime, reading.name, which_of(names))
     if reading.unresolved and not preface:
         preface = prompts.UNKNOWN_ROBOT.format(heard=reading.heard)
     choices = runtime.vocabulary.robot_choices(include_fleet=include_fleet)
@@ -74,9 +81,18 @@ def ask_zone(
     preface: str = "",
 ) -> Response:
     """Elicit a zone, listing the choices (only delivery zones when `deliverable`)."""
+    heard_as = [z for z in reading.choices if not (deliverable and z == LOADING)]
+    if len(heard_as) > 1:
+        names = [runtime.vocabulary.zone(zone_id) for zone_id in heard_as]
+        return _ask(handler_input, runtime, reading.name, which_of(names))
     if reading.unresolved and not preface:
         preface = prompts.UNKNOWN_ZONE.format(heard=reading.heard)
     robot_name = runtime.vocabulary.robot(robot_id) if robot_id else ""
     choices = runtime.vocabulary.zone_choices(deliverable=deliverable)
     text = question.format(choices=choices, robot=robot_name)
     return _ask(handler_input, runtime, reading.name, preface + text)
+
+
+def which_of(names: list[str]) -> str:
+    """The targeted question for a value heard several ways: "Zone B or zone D?"."""
+    return capitalise(prompts.ASK_WHICH_OF.format(choices=join_choices(names)))

@@ -30,7 +30,7 @@ NEXT = "What else would you like the robots to do?"
 GOODBYE = "Goodbye."
 GOODBYE_ROBOTS_KEEP_GOING = "Goodbye. The robots carry on; to halt them, say emergency stop."
 FALLBACK = (
-    f"Sorry, {SKILL_NAME} can't help with that. "
+    f"Sorry, {SKILL_NAME} can't help with that. I sent nothing to the robots. "
     "You can say: send {robot} to {zone}, or: where are the robots?"
 )
 FALLBACK_REPROMPT = "What would you like the robots to do?"
@@ -52,6 +52,8 @@ OTHER_WEATHER_RULE = (
     "Weather deliveries always go to {sunny} when it is sunny and {rainy} when it is rainy, "
     "so I sent no robot. For that rule, say: have {robot} deliver based on the weather."
 )
+# A value heard several ways is asked about by name: "Zone B or zone D?".
+ASK_WHICH_OF = "{choices}?"
 GIVE_UP = (
     "Sorry, I still did not get that, so I sent nothing. Try, for example: send {robot} to {zone}."
 )
@@ -157,6 +159,23 @@ WEATHER = {weather: f"The weather is {weather}." for weather in WEATHERS}
 GATEWAY_ERROR = "Sorry, I could not reach the robots just now. Please try again in a moment."
 GENERIC_ERROR = "Sorry, something went wrong on my side. Please try again."
 ERROR_REPROMPT = "What would you like the robots to do?"
+
+# Corrections and undo of the last command ("no, zone b", "I meant placebot two", "cancel
+# that"). The report of what the robots did follows the first sentence.
+CORRECTED = "Okay, not {old}. "
+ALREADY_SO = "{robot} is already on that command; I changed nothing."
+NOTHING_TO_CORRECT = "There is no command of mine to correct, so I changed nothing."
+NOTHING_TO_UNDO = (
+    "There is no command of mine to cancel, so I changed nothing. "
+    "To halt every robot, say emergency stop."
+)
+UNDONE = "Okay, I cancelled that. "
+ASK_CORRECT_ROBOT = "Which robot did you mean: {choices}?"
+CONFIRM_OTHER_ROBOT = "{robot} instead?"
+WEATHER_HAS_NO_ZONE = (
+    "{robot} delivers where the weather says, so there is no zone to change; I changed nothing."
+)
+INTENT_DENIED = "Okay, I sent nothing."
 
 # The word before the last of several choices ("zone a, zone b, or zone c").
 OR = "or"

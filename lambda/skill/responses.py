@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ask_sdk_model import Slot, SlotConfirmationStatus
-from ask_sdk_model.dialog import ElicitSlotDirective
+from ask_sdk_model.dialog import ConfirmSlotDirective, ElicitSlotDirective
 
 from skill import prompts
 
@@ -103,5 +103,31 @@ def elicit(handler_input: HandlerInput, slot_name: str, question: str) -> Respon
         handler_input.response_builder.speak(plain_text(question))
         .ask(plain_text(question))
         .add_directive(ElicitSlotDirective(updated_intent=intent, slot_to_elicit=slot_name))
+        .response
+    )
+
+
+def confirm_slot(
+    handler_input: HandlerInput, slot_name: str, value: str, question: str
+) -> Response:
+    """Ask a yes-or-no question about one slot (Dialog.ConfirmSlot), with `value` filled in
+    as what the skill takes it to be; the answer comes back as the slot's
+    confirmationStatus."""
+    request: IntentRequest = handler_input.request_envelope.request  # type: ignore[assignment]
+    intent = request.intent
+    assert intent is not None
+    if intent.slots is None:
+        intent.slots = {}
+    slot = intent.slots.setdefault(
+        slot_name, Slot(name=slot_name, confirmation_status=SlotConfirmationStatus.NONE)
+    )
+    slot.value = value
+    slot.resolutions = None
+    slot.slot_value = None
+    slot.confirmation_status = SlotConfirmationStatus.NONE
+    return (
+        handler_input.response_builder.speak(plain_text(question))
+        .ask(plain_text(question))
+        .add_directive(ConfirmSlotDirective(updated_intent=intent, slot_to_confirm=slot_name))
         .response
     )

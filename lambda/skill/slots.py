@@ -1,7 +1,8 @@
 """Read a slot from an IntentRequest: what the person said and which id it resolved to.
 
 Alexa's entity resolution is trusted first (ER_SUCCESS_MATCH carries the id), unless it
-matched the words to several values. When a
+matched the words to several values: then the slot does not resolve and `choices` holds
+the values the words fit, so the skill can ask which one was meant. When a
 request carries no resolutions (a hand-built envelope, a test console), the spoken value is
 looked up in the fleet's names, so the same words work either way.
 """
@@ -26,6 +27,8 @@ class SlotReading(msgspec.Struct, frozen=True):
     name: str
     heard: str | None
     id: str | None
+    # The known values the words fit about equally (two or more), when they fit several.
+    choices: tuple[str, ...] = ()
 
     @property
     def missing(self) -> bool:
@@ -54,11 +57,14 @@ def read_slot(
                 authority.status.code.value if authority.status and authority.status.code else None
             )
             if code == MATCH and authority.values and authority.values[0].value:
-                matched = {wrapper.value.id for wrapper in authority.values if wrapper.value}
+                matched = list(
+                    dict.fromkeys(w.value.id for w in authority.values if w.value and w.value.id)
+                )
                 if len(matched) > 1:
                     # The words fit several values ("robot" for either robot): taking the
                     # first would act on a guess, so the slot counts as unresolved.
-                    return SlotReading(name, heard, None)
+                    known = tuple(value for value in matched if value in known_ids)
+                    return SlotReading(name, heard, None, known if len(known) > 1 else ())
                 resolved = authority.values[0].value.id
                 return SlotReading(name, heard, resolved if resolved in known_ids else None)
         # Resolutions were present and none matched (ER_SUCCESS_NO_MATCH).

@@ -428,6 +428,53 @@ WEATHER = IntentSpec(
     ),
 )
 
+# A correction of the last command ("no, zone b", "I meant placebot two", "not that
+# robot"): the skill sends it again to the robot or zone named (lambda/skill/handlers/
+# correction.py). Nothing named means the robot was wrong.
+CORRECTION = IntentSpec(
+    name="CorrectionIntent",
+    slots=(ROBOT, ZONE),
+    essentials=(
+        "no {zone}",
+        "no i meant {zone}",
+        "i meant {robot}",
+        "not that robot",
+        "wrong robot",
+    ),
+    templates=(
+        "(no|nope|no no|oh no|no wait|wait|correction) [i meant|i said] {zone} [instead|please]",
+        "(no|nope|no no|no wait|wait|correction) [i meant|i said] {robot} [instead|please]",
+        "i meant {robot} [instead|please]",
+        "i meant {zone} [instead|please]",
+        "(wrong zone|not that zone|that's the wrong zone) [i meant] {zone}",
+        "(wrong robot|not that robot|that's the wrong robot) [i meant] {robot}",
+        "{zone} instead [please]",
+        "{robot} instead [please]",
+        "(actually|no actually) [i meant] {zone} instead",
+        "no i meant {robot} (to|in|at) {zone}",
+        "(not that robot|wrong robot|that's the wrong robot|not this robot|you sent the wrong "
+        "robot|the wrong robot) [please]",
+        "no (not that robot|wrong robot|the wrong robot)",
+    ),
+)
+
+# "Cancel that", "undo": stop the robot the last command went to, only it.
+# (AMAZON.CancelIntent keeps "cancel" alone: it ends the session and the robots carry on.)
+UNDO = IntentSpec(
+    name="UndoIntent",
+    essentials=("cancel that", "undo", "undo that", "scratch that"),
+    templates=(
+        "[no|wait|oops] (cancel|undo|scrap|scratch|call off) (that|the last command|the last "
+        "one|my last command|what i just said|that command|that order|that last command) "
+        "[please|now]",
+        "[no|wait|oops] (undo|undo it|forget that|ignore that|ignore what i just said|take that "
+        "back|belay that|disregard that|strike that) [please]",
+        "i (didn't|did not) mean (that|it) [cancel it|undo it]",
+        "(that was|that's) a mistake (cancel|undo) (it|that)",
+        "(don't|do not) go there [after all]",
+    ),
+)
+
 CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     NAVIGATE,
     DELIVER,
@@ -437,6 +484,8 @@ CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     PROBLEM_ROBOTS,
     EMERGENCY_STOP,
     WEATHER,
+    CORRECTION,
+    UNDO,
 )
 
 BUILT_IN_INTENTS: tuple[str, ...] = (

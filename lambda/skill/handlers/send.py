@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from skill import speech
+from skill import session, speech
 from skill.commands import dispatch
 from skill.responses import answer
 
@@ -25,4 +25,5 @@ def send_and_report(
     """Publish `action` to one robot (or the fleet) and say what the robots answered."""
     item = dispatch(runtime.fleet, action, target, params)
     answers = runtime.robots.send([item])
+    session.remember(handler_input, item)
     return answer(handler_input, speech.command_report(runtime.vocabulary, item, answers))

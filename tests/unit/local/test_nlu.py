@@ -202,7 +202,12 @@ def test_both_robots_named_one_by_one_are_the_fleet(model: InteractionModel) -> 
 def test_several_robots_for_one_slot_are_the_fleet_only_when_listed(
     model: InteractionModel, utterance: str, robot: str | None
 ) -> None:
-    assert model.understand(utterance).slots["robot"].id == robot
+    value = model.understand(utterance).slots["robot"]
+    if robot is None:
+        # Asked about: the robots said, as one value with the others as its alternatives.
+        assert value.alternatives
+    else:
+        assert (value.id, value.alternatives) == (robot, ())
 
 
 def test_names_that_overlap_and_disagree_are_asked_about(model: InteractionModel) -> None:
@@ -243,7 +248,12 @@ def test_of_two_zones_the_destination_is_the_one_after_to(model: InteractionMode
 
 def test_two_zones_without_a_destination_are_asked_about(model: InteractionModel) -> None:
     zone = model.understand("move robot one to zone a or zone b").slots["zone"]
-    assert (zone.spoken, zone.id) == ("zone a and zone b", None)
+    # Both are offered, so the skill asks "Zone A or zone B?".
+    assert (zone.spoken, zone.id, zone.alternatives) == (
+        "zone a and zone b",
+        "A",
+        (("B", "zone b"),),
+    )
 
 
 @pytest.mark.parametrize(

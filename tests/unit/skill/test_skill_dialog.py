@@ -39,10 +39,11 @@ def elicited(response: dict[str, Any]) -> tuple[str, dict[str, Any]]:
             f"I don't know a robot called the blue robot. Which robot: {ROBOTS}?",
         ),
         (
-            # Alexa matched "robot" to both robots: the skill asks rather than take the first.
+            # Alexa matched "robot" to both robots: the skill asks which rather than take
+            # the first.
             "alexa_navigate_robot_ambiguous",
             "robot",
-            f"I don't know a robot called robot. Which robot: {ROBOTS}?",
+            "Placebot one or placebot two?",
         ),
         (
             "alexa_deliver_to_loading",

@@ -225,6 +225,15 @@ def test_every_model_intent_has_exactly_one_handler_and_every_handler_an_intent(
         claimed = [h for h in handlers if h.can_handle(HandlerInput(request_envelope=envelope))]
         assert len(claimed) == 1
         used.add(type(claimed[0]))
+    # A denied intent is answered by the handler registered first for it, before the
+    # intent's own handler could act on it.
+    envelope = serializer.deserialize(
+        json.dumps(load_event("alexa_dialog_confirm_intent_denied")),
+        "ask_sdk_model.RequestEnvelope",
+    )
+    claimed = [h for h in handlers if h.can_handle(HandlerInput(request_envelope=envelope))]
+    assert type(claimed[0]).__name__ == "DeniedIntentHandler"
+    used.add(type(claimed[0]))
     assert {type(handler) for handler in handlers} == used
 
 

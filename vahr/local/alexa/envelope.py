@@ -1,5 +1,11 @@
 """ASK request envelopes, built with ask-sdk-model's own classes and serializer, so the
-skill receives exactly the JSON shape Alexa sends (tests/events/ holds recorded ones)."""
+skill receives exactly the JSON shape Alexa sends (tests/events/ holds recorded ones).
+
+A slot whose words fit several values about equally carries them all, in the order of
+preference, as the values of one ER_SUCCESS_MATCH resolution (as Alexa resolves "robot"
+to either robot). While a dialog confirms a slot or the whole intent, the person's yes or
+no travels as the slot's or the intent's confirmationStatus (CONFIRMED, DENIED).
+"""
 
 from __future__ import annotations
 
@@ -37,6 +43,8 @@ from ask_sdk_model.slu.entityresolution import (
 )
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from ask_sdk_model import Request
 
     from vahr.local.alexa.nlu import SlotValue, Understanding
@@ -75,16 +83,20 @@ def session_ended_request(reason: str = "USER_INITIATED") -> SessionEndedRequest
     )
 
 
-def slot(identity: Identity, value: SlotValue | None, name: str) -> Slot:
+def slot(
+    identity: Identity, value: SlotValue | None, name: str, confirmation: str = "NONE"
+) -> Slot:
     """A slot as Alexa fills it: empty, or with a value and its entity resolution."""
+    status = SlotConfirmationStatus(confirmation)
     if value is None:
-        return Slot(name=name, confirmation_status=SlotConfirmationStatus.NONE)
+        return Slot(name=name, confirmation_status=status)
     authority = f"amzn1.er-authority.echo-sdk.{identity.skill_id}.{value.type}"
     if value.resolved:
+        matched = [(value.id, value.canonical), *value.alternatives]
         resolution = Resolution(
             authority=authority,
             status=Status(code=StatusCode.ER_SUCCESS_MATCH),
-            values=[ValueWrapper(value=Value(name=value.canonical, id=value.id))],
+            values=[ValueWrapper(value=Value(name=n, id=i)) for i, n in matched],
         )
     else:
         resolution = Resolution(
@@ -93,16 +105,24 @@ def slot(identity: Identity, value: SlotValue | None, name: str) -> Slot:
     return Slot(
         name=name,
         value=value.spoken,
-        confirmation_status=SlotConfirmationStatus.NONE,
+        confirmation_status=status,
         resolutions=Resolutions(resolutions_per_authority=[resolution]),
     )
 
 
 def intent_request(
-    identity: Identity, understanding: Understanding, dialog_state: str | None
+    identity: Identity,
+    understanding: Understanding,
+    dialog_state: str | None,
+    *,
+    intent_confirmation: str = "NONE",
+    slot_confirmations: Mapping[str, str] | None = None,
 ) -> IntentRequest:
+    """An IntentRequest for `understanding`; the confirmations are the person's answers to
+    Dialog.ConfirmIntent and Dialog.ConfirmSlot (NONE, CONFIRMED or DENIED)."""
+    confirmations = slot_confirmations or {}
     slots = {
-        name: slot(identity, understanding.slots.get(name), name)
+        name: slot(identity, understanding.slots.get(name), name, confirmations.get(name, "NONE"))
         for name in understanding.declared or tuple(understanding.slots)
     }
     return IntentRequest(
@@ -113,7 +133,7 @@ def intent_request(
         intent=Intent(
             name=understanding.intent,
             slots=slots or None,
-            confirmation_status=IntentConfirmationStatus.NONE,
+            confirmation_status=IntentConfirmationStatus(intent_confirmation),
         ),
     )
 

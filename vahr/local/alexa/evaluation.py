@@ -9,8 +9,8 @@ sentences the skill should not act on. Each utterance ends in one of four outcom
   or a slot resolved to another robot or zone than said (for an out-of-domain sentence, any
   custom intent);
 - fallback: AMAZON.FallbackIntent (what an out-of-domain sentence should get);
-- asks: the right intent with a slot missing or unresolved, so the skill asks for it (for an
-  out-of-domain sentence, a built-in intent such as help).
+- asks: the right intent with a slot missing, unresolved or heard as several values, so the
+  skill asks for it (for an out-of-domain sentence, a built-in intent such as help).
 """
 
 from __future__ import annotations
@@ -112,7 +112,8 @@ def outcome(model: InteractionModel, item: LabelledUtterance, got: Understanding
         return "asks" if got.intent.startswith("AMAZON.") else "wrong"
     if got.intent != item.intent:
         return "wrong"
-    said = {name: value.id for name, value in got.slots.items()}
+    # A value with alternatives is asked about ("Zone B or zone D?"), never acted on.
+    said = {name: None if value.alternatives else value.id for name, value in got.slots.items()}
     declared = model.intent_slots.get(item.intent, {})
     if any(said.get(name) not in (None, item.slots.get(name)) for name in declared):
         return "wrong"

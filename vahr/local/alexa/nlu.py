@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import json
 import threading
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -37,6 +37,7 @@ from rapidfuzz import fuzz, process
 
 from vahr.errors import VahrError
 from vahr.local.alexa import roles
+from vahr.local.alexa.ambiguity import SlotAmbiguity
 from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
 from vahr.local.alexa.consistency import SlotConsistency
 from vahr.local.alexa.intent_classifier import load_or_train
@@ -84,6 +85,9 @@ class SlotValue:
     canonical: str | None = None
     # 100 for an exact name; lower when a misheard word was read as a name's word.
     similarity: float = 100.0
+    # (id, canonical name) of the other values the words fit about as well (`ambiguity`):
+    # the skill asks which was meant rather than act on this one.
+    alternatives: tuple[tuple[str, str], ...] = ()
 
     @property
     def resolved(self) -> bool:
@@ -158,6 +162,7 @@ class InteractionModel:
             known,
             self._understanding.finder,
         )
+        self._ambiguity = SlotAmbiguity(self._slot_types, known)
         robot_values = [
             value for t in self._slot_types if t.name == ROBOT_TYPE for value in t.names.values()
         ]
@@ -275,6 +280,7 @@ class InteractionModel:
             guess = None if intent == FALLBACK else intent
             return Understanding(FALLBACK, confidence=confidence, best_guess=guess)
         slots = {name: _slot_value(name, declared[name], m) for name, m in assigned.items()}
+        slots = self._with_alternatives(slots, assigned, words, matches)
         return Understanding(
             intent,
             slots,
@@ -292,6 +298,35 @@ class InteractionModel:
             return {}
         labels = self._taggers[intent].labels(words, matches)
         return roles.assign(declared, matches, labels, self._fleet)
+
+    def _with_alternatives(
+        self,
+        slots: dict[str, SlotValue],
+        found: dict[str, SlotMatch],
+        words: list[str],
+        matches: list[SlotMatch] | None = None,
+    ) -> dict[str, SlotValue]:
+        """`slots`, each resolved value given the other values its words fit as well; a
+        value said as several ("zone b or zone d") is those values, the first with the
+        others as its alternatives, so the skill asks which one is meant."""
+        corrected, _ = self._finder.correct(words)
+        out = dict(slots)
+        for name, value in slots.items():
+            said = _values_said(value, matches or [])
+            if len(said) > 1:
+                (first_id, first_name), *rest = said
+                out[name] = replace(
+                    value, id=first_id, canonical=first_name, alternatives=tuple(rest)
+                )
+                continue
+            match = found.get(name)
+            if match is None or not value.resolved or value.similarity >= 100.0:
+                continue
+            span = (match.start, match.end)
+            others = self._ambiguity.alternatives(words, corrected, span, value.type, value.id)
+            if others:
+                out[name] = replace(value, alternatives=others)
+        return out
 
     def answer(self, utterance: str, intent: str, slot: str) -> SlotValue | None:
         """`utterance` read as the answer to a question for `slot` of `intent` ("which
@@ -312,7 +347,11 @@ class InteractionModel:
         tagger = self._taggers.get(intent)
         labels = tagger.labels(words, values) if tagger else [""] * len(values)
         modes = [label[:1] if label[:1] in (roles.LISTED, roles.CHOICE) else "" for label in labels]
-        return _slot_value(slot, slot_type, roles.combine(values, modes, self._fleet))
+        match = roles.combine(values, modes, self._fleet)
+        found = self._with_alternatives(
+            {slot: _slot_value(slot, slot_type, match)}, {slot: match}, words, values
+        )
+        return found[slot]
 
     def nearest_sample(self, intent: str, abstracted: str) -> str | None:
         """The intent's sample utterance whose words are closest to `abstracted`."""
@@ -347,6 +386,20 @@ def _slot_type(document: dict[str, Any]) -> SlotTypeValues:
         for phrase in [name, *value["name"].get("synonyms", [])]:
             names.setdefault(normalize_utterance(phrase), (value_id, name))
     return SlotTypeValues(document["name"], names)
+
+
+def _values_said(value: SlotValue, matches: list[SlotMatch]) -> list[tuple[str, str]]:
+    """(id, name) of the values an unresolved slot value was said as, when the tagger read
+    several names as one value ("zone b or zone d", spoken "zone b and zone d")."""
+    if value.resolved:
+        return []
+    parts = value.spoken.split(" and ")
+    said = {
+        m.id: m.canonical or m.id
+        for m in matches
+        if m.type == value.type and m.id is not None and m.spoken in parts
+    }
+    return list(said.items())
 
 
 def _slot_value(name: str, slot_type: str, match: SlotMatch) -> SlotValue:
