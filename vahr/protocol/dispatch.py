@@ -58,7 +58,7 @@ class DispatchError(ValueError):
     fleet cannot meet. `str(error)` is one line a person can act on; nothing was changed."""
 
 
-class Task(msgspec.Struct, frozen=True, kw_only=True, omit_defaults=True):
+class Task(msgspec.Struct, frozen=True, kw_only=True):
     """One robot's share of an order, as the store keeps it and `GET /vahr/tasks` shows it.
 
     `id` is also the id of the command published for it (so republishing after a restart is
