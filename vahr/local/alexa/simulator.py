@@ -1,10 +1,25 @@
 """The simulated Echo: an utterance in, the skill's spoken answer out.
 
 It strips the wake word and invocation ("Alexa, ask robot fleet to ..."), opens and keeps
-a session (attributes carried across turns, Dialog.ElicitSlot answered by a bare slot
-value), builds the ASK envelope, and calls the skill handler in-process. One turn at a
-time, as one person speaks to one device. Each turn, once answered, goes to `on_turn` (the
-local stack publishes it on `topics.ASSISTANT_TURNS` for the operator station).
+a session (attributes carried across turns), builds the ASK envelope, and calls the skill
+handler in-process. One turn at a time, as one person speaks to one device. Each turn, once
+answered, goes to `on_turn` (the local stack publishes it on `topics.ASSISTANT_TURNS` for
+the operator station).
+
+The dialog is kept as Alexa keeps it (`dialogState` STARTED, then IN_PROGRESS):
+
+- after Dialog.ElicitSlot the answer fills the slot asked for, by its value alone ("zone
+  b") or in a whole sentence; slot values the answer carries replace the intent's ("robot
+  two please go to zone a" after "which robot?" for zone D goes to zone A); an answer that
+  is another request starts that intent instead;
+- after Dialog.ConfirmSlot or Dialog.ConfirmIntent a yes or a no comes back as the same
+  intent with the slot's or the intent's confirmationStatus CONFIRMED or DENIED; anything
+  else is a request of its own.
+
+Silence is answered by the device itself (nothing reaches the skill); a ramble longer than
+any request the model knows reaches it as AMAZON.FallbackIntent, so nothing moves. The
+skill's last command (`vahr.protocol.conversation`) outlives the session for the same
+origin for a short window, so a correction said just after a one-shot request works.
 """
 
 from __future__ import annotations
@@ -16,11 +31,15 @@ import time
 import uuid
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
+from functools import cache
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import yaml
+
 from vahr.local.alexa import envelope
-from vahr.local.alexa.localized import invocation_patterns
-from vahr.local.alexa.nlu import Understanding, normalize_utterance
+from vahr.local.alexa.nlu import FALLBACK, Understanding, normalize_utterance
+from vahr.protocol.conversation import CORRECTION_WINDOW_S, LAST_COMMAND_ATTRIBUTE
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -31,6 +50,17 @@ log = logging.getLogger(__name__)
 
 _TAGS = re.compile(r"<[^>]+>")
 _EXIT = {"exit", "quit", "goodbye", "good bye", "bye"}
+_CONFIRMATION_PHRASES = Path(__file__).with_name("data") / "confirmation-en-US.yaml"
+# What the device says when it heard nothing: Alexa answers silence itself, the skill never
+# hears of it.
+SILENCE = "I didn't hear anything, so I sent nothing to the robots."
+# A request is read only when it is at most this many times as long as the longest sentence
+# the model learnt from (21 words for the default model, so 42: about 17 s of speech at 150
+# words a minute); anything longer is a ramble no intent describes.
+RAMBLE_FACTOR = 2
+ELICIT = "Dialog.ElicitSlot"
+CONFIRM_SLOT = "Dialog.ConfirmSlot"
+CONFIRM_INTENT = "Dialog.ConfirmIntent"
 
 
 @dataclass
@@ -74,12 +104,37 @@ class Turn:
         return {**self.to_json(), "utterance": self.utterance, "at": self.at.isoformat()}
 
 
+@dataclass(frozen=True)
+class PendingDialog:
+    """What the skill asked last: the intent so far (as its updatedIntent left it), the
+    directive, and the slot asked about (None for Dialog.ConfirmIntent)."""
+
+    understanding: Understanding
+    directive: str
+    slot: str | None
+
+
 @dataclass
 class _Session:
     id: str = field(default_factory=lambda: f"amzn1.echo-api.session.{uuid.uuid4()}")
     attributes: dict[str, Any] = field(default_factory=dict)
     turns: int = 0
-    eliciting: tuple[Understanding, str] | None = None
+    pending: PendingDialog | None = None
+
+
+@cache
+def _confirmation_phrases() -> dict[str, frozenset[str]]:
+    document = yaml.safe_load(_CONFIRMATION_PHRASES.read_text())
+    return {
+        "CONFIRMED": frozenset(normalize_utterance(p) for p in document["yes"]),
+        "DENIED": frozenset(normalize_utterance(p) for p in document["no"]),
+    }
+
+
+def confirmation_of(text: str) -> str | None:
+    """CONFIRMED for a yes, DENIED for a no, None for anything else."""
+    said = normalize_utterance(text)
+    return next((status for status, ps in _confirmation_phrases().items() if said in ps), None)
 
 
 def speech_text(output: dict[str, Any] | None) -> str:
@@ -127,7 +182,7 @@ class AlexaSimulator:
         identity: envelope.Identity | None = None,
         command_log: Callable[[], list[str]] | None = None,
         on_turn: Callable[[Turn], None] | None = None,
-        locale: str = "en-US",
+        clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.model = model
         self.handler = handler
@@ -136,24 +191,49 @@ class AlexaSimulator:
         self.on_turn = on_turn
         self._session: _Session | None = None
         self._lock = threading.Lock()
-        # The language spoken: the request's locale, and how the skill is addressed in it.
-        self.locale = locale
-        self._one_shot, self._open = invocation_patterns(model.invocation_name, locale)
+        self._clock = clock
+        # origin -> (when, the skill's last command) of that origin's latest turn.
+        self._recent: dict[str, tuple[float, Any]] = {}
+        self._origin = "say"
+        longest = max((len(text.split()) for text in model.training[0]), default=0)
+        self._longest_words = RAMBLE_FACTOR * longest
+        invocation = re.escape(normalize_utterance(model.invocation_name))
+        self._one_shot = re.compile(
+            rf"^(?:alexa\s+)?(?:ask|tell)\s+{invocation}(?:\s+(?:to|for|about|if|whether))?"
+            rf"(?:\s+(?P<rest>.*))?$"
+        )
+        self._open = re.compile(
+            rf"^(?:alexa\s+)?(?:open|launch|start|begin|talk to|use)\s+{invocation}$"
+        )
 
     @property
     def session_open(self) -> bool:
         return self._session is not None
 
+    @property
+    def pending(self) -> PendingDialog | None:
+        """What the skill asked and waits for an answer to, in the open session."""
+        return self._session.pending if self._session else None
+
     def say(
-        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+        self,
+        utterance: str,
+        *,
+        origin: str = "say",
+        heard: dict[str, Any] | None = None,
+        understanding: Understanding | None = None,
     ) -> Turn:
         """Speak one utterance; returns the skill's answer and what the turn did.
 
         `origin` says who spoke and `heard` what a recognizer made of their speech; both
-        travel with the turn to `on_turn`.
+        travel with the turn to `on_turn`. `understanding`, when given, is used instead of
+        understanding the words (a recognizer that weighed several hearings built it);
+        while a slot is elicited it is an answer when its intent is the pending one or
+        it names the slot alone (`pending` says which).
         """
         with self._lock:
-            turn = self._say(utterance)
+            self._origin = origin
+            turn = self._say(utterance, understanding)
             turn.origin, turn.heard = origin, heard
             self._announce(turn)
             return turn
@@ -175,18 +255,28 @@ class AlexaSimulator:
         except Exception:  # whoever watches must not break the conversation
             log.exception("the turn observer failed")
 
-    def _say(self, utterance: str) -> Turn:
+    def _new_session(self) -> _Session:
+        """A fresh session, holding the speaker's last command while it may be corrected."""
+        session = _Session()
+        recent = self._recent.get(self._origin)
+        if recent is not None and self._clock() - recent[0] <= CORRECTION_WINDOW_S:
+            session.attributes[LAST_COMMAND_ATTRIBUTE] = recent[1]
+        return session
+
+    def _say(self, utterance: str, given: Understanding | None = None) -> Turn:
         text = normalize_utterance(utterance)
+        if not text and given is None:
+            return self._silence(utterance)
         opening = self._open.match(text)
         if opening:
-            self._session = _Session()
+            self._session = self._new_session()
             return self._send(utterance, envelope.launch_request(), None)
         one_shot = self._one_shot.match(text)
         if one_shot:
             rest = one_shot["rest"] or ""
             # Invoking the skill again starts a new session, as it does on an Echo.
-            self._session = _Session()
-            if not rest:
+            self._session = self._new_session()
+            if not rest and given is None:
                 return self._send(utterance, envelope.launch_request(), None)
             text = rest
         elif text.startswith("alexa "):
@@ -196,30 +286,72 @@ class AlexaSimulator:
         if self._session is None:
             # A bare utterance with no session: treat it as addressed to this skill, as the
             # developer console's simulator does once the skill is selected.
-            self._session = _Session()
-        understanding = self._understand(text)
-        dialog_state = "IN_PROGRESS" if self._session.eliciting else "STARTED"
-        self._session.eliciting = None
-        request = envelope.intent_request(self.identity, understanding, dialog_state)
+            self._session = self._new_session()
+        pending, self._session.pending = self._session.pending, None
+        request, understanding = self._request(text, pending, given)
         return self._send(utterance, request, understanding)
 
-    def _understand(self, text: str) -> Understanding:
-        assert self._session is not None
-        if self._session.eliciting is None:
-            return self.model.understand(text)
-        pending, slot_name = self._session.eliciting
+    def _request(
+        self, text: str, pending: PendingDialog | None, given: Understanding | None
+    ) -> tuple[Any, Understanding]:
+        """The IntentRequest for `text`, read as the answer to `pending` when it is one."""
+        if pending is not None and pending.directive in (CONFIRM_SLOT, CONFIRM_INTENT):
+            status = confirmation_of(text)
+            if status is not None:
+                so_far = pending.understanding
+                if pending.directive == CONFIRM_INTENT:
+                    request = envelope.intent_request(
+                        self.identity, so_far, "IN_PROGRESS", intent_confirmation=status
+                    )
+                else:
+                    confirmations = {str(pending.slot): status}
+                    request = envelope.intent_request(
+                        self.identity, so_far, "IN_PROGRESS", slot_confirmations=confirmations
+                    )
+                return request, so_far
+            pending = None
+        if given is not None:
+            understanding = given
+            if pending is not None and given.intent == pending.understanding.intent:
+                slots = {**pending.understanding.slots, **given.slots}
+                understanding = replace(given, slots=slots)
+        elif len(text.split()) > self._longest_words:
+            understanding = Understanding(FALLBACK, confidence=1.0)
+        elif pending is not None and pending.slot is not None:
+            understanding = self._answer(text, pending.understanding, pending.slot)
+        else:
+            understanding = self.model.understand(text)
+        same = pending is not None and understanding.intent == pending.understanding.intent
+        state = "IN_PROGRESS" if same else "STARTED"
+        return envelope.intent_request(self.identity, understanding, state), understanding
+
+    def _answer(self, text: str, so_far: Understanding, slot_name: str) -> Understanding:
+        """`text` as the answer to the question for `slot_name` of the intent `so_far`."""
         # An answer to "which zone?" is the slot value alone (or wrapped in a few words).
-        value = self.model.answer(text, pending.intent, slot_name)
-        if value is not None:
-            return Understanding(
-                pending.intent, {**pending.slots, slot_name: value}, pending.declared
-            )
+        value = self.model.answer(text, so_far.intent, slot_name)
         understanding = self.model.understand(text)
-        if understanding.intent == pending.intent:
-            # The same request said again in full keeps what was already given.
-            slots = {**pending.slots, **understanding.slots}
-            return replace(understanding, slots=slots)
-        return understanding
+        same = understanding.intent == so_far.intent
+        if value is None and not same:
+            return understanding
+        # As on Alexa, values the answer carries replace the intent's: "robot two please go
+        # to zone a" answering "which robot?" for zone D is robot two to zone A.
+        slots = {**so_far.slots, **({slot_name: value} if value else {})}
+        if same:
+            slots.update(understanding.slots)
+        return replace(so_far, slots=slots)
+
+    def _silence(self, utterance: str) -> Turn:
+        """Nothing was said: the device says so and the session, if any, stays as it was."""
+        return Turn(
+            utterance=utterance,
+            speech=SILENCE,
+            intent=None,
+            slots={},
+            commands=[],
+            latency_ms=0.0,
+            session_open=self._session is not None,
+            request_type="Silence",
+        )
 
     def _send(self, utterance: str, request: Any, understanding: Understanding | None) -> Turn:
         session = self._session or _Session()
@@ -230,7 +362,6 @@ class AlexaSimulator:
             new=session.turns == 0,
             attributes=session.attributes,
         )
-        event["request"]["locale"] = self.locale
         self._command_log()  # forget commands published outside this turn
         started = time.perf_counter()
         response = self.handler(event, None)
@@ -238,12 +369,15 @@ class AlexaSimulator:
         commands = self._command_log()
         body = response.get("response", {})
         ended = request.object_type == "SessionEndedRequest" or body.get("shouldEndSession", True)
+        attributes = response.get("sessionAttributes") or {}
+        if LAST_COMMAND_ATTRIBUTE in attributes:
+            self._recent[self._origin] = (self._clock(), attributes[LAST_COMMAND_ATTRIBUTE])
         if ended:
             self._session = None
         else:
             session.turns += 1
-            session.attributes = response.get("sessionAttributes") or {}
-            session.eliciting = _elicitation(body, understanding)
+            session.attributes = attributes
+            session.pending = _pending(body, understanding, self.model)
         slots = {
             name: {"value": value.spoken, "id": value.id}
             for name, value in (understanding.slots.items() if understanding else ())
@@ -263,22 +397,33 @@ class AlexaSimulator:
         )
 
 
-def _elicitation(
-    body: dict[str, Any], understanding: Understanding | None
-) -> tuple[Understanding, str] | None:
-    """The (intent so far, slot asked for) of a Dialog.ElicitSlot directive, if any."""
+def _pending(
+    body: dict[str, Any], understanding: Understanding | None, model: InteractionModel
+) -> PendingDialog | None:
+    """What a Dialog directive in the response asks, with the intent its updatedIntent keeps
+    (a value the skill cleared, or changed, is dropped)."""
     for directive in body.get("directives") or []:
-        if directive.get("type") != "Dialog.ElicitSlot" or understanding is None:
+        kind = directive.get("type")
+        if kind not in (ELICIT, CONFIRM_SLOT, CONFIRM_INTENT) or understanding is None:
             continue
-        slot_name = directive.get("slotToElicit")
         updated = directive.get("updatedIntent") or {}
+        if updated.get("name", understanding.intent) != understanding.intent:
+            continue
+        updated_slots = updated.get("slots") or {}
         kept = {
             name: value
             for name, value in understanding.slots.items()
-            if (updated.get("slots") or {}).get(name, {}).get("value") is not None
+            if (updated_slots.get(name) or {}).get("value") == value.spoken
         }
-        return (
-            Understanding(understanding.intent, kept, understanding.declared, None),
-            str(slot_name),
-        )
+        # A value the skill filled in itself ("Placebot two instead?") is said back to it
+        # as the words of that value's name.
+        for name, slot in updated_slots.items():
+            said = (slot or {}).get("value")
+            if said and name not in kept:
+                value = model.answer(str(said), understanding.intent, name)
+                if value is not None:
+                    kept[name] = value
+        so_far = Understanding(understanding.intent, kept, understanding.declared, None)
+        slot = directive.get("slotToElicit") or directive.get("slotToConfirm")
+        return PendingDialog(so_far, str(kind), str(slot) if slot else None)
     return None
