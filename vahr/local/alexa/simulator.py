@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any
 import yaml
 
 from vahr.local.alexa import envelope
+from vahr.local.alexa.localized import invocation_patterns
 from vahr.local.alexa.nlu import FALLBACK, Understanding, normalize_utterance
 from vahr.protocol.conversation import CORRECTION_WINDOW_S, LAST_COMMAND_ATTRIBUTE
 
@@ -182,6 +183,7 @@ class AlexaSimulator:
         identity: envelope.Identity | None = None,
         command_log: Callable[[], list[str]] | None = None,
         on_turn: Callable[[Turn], None] | None = None,
+        locale: str = "en-US",
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.model = model
@@ -197,14 +199,9 @@ class AlexaSimulator:
         self._origin = "say"
         longest = max((len(text.split()) for text in model.training[0]), default=0)
         self._longest_words = RAMBLE_FACTOR * longest
-        invocation = re.escape(normalize_utterance(model.invocation_name))
-        self._one_shot = re.compile(
-            rf"^(?:alexa\s+)?(?:ask|tell)\s+{invocation}(?:\s+(?:to|for|about|if|whether))?"
-            rf"(?:\s+(?P<rest>.*))?$"
-        )
-        self._open = re.compile(
-            rf"^(?:alexa\s+)?(?:open|launch|start|begin|talk to|use)\s+{invocation}$"
-        )
+        # The language spoken: the request's locale, and how the skill is addressed in it.
+        self.locale = locale
+        self._one_shot, self._open = invocation_patterns(model.invocation_name, locale)
 
     @property
     def session_open(self) -> bool:
@@ -362,6 +359,7 @@ class AlexaSimulator:
             new=session.turns == 0,
             attributes=session.attributes,
         )
+        event["request"]["locale"] = self.locale
         self._command_log()  # forget commands published outside this turn
         started = time.perf_counter()
         response = self.handler(event, None)
