@@ -113,14 +113,24 @@ class IotFleetIndex:
         return int(answer["statistics"]["count"])
 
     def search(self, query: str, limit: int) -> list[IndexedRobot]:
-        answer = self._call(
-            "searching the fleet",
-            self._client.search_index,
-            indexName=INDEX_NAME,
-            queryString=query,
-            maxResults=max(1, min(limit, SEARCH_MAX)),
-        )
-        return [_robot(document) for document in answer.get("things", [])][:limit]
+        """Page by page (at most `SEARCH_MAX` a call) until `limit` robots or the end."""
+        found: list[IndexedRobot] = []
+        token: str | None = None
+        while len(found) < limit:
+            page: dict[str, Any] = {"nextToken": token} if token else {}
+            answer = self._call(
+                "searching the fleet",
+                self._client.search_index,
+                indexName=INDEX_NAME,
+                queryString=query,
+                maxResults=max(1, min(limit - len(found), SEARCH_MAX)),
+                **page,
+            )
+            found += [_robot(document) for document in answer.get("things", [])]
+            token = answer.get("nextToken")
+            if not token:
+                break
+        return found[:limit]
 
     @staticmethod
     def _call(what: str, call: Any, **arguments: Any) -> Any:

@@ -22,6 +22,7 @@ if TYPE_CHECKING:
 
     from skill.acknowledgment import RobotAnswer
     from skill.commands import Dispatch
+    from skill.fleet_acknowledgment import FleetAcknowledgments
     from skill.gateway import RobotGateway
     from vahr.protocol import RobotShadow
 
@@ -49,11 +50,15 @@ class Robots:
         *,
         reply_budget_s: float = REPLY_BUDGET_S,
         clock: Callable[[], float] = time.monotonic,
+        many: FleetAcknowledgments | None = None,
     ) -> None:
+        """`many` counts the acknowledgments of one command to many robots with the fleet
+        index (skill.fleet_acknowledgment): their shadows cannot all be read in time."""
         self.gateway = gateway
         self.ack_timeout_s = ack_timeout_s
         self.reply_budget_s = reply_budget_s
         self._clock = clock
+        self._many = many
 
     def send(self, dispatches: Sequence[Dispatch]) -> dict[str, RobotAnswer]:
         """Publish every dispatch, then wait for every recipient; one answer per robot."""
@@ -71,7 +76,10 @@ class Robots:
         # With no time left the robots are still read once: an answer may already be there.
         left = self.reply_budget_s - (self._clock() - started)
         budget = max(0.0, min(self.ack_timeout_s, left))
-        answers = await_acknowledgments(self.gateway, expected, budget, clock=self._clock)
+        if self._many is not None and self._many.applies(expected):
+            answers = self._many(expected, budget)
+        else:
+            answers = await_acknowledgments(self.gateway, expected, budget, clock=self._clock)
         log_event(
             "acknowledgments",
             outcomes={thing: answer.outcome for thing, answer in answers.items()},

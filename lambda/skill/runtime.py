@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from skill import fleet_source
+from skill.fleet_acknowledgment import FleetAcknowledgments
 from skill.robots import Robots
 from skill.vocabulary import Vocabulary
 
@@ -37,6 +38,8 @@ class SkillRuntime(msgspec.Struct, frozen=True):
             fleet=fleet,
             vocabulary=Vocabulary(fleet),
             gateway=gateway,
-            robots=Robots(gateway, config.ack_timeout_s),
+            robots=Robots(
+                gateway, config.ack_timeout_s, many=FleetAcknowledgments.for_config(config)
+            ),
             rng=random.Random(),
         )

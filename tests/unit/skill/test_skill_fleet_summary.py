@@ -243,3 +243,58 @@ def test_robots_are_named_in_the_order_a_person_counts_them() -> None:
 
     robots = [IndexedRobot(thing, Reported()) for thing in ("rover1000", "rover101", "rover99")]
     assert [robot.thing for robot in spoken_order(robots)] == ["rover99", "rover101", "rover1000"]
+
+
+@pytest.fixture
+def answering_plane(
+    big_fleet: Fleet, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> Iterator[tuple[Callable[[dict[str, Any], Any], dict[str, Any]], Meter]]:
+    """1,000 robots that answer a fleet command in their shadows as robots do, except
+    rover5 and rover6 (refuse it) and rover7 to rover10 (never hear it); and the skill."""
+    from skill.app import make_lambda_handler
+    from skill.config import SkillConfig
+    from vahr.protocol import LastCommand, decode_command
+
+    store = ShadowStore()
+    for thing in big_fleet.robot_things:
+        _report(store, thing, Reported(status="idle", connected=True))
+    store.commit()
+
+    def robots_answer(topic: str, payload: bytes, _qos: int, _retain: bool) -> None:
+        command = decode_command(payload)
+        for number, thing in enumerate(big_fleet.robot_things, start=1):
+            if 7 <= number <= 10:
+                continue
+            refused = number in (5, 6)
+            last = LastCommand(
+                id=command.id,
+                action=command.action,
+                result="rejected" if refused else "accepted",
+                reason="its battery is low" if refused else None,
+            )
+            _report(store, thing, Reported(status="navigating", last_command=last, connected=True))
+        store.commit()
+
+    meter = Meter()
+    dataplane = DataPlane(ShadowService(store, lambda _t, _p: None), robots_answer, meter)
+    monkeypatch.setenv("AWS_ACCESS_KEY_ID", "testing")
+    monkeypatch.setenv("AWS_SECRET_ACCESS_KEY", "testing")
+    fleet_file = write_fleet(big_fleet, tmp_path / "fleet.yaml")
+    with DataPlaneServer(dataplane, 0) as server:
+        config = SkillConfig(data_endpoint=server.url, fleet_file=str(fleet_file))
+        yield make_lambda_handler(config), meter
+
+
+def test_a_command_to_a_thousand_robots_is_confirmed_by_the_index(
+    answering_plane: tuple[Callable[[dict[str, Any], Any], dict[str, Any]], Meter],
+) -> None:
+    skill, meter = answering_plane
+    # When the person sends every robot to the loading zone
+    said = speech(skill(load_event("alexa_navigate_fleet"), None))
+    # Then the reply counts the 994 that confirmed and names the first of the six that did not
+    assert said == (
+        "994 of 1,000 robots confirmed; rover 5 refused: its battery is low; rover 6 refused: "
+        "its battery is low; rover 7 did not answer; and 3 more did not confirm."
+    )
+    # And not one shadow was read to find out
+    assert "http.shadow.get" not in json.dumps(meter.snapshot())
