@@ -5,7 +5,8 @@ The dispatcher serves the queue at `GET {api}/vahr/tasks` (`{"tasks": [...]}`). 
 sends it to the pages only when it changed (`Feed.set_tasks`): the page never polls, and
 however many pages are open the dispatcher is asked once a period. A deployment without a
 dispatcher (a 404) shows the queue as not available; an unreachable or unreadable answer
-is logged once and the last queue stays shown.
+leaves the last queue shown, and is logged as a warning the first time only (a busy data
+plane that answers late now and then would otherwise fill the station's log).
 """
 
 from __future__ import annotations
@@ -63,7 +64,7 @@ class TaskPoller:
         self.every_s = every_s
         self._stopped = threading.Event()
         self._thread = threading.Thread(target=self._run, name="vahr-station-tasks", daemon=True)
-        self._failing = False
+        self._warned = False
 
     def start(self) -> TaskPoller:
         self._thread.start()
@@ -79,11 +80,10 @@ class TaskPoller:
         try:
             tasks = read_tasks(self.url)
         except (OSError, msgspec.MsgspecError) as err:
-            if not self._failing:
-                log.warning("cannot read the task queue at %s: %s", self.url, err)
-            self._failing = True
+            level = logging.DEBUG if self._warned else logging.WARNING
+            log.log(level, "cannot read the task queue at %s: %s", self.url, err)
+            self._warned = True
             return
-        self._failing = False
         self.feed.set_tasks(tasks)
 
     def _run(self) -> None:
