@@ -127,8 +127,8 @@ class _Session:
 def _confirmation_phrases() -> dict[str, frozenset[str]]:
     document = yaml.safe_load(_CONFIRMATION_PHRASES.read_text())
     return {
-        "CONFIRMED": frozenset(normalize_utterance(p) for p in document["yes"]),
-        "DENIED": frozenset(normalize_utterance(p) for p in document["no"]),
+        "CONFIRMED": frozenset(normalize_utterance(p) for p in document["confirmed"]),
+        "DENIED": frozenset(normalize_utterance(p) for p in document["denied"]),
     }
 
 
