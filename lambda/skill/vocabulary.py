@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from skill import prompts
 from skill.catalog import current_locale
 from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
-from vahr.protocol.fleet import SPOKEN_LOCALE, spoken_in
+from vahr.protocol.fleet import SPOKEN_LOCALE, names_by_locale, spoken_in
 from vahr.protocol.text import normalize
 
 if TYPE_CHECKING:
@@ -147,4 +147,4 @@ class Vocabulary:
 
 def _every_name(entry: Robot | Zone | Group) -> list[str]:
     """A robot's, zone's or group's names in every language the fleet file gives."""
-    return [*entry.spoken, *(name for names in entry.spoken_by_locale.values() for name in names)]
+    return [*entry.spoken, *(name for names in names_by_locale(entry).values() for name in names)]

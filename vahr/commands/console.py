@@ -19,11 +19,18 @@ def configure(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="speak replies, and what the assistant announces unprompted, with espeak-ng",
     )
+    parser.add_argument(
+        "--locale",
+        default="en-US",
+        help="the language spoken: en-US (default) or de-DE; the system must run in it",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
+    from vahr.local.alexa.localized import supported
     from vahr.local.client import call, default_api
 
+    supported(args.locale)
     api = args.api or default_api()
     call(api, "GET", "/vahr/health")  # fail now, with one line, if nothing runs
     interactive = sys.stdin.isatty()
@@ -60,7 +67,7 @@ def _converse(api: str, args: argparse.Namespace, interactive: bool) -> None:
         if not utterance:
             continue
         try:
-            turn = say(api, utterance)
+            turn = say(api, utterance, args.locale)
         except VahrError as err:
             print(f"error: {err}", file=sys.stderr)
             continue
@@ -70,9 +77,9 @@ def _converse(api: str, args: argparse.Namespace, interactive: bool) -> None:
             f"{turn['latency_ms']:.0f} ms]"
         )
         if args.speak and turn["speech"]:
-            from vahr.local.speaker import speak
+            from vahr.local.speaker import speak, voice_for
 
-            speak(turn["speech"])
+            speak(turn["speech"], voice=voice_for(args.locale))
 
 
 def _lines(interactive: bool) -> Iterator[str]:

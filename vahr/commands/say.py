@@ -14,21 +14,29 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--api", help="the running system's API (default $VAHR_API or :8180)")
     parser.add_argument("--json", action="store_true", help="print the whole turn as JSON")
     parser.add_argument("--speak", action="store_true", help="also speak the reply (espeak-ng)")
+    parser.add_argument(
+        "--locale",
+        default="en-US",
+        help="the language spoken: en-US (default) or de-DE; the system must run in it "
+        "(vahr up --locale)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
+    from vahr.local.alexa.localized import supported
     from vahr.local.client import default_api, say
 
+    supported(args.locale)
     if not args.utterance.strip():
         raise VahrError("the utterance is empty")
-    turn = say(args.api or default_api(), args.utterance)
+    turn = say(args.api or default_api(), args.utterance, args.locale)
     if args.json:
         print(json.dumps(turn))
     else:
         print(turn["speech"] or "(no answer)")
     if args.speak and turn.get("speech"):
-        from vahr.local.speaker import speak
+        from vahr.local.speaker import speak, voice_for
 
-        speak(turn["speech"])
+        speak(turn["speech"], voice=voice_for(args.locale))
     return 0

@@ -63,6 +63,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--no-voice", action="store_true", help="no room assistant (robots cannot ask by voice)"
     )
+    parser.add_argument(
+        "--locale",
+        default="en-US",
+        help="the language people speak to the simulated Echo: en-US (default) or de-DE "
+        "(speech recognition and the robots' voice stay English)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON lines")
     add_logging_flag(parser)
     parser.set_defaults(log_level="WARNING")
@@ -75,6 +81,15 @@ def run(args: argparse.Namespace) -> int:
     from vahr.station.deployment import on_local_system
 
     setup_logging(args.log_level)
+    from vahr.local.alexa.localized import supported
+    from vahr.protocol.locale import load_language
+
+    if not load_language(supported(args.locale)).speech.recognised:
+        print(
+            f"vahr up: {args.locale} is understood and spoken; speech recognition here is "
+            "English only, so push-to-talk and the robots' spoken weather exchange stay English",
+            file=sys.stderr,
+        )
     for flag in ("api_port", "mqtts_port", "mqtt_port", "station_port"):
         value = getattr(args, flag)
         if not 0 <= value <= 65535 or (value == 0 and flag not in ("mqtt_port", "station_port")):
@@ -102,6 +117,7 @@ def run(args: argparse.Namespace) -> int:
         voice=not args.no_voice,
         log_level=args.log_level,
         station_port=args.station_port or None,
+        locale=args.locale,
     )
     stopping = threading.Event()
     # SIGTERM ends the run like Ctrl-C does; both just set the event the main thread waits on.

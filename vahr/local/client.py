@@ -78,10 +78,14 @@ def call(
         raise VahrError(f"{api}{path} did not answer with JSON") from err
 
 
-def say(api: str, utterance: str) -> dict[str, Any]:
-    """The turn's JSON, with `latency_ms` measured here: utterance in to reply out."""
+def say(api: str, utterance: str, locale: str | None = None) -> dict[str, Any]:
+    """The turn's JSON, with `latency_ms` measured here: utterance in to reply out.
+    `locale` is the language spoken; the system refuses one it was not started in."""
     started = time.perf_counter()
-    turn = call(api, "POST", SAY_PATH, {"utterance": utterance})
+    body = (
+        {"utterance": utterance} if locale is None else {"utterance": utterance, "locale": locale}
+    )
+    turn = call(api, "POST", SAY_PATH, body)
     turn["skill_ms"] = turn.get("latency_ms")
     turn["latency_ms"] = round((time.perf_counter() - started) * 1000, 1)
     return turn

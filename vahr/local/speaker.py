@@ -1,4 +1,5 @@
-"""Speak the assistant's replies aloud with espeak-ng (for `vahr console --speak`)."""
+"""Speak the assistant's replies aloud with espeak-ng (for `vahr console --speak`), in the
+voice of the reply's language (`voice_for`: "en-us+f4", German "de+f4")."""
 
 from __future__ import annotations
 
@@ -9,6 +10,15 @@ from vahr.errors import VahrError
 
 VOICE = "en-us+f4"
 SPEAK_TIMEOUT_S = 30.0
+
+
+def voice_for(locale: str) -> str:
+    """The espeak-ng voice replies in `locale` are spoken with (its language.yaml's)."""
+    from vahr.protocol.locale import DEFAULT_LOCALE, load_language
+
+    if locale == DEFAULT_LOCALE:
+        return VOICE
+    return load_language(locale).speech.espeak_voice + "+f4"
 
 
 def speak(text: str, *, voice: str = VOICE) -> None:

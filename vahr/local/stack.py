@@ -159,12 +159,15 @@ class LocalStack:
         model_file: Path | None = None,
         fleet_file: Path | None = None,
         log_level: str = "WARNING",
+        locale: str = "en-US",
     ) -> AlexaSimulator:
-        """Serve the Alexa simulator (and the skill, in-process) at `POST /vahr/say`."""
+        """Serve the Alexa simulator (and the skill, in-process) at `POST /vahr/say`, in
+        `locale`: its understanding data, and the locale of every request it sends."""
         from vahr.local.alexa.commands_seen import CommandLog
         from vahr.local.alexa.nlu import InteractionModel
         from vahr.local.alexa.simulator import AlexaSimulator
         from vahr.local.alexa.skill import load_skill_handler
+        from vahr.local.alexa.understanding import load_understanding
 
         assert self.dataplane is not None, "start() first"
         log = CommandLog(starts_seen=True)
@@ -172,7 +175,8 @@ class LocalStack:
         self.dataplane.publish_observers.append(log.observe)
         # The classifier loads (or trains, when its cache is cold) while the rest starts;
         # the first utterance waits for it.
-        model = InteractionModel.load(model_file, background=True)
+        understanding = load_understanding(locale)
+        model = InteractionModel.load(model_file, background=True, understanding=understanding)
         handler = load_skill_handler(
             self.api_url,
             ack_timeout_s=ack_timeout_s,
@@ -187,7 +191,9 @@ class LocalStack:
                 payload = json.dumps(turn.to_message(), separators=(",", ":")).encode()
                 service.publish(topics.ASSISTANT_TURNS, payload, qos=1, wait=False)
 
-        simulator = AlexaSimulator(model, handler, command_log=log.take, on_turn=publish_turn)
+        simulator = AlexaSimulator(
+            model, handler, command_log=log.take, on_turn=publish_turn, locale=locale
+        )
         self.alexa = simulator
 
         def say(request: dict[str, Any]) -> tuple[int, dict[str, Any]]:
@@ -197,6 +203,12 @@ class LocalStack:
                 return 200, ended.to_json() if ended else {"session_open": False}
             if not isinstance(utterance, str) or not utterance.strip():
                 return 400, {"code": 400, "message": "utterance: a non-empty string is required"}
+            asked = request.get("locale", locale)
+            if asked != locale:
+                message = (
+                    f"locale: this system speaks {locale}; start it with vahr up --locale {asked}"
+                )
+                return 400, {"code": 400, "message": message}
             try:
                 origin, heard = _speaker(request)
             except ProtocolError as err:

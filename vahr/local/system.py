@@ -40,7 +40,8 @@ from vahr.local.robots import (
 from vahr.local.shadow_store import ShadowError
 from vahr.local.stack import LocalStack, StackConfig
 from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
-from vahr.skill_model.generator import build_interaction_model, render
+from vahr.protocol.fleet import SPOKEN_LOCALE
+from vahr.skill_model.generator import build_interaction_model, build_locale_model, render
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -80,6 +81,9 @@ class SystemConfig:
     # How often the robots report progress: "local" (every simulated second) or "aws"
     # (robot-agent's defaults, what a deployment on AWS gets).
     progress: ProgressRate = "local"
+    # The language people speak to the simulated Echo (`vahr up --locale`); the robots'
+    # own spoken exchange with the assistant stays English (an English recognizer).
+    locale: str = "en-US"
 
 
 class ServedStation(Protocol):
@@ -171,7 +175,11 @@ class LocalSystem:
         # The simulator understands the names of the fleet it runs: its interaction model is
         # generated from that fleet (skill-package/ holds the bundled fleet's). First, as a
         # fleet Alexa would refuse stops the start before anything runs.
-        model = build_interaction_model(self.fleet)
+        model = (
+            build_interaction_model(self.fleet)
+            if cfg.locale == SPOKEN_LOCALE
+            else build_locale_model(self.fleet, cfg.locale)
+        )
         if cfg.station_port:
             # The data plane's port first: a conflict is named the same with or without a station.
             ensure_free(cfg.api_port, "data-plane API")
@@ -186,6 +194,7 @@ class LocalSystem:
                 model_file=model_file,
                 fleet_file=fleet_file,
                 log_level=cfg.log_level,
+                locale=cfg.locale,
             )
             assert self.stack.dataplane is not None and self.stack.ca is not None
             self.stack.dataplane.local_routes[("GET", "/vahr/status")] = self._status
@@ -256,11 +265,16 @@ class LocalSystem:
 
     def _start_room(self) -> None:
         """The assistant robots talk to: a second simulated Echo on the same skill."""
+        from vahr.local.alexa.nlu import InteractionModel
         from vahr.local.alexa.simulator import AlexaSimulator
         from vahr.local.room import offline_room_assistant
 
         assert self.alexa is not None
-        room_echo = AlexaSimulator(self.alexa.model, self.alexa.handler)
+        model = self.alexa.model
+        if self.config.locale != SPOKEN_LOCALE:
+            # Robots ask in English whatever the people speak: the room's Echo is English.
+            model = InteractionModel(build_interaction_model(self.fleet), background=True)
+        room_echo = AlexaSimulator(model, self.alexa.handler)
 
         def ask(request: str) -> str | None:
             turn = room_echo.say(f"alexa {request}")

@@ -123,8 +123,9 @@ class Robot(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     thing: str
     spoken: SpokenNames
     start: Pose
-    # Names in other languages than en-US's `spoken`, by locale ("de-DE": [...]).
-    spoken_by_locale: dict[str, SpokenNames] = {}
+    # Names in other languages than en-US's `spoken`, by locale ("de-DE": [...]); left out
+    # of the fleet's JSON when the file gives none.
+    spoken_by_locale: dict[str, SpokenNames] | msgspec.UnsetType = msgspec.UNSET
 
 
 class Zone(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -135,7 +136,7 @@ class Zone(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     pose: Pose
     arm: Literal["loader", "unloader"] | None = None
     radius: Annotated[float, msgspec.Meta(gt=0)] = 0.5
-    spoken_by_locale: dict[str, SpokenNames] = {}
+    spoken_by_locale: dict[str, SpokenNames] | msgspec.UnsetType = msgspec.UNSET
 
 
 class Group(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -144,7 +145,7 @@ class Group(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     id: str
     spoken: SpokenNames
     robots: list[str]
-    spoken_by_locale: dict[str, SpokenNames] = {}
+    spoken_by_locale: dict[str, SpokenNames] | msgspec.UnsetType = msgspec.UNSET
 
 
 class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
@@ -287,13 +288,19 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
         return spoken_in(self.robot(thing), locale)[0]
 
 
+def names_by_locale(entry: Robot | Zone | Group) -> dict[str, list[str]]:
+    """A robot's, zone's or group's names in other locales than en-US, by locale."""
+    names = entry.spoken_by_locale
+    return names if isinstance(names, dict) else {}
+
+
 def spoken_in(entry: Robot | Zone | Group, locale: str = SPOKEN_LOCALE) -> list[str]:
     """What people call a robot, zone or group in `locale`: `spoken` in en-US, else its
     `spoken_by_locale` names; a fleet file without them falls back to the en-US names
     and says so once per locale."""
     if locale == SPOKEN_LOCALE:
         return entry.spoken
-    names = entry.spoken_by_locale.get(locale)
+    names = names_by_locale(entry).get(locale)
     if names:
         return names
     if locale not in _WARNED_LOCALES:

@@ -95,7 +95,8 @@ def test_a_deployed_endpoint_in_skill_json_survives_regeneration(tmp_path: Path)
     manifest = json.loads(manifest_file.read_text())
     endpoint = {"uri": "arn:aws:lambda:us-east-1:123456789012:function:vahr-skill"}
     manifest["manifest"]["apis"]["custom"]["endpoint"] = endpoint
-    manifest_file.write_text(json.dumps(manifest, indent=2) + "\n")
+    # (as infra.skill_endpoint writes it: UTF-8, the German store entry unescaped)
+    manifest_file.write_text(json.dumps(manifest, indent=2, ensure_ascii=False) + "\n")
     # When the generator checks and runs again
     assert skill_model_main(["--root", str(out), "--check"]) == 0
     assert skill_model_main(["--root", str(out)]) == 0
@@ -245,7 +246,8 @@ def test_every_event_has_the_full_ask_shape_and_a_known_intent(model: dict[str, 
         assert system["application"]["applicationId"].startswith("amzn1.ask.skill.")
         assert {"user", "device", "apiEndpoint", "apiAccessToken"} <= system.keys()
         assert event["request"]["requestId"].startswith("amzn1.echo-api.request.")
-        assert event["request"]["locale"] == "en-US"
+        # English events, and German ones (named *_de) for the skill's German replies.
+        assert event["request"]["locale"] == ("de-DE" if path.stem.endswith("_de") else "en-US")
         if event["request"]["type"] == "IntentRequest" and path.stem != "alexa_unknown_intent":
             assert event["request"]["intent"]["name"] in known, path.name
 
