@@ -9,6 +9,10 @@ the HTTP data plane go through `publish_update_result`, so MQTT subscribers see 
 It also reproduces the cloud stack's presence rule: a robot's retained presence message
 sets `reported.connected` in its classic shadow.
 
+Every change the store makes to a classic shadow also updates its fleet index
+(`store.index`, `vahr.local.fleet_index`), which the data plane serves as AWS IoT fleet
+indexing and the local stack queries in process.
+
 Requests are served in bursts on a thread of the service's own (`start()`): the MQTT
 client's network thread only queues what arrives, so it never waits on JSON work or on
 disk. The worker takes everything queued (up to `BURST` requests), applies it in memory
