@@ -1,0 +1,34 @@
+"""Speaking to a running station's push-to-talk (`POST /api/voice`) as its page does: a
+clip synthesized by a named voice, padded with the silence a button press leaves."""
+
+from __future__ import annotations
+
+import http.client
+import json
+import urllib.parse
+from typing import Any
+
+from vahr.speech.audio import Audio, concatenate
+from vahr.speech.tts import make_synthesizer
+
+
+def clip(voice: str, text: str) -> Audio:
+    spoken = make_synthesizer(voice).synthesize(text)
+    return concatenate(Audio.silence(0.3), spoken, Audio.silence(0.3))
+
+
+def talk(station_url: str, audio: Audio) -> dict[str, Any]:
+    """Release of the talk button: the clip posted as the page posts it; the answer's JSON."""
+    station = urllib.parse.urlsplit(station_url)
+    connection = http.client.HTTPConnection(station.hostname, station.port, timeout=60)
+    try:
+        connection.request(
+            "POST", "/api/voice", body=audio.to_wav(), headers={"Content-Type": "audio/wav"}
+        )
+        response = connection.getresponse()
+        body = response.read()
+    finally:
+        connection.close()
+    assert response.status == 200, body
+    answer: dict[str, Any] = json.loads(body)
+    return answer
