@@ -20,7 +20,7 @@ def clip(voice: str, text: str) -> Audio:
 def talk(station_url: str, audio: Audio) -> dict[str, Any]:
     """Release of the talk button: the clip posted as the page posts it; the answer's JSON."""
     station = urllib.parse.urlsplit(station_url)
-    connection = http.client.HTTPConnection(station.hostname, station.port, timeout=60)
+    connection = http.client.HTTPConnection(station.hostname or "", station.port, timeout=60)
     try:
         connection.request(
             "POST", "/api/voice", body=audio.to_wav(), headers={"Content-Type": "audio/wav"}
