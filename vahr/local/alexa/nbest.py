@@ -11,13 +11,15 @@ the fallback. Then:
 
 - the intent is the one with the most weight; below `MIN_INTENT_CONFIDENCE` of the whole,
   or the fallback, nothing is acted on;
+- nothing is weighed when the best transcript holds a word the lattice gives less than
+  `MIN_WORD_POSTERIOR` (speech about something else, heard as the model's words);
 - each robot or zone slot of the leading reading gets P(value) = the weight of the
   readings of that intent giving the slot that value, over all readings of that intent. A
   value below `MIN_SLOT_CONFIDENCE` is not acted on: with rival values heard, the slot
   carries them as alternatives and the skill asks ("Zone B or zone D?"); with none (the
   other readings lack the slot) the slot is left empty and the skill asks for it.
 
-The three constants are chosen on the tuning voices only (`bench/station_hearing.py`,
+The four constants are chosen on the tuning voices only (`bench/station_hearing.py`,
 docs/voice.md "Push-to-talk: asking when unsure").
 """
 
@@ -46,6 +48,10 @@ SHARPNESS = 1 / 200
 # wrong actions (a robot sent where nobody asked costs far more than a question).
 MIN_SLOT_CONFIDENCE = 0.7
 MIN_INTENT_CONFIDENCE = 0.5
+# The least lattice posterior of a word of the best transcript (`Recognition.confidence`)
+# for anything to be weighed at all: speech about something else comes out as the model's
+# words, each barely supported by the audio, which an NLU may still read as a request.
+MIN_WORD_POSTERIOR = 0.1
 # Slot types whose value moves a robot somewhere: never acted on when unsure.
 MOVING_TYPES = frozenset({ROBOT_TYPE, ZONE_TYPE})
 # A rival value is offered in the question only when it holds this share of the weight.
@@ -78,6 +84,7 @@ class Weighing:
     sharpness: float = SHARPNESS
     min_slot_confidence: float = MIN_SLOT_CONFIDENCE
     min_intent_confidence: float = MIN_INTENT_CONFIDENCE
+    min_word_posterior: float = MIN_WORD_POSTERIOR
 
 
 def posteriors(hypotheses: Sequence[Hypothesis], sharpness: float) -> list[float]:
@@ -140,6 +147,9 @@ def weigh_recognition(
     def understand(text: str) -> Understanding:
         return model.understand(strip_invocation(model.invocation_name, text))
 
+    if not recognition.accepted or recognition.confidence < weighing.min_word_posterior:
+        nothing = Understanding(FALLBACK, confidence=1.0)
+        return Weighed(nothing, 0.0, {}, 0)
     hypotheses = recognition.hypotheses or (Hypothesis(recognition.text, 0.0),)
     return weigh(hypotheses, understand, weighing)
 
