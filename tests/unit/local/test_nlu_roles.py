@@ -71,7 +71,9 @@ def test_a_weather_report_before_a_zone_makes_no_rule(model: InteractionModel) -
 
 def test_robots_offered_as_a_choice_are_asked_about(model: InteractionModel) -> None:
     robot = model.understand("send robot one or robot two to zone a").slots["robot"]
-    assert (robot.spoken, robot.id) == ("robot one and robot two", None)
+    # Both robots are offered, so the skill asks which one ("Placebot one or placebot two?")
+    assert robot.spoken == "robot one and robot two"
+    assert {robot.id, *(other for other, _ in robot.alternatives)} == {"placebot1", "placebot2"}
 
 
 def test_a_value_never_takes_another_types_slot(model: InteractionModel) -> None:
