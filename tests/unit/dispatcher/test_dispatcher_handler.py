@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import boto3
 import msgspec
 import pytest
-from conftest import REGION, load_event
+from conftest import REGION, AtomicCalls, load_event
 from moto.core import DEFAULT_ACCOUNT_ID
 from moto.iotdata.models import iotdata_backends
 
@@ -22,6 +22,7 @@ from dispatcher.command_channel import CommandChannel
 from dispatcher.config import DispatcherConfig
 from dispatcher.errors import ConfigError, DispatcherError
 from dispatcher.fleet_search import FleetSearch
+from dispatcher.task_table import TaskTable
 from vahr.local.dataplane import DataPlane, DataPlaneServer
 from vahr.local.meter import Meter
 from vahr.local.shadow_service import ShadowService
@@ -32,7 +33,6 @@ from vahr.protocol.dispatch import Dispatcher, Task, timestamp
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-    from dispatcher.task_table import TaskTable
 
 LONG_AGO = datetime(2026, 11, 26, 22, 0, tzinfo=UTC)
 
@@ -288,3 +288,46 @@ def test_the_lambda_entry_point_builds_its_adapters_from_the_environment(
             app.lambda_handler({"operation": "submit", "order": {"zone": "A"}}, None)
     finally:
         app.runtime.cache_clear()
+
+
+def test_two_robots_freed_at_once_take_one_queued_task_once(
+    table: TaskTable, index: Index, published: list[tuple[str, dict[str, Any]]]
+) -> None:
+    """Two rule events, two function instances, one queued task: one robot takes it."""
+    import threading
+
+    # Given both robots reported busy-with-errors (no candidate), and one task queued
+    index.report("placebot1", status="stuck", zone="B")
+    index.report("placebot2", status="stuck", zone="C")
+    queued = submit(make_dispatcher(table, index), zone="D")["body"]["queued"][0]
+    # When both become idle and their events are handled at the same moment
+    for thing in ("placebot1", "placebot2"):
+        index.report(thing, status="idle", zone="B")
+    start = threading.Barrier(2)
+    took: dict[str, Any] = {}
+
+    def freed(thing: str) -> None:
+        # An instance of its own, as Lambda's, on a client whose calls are atomic
+        # (conftest.AtomicCalls: DynamoDB's are, moto's are not)
+        store = TaskTable(
+            "vahr-tasks", client=AtomicCalls(boto3.client("dynamodb", region_name=REGION))
+        )
+        dispatcher = make_dispatcher(store, index)
+        event = {"thing": thing, "reported": {"status": "idle", "zone": "B", "connected": True}}
+        start.wait(timeout=60)
+        try:
+            took[thing] = app.handle(event, dispatcher)["took"]
+        except Exception as err:  # noqa: BLE001 - shown by the assertion below
+            took[thing] = err
+
+    threads = [threading.Thread(target=freed, args=(t,)) for t in ("placebot1", "placebot2")]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout=20)
+    # Then exactly one of them took it, and exactly one command went out
+    assert not [err for err in took.values() if isinstance(err, Exception)], took
+    assert sorted(took.values(), key=lambda taken: taken is None) == [queued["id"], None]
+    [holder] = [thing for thing, task in took.items() if task is not None]
+    assert [(t.id, t.thing) for t in table.active()] == [(queued["id"], holder)]
+    assert [topic for topic, _ in published] == [topics.robot_cmd(holder)]

@@ -7,6 +7,7 @@ import threading
 from typing import TYPE_CHECKING, Any
 
 import pytest
+from conftest import AtomicCalls
 
 from dispatcher.errors import StoreError
 from dispatcher.task_table import TaskTable
@@ -58,7 +59,8 @@ def test_a_robot_holding_a_task_cannot_take_a_second(table: TaskTable) -> None:
 def test_two_robots_claiming_one_task_at_once_one_wins(table: TaskTable, dynamodb: Any) -> None:
     """Two dispatchers race for one task from two threads; exactly one claim holds."""
     table.add(task("t1"))
-    second = TaskTable("vahr-tasks", client=dynamodb)
+    first = TaskTable("vahr-tasks", client=AtomicCalls(dynamodb))
+    second = TaskTable("vahr-tasks", client=AtomicCalls(dynamodb))
     start = threading.Barrier(2)
     won: dict[str, Task | None] = {}
 
@@ -70,7 +72,7 @@ def test_two_robots_claiming_one_task_at_once_one_wins(table: TaskTable, dynamod
         return run
 
     threads = [
-        threading.Thread(target=claim(table, "placebot1")),
+        threading.Thread(target=claim(first, "placebot1")),
         threading.Thread(target=claim(second, "placebot2")),
     ]
     for thread in threads:
