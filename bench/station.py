@@ -240,7 +240,7 @@ def measure(args: argparse.Namespace) -> tuple[list[float], dict[str, Any]]:
             address = parse_broker_url(broker)
             with MqttClient(MqttEndpoint(host=address.host, port=address.port)) as link:
                 link.subscribe(topics.ALL_SHADOW_DOCUMENTS, clock.on_documents)
-                result = drive(args, url, link, microphone, clock, latencies)
+                result = drive(args, url, link, microphone, clock, latencies, station.pid)
         finally:
             if station is not None and station.poll() is None:
                 station.send_signal(signal.SIGTERM)
@@ -276,6 +276,7 @@ def drive(
     microphone: Path,
     clock: BrokerClock,
     latencies: list[float],
+    station_pid: int,
 ) -> dict[str, Any]:
     with sync_playwright() as playwright:
         browser = launch(playwright, microphone=microphone)
@@ -300,6 +301,7 @@ def drive(
         time.sleep(LEG_S)
         collect(page, clock, [])
         heap_start = heap_mb(cdp)
+        started, page_cpu, station_cpu = time.monotonic(), busy_s(cdp), cpu_s(station_pid)
         ends = time.monotonic() + args.minutes * 60
         while time.monotonic() < ends:
             send_everyone()
@@ -307,6 +309,9 @@ def drive(
             collect(page, clock, latencies, arrivals)
         time.sleep(1.0)
         collect(page, clock, latencies, arrivals)
+        elapsed = time.monotonic() - started
+        page_share = (busy_s(cdp) - page_cpu) / elapsed
+        station_share = (cpu_s(station_pid) - station_cpu) / elapsed
         cdp.send("HeapProfiler.collectGarbage")
         heap_end = heap_mb(cdp)
         messages = page.evaluate("() => window.vahrMetrics.messages")
@@ -318,13 +323,27 @@ def drive(
         "messages": messages,
         "ptt": ptt,
         "arrivals": arrivals,
+        "page_busy": page_share,
+        "station_cpu": station_share,
     }
+
+
+def busy_s(cdp: Any) -> float:
+    """Seconds the page's main thread has been busy (Chromium's TaskDuration)."""
+    metrics = {m["name"]: m["value"] for m in cdp.send("Performance.getMetrics")["metrics"]}
+    return float(metrics["TaskDuration"])
+
+
+def cpu_s(pid: int) -> float:
+    """CPU seconds (user and system) process `pid` and its threads have used."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def press(page: Any, presses: int) -> list[dict[str, Any]]:
     """Hold to talk for the clip's length, `presses` times; what the page measured."""
     box = page.locator("#talk").bounding_box()
-    found = []
+    found: list[dict[str, Any]] = []
     for index in range(presses):
         page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
         page.mouse.down()
@@ -360,6 +379,8 @@ def figures(
         "received_p95_ms": round(percentile(arrivals, 95), 1),
         "updates_painted": len(latencies),
         "page_messages": result["messages"],
+        "page_main_thread_busy": round(result["page_busy"], 3),
+        "station_cpu_cores": round(result["station_cpu"], 3),
         "heap_start_mb": round(result["heap_start"], 1),
         "heap_end_mb": round(result["heap_end"], 1),
         "ptt_reply_shown_ms": round(median([p["reply_shown_ms"] for p in ptt])) if ptt else None,
@@ -396,6 +417,8 @@ def report(args: argparse.Namespace, runs: list[dict[str, Any]]) -> None:
         row("of which the broker to the page's receipt, p95", "received_p95_ms"),
         row("shadow updates painted", "updates_painted", ""),
         row("messages the page received", "page_messages", ""),
+        row("the page's main thread busy (share of wall time)", "page_main_thread_busy", ""),
+        row("`vahr station`'s CPU (cores used, on average)", "station_cpu_cores", ""),
         "| the station's feed alone, per shadow document / per progress event (one core) | "
         + " | ".join(f"{run['feed']['document_us']} / {run['feed']['event_us']} µs" for run in runs)
         + " |",
