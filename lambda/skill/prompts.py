@@ -37,6 +37,8 @@ FALLBACK_REPROMPT = "What would you like the robots to do?"
 
 # Elicitation: the choices are listed so the person knows what they can say.
 ASK_ROBOT = "Which robot: {choices}?"
+# The last choice when a large fleet's robots are too many to list (skill.vocabulary).
+ANOTHER_ROBOT = "another of the {count} robots by its name"
 ASK_FIRST_ROBOT = "Which robot delivers first: {choices}?"
 ASK_SECOND_ROBOT = "Which robot delivers second: {choices}?"
 ASK_ZONE = "To which zone: {choices}?"

@@ -49,6 +49,12 @@ def capitalise(sentence: str) -> str:
     return sentence[:1].upper() + sentence[1:]
 
 
+# A fleet of more robots than this is not listed one by one when the skill asks which robot
+# (each name is a few words, and a question should stay short enough to hear).
+ROBOT_CHOICES_MAX = 6
+ROBOT_CHOICES_SHOWN = 3
+
+
 def join_choices(names: list[str]) -> str:
     """'a', 'a or b', 'a, b, or c' (in German 'a, b oder c')."""
     word = prompts.OR
@@ -121,7 +127,13 @@ class Vocabulary:
         return self._zone_ids.get(normalize(heard))
 
     def robot_choices(self, *, include_fleet: bool = True) -> str:
-        names = [self.robot(thing) for thing in self.fleet.robot_things]
+        things = self.fleet.robot_things
+        if len(things) > ROBOT_CHOICES_MAX:
+            # A thousand names are minutes of speech: a few, then how to name the others.
+            names = [self.robot(thing) for thing in things[:ROBOT_CHOICES_SHOWN]]
+            count = f"{len(things):,}"
+            return join_choices([*names, prompts.ANOTHER_ROBOT.format(count=count)])
+        names = [self.robot(thing) for thing in things]
         if include_fleet and len(names) > 1:
             names.append(self.robot(FLEET))
         return join_choices(names)

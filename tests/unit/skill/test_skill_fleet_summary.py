@@ -298,3 +298,12 @@ def test_a_command_to_a_thousand_robots_is_confirmed_by_the_index(
     )
     # And not one shadow was read to find out
     assert "http.shadow.get" not in json.dumps(meter.snapshot())
+
+
+def test_asking_which_robot_of_a_thousand_names_a_few_and_how_to_name_the_others(
+    big_fleet: Fleet,
+) -> None:
+    from skill.vocabulary import Vocabulary
+
+    choices = Vocabulary(big_fleet).robot_choices()
+    assert choices == "rover 1, rover 2, rover 3, or another of the 1,000 robots by its name"
