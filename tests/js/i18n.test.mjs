@@ -1,0 +1,43 @@
+// The station's words per locale: which language the page shows, and that both word lists
+// name the same places on the page, each of which the page has.
+import assert from "node:assert/strict";
+import { readFileSync } from "node:fs";
+import { test } from "node:test";
+
+import { chooseLocale, SUPPORTED } from "../../vahr/station/static/i18n.js";
+
+const LOCALES = new URL("../../vahr/station/locales/", import.meta.url);
+const PAGE = readFileSync(new URL("../../vahr/station/static/index.html", import.meta.url), "utf8");
+const words = (locale) => JSON.parse(readFileSync(new URL(`${locale}.json`, LOCALES), "utf8"));
+
+test("a German browser gets German, an Austrian one too, anything else English", () => {
+  assert.equal(chooseLocale(null, ["de-DE", "en-US"]), "de-DE");
+  assert.equal(chooseLocale(null, ["de-AT"]), "de-DE");
+  assert.equal(chooseLocale(null, ["fr-FR", "en-GB"]), "en-US");
+  assert.equal(chooseLocale(null, ["fr-FR"]), "en-US");
+});
+
+test("a language chosen in the selector wins over the browser's", () => {
+  assert.equal(chooseLocale("en-US", ["de-DE"]), "en-US");
+  assert.equal(chooseLocale("xx-XX", ["de-DE"]), "de-DE");
+});
+
+test("every locale words the same places of the page", () => {
+  const english = words("en-US");
+  for (const locale of SUPPORTED) {
+    const other = words(locale);
+    for (const part of ["text", "html", "after", "attr"]) {
+      assert.deepEqual(Object.keys(other[part]).sort(), Object.keys(english[part]).sort(), `${locale} ${part}`);
+    }
+  }
+});
+
+test("the English words are the page's own", () => {
+  const english = words("en-US");
+  for (const text of [...Object.values(english.text), ...Object.values(english.after)]) {
+    assert.ok(PAGE.includes(text.replace("'", "&#39;")) || PAGE.includes(text), text);
+  }
+  for (const attributes of Object.values(english.attr)) {
+    for (const value of Object.values(attributes)) assert.ok(PAGE.includes(`"${value}"`), value);
+  }
+});
