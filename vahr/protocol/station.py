@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 import msgspec
 
 from vahr.protocol.announcements import Announcement
+from vahr.protocol.dispatch import Task  # noqa: TC001 (msgspec reads it at run time)
 from vahr.protocol.errors import ProtocolError, from_validation_error
 
 # The page's structs name these in annotations, which msgspec reads at run time.
@@ -272,27 +273,13 @@ class CommandParams(msgspec.Struct, frozen=True, omit_defaults=True):
     after: str | None | msgspec.UnsetType = msgspec.UNSET
 
 
-TaskStatusWord = Literal["queued", "assigned", "done", "cancelled"]
-
-
-class FleetTask(msgspec.Struct, frozen=True, kw_only=True):
-    """One task of the fleet's queue as the dispatcher serves it (`GET {api}/vahr/tasks`):
-    what is to be done where, its state, and the robot that took it (None while queued).
-    Fields the dispatcher adds beyond these are not passed on."""
-
-    id: ShortText
-    kind: ShortText
-    zone: ShortText | None = None
-    status: TaskStatusWord
-    thing: ShortText | None = None
-    created_at: ShortText | None = None
-
-
 class TasksMessage(msgspec.Struct, frozen=True, kw_only=True, tag="tasks", tag_field="type"):
-    """The fleet's task queue, sent when it changed: every task the dispatcher lists, in
-    its order; `available` is False when the deployment has no dispatcher to ask."""
+    """The fleet's task queue, sent when it changed: every task the dispatcher lists
+    (`GET {api}/vahr/tasks`, `vahr.protocol.dispatch.Task`: what is to be done where, its
+    state, the robot that took it), in its order; `available` is False when the deployment
+    has no dispatcher to ask."""
 
-    tasks: list[FleetTask]
+    tasks: list[Task]
     available: bool
 
 

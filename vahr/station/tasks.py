@@ -19,7 +19,8 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from vahr.protocol.station import FleetTask, TasksMessage
+from vahr.protocol.dispatch import Task  # noqa: TC001 (msgspec reads it at run time)
+from vahr.protocol.station import TasksMessage
 
 if TYPE_CHECKING:
     from vahr.station.feed import Feed
@@ -34,7 +35,7 @@ TASKS_SHOWN = 200
 
 
 class _Tasks(msgspec.Struct):
-    tasks: list[FleetTask]
+    tasks: list[Task]
 
 
 _decoder = msgspec.json.Decoder(_Tasks)

@@ -69,9 +69,12 @@ class Dispatcher:
 
 
 def task(id: str, status: str, thing: str | None = None, zone: str = "C") -> dict[str, Any]:
+    """A task as `GET /vahr/tasks` serves it (`vahr.protocol.dispatch.Task`)."""
     return {
-        "id": id, "kind": "deliver", "zone": zone, "status": status, "thing": thing,
-        "created_at": f"2026-11-26T23:00:0{id[-1]}Z", "priority": 1,
+        "id": id, "request": f"order-{id}", "kind": "deliver", "zone": zone,
+        "pickup": "LOADING", "group": None, "robots": [], "status": status, "thing": thing,
+        "created_at": f"2026-11-26T23:00:0{id[-1]}.000000Z", "assigned_at": None,
+        "outcome": None, "version": 1,
     }  # fmt: skip
 
 

@@ -12,10 +12,10 @@ import pytest
 from tests.conftest import load_event
 from tests.support.station import RecordingAssistant, Wire
 from vahr.protocol import Event, EventPose, Presence, encode, new_command, topics, utc_now
+from vahr.protocol.dispatch import Task
 from vahr.protocol.station import (
     AlertAcknowledgedMessage,
     AnnouncementMessage,
-    FleetTask,
     PageMessage,
     RobotsMessage,
     SnapshotMessage,
@@ -501,7 +501,9 @@ def test_the_task_queue_reaches_pages_when_it_changed_and_new_pages_start_with_i
 ) -> None:
     page = feed.subscribe()
     messages(page)
-    queued = FleetTask(id="t1", kind="deliver", zone="C", status="queued")
+    queued = Task(
+        id="t1", request="r1", kind="deliver", zone="C", created_at="2026-11-26T23:00:00Z"
+    )
     # When the dispatcher's queue is read three times, changing once in between
     feed.set_tasks(TasksMessage(tasks=[queued], available=True))
     feed.set_tasks(TasksMessage(tasks=[queued], available=True))

@@ -158,19 +158,6 @@
  */
 
 /**
- * One task of the fleet's queue as the dispatcher serves it (`GET {api}/vahr/tasks`): what is
- * to be done where, its state, and the robot that took it (None while queued). Fields the
- * dispatcher adds beyond these are not passed on.
- * @typedef {object} FleetTask
- * @property {string} id
- * @property {string} kind
- * @property {string|null} zone
- * @property {"assigned"|"cancelled"|"done"|"queued"} status
- * @property {string|null} thing
- * @property {string|null} created_at
- */
-
-/**
  * The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`).
  * @typedef {object} FleetView
  * @property {Array<RobotEntry>} robots
@@ -353,6 +340,30 @@
  */
 
 /**
+ * One robot's share of an order, as the store keeps it and `GET /vahr/tasks` shows it.
+ *
+ * `id` is also the id of the command published for it (so republishing after a restart is
+ * executed once, DESIGN.md). `robots` lists the only robots that may take it (a group's member,
+ * a robot in a named zone); empty means any. `created_at` (RFC 3339 UTC with microseconds) then
+ * `id` order the queue. `version` grows by one on every write; stores use it for their
+ * conditional writes.
+ * @typedef {object} Task
+ * @property {string} id
+ * @property {string} request
+ * @property {"deliver"|"navigate"} kind
+ * @property {string} zone
+ * @property {string|null} pickup
+ * @property {string|null} group
+ * @property {Array<string>} robots
+ * @property {"assigned"|"cancelled"|"done"|"queued"} status
+ * @property {string|null} thing
+ * @property {string} created_at
+ * @property {string|null} assigned_at
+ * @property {"cancelled"|"done"|"failed"|"preempted"|"rejected"|null} outcome
+ * @property {number} version
+ */
+
+/**
  * One task as the judge sees it now: not started, running (with the verdict so far), or ended
  * with success or failure and why.
  * @typedef {object} TaskStatus
@@ -364,11 +375,13 @@
  */
 
 /**
- * The fleet's task queue, sent when it changed: every task the dispatcher lists, in its order;
- * `available` is False when the deployment has no dispatcher to ask.
+ * The fleet's task queue, sent when it changed: every task the dispatcher lists (`GET
+ * {api}/vahr/tasks`, `vahr.protocol.dispatch.Task`: what is to be done where, its state, the
+ * robot that took it), in its order; `available` is False when the deployment has no dispatcher
+ * to ask.
  * @typedef {object} TasksMessage
  * @property {"tasks"} type
- * @property {Array<FleetTask>} tasks
+ * @property {Array<Task>} tasks
  * @property {boolean} available
  */
 
