@@ -6,11 +6,13 @@ The rule reads every classic shadow's `update/documents` and passes on only the 
 that leave a robot idle or stopped when it was not, or that change whether it is
 connected while it is free (`freed_sql`); driving, progress and pose reports cost a rule
 evaluation and nothing more. The skill invokes the function synchronously to submit,
-list and cancel tasks.
+list and cancel tasks. An EventBridge schedule wakes it once a minute to give queued tasks
+to robots that are free now, should a rule event have been lost.
 
 Least privilege: the function may read and write only its task table, search only the
 `AWS_Things` index, publish only on the fleet's robots' command topics, write its own
-logs and send to its dead-letter queue. IoT may invoke it only from its rule. A message
+logs and send to its dead-letter queue. IoT may invoke it only from its rule, EventBridge
+only from its schedule. A message
 the rule cannot deliver and an event the function failed on after Lambda's two retries
 land in one encrypted queue, kept 14 days.
 """
@@ -20,6 +22,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import aws_cdk as cdk
+from aws_cdk import aws_events as events
+from aws_cdk import aws_events_targets as targets
 from aws_cdk import aws_iam as iam
 from aws_cdk import aws_iot as iot
 from aws_cdk import aws_sqs as sqs
@@ -44,6 +48,9 @@ TIMEOUT = cdk.Duration.seconds(30)
 MEMORY_MB = 512
 # The fleet index the skill may ask for counts and searches (issue 35's status summary).
 SKILL_INDEX_ACTIONS = ("iot:SearchIndex", "iot:GetBucketsAggregation", "iot:GetStatistics")
+# How often the schedule has the function give queued tasks to robots free now, in case a
+# robot's rule event was lost. With nothing queued a tick is one read of the queue.
+TICK = cdk.Duration.minutes(1)
 
 
 def freed_sql() -> str:
@@ -175,6 +182,14 @@ class Dispatcher(Construct):
                     )
                 ),
             ),
+        )
+        # A tick EventBridge cannot deliver is not retried: the next one does the same work.
+        self.schedule = events.Rule(
+            self,
+            "Tick",
+            description="Wakes the VAHR dispatcher to give queued tasks to free robots",
+            schedule=events.Schedule.rate(TICK),
+            targets=[targets.LambdaFunction(self.function, retry_attempts=0, max_event_age=TICK)],
         )
         self.function.add_permission(
             "RuleInvoke",

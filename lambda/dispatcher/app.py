@@ -1,10 +1,11 @@
 """The dispatcher's Lambda handler. Thin: parse the event, run the core, answer.
 
-Two callers (see `dispatcher.requests`): the skill, synchronously, and the topic rule on
-the robots' shadow documents. Errors are mapped here and nowhere else: a request that
-cannot be carried out (a bad order, an unknown task) is answered with its one line, and
-the skill speaks it; an AWS failure raises, so a rule's event is retried by Lambda and
-then kept in the dead-letter queue, and the skill hears that the dispatcher failed.
+Three callers (see `dispatcher.requests`): the skill, synchronously, the topic rule on the
+robots' shadow documents, and an EventBridge schedule once a minute. Errors are mapped
+here and nowhere else: a request that cannot be carried out (a bad order, an unknown
+task) is answered with its one line, and the skill speaks it; an AWS failure raises, so a
+rule's event is retried by Lambda and then kept in the dead-letter queue, and the skill
+hears that the dispatcher failed.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from dispatcher.requests import (
     SkillRequest,
     Submit,
     is_robot_update,
+    is_tick,
 )
 from dispatcher.robot_updates import robot_freed
 from dispatcher.task_table import TaskTable
@@ -69,9 +71,12 @@ def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
 
 
 def handle(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, Any]:
-    """One invocation: a robot's update (from the rule) or a skill's request."""
+    """One invocation: a robot's update (from the rule), the schedule's tick, or a skill's
+    request."""
     if is_robot_update(event):
         return on_robot_update(event, dispatcher)
+    if is_tick(event):
+        return on_tick(dispatcher)
     try:
         answer = on_request(_request(event), dispatcher)
     except BadRequest as err:
@@ -95,6 +100,16 @@ def on_robot_update(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, 
     if taken is not None:
         log.info("task %s (%s to %s) given to %s", taken.id, taken.kind, taken.zone, taken.thing)
     return {"took": taken.id if taken is not None else None}
+
+
+def on_tick(dispatcher: Dispatcher) -> dict[str, Any]:
+    """Once a minute: queued tasks go to robots that are free now. A robot freed while its
+    rule event was lost (dead-lettered, or the function failed) would otherwise wait for its
+    next change; with nothing queued this is one read of the queue and nothing more."""
+    given = dispatcher.drain()
+    for task in given:
+        log.info("task %s (%s to %s) given to %s", task.id, task.kind, task.zone, task.thing)
+    return {"given": [task.id for task in given]}
 
 
 def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:

@@ -16,7 +16,8 @@ adapters read one shape. A request that cannot be carried out is `{"status": 400
 "body": {"code": N, "message": "one line"}}` and changes nothing.
 
 The topic rule (infra/constructs/dispatcher.py) sends `{"thing", "reported", "timestamp"}`:
-the robot's whole reported state after an update that left it idle or stopped.
+the robot's whole reported state after an update that left it idle or stopped. An
+EventBridge schedule sends its scheduled event once a minute (`is_tick`).
 """
 
 from __future__ import annotations
@@ -61,6 +62,15 @@ class RobotUpdate(msgspec.Struct, frozen=True, kw_only=True):
 class Answer(msgspec.Struct, frozen=True):
     status: int
     body: Any
+
+
+# An EventBridge scheduled event's source and detail type.
+SCHEDULE = ("aws.events", "Scheduled Event")
+
+
+def is_tick(event: dict[str, Any]) -> bool:
+    """The once-a-minute schedule (infra/constructs/dispatcher.py)."""
+    return (event.get("source"), event.get("detail-type")) == SCHEDULE
 
 
 def is_robot_update(event: dict[str, Any]) -> bool:

@@ -158,6 +158,25 @@ def test_the_rule_reads_shadow_documents_into_the_function_and_dead_letters_fail
     assert permission["SourceArn"] == f"<{rule_id}.Arn>"
 
 
+def test_a_schedule_wakes_the_function_once_a_minute_and_never_piles_up(
+    dispatcher_template: dict[str, Any],
+) -> None:
+    schedule = only(dispatcher_template, "AWS::Events::Rule")
+    function = functions(dispatcher_template)["dispatcher.app.lambda_handler"]
+    assert schedule["ScheduleExpression"] == "rate(1 minute)"
+    [target] = schedule["Targets"]
+    assert target["Arn"] == f"<{function['id']}.Arn>"
+    assert target["RetryPolicy"] == {"MaximumRetryAttempts": 0, "MaximumEventAgeInSeconds": 60}
+    # And EventBridge may invoke the function from this schedule only
+    [schedule_id] = resources(dispatcher_template, "AWS::Events::Rule")
+    [permission] = [
+        p
+        for p in resources(dispatcher_template, "AWS::Lambda::Permission").values()
+        if p["Principal"] == "events.amazonaws.com"
+    ]
+    assert permission["SourceArn"] == f"<{schedule_id}.Arn>"
+
+
 def test_the_function_retries_then_dead_letters_and_knows_its_table_and_index(
     dispatcher_template: dict[str, Any],
 ) -> None:

@@ -6,15 +6,18 @@ it makes is counted, with the DynamoDB request units each bills
 (`infra.cost_estimate.dynamodb_units`).
 
 Used by tests/unit/dispatcher/test_dispatcher_costs.py and bench/billable_operations.py.
-Call it inside `moto.mock_aws()` with fake credentials set.
+Call it inside `moto.mock_aws()` with fake credentials set. Also the dispatcher tests'
+helpers: `load_event` (tests/events/ by name) and `AtomicCalls`.
 """
 
 from __future__ import annotations
 
 import json
+import threading
 from collections import Counter
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
+from pathlib import Path
 from typing import Any
 
 import boto3
@@ -33,6 +36,39 @@ from vahr.protocol.dispatch import Dispatcher
 
 REGION = "us-east-1"
 TABLE = "vahr-tasks"
+EVENTS = Path(__file__).resolve().parents[1] / "events"
+
+
+def load_event(name: str) -> dict[str, Any]:
+    """A real-shaped JSON document from tests/events/ by name."""
+    loaded: dict[str, Any] = json.loads((EVENTS / f"{name}.json").read_text())
+    return loaded
+
+
+# moto applies a DynamoDB transaction to a copy of its tables and, when a condition fails,
+# puts the copy back: a transaction failing in one thread can undo one that succeeded in
+# another meanwhile. DynamoDB itself runs each request atomically, so the race tests make
+# each moto call atomic too; what they race is what the dispatchers race on AWS, the
+# reads and conditional writes in between.
+_MOTO = threading.Lock()
+
+
+class AtomicCalls:
+    """A boto3 client whose calls run one at a time, as DynamoDB runs each request."""
+
+    def __init__(self, client: Any) -> None:
+        self._client = client
+
+    def __getattr__(self, name: str) -> Any:
+        attribute = getattr(self._client, name)
+        if not callable(attribute):
+            return attribute
+
+        def call(*args: Any, **kwargs: Any) -> Any:
+            with _MOTO:
+                return attribute(*args, **kwargs)
+
+        return call
 
 
 @dataclass

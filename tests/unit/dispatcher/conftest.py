@@ -3,9 +3,6 @@ as the CDK stack makes it (infra/constructs/task_table.py), and real-shaped even
 
 from __future__ import annotations
 
-import json
-import threading
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import boto3
@@ -13,45 +10,10 @@ import pytest
 from moto import mock_aws
 
 from dispatcher.task_table import TaskTable
+from tests.support.dispatch_meter import REGION, TABLE
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
-
-EVENTS = Path(__file__).resolve().parents[2] / "events"
-REGION = "us-east-1"
-TABLE = "vahr-tasks"
-
-
-def load_event(name: str) -> dict[str, Any]:
-    """A real-shaped JSON document from tests/events/ by name."""
-    loaded: dict[str, Any] = json.loads((EVENTS / f"{name}.json").read_text())
-    return loaded
-
-
-# moto applies a DynamoDB transaction to a copy of its tables and, when a condition fails,
-# puts the copy back: a transaction failing in one thread can undo one that succeeded in
-# another meanwhile. DynamoDB itself runs each request atomically, so the race tests make
-# each moto call atomic too; what they race is what the dispatchers race on AWS, the
-# reads and conditional writes in between.
-_MOTO = threading.Lock()
-
-
-class AtomicCalls:
-    """A boto3 client whose calls run one at a time, as DynamoDB runs each request."""
-
-    def __init__(self, client: Any) -> None:
-        self._client = client
-
-    def __getattr__(self, name: str) -> Any:
-        attribute = getattr(self._client, name)
-        if not callable(attribute):
-            return attribute
-
-        def call(*args: Any, **kwargs: Any) -> Any:
-            with _MOTO:
-                return attribute(*args, **kwargs)
-
-        return call
 
 
 @pytest.fixture

@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING, Any
 import boto3
 import msgspec
 import pytest
-from conftest import REGION, AtomicCalls, load_event
 from moto.core import DEFAULT_ACCOUNT_ID
 from moto.iotdata.models import iotdata_backends
 
@@ -23,6 +22,7 @@ from dispatcher.config import DispatcherConfig
 from dispatcher.errors import ConfigError, DispatcherError
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
+from tests.support.dispatch_meter import REGION, AtomicCalls, load_event
 from vahr.local.dataplane import DataPlane, DataPlaneServer
 from vahr.local.meter import Meter
 from vahr.local.shadow_service import ShadowService
@@ -331,3 +331,19 @@ def test_two_robots_freed_at_once_take_one_queued_task_once(
     [holder] = [thing for thing, task in took.items() if task is not None]
     assert [(t.id, t.thing) for t in table.active()] == [(queued["id"], holder)]
     assert [topic for topic, _ in published] == [topics.robot_cmd(holder)]
+
+
+def test_the_schedule_gives_a_queued_task_to_a_robot_whose_event_was_lost(
+    table: TaskTable, index: Index, published: list[tuple[str, dict[str, Any]]]
+) -> None:
+    # Given a task queued while the only robot was stuck
+    index.report("placebot1", status="stuck", zone="B")
+    dispatcher = make_dispatcher(table, index)
+    queued = submit(dispatcher, zone="D")["body"]["queued"][0]
+    tick = load_event("eventbridge_schedule")
+    assert app.handle(tick, dispatcher) == {"given": []}  # still stuck: nothing to give
+    # When the robot is idle again but its rule event never reached the function
+    index.report("placebot1", status="idle", zone="B")
+    # Then the next tick gives it the task
+    assert app.handle(tick, dispatcher) == {"given": [queued["id"]]}
+    assert [topic for topic, _ in published] == [topics.robot_cmd("placebot1")]

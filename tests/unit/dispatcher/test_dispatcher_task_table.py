@@ -7,10 +7,10 @@ import threading
 from typing import TYPE_CHECKING, Any
 
 import pytest
-from conftest import AtomicCalls
 
 from dispatcher.errors import StoreError
 from dispatcher.task_table import TaskTable
+from tests.support.dispatch_meter import AtomicCalls
 from vahr.protocol.dispatch import Task
 
 if TYPE_CHECKING:
