@@ -130,7 +130,8 @@ class InteractionModel:
             language = document["interactionModel"]["languageModel"]
             self.invocation_name: str = language["invocationName"]
             intents = language["intents"]
-            self._slot_types = [_slot_type(t) for t in language.get("types", [])]
+            locale = self._understanding.locale
+            self._slot_types = [_slot_type(t, locale) for t in language.get("types", [])]
             self.intent_slots: dict[str, dict[str, str]] = {
                 intent["name"]: {slot["name"]: slot["type"] for slot in intent.get("slots", [])}
                 for intent in intents
@@ -161,6 +162,7 @@ class InteractionModel:
             + [(answer, self.intent_slots[name]) for name, answer in sorted(answers)],
             known,
             self._understanding.finder,
+            self._understanding.locale,
         )
         self._ambiguity = SlotAmbiguity(self._slot_types, known)
         robot_values = [
@@ -255,7 +257,7 @@ class InteractionModel:
         return self._classifier
 
     def find_slots(self, utterance: str) -> tuple[list[str], list[SlotMatch]]:
-        words = normalize_utterance(utterance).split()
+        words = normalize_utterance(utterance, self._understanding.locale).split()
         return words, self._finder.find(words)
 
     def understand(self, utterance: str) -> Understanding:
@@ -378,13 +380,13 @@ class InteractionModel:
         return " ".join(word for word in words if word)
 
 
-def _slot_type(document: dict[str, Any]) -> SlotTypeValues:
+def _slot_type(document: dict[str, Any], locale: str) -> SlotTypeValues:
     names: dict[str, tuple[str, str]] = {}
     for value in document.get("values", []):
         name = value["name"]["value"]
         value_id = value.get("id") or name
         for phrase in [name, *value["name"].get("synonyms", [])]:
-            names.setdefault(normalize_utterance(phrase), (value_id, name))
+            names.setdefault(normalize_utterance(phrase, locale), (value_id, name))
     return SlotTypeValues(document["name"], names)
 
 

@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 
 from rapidfuzz import fuzz, process
 
+from vahr.protocol.locale import DEFAULT_LOCALE, LocaleError
 from vahr.protocol.text import normalize, spell_numbers
 
 if TYPE_CHECKING:
@@ -49,13 +50,27 @@ FUZZY_CUTOFF = 75.0
 # The NLU reads numbers up to twenty as words (a larger one stays digits), and never bends
 # those words into a slot word: a changed number would name another robot or zone.
 SPELLED_BELOW = 21
-NUMBER_WORDS = frozenset(spell_numbers(str(number)) for number in range(SPELLED_BELOW))
 
 
-def normalize_utterance(text: str) -> str:
+def number_words(locale: str = DEFAULT_LOCALE) -> frozenset[str]:
+    """The words `locale` says the numbers up to twenty with (its `language.yaml`); none
+    for a locale without language data, whose numbers stay digits."""
+    try:
+        return frozenset(
+            spell_numbers(str(number), locale=locale) for number in range(SPELLED_BELOW)
+        )
+    except LocaleError:
+        return frozenset()
+
+
+def normalize_utterance(text: str, locale: str = DEFAULT_LOCALE) -> str:
     """An utterance as the NLU reads it: `vahr.protocol.text.normalize`d, with numbers to
-    twenty in words: "Send PlaceBot-1 to Zone B!" -> "send placebot one to zone b"."""
-    return spell_numbers(normalize(text), below=SPELLED_BELOW)
+    twenty in the locale's words: "Send PlaceBot-1 to Zone B!" -> "send placebot one to
+    zone b" ("placebot eins" in de-DE); digits stay for a locale without language data."""
+    try:
+        return spell_numbers(normalize(text), below=SPELLED_BELOW, locale=locale)
+    except LocaleError:
+        return normalize(text)
 
 
 @dataclass(frozen=True)
@@ -91,10 +106,13 @@ class SlotFinder:
         samples: Iterable[tuple[str, Mapping[str, str]]],
         known_words: Iterable[str],
         function_words: FinderWords,
+        locale: str = DEFAULT_LOCALE,
     ) -> None:
         """`samples` are (sample text, its slot name -> type); `known_words` are every word
         the classifier was trained on, which are never corrected into slot words;
-        `function_words` are the locale's (`understanding.yaml`)."""
+        `function_words` are the locale's (`understanding.yaml`), and its number words its
+        `language.yaml`'s."""
+        self._numbers = number_words(locale)
         articles = frozenset(function_words.articles)
         self._joiners = frozenset(function_words.joiners)
         self._turns = frozenset(function_words.turns)
@@ -136,7 +154,7 @@ class SlotFinder:
                     self._before[slot].add(words[index - 1])
                 if index + 1 < len(words) and not words[index + 1].startswith("{"):
                     self._after[slot].add(words[index + 1])
-        self._known = frozenset({*known_words, *sample_words, *slot_words, *NUMBER_WORDS})
+        self._known = frozenset({*known_words, *sample_words, *slot_words, *self._numbers})
 
     def correct(self, words: list[str]) -> tuple[list[str], list[float]]:
         """The words with misheard slot words corrected, and each word's similarity."""
@@ -291,7 +309,7 @@ class SlotFinder:
         if type_name is None or start + 1 >= len(corrected):
             return None
         following = corrected[start + 1]
-        if not (following in NUMBER_WORDS or len(following) == 1 or following not in self._known):
+        if not (following in self._numbers or len(following) == 1 or following not in self._known):
             return None
         return SlotMatch(
             type=type_name,
