@@ -65,8 +65,11 @@ def test_the_german_development_set_is_no_sample_or_training_phrase(
         for template in templates
         for sentence in expand(template)
     }
+    tuning = msgspec.yaml.decode(DEVSET.with_name("tuning-de-DE.yaml").read_bytes())
+    tuned_on = {item["text"] for item in tuning["utterances"]} | set(tuning["out_of_domain"])
     for sentence in sentences:
         assert sentence not in training and sentence not in phrases, sentence
+        assert sentence not in tuned_on, sentence
 
 
 def test_an_unknown_locale_is_refused_in_one_line() -> None:
