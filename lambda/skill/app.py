@@ -30,6 +30,14 @@ from skill.handlers.catch_all import CatchAllExceptionHandler
 from skill.handlers.confirmation import DeniedIntentHandler
 from skill.handlers.correction import CorrectionIntentHandler, UndoIntentHandler
 from skill.handlers.deliver import DeliverIntentHandler
+from skill.handlers.dispatch import (
+    CancelTaskIntentHandler,
+    FleetDeliverHandler,
+    FleetNavigateIntentHandler,
+    IdleRobotsIntentHandler,
+    TaskQueueIntentHandler,
+    ZoneRobotsIntentHandler,
+)
 from skill.handlers.emergency_stop import EmergencyStopIntentHandler
 from skill.handlers.navigate import NavigateIntentHandler
 from skill.handlers.sequential_delivery import SequentialDeliveryIntentHandler
@@ -45,6 +53,7 @@ from skill.interceptors import (
 from skill.iot_data import IotDataGateway
 from skill.logs import log_event
 from skill.runtime import SkillRuntime
+from skill.tasks import task_desk
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -60,17 +69,24 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
     No two handlers claim the same request, so the order only reads from the most to the
     least frequent; SessionEndedRequest comes last as it never speaks.
     """
+    desk = task_desk(runtime.config)
     return [
         # A denied intent is answered before its own handler could act on it.
         DeniedIntentHandler(),
         NavigateIntentHandler(runtime),
-        DeliverIntentHandler(runtime),
+        # A delivery naming no robot goes to the fleet; one naming a robot, as before.
+        FleetDeliverHandler(runtime, desk, named=DeliverIntentHandler(runtime)),
         WeatherDeliveryIntentHandler(runtime),
         SequentialDeliveryIntentHandler(runtime),
         StatusIntentHandler(runtime),
         ProblemRobotsIntentHandler(runtime),
         EmergencyStopIntentHandler(runtime),
         WeatherIntentHandler(runtime),
+        FleetNavigateIntentHandler(runtime, desk),
+        ZoneRobotsIntentHandler(runtime, desk),
+        IdleRobotsIntentHandler(runtime, desk),
+        TaskQueueIntentHandler(runtime, desk),
+        CancelTaskIntentHandler(runtime, desk),
         CorrectionIntentHandler(runtime),
         UndoIntentHandler(runtime),
         LaunchRequestHandler(runtime),

@@ -11,6 +11,7 @@ Every setting has a default, so the handler runs with only a region configured:
 | `VAHR_ACK_TIMEOUT_S` | 2.5 | how long to wait for robots to acknowledge a command (0-6 s) |
 | `VAHR_FLEET_FILE` | bundled fleet.yaml | the fleet definition |
 | `VAHR_LOG_LEVEL` | INFO | DEBUG, INFO, WARNING or ERROR |
+| `VAHR_DISPATCHER_FUNCTION` | unset | the fleet dispatcher function (the CDK stack sets it) |
 """
 
 from __future__ import annotations
@@ -69,6 +70,7 @@ class SkillConfig(msgspec.Struct, frozen=True):
             ack_timeout_s=_ack_timeout(env.get("VAHR_ACK_TIMEOUT_S")),
             fleet_file=_blank_to_none(env.get("VAHR_FLEET_FILE")),
             log_level=_log_level(env.get("VAHR_LOG_LEVEL")),
+            dispatcher_function=_blank_to_none(env.get("VAHR_DISPATCHER_FUNCTION")),
             control_endpoint=_blank_to_none(env.get("AWS_ENDPOINT_URL_IOT")),
         )
 

@@ -185,3 +185,54 @@ OR = "or"
 # Every other locale's sentences are vahr/protocol/locales/<locale>/replies.yaml, under these
 # names; the request's locale chooses (skill.catalog).
 localise(sys.modules[__name__])
+
+# Fleet dispatch (skill.handlers.dispatch, skill.task_speech): tasks without a robot's name.
+TASK_NAMES = {"navigate": "the trip to {zone}", "deliver": "the delivery to {zone}"}
+TASK_NAMES_PLURAL = {"navigate": "trips to {zone}", "deliver": "deliveries to {zone}"}
+DISPATCHED = {
+    "navigate": "{robot} is on its way to {zone}.",
+    "deliver": "{robot} is on its way to pick up a package for {zone}.",
+}
+DISPATCHED_MANY = {
+    "navigate": "{robots} are on their way to {zone}.",
+    "deliver": "{robots} are on their way to pick up packages for {zone}.",
+}
+ALL_BUSY = "All robots are busy; {task} is {place} in line."
+ALL_BUSY_MANY = "All robots are busy; {count} {tasks} are queued, the first {place} in line."
+QUEUED_REST = {
+    1: "No other robot is free, so one more waits, {place} in line.",
+    2: "No other robot is free, so {count} more wait, from {place} in line.",
+}
+MEMBERS_BUSY = "{robots} {verb} busy and will go when free."
+ORDINALS = (
+    "first",
+    "second",
+    "third",
+    "fourth",
+    "fifth",
+    "sixth",
+    "seventh",
+    "eighth",
+    "ninth",
+    "tenth",
+)
+ORDINAL_BEYOND = "number {n}"
+QUEUE_EMPTY = "Nothing is queued."
+QUEUE_LISTED = {1: "One task is queued: {tasks}.", 2: "{count} tasks are queued: {tasks}."}
+QUEUE_ENTRY = "{place}, {task}"
+QUEUE_MORE = "and {count} more"
+CANCELLED_QUEUED = "I cancelled {task}, which was {place} in line."
+CANCELLED_HELD = "I cancelled {task} and stopped {robot}."
+NOTHING_TO_CANCEL = "There is no task to {zone} to cancel."
+NO_DISPATCHER = (
+    "Sending a robot without its name needs the fleet dispatcher, which is not running here, "
+    "so I sent no robot."
+)
+UNKNOWN_GROUP = "I don't know a group called {heard}; the groups are {choices}."
+NO_GROUPS = "I don't know a group called {heard}; this fleet has no groups."
+TOO_MANY = "{owner} has {most} robots, so I cannot send {count}."
+NO_ROBOT_IN_ZONE = "No free robot is in {zone}, so I sent none."
+NO_IDLE_ROBOT = "No robot is idle just now, so I sent none."
+NO_FREE_ROBOT = "No robot is free to go just now, so I sent none."
+DISPATCH_REFUSED = "The dispatcher refused: {reason}."
+ASK_ORIGIN = "From which zone: {choices}?"

@@ -8,6 +8,7 @@ compare exactly the same bytes.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import re
@@ -22,7 +23,9 @@ from vahr.protocol.locale import load_language
 from vahr.protocol.text import number_variants, spell_numbers
 from vahr.skill_model.intents import (
     BUILT_IN_INTENTS,
+    COUNT_TYPE,
     CUSTOM_INTENTS,
+    GROUP_TYPE,
     LOCALE,
     ROBOT_TYPE,
     ZONE_TYPE,
@@ -60,6 +63,8 @@ MAX_SLOT_VALUES = 50_000
 MAX_MODEL_CHARS = 1_000_000
 MAX_SAMPLE_CHARS = 200_000
 MAX_UTTERANCE_CHARS = 200
+# "send twenty robots" is the most a COUNT names; more is said as a group or "every idle robot".
+MAX_COUNT = 20
 
 
 class ModelError(VahrError):
@@ -103,7 +108,15 @@ def render(document: dict[str, Any]) -> str:
 def build_interaction_model(
     fleet: Fleet, intents: tuple[IntentSpec, ...] = CUSTOM_INTENTS
 ) -> dict[str, Any]:
-    """The interaction model for one locale: language model plus a skill-driven dialog."""
+    """The interaction model for one locale: language model plus a skill-driven dialog.
+
+    A slot type the fleet gives no value (GROUP, when the fleet has no group besides the
+    whole fleet) is left out, with every slot and sample that needs it: Alexa refuses a
+    custom type without values.
+    """
+    types = [robot_type(fleet), zone_type(fleet), group_type(fleet), count_type()]
+    present = [slot_type for slot_type in types if slot_type["values"]]
+    intents = for_types(intents, {slot_type["name"] for slot_type in present})
     check_samples(intents)
     custom = [
         {
@@ -123,7 +136,7 @@ def build_interaction_model(
                 "invocationName": INVOCATION_NAME,
                 "modelConfiguration": {"fallbackIntentSensitivity": {"level": "LOW"}},
                 "intents": custom + built_in,
-                "types": [robot_type(fleet), zone_type(fleet)],
+                "types": present,
             },
             # The handlers elicit missing slots themselves (Dialog.ElicitSlot), which needs a
             # dialog model that lists the slots and leaves delegation to the skill.
@@ -195,6 +208,46 @@ def zone_type(fleet: Fleet) -> dict[str, Any]:
     values = [_value(zone.id, zone.spoken) for zone in fleet.zones]
     _check_unique_names(ZONE_TYPE, values)
     return {"name": ZONE_TYPE, "values": values}
+
+
+def group_type(fleet: Fleet) -> dict[str, Any]:
+    """GROUP: one value per group of fleet.yaml other than the whole fleet (which is ROBOT's
+    `all`), id = group id, names = its spoken names."""
+    values = [_value(group.id, group.spoken) for group in fleet.groups if group.id != FLEET_GROUP]
+    _check_unique_names(GROUP_TYPE, values)
+    return {"name": GROUP_TYPE, "values": values}
+
+
+def count_type() -> dict[str, Any]:
+    """COUNT: how many robots a task asks for, two to MAX_COUNT whatever the fleet's size
+    (so that "send nine robots" to a fleet of six is heard, and answered with how many it
+    has), spelled out ("two", id "2"); "a robot" and "one robot" are words of the samples."""
+    values = [_value(str(n), [spell_numbers(str(n))]) for n in range(2, MAX_COUNT + 1)]
+    return {"name": COUNT_TYPE, "values": values}
+
+
+def for_types(intents: tuple[IntentSpec, ...], types: set[str]) -> tuple[IntentSpec, ...]:
+    """The intents without the slots whose type is not in `types`, and without the samples
+    that name such a slot; an intent left with no sample is left out."""
+    kept = []
+    for intent in intents:
+        missing = {slot.name for slot in intent.slots if slot.type not in types}
+        if not missing:
+            kept.append(intent)
+            continue
+
+        def names_none(template: str, missing: set[str] = missing) -> bool:
+            return not any("{" + name + "}" in template for name in missing)
+
+        trimmed = dataclasses.replace(
+            intent,
+            slots=tuple(slot for slot in intent.slots if slot.name not in missing),
+            templates=tuple(filter(names_none, intent.templates)),
+            essentials=tuple(filter(names_none, intent.essentials)),
+        )
+        if trimmed.templates or trimmed.essentials:
+            kept.append(trimmed)
+    return tuple(kept)
 
 
 def _value(value_id: str, spoken: list[str]) -> dict[str, Any]:

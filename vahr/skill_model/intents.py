@@ -21,6 +21,9 @@ from vahr.skill_model.templates import draw
 LOCALE = "en-US"
 ROBOT_TYPE = "ROBOT"
 ZONE_TYPE = "ZONE"
+# The fleet's groups other than the whole fleet, and how many robots (fleet dispatch).
+GROUP_TYPE = "GROUP"
+COUNT_TYPE = "COUNT"
 # How many expanded samples an intent keeps at most: enough variety for Alexa (and the
 # simulator's classifier) to generalize, far inside the model's size limits (generator.py).
 MAX_SAMPLES_PER_INTENT = 240
@@ -28,6 +31,8 @@ MAX_SAMPLES_PER_INTENT = 240
 # The answers a person (or a robot) gives when the skill elicits one slot.
 ROBOT_ANSWERS = ("{slot}", "use {slot}", "with {slot}", "i mean {slot}", "i want {slot}")
 ZONE_ANSWERS = ("{slot}", "to {slot}", "go to {slot}", "deliver it to {slot}", "i mean {slot}")
+GROUP_ANSWERS = ("{slot}", "i mean {slot}")
+COUNT_ANSWERS = ("{slot}", "{slot} robots")
 
 
 @dataclass(frozen=True)
@@ -39,7 +44,9 @@ class SlotSpec:
 
     @property
     def answers(self) -> list[str]:
-        template = ROBOT_ANSWERS if self.type == ROBOT_TYPE else ZONE_ANSWERS
+        template = {ROBOT_TYPE: ROBOT_ANSWERS, GROUP_TYPE: GROUP_ANSWERS}.get(
+            self.type, COUNT_ANSWERS if self.type == COUNT_TYPE else ZONE_ANSWERS
+        )
         return [answer.replace("{slot}", "{" + self.name + "}") for answer in template]
 
 
@@ -106,7 +113,8 @@ NAVIGATE = IntentSpec(
         "<ask> (navigate|drive|head) {robot} <way> <to> {zone}",
         "<ask> (send|move|take|drive|get) {robot} <way> (there|to it|to that zone)",
         "<ask> (send|move|dispatch) {robot} <end>",
-        "<ask> (send|move|dispatch) (a|one|some) (robot|bot) <way> <to> {zone} <end>",
+        # "send a robot to zone b" is FleetNavigateIntent: the fleet picks the robot.
+        "<ask> (send|move|dispatch) (one|some) (robot|bot) <way> <to> {zone} <end>",
         "<ask> (navigate|drive|head) <way> <to> {zone} <end>",
         "<ask> (start|begin) (navigating|driving|moving|heading) <to> {zone} with {robot}",
         "<ask> (move|relocate|reposition) {robot} (over|across) <to> {zone}",
@@ -475,6 +483,111 @@ UNDO = IntentSpec(
     ),
 )
 
+# Fleet dispatch: tasks without a robot's name (docs/dispatch.md). A robot-less delivery
+# ("deliver a package to zone c") stays DeliverIntent; its handler gives it to the fleet.
+COUNT = SlotSpec("count", COUNT_TYPE)
+GROUP = SlotSpec("group", GROUP_TYPE)
+ORIGIN = SlotSpec("origin", ZONE_TYPE)
+
+FLEET_NAVIGATE = IntentSpec(
+    name="FleetNavigateIntent",
+    slots=(ZONE, COUNT, GROUP),
+    commands_robots=True,
+    essentials=(
+        "send a robot to {zone}",
+        "send {count} robots to {zone}",
+        "send {group} to {zone}",
+    ),
+    templates=(
+        "<ask> (send|move|dispatch|get|bring) (a|any) (robot|bot|free robot|available robot|"
+        "spare robot) <way> <to> {zone} <end>",
+        "<ask> (send|move|dispatch|get|bring) {count} (robots|bots|free robots|available robots) "
+        "<way> <to> {zone} <end>",
+        "(i need|i want|i'd like|we need|get me) (a|any|one) (robot|free robot|bot) (in|at|over "
+        "at) {zone} <end>",
+        "(i need|i want|i'd like|we need|get me) {count} (robots|free robots|bots) (in|at|over "
+        "at) {zone} <end>",
+        "<ask> (send|move|dispatch|get) {group} <way> <to> {zone} <end>",
+        "<ask> (have|let|make|tell) {group} <go> <way> <to> {zone} <end>",
+        "{group} (please|should|need to|can) <go> <way> <to> {zone} <end>",
+    ),
+)
+
+# The robots reported in one zone, sent to another. An intent of its own, as its two ZONE
+# slots come in this order in every sample.
+ZONE_ROBOTS = IntentSpec(
+    name="ZoneRobotsIntent",
+    slots=(ORIGIN, ZONE),
+    commands_robots=True,
+    essentials=("send the robots in {origin} to {zone}",),
+    templates=(
+        "<ask> (send|move|bring|take|get) the robots (in|at|that are in|sitting in|waiting in) "
+        "{origin} <way> <to> {zone} <end>",
+        "<ask> (have|let|make) the robots (in|at) {origin} <go> <way> <to> {zone} <end>",
+        "{origin} (robots|bots) (please|should|can) <go> <way> <to> {zone} <end>",
+        "<ask> (whoever|whichever robots|any robots) (is|are) (in|at) {origin} (should|can) <go> "
+        "<way> <to> {zone}",
+        "<ask> (clear|empty) {origin} (and|by) (send|sending|move|moving) (the|its|all the) "
+        "robots <to> {zone}",
+        "(every|each) robot (in|at) {origin} (should|must|can) <go> <way> <to> {zone} <end>",
+    ),
+)
+
+IDLE_ROBOTS = IntentSpec(
+    name="IdleRobotsIntent",
+    slots=(ZONE,),
+    commands_robots=True,
+    essentials=("send every idle robot to {zone}", "send the idle robots to {zone}"),
+    templates=(
+        "<ask> (send|move|dispatch|get|bring|take) (every|each|any|all) (idle|free|available|"
+        "unused|waiting) (robot|robots|bot|bots) <way> <to> {zone} <end>",
+        "<ask> (send|move|dispatch|get|bring|take) (the|all the|all) (idle|free|available|unused|"
+        "waiting) (robots|bots) <way> <to> {zone} <end>",
+        "<ask> (have|let|make) (every|each|all) (idle|free|available) (robot|robots) <go> <way> "
+        "<to> {zone} <end>",
+        "(every|each|all) (idle|free|available) (robot|robots) (should|must|can) <go> <way> <to> "
+        "{zone} <end>",
+        "<ask> (whoever|every robot that|any robot that|all robots that) (is|are) (idle|free|not "
+        "busy|doing nothing) <go> <way> <to> {zone}",
+        "{zone} (needs|wants|could use) (every|all the|all) (idle|free|available) (robots|bots) "
+        "<end>",
+    ),
+)
+
+TASK_QUEUE = IntentSpec(
+    name="TaskQueueIntent",
+    essentials=("what is queued", "what's in the queue", "what tasks are waiting"),
+    templates=(
+        "[<ask>] (what is|what's|what has been|what got) (queued|waiting|lined up|pending) "
+        "[up|now|right now|for the robots]",
+        "[<ask>] (what's|what is) (in|on) the (queue|task queue|waiting list|backlog) [now|right "
+        "now]",
+        "[<ask>] (which|what) (tasks|deliveries|jobs|orders) are (waiting|queued|pending|in line|"
+        "lined up) [now|right now]",
+        "[<ask>] (read|list|tell me|show me) the (queue|task queue|pending tasks|waiting tasks|"
+        "backlog) [please]",
+        "(is|are) (anything|any tasks|any deliveries) (queued|waiting|pending|in the queue)",
+        "how many (tasks|deliveries|jobs) are (queued|waiting|pending|in the queue)",
+        "(what's|what is) next (in line|in the queue|for the fleet)",
+    ),
+)
+
+CANCEL_TASK = IntentSpec(
+    name="CancelTaskIntent",
+    slots=(ZONE,),
+    essentials=("cancel the delivery to {zone}", "cancel the task to {zone}"),
+    templates=(
+        "[<ask>] (cancel|drop|forget|scrap|call off|remove) the (delivery|task|trip|job|order|"
+        "queued delivery|queued task) (to|for|into) {zone} <end>",
+        "[<ask>] (cancel|drop|forget|scrap|call off) (that|this) (delivery|task|trip) (to|for) "
+        "{zone} <end>",
+        "[<ask>] (never mind|forget about) the (delivery|task|trip) (to|for) {zone}",
+        "[<ask>] (take|remove) the (delivery|task) (to|for) {zone} (off|out of) the (queue|list)",
+        "[<ask>] (i don't need|we don't need|no more) the (delivery|task|trip) (to|for) {zone} "
+        "[anymore]",
+    ),
+)
+
 CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     NAVIGATE,
     DELIVER,
@@ -486,6 +599,11 @@ CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     WEATHER,
     CORRECTION,
     UNDO,
+    FLEET_NAVIGATE,
+    ZONE_ROBOTS,
+    IDLE_ROBOTS,
+    TASK_QUEUE,
+    CANCEL_TASK,
 )
 
 BUILT_IN_INTENTS: tuple[str, ...] = (

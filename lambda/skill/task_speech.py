@@ -1,0 +1,115 @@
+"""What the skill says about fleet tasks (pure): a submission, the queue, a cancellation.
+
+Sentences come from `skill.prompts`; robots are called by their first spoken name and
+zones as `skill.vocabulary` says them. Places in line are ordinals ("first in line").
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from skill import prompts
+from skill.vocabulary import capitalise
+from vahr.protocol.text import number_in_words
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from skill.vocabulary import Vocabulary
+    from vahr.protocol.dispatch import Order, Submission, Task
+
+# The queue is read out to this many tasks; the rest are counted.
+QUEUE_READ_MAX = 5
+
+
+def spoken_number(number: int) -> str:
+    return number_in_words(number) or str(number)
+
+
+def ordinal(place: int) -> str:
+    if 1 <= place <= len(prompts.ORDINALS):
+        return prompts.ORDINALS[place - 1]
+    return prompts.ORDINAL_BEYOND.format(n=place)
+
+
+def and_list(names: Sequence[str]) -> str:
+    """ "heron", "heron and plover", "heron, plover and curlew"."""
+    if len(names) <= 1:
+        return "".join(names)
+    return ", ".join(names[:-1]) + " and " + names[-1]
+
+
+def task_name(vocabulary: Vocabulary, task: Task) -> str:
+    """ "the delivery to the oven", "the trip to zone b"."""
+    return prompts.TASK_NAMES[task.kind].format(zone=vocabulary.zone(task.zone))
+
+
+def submission_report(vocabulary: Vocabulary, order: Order, submission: Submission) -> str:
+    """Who took the order's tasks, and what waits and where in line."""
+    zone = vocabulary.zone(order.zone)
+    robots = [vocabulary.robot(task.thing) for task in submission.assigned if task.thing]
+    sentences = []
+    if len(robots) == 1:
+        sentences.append(prompts.DISPATCHED[order.kind].format(robot=robots[0], zone=zone))
+    elif robots:
+        sentences.append(
+            prompts.DISPATCHED_MANY[order.kind].format(robots=and_list(robots), zone=zone)
+        )
+    queued = submission.queued
+    if queued:
+        place = ordinal(submission.positions[0]) if submission.positions else ordinal(1)
+        if order.group is not None and order.count is None:
+            # A group's task waits for its own member.
+            members = [vocabulary.robot(task.robots[0]) for task in queued if task.robots]
+            verb = "is" if len(members) == 1 else "are"
+            sentences.append(prompts.MEMBERS_BUSY.format(robots=and_list(members), verb=verb))
+        elif robots:
+            wording = prompts.QUEUED_REST[min(len(queued), 2)]
+            sentences.append(wording.format(count=spoken_number(len(queued)), place=place))
+        elif len(queued) == 1:
+            sentences.append(
+                prompts.ALL_BUSY.format(task=task_name(vocabulary, queued[0]), place=place)
+            )
+        else:
+            tasks = prompts.TASK_NAMES_PLURAL[order.kind].format(zone=zone)
+            sentences.append(
+                prompts.ALL_BUSY_MANY.format(
+                    count=spoken_number(len(queued)), tasks=tasks, place=place
+                )
+            )
+    return " ".join(capitalise(sentence) for sentence in sentences)
+
+
+def queue_report(vocabulary: Vocabulary, tasks: Sequence[Task]) -> str:
+    """The queue, next first: "2 queued: first, the delivery to the oven; second, ..."."""
+    queued = [task for task in tasks if task.status == "queued"]
+    if not queued:
+        return prompts.QUEUE_EMPTY
+    entries = [
+        prompts.QUEUE_ENTRY.format(place=ordinal(place), task=task_name(vocabulary, task))
+        for place, task in enumerate(queued[:QUEUE_READ_MAX], start=1)
+    ]
+    if len(queued) > QUEUE_READ_MAX:
+        entries.append(prompts.QUEUE_MORE.format(count=len(queued) - QUEUE_READ_MAX))
+    wording = prompts.QUEUE_LISTED[min(len(queued), 2)]
+    listed = wording.format(count=spoken_number(len(queued)), tasks="; ".join(entries))
+    return capitalise(listed)
+
+
+def task_to_cancel(tasks: Sequence[Task], zone: str) -> tuple[Task, int] | None:
+    """The task a person most likely means by "cancel the delivery to {zone}": the newest
+    queued one to that zone (with its place in line), else the newest one a robot holds
+    (place 0); None when no open task goes there."""
+    queued = [task for task in tasks if task.status == "queued"]
+    for place in range(len(queued), 0, -1):
+        if queued[place - 1].zone == zone:
+            return queued[place - 1], place
+    held = [task for task in tasks if task.status == "assigned" and task.zone == zone]
+    return (held[-1], 0) if held else None
+
+
+def cancel_report(vocabulary: Vocabulary, task: Task, place: int) -> str:
+    name = task_name(vocabulary, task)
+    if place > 0 or task.thing is None:
+        return capitalise(prompts.CANCELLED_QUEUED.format(task=name, place=ordinal(max(place, 1))))
+    return capitalise(prompts.CANCELLED_HELD.format(task=name, robot=vocabulary.robot(task.thing)))

@@ -1,0 +1,274 @@
+"""Fleet dispatch in the skill: real ASK envelopes in, the words Alexa would speak out.
+
+The skill's `TaskDesk` is a desk over the dispatch core itself (the real `Dispatcher` on a
+SQLite store in a temporary directory) whose robots are states set by each test, so the
+replies are checked against what the dispatcher really decided: which robot, which place
+in line. The fleet is the made-up six-robot bakery of tests/fleets/.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import TYPE_CHECKING, Any
+
+import pytest
+from skill_testkit import speech
+
+from skill import app as skill_app
+from skill.config import SkillConfig
+from skill.tasks import TaskRefused
+from tests.conftest import load_event
+from tests.support.fleets import SIX_ROBOTS
+from vahr.local.task_store import SqliteTaskStore
+from vahr.protocol import Command, load_fleet
+from vahr.protocol.dispatch import Dispatcher, DispatchError, Order, RobotState, Submission, Task
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterator
+    from pathlib import Path
+
+BAKERY = load_fleet(SIX_ROBOTS)
+
+
+class Robots:
+    """The dispatcher's candidates: every robot idle at its start, unless a test says."""
+
+    def __init__(self) -> None:
+        self.states = {
+            robot.thing: RobotState(thing=robot.thing, status="idle", pose=robot.start)
+            for robot in BAKERY.robots
+        }
+
+    def busy(self, *things: str) -> None:
+        for thing in things:
+            self.states[thing] = RobotState(thing=thing, status="stuck")
+
+    def available(self, *, zone: str | None = None) -> list[RobotState]:
+        return [s for s in self.states.values() if s.available and zone in (None, s.zone)]
+
+    def state(self, thing: str) -> RobotState | None:
+        return self.states.get(thing)
+
+
+class CoreDesk:
+    """A `TaskDesk` that is the dispatch core in-process, refusing as the HTTP route does."""
+
+    def __init__(self, dispatcher: Dispatcher) -> None:
+        self.dispatcher = dispatcher
+
+    def submit(self, order: Order) -> Submission:
+        try:
+            return self.dispatcher.submit(order)
+        except DispatchError as err:
+            raise TaskRefused(400, str(err)) from err
+
+    def tasks(self) -> list[Task]:
+        return self.dispatcher.tasks()
+
+    def cancel(self, task_id: str) -> Task | None:
+        return self.dispatcher.cancel(task_id)
+
+
+@pytest.fixture
+def robots() -> Robots:
+    return Robots()
+
+
+@pytest.fixture
+def sent() -> list[tuple[str, Command]]:
+    return []
+
+
+@pytest.fixture
+def desk(tmp_path: Path, robots: Robots, sent: list[tuple[str, Command]]) -> Iterator[CoreDesk]:
+    store = SqliteTaskStore.in_state_dir(tmp_path)
+    dispatcher = Dispatcher(
+        fleet=BAKERY,
+        store=store,
+        candidates=robots,
+        publish=lambda thing, command: sent.append((thing, command)),
+    )
+    yield CoreDesk(dispatcher)
+    store.close()
+
+
+@pytest.fixture
+def skill(
+    aws: None, desk: CoreDesk, monkeypatch: pytest.MonkeyPatch
+) -> Callable[[dict[str, Any]], dict[str, Any]]:
+    monkeypatch.setattr(skill_app, "task_desk", lambda config: desk)
+    handler = skill_app.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
+    return lambda event: handler(event, None)
+
+
+def _slot(name: str, spoken: str | None, value_id: str | None) -> dict[str, Any]:
+    slot: dict[str, Any] = {"name": name, "confirmationStatus": "NONE"}
+    if spoken is None:
+        return slot
+    authority = f"amzn1.er-authority.echo-sdk.amzn1.ask.skill.test.{name.upper()}"
+    if value_id is None:
+        resolution = {"authority": authority, "status": {"code": "ER_SUCCESS_NO_MATCH"}}
+    else:
+        resolution = {
+            "authority": authority,
+            "status": {"code": "ER_SUCCESS_MATCH"},
+            "values": [{"value": {"name": spoken, "id": value_id}}],
+        }
+    slot.update(
+        value=spoken,
+        source="USER",
+        resolutions={"resolutionsPerAuthority": [resolution]},
+    )
+    return slot
+
+
+def intent(name: str, **slots: tuple[str | None, str | None]) -> dict[str, Any]:
+    """A real-shaped IntentRequest for `name`, each slot (spoken words, resolved id)."""
+    event = copy.deepcopy(load_event("alexa_navigate"))
+    event["request"]["intent"] = {
+        "name": name,
+        "confirmationStatus": "NONE",
+        "slots": {slot: _slot(slot, *value) for slot, value in slots.items()},
+    }
+    return event
+
+
+def said(skill: Callable[[dict[str, Any]], dict[str, Any]], event: dict[str, Any]) -> str:
+    return speech(skill(event))
+
+
+def test_a_delivery_naming_no_robot_goes_to_the_robot_nearest_the_mill(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], sent: list[tuple[str, Command]]
+) -> None:
+    event = intent("DeliverIntent", robot=(None, None), zone=("the oven", "OVEN"))
+    # osprey starts at (2, 6), 2.2 m from the mill at (4, 7): the shortest way there and on.
+    assert said(skill, event) == "Osprey is on its way to pick up a package for the oven."
+    [(thing, command)] = sent
+    assert (thing, command.action, command.params.zone) == ("osprey", "deliver", "OVEN")  # type: ignore[union-attr]
+
+
+def test_a_delivery_naming_a_robot_is_unchanged(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], sent: list[tuple[str, Command]]
+) -> None:
+    event = intent("DeliverIntent", robot=("kestrel", "kestrel"), zone=("the oven", "OVEN"))
+    skill(event)
+    assert sent == []  # published by the skill itself, not through the dispatcher
+
+
+def test_two_robots_are_named_and_a_third_is_queued_when_only_two_are_free(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], robots: Robots
+) -> None:
+    robots.busy("kestrel", "heron", "osprey", "plover")
+    event = intent("FleetNavigateIntent", zone=("the shop", "SHOP"), count=("three", "3"))
+    assert said(skill, event) == (
+        "Curlew and dunlin are on their way to the shop. "
+        "No other robot is free, so one more waits, first in line."
+    )
+
+
+def test_with_every_robot_busy_the_delivery_is_queued_and_its_place_said(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], robots: Robots
+) -> None:
+    robots.busy(*BAKERY.robot_things)
+    first = intent("DeliverIntent", robot=(None, None), zone=("the pantry", "PANTRY"))
+    second = intent("DeliverIntent", robot=(None, None), zone=("the oven", "OVEN"))
+    assert said(skill, first) == "All robots are busy; the delivery to the pantry is first in line."
+    assert said(skill, second) == "All robots are busy; the delivery to the oven is second in line."
+    queue = said(skill, intent("TaskQueueIntent"))
+    assert queue == (
+        "Two tasks are queued: first, the delivery to the pantry; second, the delivery to the oven."
+    )
+
+
+def test_cancelling_the_delivery_to_a_zone_takes_it_out_of_line(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], robots: Robots, desk: CoreDesk
+) -> None:
+    robots.busy(*BAKERY.robot_things)
+    skill(intent("DeliverIntent", robot=(None, None), zone=("the pantry", "PANTRY")))
+    skill(intent("DeliverIntent", robot=(None, None), zone=("the oven", "OVEN")))
+    cancel = intent("CancelTaskIntent", zone=("the pantry", "PANTRY"))
+    assert said(skill, cancel) == "I cancelled the delivery to the pantry, which was first in line."
+    assert [task.zone for task in desk.tasks()] == ["OVEN"]
+    assert said(skill, cancel) == "There is no task to the pantry to cancel."
+
+
+def test_cancelling_a_task_a_robot_holds_stops_that_robot(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], sent: list[tuple[str, Command]]
+) -> None:
+    skill(intent("FleetNavigateIntent", zone=("the shop", "SHOP")))
+    thing = sent[-1][0]
+    assert said(skill, intent("CancelTaskIntent", zone=("the shop", "SHOP"))) == (
+        f"I cancelled the trip to the shop and stopped {thing}."
+    )
+    assert sent[-1] == (thing, sent[-1][1]) and sent[-1][1].action == "stop"
+
+
+def test_a_group_sends_each_member_and_says_which_are_busy(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], robots: Robots
+) -> None:
+    robots.busy("curlew")
+    event = intent("FleetNavigateIntent", zone=("the oven", "OVEN"), group=("the waders", "waders"))
+    assert said(skill, event) == (
+        "Plover and dunlin are on their way to the oven. Curlew is busy and will go when free."
+    )
+
+
+def test_an_unknown_group_is_said_with_the_groups_there_are(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], sent: list[tuple[str, Command]]
+) -> None:
+    event = intent("FleetNavigateIntent", zone=("the oven", "OVEN"), group=("the swimmers", None))
+    assert (
+        said(skill, event) == "I don't know a group called the swimmers; the groups are the waders."
+    )
+    assert sent == []
+
+
+def test_more_robots_than_the_fleet_has_is_said_and_nothing_moves(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], sent: list[tuple[str, Command]]
+) -> None:
+    event = intent("FleetNavigateIntent", zone=("the oven", "OVEN"), count=("nine", "9"))
+    assert said(skill, event) == "The fleet has 6 robots, so I cannot send 9."
+    assert sent == []
+
+
+def test_an_unknown_zone_is_asked_about_with_the_zones_there_are(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], sent: list[tuple[str, Command]]
+) -> None:
+    response = skill(intent("FleetNavigateIntent", zone=("the moon", None)))
+    assert speech(response).startswith("I don't know a zone called the moon. To which zone: ")
+    assert "the shop" in speech(response)
+    assert response["response"]["directives"][0]["type"] == "Dialog.ElicitSlot"
+    assert sent == []
+
+
+def test_the_robots_in_a_zone_go_and_none_there_is_said(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], robots: Robots
+) -> None:
+    for thing in ("heron", "plover"):
+        robots.states[thing] = RobotState(thing=thing, status="idle", zone="SHOP")
+    event = intent("ZoneRobotsIntent", origin=("the shop", "SHOP"), zone=("the mill", "LOADING"))
+    assert said(skill, event) == "Heron and plover are on their way to the mill."
+    empty = intent(
+        "ZoneRobotsIntent", origin=("the pantry", "PANTRY"), zone=("the mill", "LOADING")
+    )
+    assert said(skill, empty) == "No free robot is in the pantry, so I sent none."
+
+
+def test_every_idle_robot_goes_and_busy_ones_stay(
+    skill: Callable[[dict[str, Any]], dict[str, Any]],
+    robots: Robots,
+    sent: list[tuple[str, Command]],
+) -> None:
+    robots.states["heron"] = RobotState(thing="heron", status="navigating")
+    event = intent("IdleRobotsIntent", zone=("the shop", "SHOP"))
+    assert said(skill, event) == (
+        "Curlew, dunlin, kestrel, osprey and plover are on their way to the shop."
+    )
+    assert "heron" not in {thing for thing, _ in sent}
+
+
+def test_without_a_dispatcher_the_skill_says_so(aws: None, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(skill_app, "task_desk", lambda config: None)
+    handler = skill_app.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
+    response = handler(intent("FleetNavigateIntent", zone=("the shop", "SHOP")), None)
+    assert "fleet dispatcher, which is not running here" in speech(response)
