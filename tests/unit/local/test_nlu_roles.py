@@ -12,9 +12,10 @@ from typing import TYPE_CHECKING
 
 import pytest
 
+from vahr.errors import VahrError
 from vahr.local.alexa import roles
 from vahr.local.alexa.nlu import FALLBACK, InteractionModel
-from vahr.local.alexa.understanding import load_understanding
+from vahr.local.alexa.understanding import LOCALES_DIR, load_understanding
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -113,11 +114,16 @@ def test_the_weather_words_are_the_locales() -> None:
     assert roles.WeatherLexicon.of_locale("xx-XX").weather_of(words, 4) is None
 
 
-def test_the_shipped_english_understanding_has_no_hand_rules() -> None:
-    # The English rules are gone: en-US is understood as every other locale is
-    understanding = load_understanding()
-    assert understanding.locale == "en-US"
-    assert not hasattr(understanding, "english_role_rules")
+def test_a_switch_back_to_hand_rules_is_refused_in_one_line(tmp_path: Path) -> None:
+    # Given an understanding file that still asks for the English hand rules, which are gone
+    shipped = (LOCALES_DIR / "en-US" / "understanding.yaml").read_text()
+    (tmp_path / "en-US").mkdir()
+    (tmp_path / "en-US" / "understanding.yaml").write_text(shipped + "english_role_rules: true\n")
+    # When it is loaded, Then one line names the key
+    with pytest.raises(VahrError, match=r"understanding.yaml: .*english_role_rules"):
+        load_understanding("en-US", directory=tmp_path)
+    # and the shipped file is en-US's, with no such key
+    assert load_understanding().locale == "en-US"
 
 
 @pytest.mark.parametrize(
