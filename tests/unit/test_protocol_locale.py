@@ -3,9 +3,12 @@ they always were, and an unknown locale refused in one line naming the shipped o
 
 from __future__ import annotations
 
+import logging
+
 import pytest
 
-from vahr.protocol import text, weather
+from vahr.protocol import Fleet, load_fleet, text, weather
+from vahr.protocol.fleet import spoken_in
 from vahr.protocol.locale import SUPPORTED_LOCALES, LocaleError, check_locale, load_language
 
 
@@ -56,3 +59,26 @@ def test_english_weather_words_are_unchanged_and_german_has_its_own() -> None:
     assert weather.NEGATIONS[:3] == ("not", "isn't", "no") and "leave" in weather.NEGATIONS
     assert "regnet" in weather.weather_words("de-DE")["rainy"]
     assert "nicht" in weather.plain_negations("de-DE")
+
+
+def test_a_fleet_without_a_locales_names_falls_back_to_english_and_warns_once(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    # Given the bundled fleet without its German names
+    bundled = load_fleet()
+    english_only = Fleet.from_yaml(
+        b"robots: [{thing: r1, spoken: [rover one], start: {x: 1, y: 1, theta: 0}}]\n"
+        b"zones: [{id: LOADING, spoken: [loading zone], pose: {x: 3, y: 1, theta: 0}}]\n"
+    )
+    # When names are asked for in German
+    with caplog.at_level(logging.WARNING, logger="vahr.protocol.fleet"):
+        robot = spoken_in(english_only.robots[0], "xx-XX")
+        zone = spoken_in(english_only.zones[0], "xx-XX")
+    # Then the English names serve, with one warning for the locale
+    assert (robot, zone) == (["rover one"], ["loading zone"])
+    assert [r.getMessage() for r in caplog.records] == [
+        "fleet: 'r1' and maybe others have no xx-XX names (spoken_by_locale); their en-US "
+        "names are used"
+    ]
+    # And a fleet that has them uses its own
+    assert bundled.spoken_name("placebot2", "de-DE") == "placebot zwei"

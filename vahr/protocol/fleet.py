@@ -306,9 +306,10 @@ def spoken_in(entry: Robot | Zone | Group, locale: str = SPOKEN_LOCALE) -> list[
     if locale not in _WARNED_LOCALES:
         _WARNED_LOCALES.add(locale)
         _log.warning(
-            "fleet: no %s names for %r (spoken_by_locale); using its en-US names",
-            locale,
+            "fleet: %r and maybe others have no %s names (spoken_by_locale); their en-US "
+            "names are used",
             getattr(entry, "thing", None) or getattr(entry, "id", ""),
+            locale,
         )
     return entry.spoken
 
