@@ -179,13 +179,6 @@ WEATHER_HAS_NO_ZONE = (
 )
 INTENT_DENIED = "Okay, I sent nothing."
 
-# The word before the last of several choices ("zone a, zone b, or zone c").
-OR = "or"
-
-# Every other locale's sentences are vahr/protocol/locales/<locale>/replies.yaml, under these
-# names; the request's locale chooses (skill.catalog).
-localise(sys.modules[__name__])
-
 # Fleet dispatch (skill.handlers.dispatch, skill.task_speech): tasks without a robot's name.
 TASK_NAMES = {"navigate": "the trip to {zone}", "deliver": "the delivery to {zone}"}
 TASK_NAMES_PLURAL = {"navigate": "trips to {zone}", "deliver": "deliveries to {zone}"}
@@ -236,3 +229,10 @@ NO_IDLE_ROBOT = "No robot is idle just now, so I sent none."
 NO_FREE_ROBOT = "No robot is free to go just now, so I sent none."
 DISPATCH_REFUSED = "The dispatcher refused: {reason}."
 ASK_ORIGIN = "From which zone: {choices}?"
+
+# The word before the last of several choices ("zone a, zone b, or zone c").
+OR = "or"
+
+# Every other locale's sentences are vahr/protocol/locales/<locale>/replies.yaml, under these
+# names; the request's locale chooses (skill.catalog).
+localise(sys.modules[__name__])

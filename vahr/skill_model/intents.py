@@ -483,6 +483,7 @@ UNDO = IntentSpec(
     ),
 )
 
+
 # Fleet dispatch: tasks without a robot's name (docs/dispatch.md). A robot-less delivery
 # ("deliver a package to zone c") stays DeliverIntent; its handler gives it to the fleet.
 COUNT = SlotSpec("count", COUNT_TYPE)
@@ -587,6 +588,7 @@ CANCEL_TASK = IntentSpec(
         "[anymore]",
     ),
 )
+
 
 CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     NAVIGATE,
