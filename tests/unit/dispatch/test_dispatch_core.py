@@ -404,3 +404,45 @@ def test_the_store_refuses_a_second_robot_and_a_second_task(store: SqliteTaskSto
 
 def msgspec_task(task_id: str, created_at: str) -> Task:
     return Task(id=task_id, request="r", kind="navigate", zone="FAR", created_at=created_at)
+
+
+# --- a dispatcher restarted mid-assignment ----------------------------------------------
+
+
+def test_a_restarted_dispatcher_sends_again_what_no_robot_acknowledged(
+    floor: Fleet, store: SqliteTaskStore, robots: Robots
+) -> None:
+    """The first dispatcher stored three assignments and died before publishing any: the
+    next one sends each command again with the task's id, except where the robot already
+    reports it (running, or finished: then the task is closed)."""
+    for name in ("never-sent", "running", "finished"):
+        store.add(msgspec_task(name, f"2026-11-26T12:00:0{len(name) % 10}.000000Z"))
+    store.assign("never-sent", "ant", at="x")
+    store.assign("running", "bee", at="x")
+    store.assign("finished", "cricket", at="x")
+    robots.set("bee", last_command_id="running", last_result="accepted", status="navigating")
+    robots.set("cricket", last_command_id="finished", last_result="done")
+    sent: list[tuple[str, Command]] = []
+    restarted = Dispatcher(
+        fleet=floor, store=store, candidates=robots, publish=lambda t, c: sent.append((t, c))
+    )
+    again = restarted.resume()
+    assert [task.id for task in again] == ["never-sent"]
+    assert [(thing, command.id, command.action) for thing, command in sent] == [
+        ("ant", "never-sent", "navigate")
+    ]
+    assert store.get("finished").status == "done"  # type: ignore[union-attr]
+    assert store.get("running").status == "assigned"  # type: ignore[union-attr]
+
+
+def test_a_restart_with_the_broker_down_keeps_the_task_in_line(
+    floor: Fleet, store: SqliteTaskStore, robots: Robots
+) -> None:
+    store.add(msgspec_task("stranded", "2026-11-26T12:00:00.000000Z"))
+    store.assign("stranded", "ant", at="x")
+
+    def unreachable(thing: str, command: Command) -> None:
+        raise ConnectionError("broker down")
+
+    Dispatcher(fleet=floor, store=store, candidates=robots, publish=unreachable).resume()
+    assert [task.id for task in store.pending()] == ["stranded"]
