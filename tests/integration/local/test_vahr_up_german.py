@@ -16,6 +16,7 @@ from vahr.local.client import call
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
+    from pathlib import Path
 
 GERMAN_REQUEST = "Alexa, sage Roboterflotte, schicke Placebot eins in Zone B"
 
@@ -74,3 +75,19 @@ def test_an_unknown_locale_is_one_line_naming_the_supported_ones(up: Up) -> None
         2,
         "vahr say: error: unknown locale 'fr-FR'; supported: de-DE, en-US\n",
     )
+
+
+@pytest.mark.parametrize("command", ["up", "console", "nlu"])
+def test_every_command_refuses_an_unknown_locale_before_it_starts(
+    command: str, tmp_path: Path
+) -> None:
+    extra = ["--state-dir", str(tmp_path)] if command == "up" else []
+    result = subprocess.run(
+        [*VAHR, command, "--locale", "fr-FR", *extra, *(["bonjour"] if command == "nlu" else [])],
+        cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert (result.returncode, result.stderr) == (
+        2,
+        f"vahr {command}: error: unknown locale 'fr-FR'; supported: de-DE, en-US\n",
+    )
+    assert list(tmp_path.iterdir()) == []
