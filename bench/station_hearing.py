@@ -305,7 +305,7 @@ def main() -> int:
     body = f"""
 Spoken requests heard by the station's recognizer; its N best transcripts (at most 10)
 understood by the simulator's NLU and weighed into one understanding
-(`vahr/station/confidence.py`). Load average {" ".join(load)} (the machine is shared).
+(`vahr/local/alexa/nbest.py`). Load average {" ".join(load)} (the machine is shared).
 
 **Tuning** ({len(tuning)} clips: every {TUNING_EVERY}th sentence of {TUNING_SET.name},
 spoken in turn by {", ".join(TUNING_VOICES)}). Mean negative log-likelihood of the labelled
