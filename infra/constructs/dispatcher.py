@@ -64,7 +64,7 @@ def freed_sql() -> str:
     free = " OR ".join(f"{now}.status = '{status}'" for status in sorted(IDLE_STATUSES))
     changed = f"{before}.status <> {now}.status OR {before}.connected <> {now}.connected"
     return (
-        f"SELECT topic(3) AS thing, {now} AS reported, timestamp "
+        f"SELECT topic(3) AS thing, {now} AS reported "
         f"FROM '{topics.ALL_SHADOW_DOCUMENTS}' "
         f"WHERE ({free}) AND CASE isUndefined({before}.status) WHEN true THEN true "
         f"ELSE {changed} END"

@@ -15,7 +15,7 @@ answers `POST`, `GET` and `DELETE {api}/vahr/tasks` with, so the skill's two `Ta
 adapters read one shape. A request that cannot be carried out is `{"status": 400 or 404,
 "body": {"code": N, "message": "one line"}}` and changes nothing.
 
-The topic rule (infra/constructs/dispatcher.py) sends `{"thing", "reported", "timestamp"}`:
+The topic rule (infra/constructs/dispatcher.py) sends `{"thing", "reported"}`:
 the robot's whole reported state after an update that left it idle or stopped. An
 EventBridge schedule sends its scheduled event once a minute (`is_tick`).
 """
@@ -51,12 +51,10 @@ OPERATIONS = ("submit", "tasks", "pending", "cancel")
 
 
 class RobotUpdate(msgspec.Struct, frozen=True, kw_only=True):
-    """One robot's reported state after an update, as the topic rule selects it.
-    `timestamp` is the shadow document's (seconds since the epoch)."""
+    """One robot's reported state after an update, as the topic rule selects it."""
 
     thing: str
     reported: dict[str, Any]
-    timestamp: float | None = None
 
 
 class Answer(msgspec.Struct, frozen=True):
