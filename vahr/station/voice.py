@@ -168,5 +168,6 @@ class PushToTalk:
             return self.assistant.ask(text, origin=ORIGIN, heard=heard)
         question = ask_back(weighed)
         if question is not None:
-            return {"speech": question, "intent": None, "utterance": text}
+            intent = weighed.understanding.intent
+            return {"speech": question, "intent": intent, "commands": [], "utterance": text}
         return self.assistant.ask(text, origin=ORIGIN, heard=heard)

@@ -11,7 +11,7 @@ import pytest
 
 from vahr.protocol.text import spell_numbers
 from vahr.speech.pronounce import arpabet, compound_phones
-from vahr.speech.stt import NOTHING_HEARD, Recognition
+from vahr.speech.stt import NOTHING_HEARD, Hypothesis, Recognition
 from vahr.station.errors import RequestError
 from vahr.station.vocabulary import load_model, sentences
 from vahr.station.voice import SORRY, PushToTalk, read_clip
@@ -143,3 +143,22 @@ def test_made_up_words_are_pronounced_two_ways() -> None:
     # espeak-ng's own reading, its mnemonics mapped to ARPAbet
     assert arpabet("pl@s'Eb0t") == "P L AH S EH B AA T"
     assert arpabet("tS'A@li") == "CH AA R L IY"
+
+
+def test_a_remote_assistant_is_not_sent_a_zone_the_hearing_is_unsure_of() -> None:
+    # The N best split between zone d and zone b; the assistant (over HTTP) would re-read
+    # the words and act on zone d, so the station asks back itself.
+    assistant = Assistant("NavigateIntent")
+    heard = Recognition(
+        "send placebot two to zone d",
+        0.6,
+        True,
+        hypotheses=(
+            Hypothesis("send placebot two to zone d", 0.0),
+            Hypothesis("send placebot two to zone b", -100.0),
+        ),
+    )
+    result = PushToTalk(assistant, lambda: Heard(heard)).handle(wav())
+    assert assistant.asked == []
+    assert result["speech"] == "Did you say zone d or zone b? Please say it again."
+    assert result["heard"]["weighed"]["slots"]["zone"] < 0.9
