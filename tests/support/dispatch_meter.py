@@ -78,6 +78,8 @@ class CallMeter:
     calls: Counter[str] = field(default_factory=Counter)
     reads: float = 0.0
     writes: float = 0.0
+    # (service, operation, parameters) of every call, in order.
+    requests: list[tuple[str, str, dict[str, Any]]] = field(default_factory=list)
 
     def watch(self, client: Any) -> Any:
         client.meta.events.register("provide-client-params.*.*", self._remember)
@@ -90,9 +92,11 @@ class CallMeter:
     def _count(self, parsed: dict[str, Any], model: Any, context: dict[str, Any], **_: Any) -> None:
         operation = model.name
         self.calls[operation] += 1
-        if model.service_model.service_name != "dynamodb":
-            return
+        service = model.service_model.service_name
         request = dict(context.get("vahr_params", {}))
+        self.requests.append((service, operation, dict(request)))
+        if service != "dynamodb":
+            return
         if operation in ("GetItem", "Query"):
             request["_returned"] = parsed.get("Item") or parsed.get("Items") or []
         reads, writes = dynamodb_units(operation, request)

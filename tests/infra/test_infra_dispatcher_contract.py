@@ -1,0 +1,98 @@
+"""The dispatcher's role grants what its code does, and nothing it does not: every AWS call
+the real handler makes for a task (its submit, and the event that closes it) is allowed by
+the synthesized role, and every right the role holds is used."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import pytest
+from aws_cdk import aws_lambda as lambda_
+from aws_cdk.assertions import Template
+from moto import mock_aws
+from template_tools import bare_stack, resources, role_grants
+
+from infra.config import InfraConfig
+from infra.constructs.dispatcher import Dispatcher
+from infra.constructs.task_table import TaskTable
+from tests.support.dispatch_meter import measure_dispatch
+from vahr.protocol import load_fleet
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+IOT = "arn:aws:iot:us-east-1:123456789012"
+INDEX = f"{IOT}:index/AWS_Things"
+# A transaction is authorized as the writes in it.
+TRANSACTION_PARTS = {"Put": "PutItem", "Delete": "DeleteItem", "Update": "UpdateItem",
+                     "ConditionCheck": "ConditionCheckItem"}  # fmt: skip
+
+
+def needed(
+    service: str, operation: str, params: dict[str, Any], table: str
+) -> set[tuple[str, str]]:
+    """The (action, resource) pairs IAM checks for one call."""
+    if service == "dynamodb" and operation == "TransactWriteItems":
+        return {
+            (f"dynamodb:{TRANSACTION_PARTS[kind]}", table)
+            for item in params["TransactItems"]
+            for kind in item
+        }
+    if service == "dynamodb":
+        return {(f"dynamodb:{operation}", table)}
+    if operation == "SearchIndex":
+        return {("iot:SearchIndex", f"{IOT}:index/{params.get('indexName', 'AWS_Things')}")}
+    if operation == "Publish":
+        return {("iot:Publish", f"{IOT}:topic/{params['topic']}")}
+    raise AssertionError(f"an unexpected call: {service} {operation}")
+
+
+@pytest.fixture
+def credentials(monkeypatch: pytest.MonkeyPatch) -> None:
+    for name in ("AWS_ACCESS_KEY_ID", "AWS_SECRET_ACCESS_KEY"):
+        monkeypatch.setenv(name, "testing")
+    monkeypatch.setenv("AWS_DEFAULT_REGION", "us-east-1")
+    for name in ("AWS_ENDPOINT_URL", "AWS_ENDPOINT_URL_IOT", "AWS_ENDPOINT_URL_IOT_DATA_PLANE"):
+        monkeypatch.delenv(name, raising=False)
+
+
+def test_every_call_of_a_task_is_allowed_and_every_right_is_used(
+    tmp_path: Path, credentials: None
+) -> None:
+    # Given the dispatcher's role as the stack synthesizes it
+    stack = bare_stack(tmp_path)
+    tasks = TaskTable(stack, "Tasks", deletion_protection=False)
+    Dispatcher(
+        stack, "Dispatcher", config=InfraConfig(), fleet=load_fleet(),
+        code=lambda_.Code.from_inline("def lambda_handler(e, c): pass"),
+        table=tasks.table, index_arn=INDEX, data_endpoint="x-ats.iot.us-east-1.amazonaws.com",
+    )  # fmt: skip
+    template = Template.from_stack(stack).to_json()
+    [table_id] = resources(template, "AWS::DynamoDB::Table")
+    table = f"<{table_id}.Arn>"
+    [role_id] = [
+        f["Role"].strip("<>").split(".")[0]
+        for f in resources(template, "AWS::Lambda::Function").values()
+    ]
+    granted = {
+        (action, resource)
+        for effect, action, resource in role_grants(template, role_id)
+        if effect == "Allow" and not action.startswith(("logs:", "sqs:"))
+    }
+    # When the real handler dispatches a task to placebot1 or placebot2 and closes it
+    with mock_aws():
+        measured = measure_dispatch(2)
+    used: set[tuple[str, str]] = set()
+    for meter in (measured.submit, measured.freed):
+        for service, operation, params in meter.requests:
+            used |= needed(service, operation, params, table)
+    # Then each call is allowed
+    assert used <= granted, sorted(used - granted)
+    # And each right is used, but publishing to the robot that did not take this task
+    publish_rights = {(a, r) for a, r in granted if a == "iot:Publish"}
+    assert granted - publish_rights <= used, sorted(granted - publish_rights - used)
+    assert ("iot:Publish", f"{IOT}:topic/vahr/robots/{measured.assigned_to}/cmd") in used
+    assert publish_rights == {
+        ("iot:Publish", f"{IOT}:topic/vahr/robots/{thing}/cmd")
+        for thing in load_fleet().robot_things
+    }
