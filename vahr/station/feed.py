@@ -493,7 +493,11 @@ class Feed:
 
     def _acknowledged(self, command_id: str, thing: str, how: str, at: float) -> None:
         command = self._commands.get(command_id)
-        if command is None or thing in command.acks or thing not in command.robots:
+        if command is None or thing in command.acks:
+            return
+        # A fleet command's robots are the whole fleet: a set lookup, not a scan of a list
+        # of thousands for each of their thousands of answers.
+        if thing not in (self._things if command.target == "fleet" else command.robots):
             return
         latency = round(max(0.0, at - command.seen), 1)
         command.acks[thing] = Acknowledgment(how, latency)
