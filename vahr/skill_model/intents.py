@@ -500,8 +500,10 @@ FLEET_NAVIGATE = IntentSpec(
         "send {group} to {zone}",
     ),
     templates=(
-        "<ask> (send|move|dispatch|get|bring) (a|any) (robot|bot|free robot|available robot|"
-        "spare robot) <way> <to> {zone} <end>",
+        # Not "move a robot": "move" names the robot it moves ("move placebot one"), and a
+        # misheard name before "robot" must stay NavigateIntent's question, not a dispatch.
+        "<ask> (send|dispatch|get|bring) (a|any) (robot|bot|free robot|available robot|spare "
+        "robot) <way> <to> {zone} <end>",
         "<ask> (send|move|dispatch|get|bring) {count} (robots|bots|free robots|available robots) "
         "<way> <to> {zone} <end>",
         "(i need|i want|i'd like|we need|get me) (a|any|one) (robot|free robot|bot) (in|at|over "
@@ -522,7 +524,7 @@ ZONE_ROBOTS = IntentSpec(
     commands_robots=True,
     essentials=("send the robots in {origin} to {zone}",),
     templates=(
-        "<ask> (send|move|bring|take|get) the robots (in|at|that are in|sitting in|waiting in) "
+        "<ask> (send|bring|take|get) the robots (in|at|that are in|sitting in|waiting in) "
         "{origin} <way> <to> {zone} <end>",
         "<ask> (have|let|make) the robots (in|at) {origin} <go> <way> <to> {zone} <end>",
         "{origin} (robots|bots) (please|should|can) <go> <way> <to> {zone} <end>",
