@@ -54,6 +54,8 @@ class _FleetHandler(AbstractRequestHandler):
         try:
             submission = self.desk.submit(order)
         except TaskRefused as err:
+            if err.status == 404:  # a stack without the dispatcher's routes
+                return answer(handler_input, prompts.NO_DISPATCHER)
             if err.status == 400 and "free to go" in str(err):
                 return answer(handler_input, when_none)
             return answer(handler_input, prompts.DISPATCH_REFUSED.format(reason=str(err)))
@@ -198,7 +200,10 @@ class TaskQueueIntentHandler(_FleetHandler):
     def handle(self, handler_input: HandlerInput) -> Response:
         if self.desk is None:
             return answer(handler_input, prompts.NO_DISPATCHER)
-        tasks = self.desk.tasks()
+        try:
+            tasks = self.desk.tasks()
+        except TaskRefused:  # a stack without the dispatcher's routes
+            return answer(handler_input, prompts.NO_DISPATCHER)
         return answer(handler_input, task_speech.queue_report(self.runtime.vocabulary, tasks))
 
 
@@ -215,7 +220,11 @@ class CancelTaskIntentHandler(_FleetHandler):
         if self.desk is None:
             return answer(handler_input, prompts.NO_DISPATCHER)
         vocabulary = self.runtime.vocabulary
-        chosen = task_speech.task_to_cancel(self.desk.tasks(), zone.id)
+        try:
+            tasks = self.desk.tasks()
+        except TaskRefused:  # a stack without the dispatcher's routes
+            return answer(handler_input, prompts.NO_DISPATCHER)
+        chosen = task_speech.task_to_cancel(tasks, zone.id)
         cancelled = self.desk.cancel(chosen[0].id) if chosen is not None else None
         if chosen is None or cancelled is None:
             return answer(

@@ -106,6 +106,7 @@ def _slot(name: str, spoken: str | None, value_id: str | None) -> dict[str, Any]
     if spoken is None:
         return slot
     authority = f"amzn1.er-authority.echo-sdk.amzn1.ask.skill.test.{name.upper()}"
+    resolution: dict[str, Any]
     if value_id is None:
         resolution = {"authority": authority, "status": {"code": "ER_SUCCESS_NO_MATCH"}}
     else:

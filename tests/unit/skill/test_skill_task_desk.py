@@ -128,3 +128,46 @@ def test_a_refused_order_is_one_line_from_either_desk(desk: TaskDesk) -> None:
     with pytest.raises(TaskRefused, match="there is no zone 'MARS'; zones are LOADING"):
         desk.submit(Order(zone="MARS"))
     assert desk.tasks() == []
+
+
+def test_a_data_plane_without_the_dispatcher_is_said_as_such(
+    aws: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A local stack without `vahr up`'s dispatcher answers 404 on /vahr/tasks, as the data
+    plane does for any route it lacks: the skill says there is no dispatcher here."""
+    from skill_testkit import speech
+
+    from skill import app as skill_app
+    from skill.config import SkillConfig
+    from tests.unit.skill.test_skill_dispatch import intent
+
+    class NoRoute(BaseHTTPRequestHandler):
+        def _serve(self) -> None:
+            self.rfile.read(int(self.headers.get("Content-Length") or 0))
+            body = json.dumps({"code": 404, "message": f"No route for {self.command}"}).encode()
+            self.send_response(404)
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+        do_GET = do_POST = _serve  # noqa: N815
+
+        def log_message(self, *args: object) -> None:
+            pass
+
+    server = ThreadingHTTPServer(("127.0.0.1", 0), NoRoute)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        desk = HttpTaskDesk(f"http://127.0.0.1:{server.server_address[1]}")
+        monkeypatch.setattr(skill_app, "task_desk", lambda config: desk)
+        handler = skill_app.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
+        for event in (
+            intent("FleetNavigateIntent", zone=("the shop", "SHOP")),
+            intent("TaskQueueIntent"),
+        ):
+            assert "fleet dispatcher, which is not running here" in speech(handler(event, None))
+    finally:
+        server.shutdown()
+        server.server_close()
+        thread.join(timeout=5)
