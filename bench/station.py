@@ -155,7 +155,11 @@ def heap_mb(cdp: Any) -> float:
 
 
 def collect(
-    page: Any, clock: BrokerClock, latencies: list[float], arrivals: list[float] | None = None
+    page: Any,
+    clock: BrokerClock,
+    latencies: list[float],
+    arrivals: list[float] | None = None,
+    at_station: list[float] | None = None,
 ) -> None:
     """Take the page's painted marks so far (and empty its list, so it does not grow)."""
     # The page's record of what it showed is for tests; emptied here so it does not grow.
@@ -168,6 +172,9 @@ def collect(
             latencies.append(mark["at"] - seen)
             if arrivals is not None:
                 arrivals.append(mark["received"] - seen)
+            # When the station's feed took the document (its clock: the same machine's).
+            if at_station is not None and mark.get("station"):
+                at_station.append(mark["station"] - seen)
 
 
 def main() -> int:
@@ -289,6 +296,7 @@ def drive(
         zones = ["A", "D"]
         leg = 0
         arrivals: list[float] = []
+        at_station: list[float] = []
 
         def send_everyone() -> None:
             nonlocal leg
@@ -306,9 +314,9 @@ def drive(
         while time.monotonic() < ends:
             send_everyone()
             time.sleep(LEG_S)
-            collect(page, clock, latencies, arrivals)
+            collect(page, clock, latencies, arrivals, at_station)
         time.sleep(1.0)
-        collect(page, clock, latencies, arrivals)
+        collect(page, clock, latencies, arrivals, at_station)
         elapsed = time.monotonic() - started
         page_share = (busy_s(cdp) - page_cpu) / elapsed
         station_share = (cpu_s(station_pid) - station_cpu) / elapsed
@@ -323,6 +331,7 @@ def drive(
         "messages": messages,
         "ptt": ptt,
         "arrivals": arrivals,
+        "at_station": at_station,
         "page_busy": page_share,
         "station_cpu": station_share,
     }
@@ -375,6 +384,8 @@ def figures(
         "robots": robots,
         "paint_p50_ms": round(percentile(latencies, 50), 1),
         "paint_p95_ms": round(percentile(latencies, 95), 1),
+        "station_p50_ms": round(percentile(result["at_station"] or [0.0], 50), 1),
+        "station_p95_ms": round(percentile(result["at_station"] or [0.0], 95), 1),
         "received_p50_ms": round(percentile(arrivals, 50), 1),
         "received_p95_ms": round(percentile(arrivals, 95), 1),
         "updates_painted": len(latencies),
@@ -413,6 +424,8 @@ def report(args: argparse.Namespace, runs: list[dict[str, Any]]) -> None:
         "| --- |" + " --- |" * len(runs),
         row("shadow update on the broker to painted, p50", "paint_p50_ms"),
         "| shadow update on the broker to painted, p95 | " + " | ".join(verdicts) + " |",
+        row("of which the broker to the station's feed taking it, p50", "station_p50_ms"),
+        row("of which the broker to the station's feed taking it, p95", "station_p95_ms"),
         row("of which the broker to the page's receipt, p50", "received_p50_ms"),
         row("of which the broker to the page's receipt, p95", "received_p95_ms"),
         row("shadow updates painted", "updates_painted", ""),

@@ -30,7 +30,7 @@ import { TasksView } from "./tasks-view.js";
  * @property {number} skew the station's clock less the page's, in ms
  */
 
-/** A shadow update on its way to the screen. @typedef {{thing: string, version: number, received: number}} PaintMarker */
+/** A shadow update on its way to the screen; `station` is when the station received it (its clock). @typedef {{thing: string, version: number, received: number, station?: number | null}} PaintMarker */
 /** An alert on its way to the screen. @typedef {{id: string, thing: string | null, kind: string, received: number}} AlertMarker */
 
 /**
@@ -222,7 +222,7 @@ function onChange(change, received) {
     const driving = status === "navigating" && destination && zone !== destination;
     if (!change.progress) map.report(change.thing, pose, destination, Boolean(driving));
   }
-  const marker = metrics && change.version !== undefined ? { thing: change.thing, version: change.version, received } : null;
+  const marker = metrics && change.version !== undefined ? { thing: change.thing, version: change.version, received, station: change.last_seen } : null;
   changed(change.thing, marker);
 }
 
