@@ -44,6 +44,8 @@ log = logging.getLogger(__name__)
 Answer = Callable[["_Handler", str, dict[str, str]], None]
 
 STATIC = Path(__file__).with_name("static")
+# The page's words per locale (static/i18n.js), served beside its files.
+LOCALES = Path(__file__).with_name("locales")
 STATIC_PATH = "/static/"
 MAX_JSON_BYTES = 16 * 1024
 # 16 kHz mono 16-bit is 32 kB a second: a megabyte is half a minute, twice the longest clip.
@@ -60,6 +62,7 @@ CONTENT_TYPES = {
     ".js": "text/javascript; charset=utf-8",
     ".svg": "image/svg+xml",
     ".png": "image/png",
+    ".json": "application/json; charset=utf-8",
 }
 # The page loads only its own files; speech comes back as a blob it plays.
 SECURITY_HEADERS = {
@@ -262,7 +265,8 @@ class StationServer:
         self.host = host
         # Off the loopback interface the station is reachable by others: a token guards it.
         self.token = token or (None if is_loopback(host) else secrets.token_urlsafe(18))
-        self._files = {p.name: p for p in STATIC.iterdir() if p.suffix in CONTENT_TYPES}
+        pages = [*STATIC.iterdir(), *LOCALES.iterdir()]
+        self._files = {p.name: p for p in pages if p.suffix in CONTENT_TYPES}
         self._streams = 0
         self._streams_lock = threading.Lock()
         # Every route the station answers, by method and path (HEAD is GET); the page's

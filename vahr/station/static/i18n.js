@@ -75,7 +75,8 @@ function addSelector(current, names, label) {
   const bar = document.querySelector(".topbar");
   if (!bar) return;
   const wrapper = document.createElement("label");
-  wrapper.className = "language-choice";
+  // The reply-voice selector's look.
+  wrapper.className = "voice-choice language-choice";
   const caption = document.createElement("span");
   caption.textContent = label;
   const select = document.createElement("select");
