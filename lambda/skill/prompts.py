@@ -230,8 +230,10 @@ NO_FREE_ROBOT = "No robot is free to go just now, so I sent none."
 DISPATCH_REFUSED = "The dispatcher refused: {reason}."
 ASK_ORIGIN = "From which zone: {choices}?"
 
-# The word before the last of several choices ("zone a, zone b, or zone c").
+# The word before the last of several choices ("zone a, zone b, or zone c"), and of several
+# robots listed ("heron, plover and curlew").
 OR = "or"
+AND = "and"
 
 # Every other locale's sentences are vahr/protocol/locales/<locale>/replies.yaml, under these
 # names; the request's locale chooses (skill.catalog).

@@ -205,7 +205,7 @@ def _counted(template: tuple[str, str], n: int) -> str:
 def _joined(parts: Sequence[str]) -> str:
     if len(parts) <= 1:
         return "".join(parts)
-    return ", ".join(parts[:-1]) + " and " + parts[-1]
+    return ", ".join(parts[:-1]) + f" {prompts.AND} " + parts[-1]
 
 
 def _place(vocabulary: Vocabulary, robot: IndexedRobot) -> str:

@@ -36,7 +36,7 @@ def and_list(names: Sequence[str]) -> str:
     """ "heron", "heron and plover", "heron, plover and curlew"."""
     if len(names) <= 1:
         return "".join(names)
-    return ", ".join(names[:-1]) + " and " + names[-1]
+    return ", ".join(names[:-1]) + f" {prompts.AND} " + names[-1]
 
 
 def task_name(vocabulary: Vocabulary, task: Task) -> str:
