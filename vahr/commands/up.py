@@ -125,11 +125,8 @@ def run(args: argparse.Namespace) -> int:
         signum: signal.signal(signum, lambda *_: stopping.set())
         for signum in (signal.SIGINT, signal.SIGTERM)
     }
-    system = LocalSystem(
-        config,
-        on_event=lambda event: _print_event(event, args.json),
-        start_station=on_local_system,
-    )
+    printer = _EventPrinter(args.json)
+    system = LocalSystem(config, on_event=printer.print, start_station=on_local_system)
     try:
         system.start()
         if system.stack.recovered:
@@ -141,6 +138,7 @@ def run(args: argparse.Namespace) -> int:
             _emit(json.dumps(endpoints))
         else:
             _emit(_banner(endpoints, system.fleet, system.voice_enabled))
+        printer.release()
         while not stopping.wait(0.5):
             for line in system.supervise():
                 print(f"vahr up: {line}", file=sys.stderr, flush=True)
@@ -180,6 +178,30 @@ def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
         f'  talk to it: vahr say "{example}"   (Ctrl-C stops everything)',
     ]
     return "\n".join(lines)
+
+
+class _EventPrinter:
+    """Prints robots' events, holding those that come before the endpoints are printed:
+    the endpoints are the first line (a contract scripts rely on), and robots that resume
+    work while the system starts must not push it down nor be dropped."""
+
+    def __init__(self, as_json: bool) -> None:
+        self._as_json = as_json
+        self._lock = threading.Lock()
+        self._held: list[Event] | None = []
+
+    def print(self, event: Event) -> None:
+        with self._lock:
+            if self._held is not None:
+                self._held.append(event)
+                return
+        _print_event(event, self._as_json)
+
+    def release(self) -> None:
+        with self._lock:
+            held, self._held = self._held or [], None
+            for event in held:
+                _print_event(event, self._as_json)
 
 
 def _print_event(event: Event, as_json: bool) -> None:

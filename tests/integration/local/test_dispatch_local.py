@@ -75,12 +75,10 @@ def settled(api: str, things: tuple[str, ...] | list[str], zone: str) -> bool:
 
 
 def endpoint(up: Up) -> str:
-    """The data plane's URL. Robots that act while `vahr up` waits for them to come online
-    (after a restart, at once) print their events before the endpoints line."""
-    endpoints = up.endpoints
-    while "api" not in endpoints:
-        endpoints = up.lines.get(timeout=60)
-    return str(endpoints["api"])
+    """The data plane's URL, from the first line `vahr up --json` prints: robots that act
+    while it starts (after a restart, at once) print their events after it."""
+    assert "api" in up.endpoints, f"the first line is not the endpoints: {up.endpoints}"
+    return str(up.endpoints["api"])
 
 
 def warm(up: Up) -> str:
