@@ -182,6 +182,35 @@ class _BatchingPahoClient(paho.Client):
             return MQTTErrorCode.MQTT_ERR_SUCCESS
         return super()._handle_pubackcomp(cmd)  # type: ignore[no-any-return]
 
+    def _handle_publish(self) -> MQTTErrorCode:
+        # An incoming MQTT v5 PUBLISH of QoS 0 or 1 without properties (every message of
+        # the robots, the shadow service and the station) is decoded here directly. paho
+        # builds a fresh `Properties` for each one, which alone cost about 10 us, a quarter
+        # of what the station spent per message during a 1,000-robot fleet command's burst.
+        # Anything with properties, QoS 2 or MQTT 3 is paho's.
+        header = self._in_packet["command"]
+        packet = self._in_packet["packet"]
+        qos = (header & 0x06) >> 1
+        if qos < 2 and self._protocol == MQTTProtocolVersion.MQTTv5 and len(packet) >= 3:
+            topic_end = 2 + ((packet[0] << 8) | packet[1])
+            at = topic_end + 2 if qos else topic_end
+            if topic_end > 2 and len(packet) > at and packet[at] == 0:  # no properties
+                message = paho.MQTTMessage(
+                    mid=(packet[topic_end] << 8) | packet[topic_end + 1] if qos else 0,
+                    topic=bytes(packet[2:topic_end]),
+                )
+                message.dup = bool(header & 0x08)
+                message.qos = qos
+                message.retain = bool(header & 0x01)
+                message.properties = _NO_PUBLISH_PROPERTIES
+                message.payload = bytes(packet[at + 1 :])
+                message.timestamp = paho.time_func()
+                self._handle_on_message(message)
+                if qos == 1 and not self._manual_ack:
+                    return self._send_puback(message.mid)  # type: ignore[no-any-return]
+                return MQTTErrorCode.MQTT_ERR_SUCCESS
+        return super()._handle_publish()  # type: ignore[no-any-return]
+
     def _qos0_published(self, packet: Any) -> None:
         """What paho does once a QoS 0 publish is written: it counts as published."""
         with self._callback_mutex:
@@ -205,6 +234,8 @@ class _BatchingPahoClient(paho.Client):
 # Read-only: handed to on_publish for every plain PUBACK (see `_handle_pubackcomp`).
 _PUBACK_SUCCESS = ReasonCode(PacketTypes.PUBACK)
 _NO_PROPERTIES = Properties(PacketTypes.PUBACK)
+# Read-only: handed with every incoming PUBLISH that has no properties (`_handle_publish`).
+_NO_PUBLISH_PROPERTIES = Properties(PacketTypes.PUBLISH)
 
 
 def _is_qos0_publish(packet: Any) -> bool:
