@@ -106,6 +106,7 @@ class StartStation(Protocol):
         link: MqttClient,
         assistant: Assistant,
         read_shadow: Callable[[str], bytes | None],
+        tasks_url: str | None = None,
     ) -> ServedStation: ...
 
 
@@ -287,7 +288,7 @@ class LocalSystem:
 
     def _start_station(self, port: int) -> None:
         """The operator station on this stack: the simulator in-process, shadows read from
-        the store, every turn seen on the broker."""
+        the store, every turn seen on the broker, the task queue from the dispatcher."""
         assert self.start_station is not None
         assert self.alexa is not None and self.stack.dataplane is not None
         self._station_client = MqttClient(
@@ -299,6 +300,7 @@ class LocalSystem:
             link=self._station_client,
             assistant=SimulatorAssistant(self.alexa),
             read_shadow=self._stored_shadow,
+            tasks_url=self.stack.api_url + TASKS_PATH if self.dispatcher is not None else None,
         )
         self.stack.dataplane.redirects["/vahr/dashboard"] = self.station.url
 

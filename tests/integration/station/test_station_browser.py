@@ -175,6 +175,13 @@ def test_the_map_shows_both_robots_at_their_reported_poses(up: Up, station: Page
     screenshot(station, ".map-card", "station-map.png")
 
 
+def test_the_station_of_vahr_up_shows_the_fleet_task_queue(up: Up, station: Page) -> None:
+    # Given vahr up, whose dispatcher serves the fleet's task queue
+    # Then its station shows the queue's card, empty while nobody asked for a task
+    station.locator("#tasks").wait_for(state="visible", timeout=15_000)
+    assert station.locator("#task-count").inner_text().startswith("0 queued")
+
+
 def test_a_vahr_say_command_moves_a_robot_on_the_page_as_its_shadow_changes(
     up: Up, station: Page
 ) -> None:
