@@ -90,9 +90,13 @@ class LanguageModelRecognizer:
         detector: SpeechDetector | None = None,
         adaptation: Path | None = None,
         background_words: int = 0,
+        nbest: bool = False,
     ) -> None:
         from pocketsphinx import Decoder
 
+        # The N best cost an A* search of the lattice per utterance (about a quarter more
+        # time): only a caller that weighs them (push-to-talk) asks for them.
+        self.nbest = nbest
         self.sentences = tuple(dict.fromkeys(sentences))
         self.detector = detector or SpeechDetector()
         entries = dictionary_entries()
@@ -135,7 +139,7 @@ class LanguageModelRecognizer:
             with utterance(decoder):
                 decoder.process_raw(audio.pcm, full_utt=True)
             words = self._words() if decoder.hyp() is not None else ()
-            hypotheses = self._nbest() if words else ()
+            hypotheses = self._nbest() if words and self.nbest else ()
         if not words:
             return Recognition("", 0.0, False, reason="nothing recognizable")
         text = " ".join(word.text for word in words)

@@ -106,5 +106,5 @@ def command_recognizer(
     if model_file is None and fleet is not None:
         from vahr.skill_model.generator import build_interaction_model
 
-        return LanguageModelRecognizer(sentences(build_interaction_model(fleet)))
-    return LanguageModelRecognizer(sentences(load_model(model_file)))
+        return LanguageModelRecognizer(sentences(build_interaction_model(fleet)), nbest=True)
+    return LanguageModelRecognizer(sentences(load_model(model_file)), nbest=True)
