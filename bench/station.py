@@ -20,8 +20,11 @@ the station (`vahr station`, against the stack), the browser, and this script, w
 notes when each shadow update reaches the broker. Every few seconds one fleet command sends
 all robots to the other end of the floor.
 Run: `.venv/bin/python bench/station.py [--minutes 10] [--robots 1000] [--beside 100 ...]
-[--presses 5]`. It prints its figures and ends with one JSON line: `{"robots": N,
-"paint_p50_ms": ..., "paint_p95_ms": ..., ..., "beside": [{"robots": 100, ...}]}`.
+[--presses 5] [--no-voice]`. It prints its figures and ends with one JSON line: `{"robots":
+N, "paint_p50_ms": ..., "paint_p95_ms": ..., ..., "beside": [{"robots": 100, ...}]}`.
+`--no-voice` runs the station without push-to-talk, whose recognizer is built on a thread of
+the station's process for the first minute or so with 1,000 robots (docs/station.md), to
+see the intake without it; it writes nothing to docs/benchmarks.md.
 """
 
 from __future__ import annotations
@@ -187,12 +190,19 @@ def main() -> int:
     )  # fmt: skip
     parser.add_argument("--presses", type=int, default=5)
     parser.add_argument(
+        "--no-voice", action="store_true",
+        help="a station without push-to-talk (no recognizer built in its process); prints its "
+        "figures without writing docs/benchmarks.md",
+    )  # fmt: skip
+    parser.add_argument(
         "--section", default="station",
         help="the section of docs/benchmarks.md to write (a long memory run keeps its own)",
     )  # fmt: skip
     args = parser.parse_args()
     if args.robots < 1 or any(size < 1 for size in args.beside):
         parser.error("--robots and --beside take whole numbers of at least 1")
+    if args.no_voice:
+        args.presses = 0
     runs = []
     for size in [*[s for s in args.beside if s != args.robots], args.robots]:
         load_before = os.getloadavg()
@@ -203,7 +213,8 @@ def main() -> int:
         runs.append(figures(size, latencies, result, load_before))
         runs[-1]["feed"] = feed_cost(size)
         print(json.dumps(runs[-1]), flush=True)
-    report(args, runs)
+    if not args.no_voice:
+        report(args, runs)
     main_run = runs[-1]
     print(json.dumps({**main_run, "beside": runs[:-1]}))
     return 0
@@ -243,7 +254,7 @@ def measure(args: argparse.Namespace) -> tuple[list[float], dict[str, Any]]:
             parts[1].start()
             if not swarm_ready.wait(120 + args.robots / 50):
                 raise RuntimeError("the swarm did not start")
-            station, url = start_station(broker, api, fleet_file)
+            station, url = start_station(broker, api, fleet_file, voice=not args.no_voice)
             address = parse_broker_url(broker)
             with MqttClient(MqttEndpoint(host=address.host, port=address.port)) as link:
                 link.subscribe(topics.ALL_SHADOW_DOCUMENTS, clock.on_documents)
@@ -260,11 +271,14 @@ def measure(args: argparse.Namespace) -> tuple[list[float], dict[str, Any]]:
     return latencies, result
 
 
-def start_station(broker: str, api: str, fleet_file: Path) -> tuple[subprocess.Popen[str], str]:
+def start_station(
+    broker: str, api: str, fleet_file: Path, *, voice: bool = True
+) -> tuple[subprocess.Popen[str], str]:
     """`vahr station` against the stack, as a lab would run it; its page's URL."""
+    voice_flags = [] if voice else ["--no-voice"]
     process = spawn(
         [sys.executable, "-m", "vahr.cli", "station", "--broker", broker, "--api", api,
-         "--fleet", str(fleet_file), "--port", str(free_port()), "--json"],
+         "--fleet", str(fleet_file), "--port", str(free_port()), "--json", *voice_flags],
         started_for=fleet_file.parent, stdout=subprocess.PIPE, text=True,
         cwd=Path(__file__).resolve().parents[1],
     )  # fmt: skip
