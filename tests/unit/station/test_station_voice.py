@@ -162,3 +162,20 @@ def test_a_remote_assistant_is_not_sent_a_zone_the_hearing_is_unsure_of() -> Non
     assert assistant.asked == []
     assert result["speech"] == "Did you say zone d or zone b? Please say it again."
     assert result["heard"]["weighed"]["slots"]["zone"] < 0.9
+
+
+def test_a_thousand_robots_share_out_their_names_and_each_is_heard() -> None:
+    from vahr.local.robots import generated_fleet
+    from vahr.skill_model.generator import build_interaction_model
+
+    document = build_interaction_model(generated_fleet(1000))
+    found = sentences(document)
+    # Not every sample written with each of the ~1,000 names (1.2 million sentences)...
+    assert len(found) < 250_000
+    # ...yet every robot's name is among them, in more than one context
+    heard = "\n".join(f" {sentence} " for sentence in found)
+    language = document["interactionModel"]["languageModel"]
+    [robots] = [t for t in language["types"] if t["name"] == "ROBOT"]
+    for value in robots["values"]:
+        name = spell_numbers(value["name"]["value"].lower())
+        assert heard.count(f" {name} ") >= 2, name
