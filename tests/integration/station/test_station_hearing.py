@@ -5,21 +5,20 @@ and moves nothing, and silence and noise move nothing."""
 
 from __future__ import annotations
 
-import http.client
 import json
 import time
-import urllib.parse
 import urllib.request
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pytest
 
+from tests.support.push_to_talk import clip
+from tests.support.push_to_talk import talk as talk_to
 from tests.support.vahr_up import Up, start_up, stop_up
 from vahr.local.alexa.nbest import MIN_SLOT_CONFIDENCE
 from vahr.local.ports import free_port
-from vahr.speech.audio import Audio, concatenate
-from vahr.speech.tts import make_synthesizer
+from vahr.speech.audio import Audio
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -40,26 +39,9 @@ def up(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Up]:
         stop_up(running.process)
 
 
-def clip(voice: str, text: str) -> Audio:
-    spoken = make_synthesizer(voice).synthesize(text)
-    return concatenate(Audio.silence(0.3), spoken, Audio.silence(0.3))
-
-
 def talk(up: Up, audio: Audio) -> dict[str, Any]:
-    """Release of the talk button: the clip posted as the page posts it."""
-    station = urllib.parse.urlsplit(up.endpoints["station"])
-    connection = http.client.HTTPConnection(station.hostname, station.port, timeout=60)
-    try:
-        connection.request(
-            "POST", "/api/voice", body=audio.to_wav(), headers={"Content-Type": "audio/wav"}
-        )
-        response = connection.getresponse()
-        body = response.read()
-    finally:
-        connection.close()
-    assert response.status == 200, body
-    answer: dict[str, Any] = json.loads(body)
-    return answer
+    """Release of the talk button on `up`'s station: the answer's JSON."""
+    return talk_to(up.endpoints["station"], audio)
 
 
 def robots(up: Up) -> dict[str, dict[str, Any]]:
