@@ -16,7 +16,7 @@ from skill import prompts
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
-    from ask_sdk_model import IntentRequest, Response
+    from ask_sdk_model import Intent, IntentRequest, Response
 
 # Set by the LaunchRequest handler: the person opened the skill and expects a conversation.
 CONVERSATION = "conversation"
@@ -85,17 +85,23 @@ def may_ask_again(handler_input: HandlerInput) -> bool:
     return asked <= MAX_QUESTIONS
 
 
-def elicit(handler_input: HandlerInput, slot_name: str, question: str) -> Response:
-    """Ask for one slot (Dialog.ElicitSlot), forgetting any value that did not resolve."""
+def _intent_with_slot(handler_input: HandlerInput, slot_name: str) -> tuple[Intent, Slot]:
+    """The request's intent, to send back as the directive's updated intent, and its slot
+    `slot_name`, added when the request left it out (the directive must carry it)."""
     request: IntentRequest = handler_input.request_envelope.request  # type: ignore[assignment]
     intent = request.intent
     assert intent is not None
     if intent.slots is None:
         intent.slots = {}
-    # The updated intent must carry the slot being asked for, even if the request left it out.
     slot = intent.slots.setdefault(
         slot_name, Slot(name=slot_name, confirmation_status=SlotConfirmationStatus.NONE)
     )
+    return intent, slot
+
+
+def elicit(handler_input: HandlerInput, slot_name: str, question: str) -> Response:
+    """Ask for one slot (Dialog.ElicitSlot), forgetting any value that did not resolve."""
+    intent, slot = _intent_with_slot(handler_input, slot_name)
     slot.value = None
     slot.resolutions = None
     slot.slot_value = None
@@ -113,14 +119,7 @@ def confirm_slot(
     """Ask a yes-or-no question about one slot (Dialog.ConfirmSlot), with `value` filled in
     as what the skill takes it to be; the answer comes back as the slot's
     confirmationStatus."""
-    request: IntentRequest = handler_input.request_envelope.request  # type: ignore[assignment]
-    intent = request.intent
-    assert intent is not None
-    if intent.slots is None:
-        intent.slots = {}
-    slot = intent.slots.setdefault(
-        slot_name, Slot(name=slot_name, confirmation_status=SlotConfirmationStatus.NONE)
-    )
+    intent, slot = _intent_with_slot(handler_input, slot_name)
     slot.value = value
     slot.resolutions = None
     slot.slot_value = None
