@@ -177,3 +177,12 @@ def test_say_names_who_spoke_and_refuses_a_bad_name(
             "/vahr/say",
             {"utterance": "hi", "heard": {"confidence": "high"}},
         )
+
+
+def test_an_exit_word_of_the_locale_ends_the_open_session(alexa: AlexaSimulator) -> None:
+    opened = alexa.say("Alexa, open robot fleet")
+    assert opened.session_open
+    # "good bye" is one of en-US's exits (its understanding.yaml), said as two words
+    turn = alexa.say("Good bye!")
+    assert turn.request_type == "SessionEndedRequest"
+    assert not alexa.session_open and turn.commands == []

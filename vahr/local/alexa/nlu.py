@@ -248,6 +248,11 @@ class InteractionModel:
             raise VahrError(f"the interaction model {file} is not valid JSON: {err}") from err
         return cls(document, **options)
 
+    @property
+    def understanding(self) -> LanguageUnderstanding:
+        """What the model knows of its language beyond the interaction model."""
+        return self._understanding
+
     def wait_ready(self, timeout_s: float = BUILD_TIMEOUT_S) -> TextClassifier:
         """The classifier, once built; raises VahrError if building failed or timed out."""
         if not self._ready.wait(timeout_s):

@@ -50,7 +50,6 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 _TAGS = re.compile(r"<[^>]+>")
-_EXIT = {"exit", "quit", "goodbye", "good bye", "bye"}
 _CONFIRMATION_PHRASES = Path(__file__).with_name("data") / "confirmation-en-US.yaml"
 # What the device says when it heard nothing: Alexa answers silence itself, the skill never
 # hears of it.
@@ -187,6 +186,8 @@ class AlexaSimulator:
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.model = model
+        language = model.understanding
+        self._exits = {normalize_utterance(w, language.locale) for w in language.exits}
         self.handler = handler
         self.identity = identity or envelope.Identity()
         self._command_log = command_log or (lambda: [])
@@ -278,7 +279,7 @@ class AlexaSimulator:
             text = rest
         elif text.startswith("alexa "):
             text = text.removeprefix("alexa ")
-        if self._session is not None and text in _EXIT:
+        if self._session is not None and text in self._exits:
             return self._send(utterance, envelope.session_ended_request(), None)
         if self._session is None:
             # A bare utterance with no session: treat it as addressed to this skill, as the

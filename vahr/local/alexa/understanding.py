@@ -52,6 +52,8 @@ class LanguageUnderstanding(msgspec.Struct, frozen=True, forbid_unknown_fields=T
 
     built_in: dict[str, list[str]] = {}
     out_of_domain: list[str] = []
+    # What leaves an open session at once, as on an Echo ("exit", "goodbye").
+    exits: list[str] = []
     finder: FinderWords = FinderWords()
     roles: list[RoleExamples] = []
     # The locale the file is for (set by `load_understanding`, not written in the file): the
