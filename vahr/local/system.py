@@ -411,6 +411,11 @@ class LocalSystem:
         return 200, {"fleet": msgspec.to_builtins(self.fleet)}
 
     def stop(self) -> None:
+        # The announcer goes first: robots going offline because the whole system stops is
+        # no news to announce (a swarm of 1,000 logged a dropped announcement for each).
+        if self.announcer is not None:
+            self.announcer.stop()
+            self.announcer = None
         if self.robots is not None:
             self.robots.stop()
             self.robots = None
@@ -420,9 +425,6 @@ class LocalSystem:
         if self.station is not None:
             self.station.stop()
             self.station = None
-        if self.announcer is not None:
-            self.announcer.stop()
-            self.announcer = None
         if self.dispatcher is not None:
             self.dispatcher.stop()
             self.dispatcher = None
