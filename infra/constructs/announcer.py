@@ -34,6 +34,7 @@ from aws_cdk import aws_sqs as sqs
 from constructs import Construct
 
 from infra.constructs.python_function import python_function
+from infra.constructs.topic_rule import lambda_topic_rule
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
@@ -178,30 +179,15 @@ class Announcer(Construct):
         )
 
     def _rule(self, construct_id: str, name: str, sql: str) -> iot.CfnTopicRule:
-        rule = iot.CfnTopicRule(
+        rule = lambda_topic_rule(
             self,
             construct_id,
-            rule_name=name,
-            topic_rule_payload=iot.CfnTopicRule.TopicRulePayloadProperty(
-                sql=sql,
-                aws_iot_sql_version="2016-03-23",
-                rule_disabled=False,
-                description="Robot events and presence -> the VAHR announcer",
-                actions=[
-                    iot.CfnTopicRule.ActionProperty(
-                        lambda_=iot.CfnTopicRule.LambdaActionProperty(
-                            function_arn=self.function.function_arn
-                        )
-                    )
-                ],
-                error_action=iot.CfnTopicRule.ActionProperty(
-                    sqs=iot.CfnTopicRule.SqsActionProperty(
-                        queue_url=self.dead_letters.queue_url,
-                        role_arn=self.rule_role.role_arn,
-                        use_base64=False,
-                    )
-                ),
-            ),
+            name=name,
+            sql=sql,
+            description="Robot events and presence -> the VAHR announcer",
+            function=self.function,
+            dead_letters=self.dead_letters,
+            role=self.rule_role,
         )
         self.function.add_permission(
             f"{construct_id}RuleInvoke",

@@ -25,12 +25,12 @@ import aws_cdk as cdk
 from aws_cdk import aws_events as events
 from aws_cdk import aws_events_targets as targets
 from aws_cdk import aws_iam as iam
-from aws_cdk import aws_iot as iot
 from aws_cdk import aws_sqs as sqs
 from constructs import Construct
 
 from infra.constructs.fleet_indexing import INDEX_NAME
 from infra.constructs.python_function import python_function
+from infra.constructs.topic_rule import lambda_topic_rule
 from vahr.protocol import topics
 from vahr.protocol.dispatch import IDLE_STATUSES
 
@@ -158,30 +158,15 @@ class Dispatcher(Construct):
             description="Lets the VAHR dispatcher rule dead-letter what it cannot deliver",
         )
         self.dead_letters.grant_send_messages(self.rule_role)
-        self.rule = iot.CfnTopicRule(
+        self.rule = lambda_topic_rule(
             self,
             "RobotFreed",
-            rule_name=config.dispatcher_rule_name,
-            topic_rule_payload=iot.CfnTopicRule.TopicRulePayloadProperty(
-                sql=freed_sql(),
-                aws_iot_sql_version="2016-03-23",
-                rule_disabled=False,
-                description="A robot became free -> the VAHR dispatcher gives it the next task",
-                actions=[
-                    iot.CfnTopicRule.ActionProperty(
-                        lambda_=iot.CfnTopicRule.LambdaActionProperty(
-                            function_arn=self.function.function_arn
-                        )
-                    )
-                ],
-                error_action=iot.CfnTopicRule.ActionProperty(
-                    sqs=iot.CfnTopicRule.SqsActionProperty(
-                        queue_url=self.dead_letters.queue_url,
-                        role_arn=self.rule_role.role_arn,
-                        use_base64=False,
-                    )
-                ),
-            ),
+            name=config.dispatcher_rule_name,
+            sql=freed_sql(),
+            description="A robot became free -> the VAHR dispatcher gives it the next task",
+            function=self.function,
+            dead_letters=self.dead_letters,
+            role=self.rule_role,
         )
         # A tick EventBridge cannot deliver is not retried: the next one does the same work.
         self.schedule = events.Rule(
