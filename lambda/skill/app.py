@@ -53,7 +53,7 @@ from skill.interceptors import (
 from skill.iot_data import IotDataGateway
 from skill.logs import log_event
 from skill.runtime import SkillRuntime
-from skill.tasks import task_desk
+from skill.task_desk import task_desk
 
 if TYPE_CHECKING:
     from collections.abc import Callable

@@ -43,7 +43,7 @@ class SkillConfig(msgspec.Struct, frozen=True):
     log_level: str = DEFAULT_LOG_LEVEL
     # Where boto3 finds no region (a local endpoint needs none), sign for this one.
     fallback_region: str = "us-east-1"
-    # The fleet dispatcher's function name on AWS (skill.tasks.task_desk).
+    # The fleet dispatcher's function name on AWS (skill.task_desk.task_desk).
     dispatcher_function: str | None = None
     # The IoT control plane's URL for fleet indexing, when not boto3's default.
     control_endpoint: str | None = None

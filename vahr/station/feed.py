@@ -26,7 +26,7 @@ the typedefs of `static/contract.js`:
 - `alert_acknowledged`: someone acknowledged an alert on a page (`acknowledge`): the
   announcement and any other still open about the same robot and trouble;
 - `tasks`: the fleet's task queue and who took which task, when it changed (`set_tasks`,
-  fed by `vahr.station.tasks.TaskPoller` from the dispatcher's `GET {api}/vahr/tasks`).
+  fed by `vahr.station.task_queue.TaskPoller` from the dispatcher's `GET {api}/vahr/tasks`).
 
 Acknowledgments are the station's, not one page's: every page stops showing the alert, and
 a page that reloads does not raise it again.

@@ -23,7 +23,7 @@ from vahr.station.controls import Controls
 from vahr.station.desk import Desk
 from vahr.station.feed import Feed
 from vahr.station.server import StationServer
-from vahr.station.tasks import TaskPoller
+from vahr.station.task_queue import TaskPoller
 
 if TYPE_CHECKING:
     from collections.abc import Callable

@@ -19,7 +19,7 @@ from ask_sdk_core.utils import is_intent_name
 from skill import dialog, prompts, task_speech
 from skill.responses import answer
 from skill.slots import read_slot
-from skill.tasks import TaskRefused
+from skill.task_desk import TaskRefused
 from skill.vocabulary import capitalise, join_choices
 from vahr.protocol import FLEET_GROUP
 from vahr.protocol.dispatch import Order
@@ -31,7 +31,7 @@ if TYPE_CHECKING:
 
     from skill.runtime import SkillRuntime
     from skill.slots import SlotReading
-    from skill.tasks import TaskDesk
+    from skill.task_desk import TaskDesk
 
 
 class _FleetHandler(AbstractRequestHandler):

@@ -16,7 +16,7 @@ from skill_testkit import speech
 
 from skill import app as skill_app
 from skill.config import SkillConfig
-from skill.tasks import TaskRefused
+from skill.task_desk import TaskRefused
 from tests.conftest import load_event
 from tests.support.fleets import SIX_ROBOTS
 from vahr.local.task_store import SqliteTaskStore

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from skill.tasks import HttpTaskDesk, LambdaTaskDesk, TaskDesk, TaskRefused
+from skill.task_desk import HttpTaskDesk, LambdaTaskDesk, TaskDesk, TaskRefused
 from tests.support.fleets import SIX_ROBOTS
 from vahr.local.dispatcher import TasksApi
 from vahr.local.task_store import SqliteTaskStore
