@@ -249,8 +249,9 @@ class InteractionModel:
         return cls(document, **options)
 
     @property
-    def understanding(self) -> LanguageUnderstanding:
-        """What the model knows of its language beyond the interaction model."""
+    def language(self) -> LanguageUnderstanding:
+        """What the model knows of its language beyond the interaction model (not an
+        `Understanding`, which is what it made of one utterance)."""
         return self._understanding
 
     def wait_ready(self, timeout_s: float = BUILD_TIMEOUT_S) -> TextClassifier:

@@ -186,7 +186,7 @@ class AlexaSimulator:
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.model = model
-        language = model.understanding
+        language = model.language
         self._exits = {normalize_utterance(w, language.locale) for w in language.exits}
         self.handler = handler
         self.identity = identity or envelope.Identity()
