@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 from robot_agent.agent import RobotAgent
 from robot_agent.backends.sim import SimBackend
+from robot_agent.backends.sim_ticker import SimTicker
 from robot_agent.clock import ScaledClock
 from robot_agent.config import ExecutorSettings, MqttSettings, SimSettings
 from robot_agent.core.recent_ids import RecentIds
@@ -80,6 +81,8 @@ class Swarm:
             raise VahrError("a swarm needs at least one robot")
         self.clock = ScaledClock(speed_factor)
         self._sim = sim or SimSettings()
+        # One timer steps every robot's drive: one per robot cost more than the motion.
+        self.ticker = SimTicker(clock=self.clock, tick_s=self._sim.tick_s)
         self._settings = settings or ExecutorSettings()
         self._state_dir = state_dir
         self._client_id = client_id or f"vahr-swarm-{uuid.uuid4().hex[:8]}"
@@ -115,7 +118,9 @@ class Swarm:
             recent = RecentIds(
                 self._state_dir / thing / "recent-ids.json" if self._state_dir else None
             )
-            backend = SimBackend(start=starts[thing], clock=self.clock, settings=self._sim)
+            backend = SimBackend(
+                start=starts[thing], clock=self.clock, settings=self._sim, ticker=self.ticker
+            )
             agent = _LoggedAgent(
                 self._on_event,
                 thing=thing,

@@ -18,10 +18,17 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Progress:
-    """How far along a goal is: `fraction` of the path done (0..1) and where the robot is."""
+    """How far along a goal is: `fraction` of the path done (0..1) and where the robot is.
+
+    `at` is when the backend observed it, in the executor's clock's (simulated) seconds,
+    from a backend that keeps the time of its own motion (the simulator): the executor then
+    judges "no progress" by that time, which a busy process cannot advance without the
+    motion advancing too. None: the backend does not, and the executor's clock is used.
+    """
 
     fraction: float
     pose: Pose
+    at: float | None = None
 
 
 class NavigationFailed(Exception):

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from robot_agent.backends.port import NavigationFailed, Progress
+from robot_agent.backends.sim_ticker import SimTicker
 from robot_agent.config import SimSettings
 from vahr.protocol import Pose
 
@@ -37,9 +38,19 @@ class SimBackend:
 
     name = "sim"
 
-    def __init__(self, *, start: Pose, clock: Clock, settings: SimSettings | None = None) -> None:
+    def __init__(
+        self,
+        *,
+        start: Pose,
+        clock: Clock,
+        settings: SimSettings | None = None,
+        ticker: SimTicker | None = None,
+    ) -> None:
+        """`ticker` steps this robot's drives; robots sharing one event loop (a swarm)
+        should share one. Without it, the robot has a ticker of its own."""
         self.settings = settings or SimSettings()
         self._clock = clock
+        self._ticker = ticker or SimTicker(clock=clock, tick_s=self.settings.tick_s)
         self._pose = start
         self._faults = _Faults(
             stuck_zones=set(self.settings.stuck_zones), fail_zones=set(self.settings.fail_zones)
@@ -73,43 +84,21 @@ class SimBackend:
         start = self._pose
         total = start.distance_to(goal)
         heading = math.atan2(goal.y - start.y, goal.x - start.x) if total > 1e-6 else start.theta
+        # The first observation, before turning: it tells the executor at once that this
+        # backend times its motion (`Progress.at`), so no watchdog runs on the clock.
+        on_progress(Progress(0.0, start, self._clock.monotonic()))
         await self._turn_to(heading)
-        tick = self.settings.tick_s
-        travelled = 0.0
-        # Where a stuck or failing goal stops: half way, or where an injection found it.
-        halt_at = total / 2
-        last = self._clock.monotonic()
-        while travelled < total:
-            await self._clock.sleep(tick)
-            # A fault injected while driving applies from where the robot is now.
-            if self._faults.stuck_next or self._faults.fail_next:
-                stuck = stuck or self._faults.stuck_next
-                failure = failure or self._faults.fail_next
-                self._faults.stuck_next, self._faults.fail_next = False, None
-                halt_at = travelled
-            # Integrate over the time that really passed, so a busy machine (or a high
-            # speed factor) changes how often the pose is updated, never the robot's speed.
-            now = self._clock.monotonic()
-            elapsed, last = now - last, now
-            if (stuck or failure) and travelled >= halt_at:
-                if failure:
-                    raise NavigationFailed(f"goal to {zone.id} aborted: {failure}")
-                # Stuck: the robot holds its place and keeps reporting the same progress,
-                # which is what the executor's stuck detection must notice.
-                on_progress(Progress(travelled / total, self._pose))
-                continue
-            travelled = min(total, travelled + self.settings.speed_mps * elapsed)
-            if stuck or failure:
-                travelled = min(travelled, halt_at)
-            self._pose = Pose(
-                start.x + (goal.x - start.x) * travelled / total,
-                start.y + (goal.y - start.y) * travelled / total,
-                heading,
-            )
-            on_progress(Progress(travelled / total, self._pose))
+        if total > 1e-6:
+            drive = _Drive(self, zone, on_progress, heading=heading, stuck=stuck, failure=failure)
+            self._ticker.add(drive)
+            try:
+                await drive.ended
+            finally:
+                # Cancelled (preempted, stopped): the robot stays where the last step left it.
+                self._ticker.discard(drive)
         await self._turn_to(goal.theta)
         self._pose = Pose(goal.x, goal.y, goal.theta)
-        on_progress(Progress(1.0, self._pose))
+        on_progress(Progress(1.0, self._pose, self._clock.monotonic()))
 
     async def _turn_to(self, heading: float) -> None:
         delta = math.atan2(
@@ -126,8 +115,80 @@ class SimBackend:
         await self._clock.sleep(delay)
 
     async def halt(self) -> None:
-        # The simulator stops within one tick once the driving task is cancelled.
+        # The simulator stops at once when the driving task is cancelled (its drive leaves
+        # the ticker then).
         await asyncio.sleep(0)
 
     async def close(self) -> None:
         return None
+
+
+class _Drive:
+    """One straight drive of a `SimBackend` to its goal, stepped by a `SimTicker`."""
+
+    def __init__(
+        self,
+        backend: SimBackend,
+        zone: Zone,
+        on_progress: Callable[[Progress], None],
+        *,
+        heading: float,
+        stuck: bool,
+        failure: str | None,
+    ) -> None:
+        self.backend = backend
+        self.zone = zone
+        self.on_progress = on_progress
+        self.heading = heading
+        self.start = backend.pose
+        self.total = self.start.distance_to(zone.pose)
+        self.travelled = 0.0
+        self.stuck, self.failure = stuck, failure
+        # Where a stuck or failing goal stops: half way, or where an injection found it.
+        self.halt_at = self.total / 2
+        self.last = backend._clock.monotonic()
+        self.ended: asyncio.Future[None] = asyncio.get_running_loop().create_future()
+
+    def step(self, now: float) -> bool:
+        if self.ended.done():  # the awaiting go_to was cancelled
+            return True
+        backend, faults = self.backend, self.backend._faults
+        # A fault injected while driving applies from where the robot is now.
+        if faults.stuck_next or faults.fail_next:
+            self.stuck = self.stuck or faults.stuck_next
+            self.failure = self.failure or faults.fail_next
+            faults.stuck_next, faults.fail_next = False, None
+            self.halt_at = self.travelled
+        # Integrate over the simulated time that really passed since the last step, so a
+        # busy process changes how often the pose is updated, never the robot's speed.
+        elapsed, self.last = now - self.last, now
+        total = self.total
+        if (self.stuck or self.failure) and self.travelled >= self.halt_at:
+            if self.failure:
+                self.ended.set_exception(
+                    NavigationFailed(f"goal to {self.zone.id} aborted: {self.failure}")
+                )
+                return True
+            # Stuck: the robot holds its place and keeps reporting the same progress, with
+            # the time that passed, which is what the executor's stuck detection notices.
+            self.on_progress(Progress(self.travelled / total, backend.pose, now))
+            return False
+        travelled = min(total, self.travelled + backend.settings.speed_mps * elapsed)
+        if self.stuck or self.failure:
+            travelled = min(travelled, self.halt_at)
+        self.travelled = travelled
+        goal, start = self.zone.pose, self.start
+        backend._pose = Pose(
+            start.x + (goal.x - start.x) * travelled / total,
+            start.y + (goal.y - start.y) * travelled / total,
+            self.heading,
+        )
+        self.on_progress(Progress(travelled / total, backend._pose, now))
+        if travelled >= total:
+            self.ended.set_result(None)
+            return True
+        return False
+
+    def crash(self, error: BaseException) -> None:
+        if not self.ended.done():
+            self.ended.set_exception(error)

@@ -282,31 +282,48 @@ class Executor:
         self._emit("arrived", command, zone=zone.id, pose=self.backend.pose)
 
     async def _navigate_watched(self, command: Command, zone: Zone) -> None:
-        """Drive with stuck detection: no progress for `stuck_after_s` ends the task."""
+        """Drive with stuck detection: no progress for `stuck_after_s` ends the task.
+
+        "No progress" is judged on the backend's own time when its reports carry it
+        (`Progress.at`, the simulator's): a robot is stuck when its motion spanned
+        `stuck_after_s` without advancing. A process too busy to step the simulator
+        delays the motion and its time alike, so it never makes a robot look stuck. A
+        backend without that time (ROS) is watched on the clock instead.
+        """
+        loop = asyncio.get_running_loop()
         last_advance = self.clock.monotonic()
         last_progress: Progress | None = None
         # The drive's start counts as a report: the shadow said `navigating` from here.
         last_report, last_fraction = last_advance, 0.0
         interval, step = self.settings.progress_interval_s, self.settings.progress_step
-
+        stuck_after = self.settings.stuck_after_s
+        # Settled when the backend's timed reports show no progress for `stuck_after`.
+        stalled: asyncio.Future[None] = loop.create_future()
+        timed = False
         active = True
 
         def on_progress(progress: Progress) -> None:
-            nonlocal last_advance, last_progress, last_report, last_fraction
+            nonlocal last_advance, last_progress, last_report, last_fraction, timed
             if not active or self._current is not command:
                 # Feedback a backend queued before the goal ended (ROS threads) comes late;
                 # after `cancelled` or `arrived` the task has nothing more to say.
                 return
+            if progress.at is None:
+                now = self.clock.monotonic()
+            else:
+                now, timed = progress.at, True
             if last_progress is None or _advanced(last_progress, progress):
-                last_advance = self.clock.monotonic()
+                last_advance = now
+            elif timed and now - last_advance > stuck_after and not stalled.done():
+                stalled.set_result(None)
             last_progress = progress
-            now = self.clock.monotonic()
             fraction = min(max(progress.fraction, 0.0), 1.0)
             # Both bounds must hold (see ExecutorSettings); `step` is compared with a little
             # slack so that float steps of exactly a quarter still count as a quarter. The
-            # end of the way is never reported: `arrived`, with the pose, follows at once.
+            # start and the end of the way are never reported: nothing is done yet, or
+            # `arrived`, with the pose, follows at once.
             if (
-                fraction < 1
+                0 < fraction < 1
                 and now - last_report >= interval
                 and fraction - last_fraction >= step - 1e-9
             ):
@@ -319,28 +336,34 @@ class Executor:
                     pose=progress.pose,
                 )
 
-        drive = asyncio.get_running_loop().create_task(self.backend.go_to(zone, on_progress))
-        check_every = max(self.settings.stuck_after_s / 4, 0.05)
+        drive = loop.create_task(self.backend.go_to(zone, on_progress))
+        check_every = _wall(self.clock, max(stuck_after / 4, 0.05))
         try:
             while not drive.done():
-                await asyncio.wait({drive}, timeout=_wall(self.clock, check_every))
+                # Once the backend's reports carry its time, it says itself when the robot
+                # stalls: no timer per robot (a swarm of 10,000 would wake 10,000 of them).
+                await asyncio.wait(
+                    {drive, stalled},
+                    timeout=None if timed else check_every,
+                    return_when=asyncio.FIRST_COMPLETED,
+                )
                 if drive.done():
                     break
-                if self.clock.monotonic() - last_advance > self.settings.stuck_after_s:
+                if not stalled.done():
+                    if self.clock.monotonic() - last_advance <= stuck_after:
+                        continue
                     # A starved process wakes this watchdog and the backend at the same
                     # moment; let the backend report first so starvation is not "stuck".
                     for _ in range(3):
                         await asyncio.sleep(0)
-                    if self.clock.monotonic() - last_advance <= self.settings.stuck_after_s:
+                    if timed or self.clock.monotonic() - last_advance <= stuck_after:
                         continue
-                    drive.cancel()
-                    await asyncio.wait({drive})
-                    reason = f"no progress towards {zone.id} for {self.settings.stuck_after_s:g} s"
-                    self._update(status="stuck", pose=_pose(self.backend.pose))
-                    self._emit(
-                        "stuck", command, zone=zone.id, reason=reason, pose=self.backend.pose
-                    )
-                    raise TaskFailed(f"stuck: {reason}", status="stuck")
+                drive.cancel()
+                await asyncio.wait({drive})
+                reason = f"no progress towards {zone.id} for {stuck_after:g} s"
+                self._update(status="stuck", pose=_pose(self.backend.pose))
+                self._emit("stuck", command, zone=zone.id, reason=reason, pose=self.backend.pose)
+                raise TaskFailed(f"stuck: {reason}", status="stuck")
             try:
                 drive.result()
             except NavigationFailed as err:
