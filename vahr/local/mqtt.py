@@ -66,13 +66,17 @@ class _BatchingPahoClient(paho.Client):
     command to 10,000 robots) those system calls were most of its time. Here a read takes
     up to `READ_CHUNK` bytes and packets are served from that buffer, all buffered packets
     are handled per wake-up, queued packets go out in one `send`, and the thread is woken
-    only when its queue was empty. The MQTT behaviour is paho's own; the overridden
-    methods are paho's private ones, which is why paho is pinned exactly.
+    only when its queue was empty, and plain PUBLISH packets go from the buffer straight to
+    the client's handlers (`_deliver_plain`). The MQTT behaviour is paho's own; the
+    overridden methods are paho's private ones, which is why paho is pinned exactly.
     """
 
     def __init__(self, *args: object, **kwargs: object) -> None:
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
         self._inbound = bytearray()
+        # Where plain PUBLISH packets go straight from the buffer (`_deliver_plain`):
+        # (topic, payload, retain). Unset, every packet takes paho's way.
+        self.deliver: Callable[[str, bytes, bool], None] | None = None
         # QoS 1 publishes sent and not yet acknowledged: `MqttClient.publish` takes a slot,
         # each PUBACK gives one back (see MAX_UNACKNOWLEDGED).
         self.window = threading.BoundedSemaphore(MAX_UNACKNOWLEDGED)
@@ -102,6 +106,25 @@ class _BatchingPahoClient(paho.Client):
         for _ in range(READ_BURST):
             if self._sock is None:
                 return MQTTErrorCode.MQTT_ERR_NO_CONN
+            if self._in_packet["command"] == 0 and self.deliver is not None:
+                # Between packets: plain PUBLISHes are taken from the buffer here, and
+                # paho reads only what is left at the head (another packet, or a part).
+                if not self._inbound:
+                    try:
+                        data = super()._sock_recv(READ_CHUNK)
+                    except BlockingIOError:
+                        return MQTTErrorCode.MQTT_ERR_SUCCESS
+                    except OSError as err:
+                        self._easy_log(paho.MQTT_LOG_ERR, "failed to receive on socket: %s", err)
+                        return self._loop_rc_handle(MQTTErrorCode.MQTT_ERR_CONN_LOST)  # type: ignore[no-any-return]
+                    if not data:
+                        return self._loop_rc_handle(MQTTErrorCode.MQTT_ERR_CONN_LOST)  # type: ignore[no-any-return]
+                    self._inbound += data
+                rc = self._deliver_plain()
+                if rc > 0:
+                    return self._loop_rc_handle(rc)  # type: ignore[no-any-return]
+                if not self._inbound:
+                    continue
             rc = self._packet_read()
             if rc > 0:
                 return self._loop_rc_handle(rc)  # type: ignore[no-any-return]
@@ -112,6 +135,67 @@ class _BatchingPahoClient(paho.Client):
             with contextlib.suppress(BlockingIOError):
                 self._sockpairW.send(b"0")
         return MQTTErrorCode.MQTT_ERR_SUCCESS
+
+    def _deliver_plain(self) -> MQTTErrorCode:
+        """Hand every whole plain PUBLISH at the head of the buffer to `deliver`.
+
+        Plain: MQTT 5, QoS 0 or 1, no properties, a UTF-8 topic: every message of the
+        robots, the shadow service and the station. paho's own way costs a packet state
+        machine, an `MQTTMessage` and two locks a message, which was half of what the
+        station spent per message in a 10,000-robot fleet command's burst. Anything else
+        (another packet type, properties, QoS 2, a packet not whole yet) stays in the
+        buffer for paho, so its behaviour is paho's own.
+        """
+        buffered = self._inbound
+        deliver = self.deliver
+        size = len(buffered)
+        at = 0
+        rc = MQTTErrorCode.MQTT_ERR_SUCCESS
+        taken = 0
+        while at + 2 <= size and deliver is not None:
+            header = buffered[at]
+            if header >> 4 != 3 or self._protocol != MQTTProtocolVersion.MQTTv5:
+                break
+            # The remaining length: one to four bytes, seven bits each, low first.
+            length = shift = 0
+            cursor = at + 1
+            while cursor < size and shift <= 21:
+                byte = buffered[cursor]
+                length |= (byte & 0x7F) << shift
+                cursor += 1
+                if not byte & 0x80:
+                    break
+                shift += 7
+            else:
+                break  # the length itself is not whole yet (or is malformed: paho says)
+            end = cursor + length
+            qos = (header >> 1) & 0x03
+            if end > size or qos > 1 or length < 3:
+                break
+            topic_end = cursor + 2 + ((buffered[cursor] << 8) | buffered[cursor + 1])
+            props = topic_end + 2 if qos else topic_end
+            if props >= end or buffered[props] != 0:
+                break
+            try:
+                topic = buffered[cursor + 2 : topic_end].decode()
+            except UnicodeDecodeError:
+                break
+            payload = bytes(buffered[props + 1 : end])
+            mid = (buffered[topic_end] << 8) | buffered[topic_end + 1] if qos else 0
+            at = end
+            taken += 1
+            deliver(topic, payload, bool(header & 0x01))
+            if qos == 1 and not self._manual_ack:
+                rc = self._send_puback(mid)
+                if rc > 0:
+                    break
+        if at:
+            del buffered[:at]
+        if taken:
+            now = paho.time_func()
+            with self._msgtime_mutex:
+                self._last_bytes_received = now
+        return rc
 
     def _packet_queue(
         self,
@@ -182,35 +266,6 @@ class _BatchingPahoClient(paho.Client):
             return MQTTErrorCode.MQTT_ERR_SUCCESS
         return super()._handle_pubackcomp(cmd)  # type: ignore[no-any-return]
 
-    def _handle_publish(self) -> MQTTErrorCode:
-        # An incoming MQTT v5 PUBLISH of QoS 0 or 1 without properties (every message of
-        # the robots, the shadow service and the station) is decoded here directly. paho
-        # builds a fresh `Properties` for each one, which alone cost about 10 us, a quarter
-        # of what the station spent per message during a 1,000-robot fleet command's burst.
-        # Anything with properties, QoS 2 or MQTT 3 is paho's.
-        header = self._in_packet["command"]
-        packet = self._in_packet["packet"]
-        qos = (header & 0x06) >> 1
-        if qos < 2 and self._protocol == MQTTProtocolVersion.MQTTv5 and len(packet) >= 3:
-            topic_end = 2 + ((packet[0] << 8) | packet[1])
-            at = topic_end + 2 if qos else topic_end
-            if topic_end > 2 and len(packet) > at and packet[at] == 0:  # no properties
-                message = paho.MQTTMessage(
-                    mid=(packet[topic_end] << 8) | packet[topic_end + 1] if qos else 0,
-                    topic=bytes(packet[2:topic_end]),
-                )
-                message.dup = bool(header & 0x08)
-                message.qos = qos
-                message.retain = bool(header & 0x01)
-                message.properties = _NO_PUBLISH_PROPERTIES
-                message.payload = bytes(packet[at + 1 :])
-                message.timestamp = paho.time_func()
-                self._handle_on_message(message)
-                if qos == 1 and not self._manual_ack:
-                    return self._send_puback(message.mid)  # type: ignore[no-any-return]
-                return MQTTErrorCode.MQTT_ERR_SUCCESS
-        return super()._handle_publish()  # type: ignore[no-any-return]
-
     def _qos0_published(self, packet: Any) -> None:
         """What paho does once a QoS 0 publish is written: it counts as published."""
         with self._callback_mutex:
@@ -234,8 +289,6 @@ class _BatchingPahoClient(paho.Client):
 # Read-only: handed to on_publish for every plain PUBACK (see `_handle_pubackcomp`).
 _PUBACK_SUCCESS = ReasonCode(PacketTypes.PUBACK)
 _NO_PROPERTIES = Properties(PacketTypes.PUBACK)
-# Read-only: handed with every incoming PUBLISH that has no properties (`_handle_publish`).
-_NO_PUBLISH_PROPERTIES = Properties(PacketTypes.PUBLISH)
 
 
 def _is_qos0_publish(packet: Any) -> bool:
@@ -314,6 +367,7 @@ class MqttClient:
         self._acks_lock = threading.Lock()
         self._client.on_connect = self._on_connect
         self._client.on_message = self._on_message
+        self._client.deliver = self._deliver
         self._client.on_publish = self._on_publish
         self._client.on_socket_open = self._on_socket_open
         self._client.on_subscribe = self._on_subscribe
@@ -556,7 +610,11 @@ class MqttClient:
         self._acknowledged(self._subacks, mid, list(reason_codes))
 
     def _on_message(self, client, userdata, message):  # type: ignore[no-untyped-def]
-        topic = message.topic
+        self._deliver(message.topic, bytes(message.payload), message.retain)
+
+    def _deliver(self, topic: str, payload: bytes, retain: bool) -> None:
+        """Run the handlers of `topic` (paho's network thread calls this, directly for a
+        plain PUBLISH, through `_on_message` for anything else)."""
         # A local reference: a subscription made meanwhile starts a new cache, and what is
         # computed here from the old handlers must not land in it.
         cache = self._routes
@@ -570,9 +628,8 @@ class MqttClient:
             if len(cache) >= ROUTE_CACHE_SIZE:
                 cache.clear()
             cache[topic] = routes
-        payload = bytes(message.payload)
         for topic_filter, handler, retained in routes:
-            if message.retain and not retained:
+            if retain and not retained:
                 continue
             try:
                 handler(topic, payload)

@@ -322,9 +322,12 @@ class Feed:
     def _broadcast_change(self, change: RobotChange) -> None:
         """Send a robot's change to every page (merged with one not taken yet); call with
         the lock held."""
+        closed = False
         for subscriber in self._subscribers:
             subscriber.push_change(change)
-        self._drop_overflowed()
+            closed = closed or subscriber.closed
+        if closed:
+            self._drop_overflowed()
 
     def _drop_overflowed(self) -> None:
         for subscriber in [s for s in self._subscribers if s.closed]:
@@ -334,9 +337,12 @@ class Feed:
     def _broadcast(self, message: PageMessage, key: str | None = None) -> None:
         """Send `message` to every page; call with the lock held, so order is kept."""
         encoded = encode_page_message(message)
+        closed = False
         for subscriber in self._subscribers:
             subscriber.push(encoded, key)
-        self._drop_overflowed()
+            closed = closed or subscriber.closed
+        if closed:
+            self._drop_overflowed()
 
     # -- the broker's messages -------------------------------------------------------------
 
