@@ -29,16 +29,35 @@ Beside the best transcript the recognizer gives its N best (`Recognition.hypothe
 from the decoder's word lattice, each distinct transcript once with its best path score),
 so a caller can weigh what each reading would mean: "zone b" and "zone d" a few points
 apart is a question to ask, not an action.
+
+Building the model is pure Python (`ArpaBoLM`) and, for words the dictionary lacks, one
+espeak-ng call each: about a minute for the station's sentences with a fleet of 1,000
+robots. A caller that must not hold its interpreter lock that long (the station, whose MQTT
+intake needs it) builds the model with `cached_language_model` in a child process
+(`in_child_process`) and hands the finished `LanguageModel` to the recognizer, which then
+only loads it into the decoder. The cache keeps a built model on disk, keyed by a hash of
+everything it is built from.
 """
 
 from __future__ import annotations
 
+import hashlib
 import io
 import itertools
+import json
+import os
+import pickle
+import shutil
+import signal
+import subprocess
+import sys
 import tempfile
 import threading
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TypeVar
+
+import msgspec
 
 from vahr.speech.audio import SAMPLE_RATE, SpeechDetector
 from vahr.speech.errors import SpeechError
@@ -53,9 +72,11 @@ from vahr.speech.stt import (
 )
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
+    from collections.abc import Callable, Iterable, Sequence
 
     from vahr.speech.audio import Audio
+
+Built = TypeVar("Built")
 
 # How much of the probability mass an ARPA back-off keeps for unseen word sequences.
 DISCOUNT_MASS = 0.5
@@ -64,6 +85,33 @@ DISCOUNT_MASS = 0.5
 NBEST_PATHS = 40
 MAX_HYPOTHESES = 10
 _FILLERS = frozenset({"<s>", "</s>", "<sil>", "[NOISE]", "[SPEECH]", "[BREATH]", "[COUGH]"})
+# What a built model depends on besides its sentences, background words and the libraries'
+# versions (in the cache key): change how a model is built, change the recipe.
+MODEL_RECIPE = f"ArpaBoLM trigram, discount {DISCOUNT_MASS}; cmudict lines; pronounce.guesses"
+
+
+class LanguageModel(msgspec.Struct, frozen=True):
+    """What the decoder loads: a trigram model (ARPA text) and the pronunciation
+    dictionary's lines for each of its words (guessed ones too)."""
+
+    arpa: str
+    dictionary: str
+
+    @property
+    def words(self) -> frozenset[str]:
+        """The model's words (each has one dictionary line or more)."""
+        return frozenset(
+            line.split(" ", 1)[0].split("(")[0] for line in self.dictionary.splitlines() if line
+        )
+
+
+class _CachedModel(msgspec.Struct, frozen=True):
+    """A language model as the cache keeps it: with its key, and a digest of its text so
+    that a file damaged in place is noticed before the decoder reads it."""
+
+    key: str
+    digest: str
+    model: LanguageModel
 
 
 def arpa_model(sentences: Iterable[str]) -> str:
@@ -80,6 +128,159 @@ def arpa_model(sentences: Iterable[str]) -> str:
     return out.getvalue()
 
 
+def build_language_model(sentences: Iterable[str], background_words: int = 0) -> LanguageModel:
+    """The model of `sentences` (normalized) and of the `background_words` commonest English
+    words, built in this process."""
+    examples = tuple(dict.fromkeys(sentences))
+    entries = dictionary_entries()
+    # Each background word is a sentence of its own: known, but in no example's context.
+    background = (
+        common_words(background_words, (e for e, _ in entries if "(" not in e))
+        if background_words
+        else []
+    )
+    vocabulary = frozenset(w for s in (*examples, *background) for w in s.split())
+    # Only the model's words from the dictionary: the search is built in milliseconds
+    # instead of seconds.
+    pronunciations = _pronunciations(entries, vocabulary)
+    missing = sorted(vocabulary - {line.split(" ", 1)[0] for line in pronunciations})
+    if missing:
+        pronunciations += _guessed(entries, missing)
+    return LanguageModel(arpa_model([*examples, *background]), "".join(pronunciations))
+
+
+def model_key(sentences: Sequence[str], background_words: int = 0) -> str:
+    """The hash of everything a model is built from: the sentences, the background words,
+    the recipe, and the versions of pocketsphinx (its dictionary, `ArpaBoLM`) and of
+    espeak-ng (the guessed pronunciations)."""
+    try:
+        library = version("pocketsphinx")
+    except PackageNotFoundError:
+        library = "absent"
+    built_from = [MODEL_RECIPE, library, _espeak_version(), background_words, list(sentences)]
+    return hashlib.sha256(json.dumps(built_from).encode()).hexdigest()
+
+
+def cached_language_model(
+    sentences: Iterable[str], background_words: int = 0, *, cache_dir: Path | None
+) -> tuple[LanguageModel, bool]:
+    """The model of `sentences`, from the cache in `cache_dir` when it holds it (True) or
+    built now and cached (False). A cache file that cannot be read, does not decode or does
+    not match its digest is built again and overwritten; one that cannot be written is
+    skipped. `cache_dir=None` keeps nothing on disk."""
+    examples = tuple(dict.fromkeys(sentences))
+    key = model_key(examples, background_words)
+    file = cache_dir / f"language-model-{key[:24]}.json" if cache_dir else None
+    if file is not None:
+        cached = _read_cached(file, key)
+        if cached is not None:
+            return cached, True
+    model = build_language_model(examples, background_words)
+    if file is not None:
+        _write_cached(file, key, model)
+    return model, False
+
+
+def _digest(model: LanguageModel) -> str:
+    text = hashlib.sha256(model.arpa.encode())
+    text.update(b"\0")
+    text.update(model.dictionary.encode())
+    return text.hexdigest()
+
+
+def _read_cached(file: Path, key: str) -> LanguageModel | None:
+    try:
+        cached = msgspec.json.decode(file.read_bytes(), type=_CachedModel)
+    except (OSError, msgspec.DecodeError):
+        return None
+    if cached.key != key or cached.digest != _digest(cached.model):
+        return None
+    return cached.model
+
+
+def _write_cached(file: Path, key: str, model: LanguageModel) -> None:
+    try:
+        file.parent.mkdir(parents=True, exist_ok=True)
+        partial = file.with_suffix(f".{os.getpid()}.tmp")
+        partial.write_bytes(msgspec.json.encode(_CachedModel(key, _digest(model), model)))
+        partial.replace(file)
+    except OSError:
+        pass
+
+
+def _espeak_version() -> str:
+    executable = shutil.which("espeak-ng")
+    if executable is None:
+        return "absent"
+    try:
+        done = subprocess.run(
+            [executable, "--version"], capture_output=True, text=True, timeout=10, check=False
+        )
+    except (OSError, subprocess.TimeoutExpired):
+        return "unknown"
+    return done.stdout.strip()
+
+
+def in_child_process(function: Callable[..., Built], *args: Any) -> Built:
+    """`function(*args)` run in a fresh interpreter and its result sent back, so that this
+    process keeps its interpreter lock meanwhile. `function` (importable by name) and its
+    arguments must pickle; an error it raises is raised here. The child is tied to the
+    calling thread's life (`vahr.lifeline`): it gets SIGTERM when that ends, SIGKILL of this
+    process included.
+
+    Not multiprocessing's spawn: its child imports the caller's main module again, which
+    fails in a script without a main guard and costs the station's imports twice."""
+    from vahr.lifeline import lifeline_command
+
+    command = [sys.executable, "-c", f"from {__name__} import _child_main; _child_main()"]
+    # The import path first, on its own: unpickling `function` imports its module.
+    request = pickle.dumps(sys.path) + pickle.dumps(
+        (function, args), protocol=pickle.HIGHEST_PROTOCOL
+    )
+    try:
+        child = subprocess.Popen(
+            lifeline_command(command, signal.SIGTERM),
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+        )
+    except OSError as err:
+        raise SpeechError(f"cannot start a process for the language model: {err}") from err
+    # communicate() waits in select() without the interpreter lock.
+    answer, _ = child.communicate(request)
+    try:
+        succeeded, value = pickle.loads(answer)  # noqa: S301 - our own child's answer
+    except (pickle.UnpicklingError, EOFError, ValueError, TypeError) as err:
+        raise SpeechError(
+            f"the process building the language model ended without one "
+            f"(exit code {child.returncode})"
+        ) from err
+    if not succeeded:
+        raise value
+    built: Built = value
+    return built
+
+
+def _child_main() -> None:
+    """The child's side of `in_child_process`: a pickled call on stdin, its pickled outcome
+    on stdout (anything the call prints goes to stderr)."""
+    answer = sys.stdout.buffer
+    sys.stdout = sys.stderr
+    request = io.BytesIO(sys.stdin.buffer.read())
+    sys.path[:] = pickle.load(request)  # noqa: S301 - from our parent
+    function, args = pickle.load(request)  # noqa: S301
+    try:
+        outcome: tuple[bool, Any] = (True, function(*args))
+    except Exception as err:  # noqa: BLE001 - any failure goes back to the caller
+        outcome = (False, err)
+    try:
+        message = pickle.dumps(outcome, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception as err:  # noqa: BLE001 - pickle raises several kinds
+        failure = SpeechError(f"the language model could not be sent back: {err}")
+        message = pickle.dumps((False, failure))
+    answer.write(message)
+    answer.flush()
+
+
 class LanguageModelRecognizer:
     """pocketsphinx with an n-gram model of example sentences, and word posteriors."""
 
@@ -91,7 +292,11 @@ class LanguageModelRecognizer:
         adaptation: Path | None = None,
         background_words: int = 0,
         nbest: bool = False,
+        model: LanguageModel | None = None,
     ) -> None:
+        """`model`, when given, is the one built from `sentences` and `background_words`
+        (`cached_language_model`, maybe in another process); without it the model is built
+        here."""
         from pocketsphinx import Decoder
 
         # The N best cost an A* search of the lattice per utterance (about a quarter more
@@ -99,25 +304,13 @@ class LanguageModelRecognizer:
         self.nbest = nbest
         self.sentences = tuple(dict.fromkeys(sentences))
         self.detector = detector or SpeechDetector()
-        entries = dictionary_entries()
-        # Each background word is a sentence of its own: known, but in no example's context.
-        background = (
-            common_words(background_words, (e for e, _ in entries if "(" not in e))
-            if background_words
-            else []
-        )
-        self.vocabulary = frozenset(w for s in (*self.sentences, *background) for w in s.split())
-        # Only the model's words from the dictionary: the search is built in milliseconds
-        # instead of seconds.
-        pronunciations = _pronunciations(entries, self.vocabulary)
-        missing = sorted(self.vocabulary - {line.split(" ", 1)[0] for line in pronunciations})
-        if missing:
-            pronunciations += _guessed(entries, missing)
+        self.model = model or build_language_model(self.sentences, background_words)
+        self.vocabulary = self.model.words
         with tempfile.TemporaryDirectory() as folder:
             dictionary = Path(folder) / "words.dict"
-            dictionary.write_text("".join(pronunciations), encoding="utf-8")
+            dictionary.write_text(self.model.dictionary, encoding="utf-8")
             arpa = Path(folder) / "sentences.arpa"
-            arpa.write_text(arpa_model([*self.sentences, *background]), encoding="utf-8")
+            arpa.write_text(self.model.arpa, encoding="utf-8")
             # No second (flat) pass: it doubled the time and changed no result on the
             # tuning set.
             self._decoder = Decoder(

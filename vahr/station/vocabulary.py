@@ -9,14 +9,22 @@ many contexts), plus the built-in intents' phrases (those the simulator knows th
 `vahr.local.alexa.built_in_phrases`) and the invocation forms ("ask robot fleet to ...").
 The interaction model is generated from `fleet.yaml`, so the robots' and zones' names follow
 the fleet. Numbers are spelled out, as people say them.
+
+The station's recognizer is built from them in a child process (`command_recognizer`):
+with a fleet of 1,000 robots the sentences and their language model take about a minute of
+pure Python, which inside the station would hold the interpreter lock its MQTT intake
+needs. The model is cached on disk by a hash of what it is built from, so the next start
+only loads it.
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import re
+import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from vahr.errors import VahrError
 from vahr.local.alexa import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases
@@ -24,7 +32,9 @@ from vahr.protocol.text import normalize, spell_numbers
 
 if TYPE_CHECKING:
     from vahr.protocol import Fleet
-    from vahr.speech.lm_stt import LanguageModelRecognizer
+    from vahr.speech.lm_stt import LanguageModel, LanguageModelRecognizer
+
+log = logging.getLogger(__name__)
 
 _SLOT = re.compile(r"\{([A-Za-z0-9_.]+)\}")
 # The weather delivery's rule said aloud ("deliver to zone a if it's sunny and zone c if it's
@@ -108,15 +118,60 @@ def load_model(model_file: Path | None = None) -> dict[str, Any]:
     return loaded
 
 
-def command_recognizer(
-    model_file: Path | None = None, fleet: Fleet | None = None
-) -> LanguageModelRecognizer:
-    """The push-to-talk recognizer for the interaction model at `model_file`; without one,
-    the model generated from `fleet` (in memory), else the one that ships with the package."""
-    from vahr.speech.lm_stt import LanguageModelRecognizer
+class CommandModel(NamedTuple):
+    """The push-to-talk sentences and their language model, as the child sends them back."""
 
+    sentences: list[str]
+    model: LanguageModel
+    cached: bool  # read from the cache rather than built
+    seconds: float  # the child's time for the sentences and the model
+
+
+def command_model(
+    model_file: Path | None, fleet: Fleet | None, cache_dir: Path | None
+) -> CommandModel:
+    """The sentences of the interaction model (as `command_recognizer` picks it) and their
+    language model, from the cache in `cache_dir` or built (what the child process runs)."""
+    from vahr.speech.lm_stt import cached_language_model
+
+    started = time.perf_counter()
     if model_file is None and fleet is not None:
         from vahr.skill_model.generator import build_interaction_model
 
-        return LanguageModelRecognizer(sentences(build_interaction_model(fleet)), nbest=True)
-    return LanguageModelRecognizer(sentences(load_model(model_file)), nbest=True)
+        found = sentences(build_interaction_model(fleet))
+    else:
+        found = sentences(load_model(model_file))
+    model, cached = cached_language_model(found, cache_dir=cache_dir)
+    return CommandModel(found, model, cached, time.perf_counter() - started)
+
+
+def command_recognizer(
+    model_file: Path | None = None,
+    fleet: Fleet | None = None,
+    *,
+    cache_dir: Path | None = None,
+    use_cache: bool = True,
+) -> LanguageModelRecognizer:
+    """The push-to-talk recognizer for the interaction model at `model_file`; without one,
+    the model generated from `fleet` (in memory), else the one that ships with the package.
+    Its sentences and language model are made in a child process, only the decoder is
+    loaded here. The model is cached in `cache_dir` (default: the trained models' cache,
+    `$XDG_CACHE_HOME/vahr`) unless `use_cache` is False."""
+    from vahr.speech.lm_stt import LanguageModelRecognizer, in_child_process
+    from vahr.speech.text_classifier import default_cache_dir
+
+    cache = (cache_dir or default_cache_dir()) if use_cache else None
+    started = time.perf_counter()
+    made = in_child_process(command_model, model_file, fleet, cache)
+    received = time.perf_counter()
+    recognizer = LanguageModelRecognizer(made.sentences, nbest=True, model=made.model)
+    log.info(
+        "push-to-talk: %d sentences, language model %s in %.1f s in a child process "
+        "(%.1f s with its start), loaded in %.2f s",
+        len(made.sentences),
+        "read from the cache" if made.cached else "built",
+        made.seconds,
+        received - started,
+        time.perf_counter() - received,
+    )
+    return recognizer

@@ -1,0 +1,100 @@
+"""The station's push-to-talk recognizer (`vahr.station.vocabulary.command_recognizer`):
+its language model is made in a child process from the interaction model, kept in the
+cache, and the recognizer hears real speech with it; a second start builds nothing."""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING
+
+import pytest
+
+from tests.support.push_to_talk import clip
+from vahr.errors import VahrError
+from vahr.speech.lm_stt import LanguageModelRecognizer
+from vahr.station.vocabulary import command_model, command_recognizer, load_model, sentences
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+# An interaction model of one intent: small, so its model builds in a second.
+MODEL = {
+    "interactionModel": {
+        "languageModel": {
+            "invocationName": "robot fleet",
+            "intents": [
+                {
+                    "name": "NavigateIntent",
+                    "slots": [
+                        {"name": "robot", "type": "ROBOT"},
+                        {"name": "zone", "type": "ZONE"},
+                    ],
+                    "samples": ["send {robot} to {zone}", "move {robot} to {zone}"],
+                },
+                {"name": "AMAZON.StopIntent", "samples": []},
+            ],
+            "types": [
+                {
+                    "name": "ROBOT",
+                    "values": [
+                        {"name": {"value": "placebot 1", "synonyms": ["robot one"]}},
+                        {"name": {"value": "placebot 2", "synonyms": ["robot two"]}},
+                    ],
+                },
+                {
+                    "name": "ZONE",
+                    "values": [{"name": {"value": f"zone {z}"}} for z in "abcd"],
+                },
+            ],
+        }
+    }
+}
+
+
+@pytest.fixture
+def model_file(tmp_path: Path) -> Path:
+    file = tmp_path / "en-US.json"
+    file.write_text(json.dumps(MODEL), encoding="utf-8")
+    return file
+
+
+def test_the_recognizer_from_the_child_process_is_the_one_built_here(
+    model_file: Path, tmp_path: Path
+) -> None:
+    cache = tmp_path / "cache"
+    recognizer = command_recognizer(model_file, cache_dir=cache)
+    here = LanguageModelRecognizer(sentences(load_model(model_file)), nbest=True)
+    assert recognizer.sentences == here.sentences
+    assert recognizer.model == here.model
+    assert "send placebot two to zone b" in recognizer.sentences
+    heard = recognizer.recognize(clip("espeak-ng", "send placebot two to zone b"))
+    assert heard.text == "send placebot two to zone b"
+    assert heard.hypotheses
+
+
+def test_a_second_start_reads_the_model_from_the_cache(model_file: Path, tmp_path: Path) -> None:
+    cache = tmp_path / "cache"
+    first = command_model(model_file, None, cache)
+    assert not first.cached
+    [file] = cache.iterdir()
+    written = file.stat().st_mtime_ns
+    second = command_model(model_file, None, cache)
+    assert second.cached
+    assert second.model == first.model
+    assert file.stat().st_mtime_ns == written
+    # The station's own start, through the child process, finds it too.
+    assert command_recognizer(model_file, cache_dir=cache).model == first.model
+    assert list(cache.iterdir()) == [file]
+
+
+def test_without_the_cache_nothing_is_kept(model_file: Path, tmp_path: Path) -> None:
+    home = tmp_path / "cache-home"
+    recognizer = command_recognizer(model_file, cache_dir=home, use_cache=False)
+    assert "send placebot one to zone d" in recognizer.sentences
+    assert not home.exists()
+
+
+def test_an_unreadable_interaction_model_is_a_one_line_error(tmp_path: Path) -> None:
+    missing = tmp_path / "nowhere.json"
+    with pytest.raises(VahrError, match="cannot read the interaction model .*nowhere.json"):
+        command_recognizer(missing, cache_dir=tmp_path)
