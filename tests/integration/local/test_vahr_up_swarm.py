@@ -6,8 +6,10 @@ sized for them, "where are the robots" answered with a summary within the word b
 from __future__ import annotations
 
 import functools
+import itertools
 import subprocess
 import time
+from datetime import datetime
 from typing import TYPE_CHECKING, Any
 
 import pytest
@@ -101,6 +103,25 @@ def test_which_robots_are_stuck_after_two_faults(up: Up) -> None:
     # And one robot by name is one sentence, as for the paper's robots
     where = say(api, "Alexa, ask robot fleet where is rover 17")
     assert where["speech"].startswith("Rover 17 is stuck")
+
+
+def test_a_robot_of_the_swarm_reports_its_progress_once_a_second(up: Up) -> None:
+    # Given the swarm at 20 times real time, when rover 5 drives across the floor
+    turn = say(up.endpoints["api"], "Alexa, ask robot fleet to send rover 5 to zone d")
+    [command] = turn["commands"]
+    drive: list[dict[str, Any]] = []
+    while not drive or drive[-1]["event"] not in ("arrived", "failed"):
+        line = up.lines.get(timeout=30)
+        if line.get("command_id") == command:
+            drive.append(line)
+    # Then its progress came about once a wall-clock second (not once a simulated second,
+    # twenty times as often), so a station drawing thousands of robots is not flooded
+    assert drive[-1]["event"] == "arrived", drive
+    drive = [line for line in drive if line["event"] in ("accepted", "progress")]
+    times = [datetime.fromisoformat(line["at"]).timestamp() for line in drive]
+    assert [line["event"] for line in drive].count("progress") >= 1, drive
+    gaps = [later - earlier for earlier, later in itertools.pairwise(times)]
+    assert min(gaps) >= 0.9, gaps
 
 
 @pytest.mark.parametrize(
