@@ -20,14 +20,17 @@ when the hearing is sure of every robot and zone; otherwise the station asks its
 from __future__ import annotations
 
 import io
+import logging
 import threading
 import time
 import wave
 from typing import TYPE_CHECKING, Any
 
+from vahr.errors import VahrError
 from vahr.local.alexa import Weighed, weigh_recognition
 from vahr.local.client import SimulatorAssistant
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio
+from vahr.speech.errors import SpeechError
 from vahr.station.errors import RequestError
 
 if TYPE_CHECKING:
@@ -36,6 +39,8 @@ if TYPE_CHECKING:
     from vahr.local.alexa import InteractionModel
     from vahr.local.client import Assistant
     from vahr.speech.stt import Recognition, Recognizer
+
+log = logging.getLogger(__name__)
 
 SORRY = "Sorry, I didn't catch that. I sent nothing to the robots."
 # A clip may be up to 20 s long: the page's recorder stops there.
@@ -87,7 +92,10 @@ class PushToTalk:
     """Recognize a clip, weigh its readings, and pass the understanding to the assistant.
 
     The recognizer is built on first use, or ahead of it in the background with `warm_up`
-    (building one takes a moment; the first press should not wait for it). The NLU is the
+    (building one takes a moment; the first press should not wait for it). The recognizer
+    that `vocabulary.command_recognizer` makes has its language model made in a child
+    process, so the warm-up thread mostly waits, leaving the interpreter lock to the
+    station's MQTT intake. The NLU is the
     simulator's when the assistant is the simulator in this process, else the one that
     ships with the package (built on first use).
     """
@@ -100,9 +108,16 @@ class PushToTalk:
         self._lock = threading.Lock()
 
     def warm_up(self) -> threading.Thread:
-        thread = threading.Thread(target=self.recognizer, name="station-recognizer", daemon=True)
+        thread = threading.Thread(target=self._warm, name="station-recognizer", daemon=True)
         thread.start()
         return thread
+
+    def _warm(self) -> None:
+        try:
+            self.recognizer()
+        except (VahrError, SpeechError) as err:
+            # Said once here; the first press tries again and answers with the reason.
+            log.warning("push-to-talk: the recognizer could not be built: %s", err)
 
     def recognizer(self) -> Recognizer:
         with self._lock:

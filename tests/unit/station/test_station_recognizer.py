@@ -13,6 +13,7 @@ from tests.support.push_to_talk import clip
 from vahr.errors import VahrError
 from vahr.speech.lm_stt import LanguageModelRecognizer
 from vahr.station.vocabulary import command_model, command_recognizer, load_model, sentences
+from vahr.station.voice import PushToTalk
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -98,3 +99,14 @@ def test_an_unreadable_interaction_model_is_a_one_line_error(tmp_path: Path) -> 
     missing = tmp_path / "nowhere.json"
     with pytest.raises(VahrError, match="cannot read the interaction model .*nowhere.json"):
         command_recognizer(missing, cache_dir=tmp_path)
+
+
+def test_a_warm_up_that_fails_says_why_and_the_first_press_tries_again(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    missing = tmp_path / "nowhere.json"
+    talk = PushToTalk(None, lambda: command_recognizer(missing, cache_dir=tmp_path))  # type: ignore[arg-type]
+    talk.warm_up().join(60)
+    assert "the recognizer could not be built: cannot read the interaction model" in caplog.text
+    with pytest.raises(VahrError, match="cannot read the interaction model"):
+        talk.recognizer()
