@@ -85,6 +85,8 @@ DISCOUNT_MASS = 0.5
 NBEST_PATHS = 40
 MAX_HYPOTHESES = 10
 _FILLERS = frozenset({"<s>", "</s>", "<sil>", "[NOISE]", "[SPEECH]", "[BREATH]", "[COUGH]"})
+# The language models the cache keeps, newest first (one per fleet and interaction model).
+MODELS_KEPT = 8
 # What a built model depends on besides its sentences, background words and the libraries'
 # versions (in the cache key): change how a model is built, change the recipe.
 MODEL_RECIPE = f"ArpaBoLM trigram, discount {DISCOUNT_MASS}; cmudict lines; pronounce.guesses"
@@ -205,7 +207,22 @@ def _write_cached(file: Path, key: str, model: LanguageModel) -> None:
         partial.write_bytes(msgspec.json.encode(_CachedModel(key, _digest(model), model)))
         partial.replace(file)
     except OSError:
-        pass
+        return
+    _forget_oldest(file.parent)
+
+
+def _forget_oldest(folder: Path) -> None:
+    """Remove all but the `MODELS_KEPT` newest models: a 1,000-robot fleet's is 6 MB, and
+    every change of the interaction model or the fleet writes another."""
+    try:
+        stamped = sorted(
+            ((f.stat().st_mtime_ns, f) for f in folder.glob("language-model-*.json")),
+            reverse=True,
+        )
+        for _, old in stamped[MODELS_KEPT:]:
+            old.unlink(missing_ok=True)
+    except OSError:
+        pass  # another start removed it first, or the folder is not ours to tidy
 
 
 def _espeak_version() -> str:

@@ -115,3 +115,18 @@ def test_an_unreadable_cache_is_skipped(tmp_path: Path) -> None:
 def test_without_a_cache_folder_the_model_is_built_each_time(tmp_path: Path) -> None:
     model, cached = cached_language_model(SENTENCES, cache_dir=None)
     assert (model, cached) == (build_language_model(SENTENCES), False)
+
+
+def test_the_cache_keeps_only_the_newest_models(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(lm_stt, "MODELS_KEPT", 2)
+    files: list[Path] = []
+    for number in ("one", "two", "three"):
+        cached_language_model([f"send placebot {number} to zone a"], cache_dir=tmp_path)
+        [newest] = set(tmp_path.glob("language-model-*.json")) - set(files)
+        files.append(newest)
+    assert sorted(tmp_path.iterdir()) == sorted(files[1:])
+    # The one forgotten is built again when asked for.
+    _, cached = cached_language_model(["send placebot one to zone a"], cache_dir=tmp_path)
+    assert not cached
