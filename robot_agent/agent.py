@@ -32,6 +32,9 @@ log = logging.getLogger(__name__)
 # Events an operator should notice at the default log level and above.
 _TROUBLE = frozenset({"rejected", "failed", "stuck"})
 _ENDINGS = frozenset({"done", "failed", "cancelled", "rejected"})
+# Progress ticks are most of a driving robot's events (a swarm of 10,000 logged thousands a
+# second at INFO); the events around them say what the robot did.
+_LOG_LEVELS = {"progress": logging.DEBUG}
 
 
 class RobotAgent:
@@ -150,8 +153,14 @@ class RobotAgent:
         self.link.publish(
             topics.robot_events(self.thing), encode(event), retain=event.event == "delivered"
         )
-        level = logging.WARNING if event.event in _TROUBLE else logging.INFO
-        log.log(level, "%s: %s", self.thing, _describe(event))
+        level = (
+            logging.WARNING
+            if event.event in _TROUBLE
+            else _LOG_LEVELS.get(event.event, logging.INFO)
+        )
+        # Described only when logged: a swarm publishes thousands of events a second.
+        if log.isEnabledFor(level):
+            log.log(level, "%s: %s", self.thing, _describe(event))
         # Forgotten only once its end is on record (logged, and queued on the link).
         if event.command_id is not None and event.event in _ENDINGS:
             self.in_flight.end(event.command_id)

@@ -123,6 +123,7 @@ class Swarm:
             )
             agent = _LoggedAgent(
                 self._on_event,
+                self._tell_peers if self._listen_to_peers else None,
                 thing=thing,
                 fleet=self.fleet,
                 link=link,
@@ -138,7 +139,10 @@ class Swarm:
                 DevFaults(thing=thing, link=link, backend=backend).attach()
             self.agents[thing] = agent
         if self._listen_to_peers:
-            link.add_route(topics.ALL_EVENTS, self._on_peer_event)
+            # Only robots outside this process: the broker would send back every event this
+            # swarm publishes (most of its traffic, mostly progress), and its own robots'
+            # deliveries reach their peers here directly (`_LoggedAgent`).
+            link.add_route(topics.ALL_EVENTS, self._on_peer_event, no_local=True)
         await link.start(timeout_s)
 
     def _on_peer_event(self, topic: str, payload: bytes) -> None:
@@ -148,6 +152,9 @@ class Swarm:
             event = decode_event(payload)
         except ProtocolError:
             return
+        self._tell_peers(event)
+
+    def _tell_peers(self, event: Event) -> None:
         for agent in self.agents.values():
             agent.executor.peer_event(event)
 
@@ -181,13 +188,22 @@ class Swarm:
 
 
 class _LoggedAgent(RobotAgent):
-    """A robot whose every published event is also handed to `on_event`."""
+    """A robot whose every published event is also handed to `on_event`, and whose
+    deliveries are told to `tell_peers` (the other robots of its swarm)."""
 
-    def __init__(self, on_event: Callable[[Event], None] | None, **arguments: Any) -> None:
+    def __init__(
+        self,
+        on_event: Callable[[Event], None] | None,
+        tell_peers: Callable[[Event], None] | None,
+        **arguments: Any,
+    ) -> None:
         super().__init__(**arguments)
         self._on_event = on_event
+        self._tell_peers = tell_peers
 
     def _publish_event(self, event: Event) -> None:
         super()._publish_event(event)
+        if self._tell_peers is not None and event.event == "delivered":
+            self._tell_peers(event)
         if self._on_event is not None:
             self._on_event(event)

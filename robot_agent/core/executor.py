@@ -131,6 +131,9 @@ class Executor:
             "last_command": LastCommand(command.id, command.action, "accepted"),
             "task": command.action if command.is_motion else None,
             "destination": _destination(command),
+            # Where the robot is now: the preempted task halts here and its final update,
+            # like the next drive's first, then says nothing new (one update, not three).
+            "pose": _pose(self.backend.pose),
         }
         if isinstance(command, Navigate):
             # What `_drive` would report a moment later: the same shadow update says it.
@@ -285,10 +288,11 @@ class Executor:
         """Drive with stuck detection: no progress for `stuck_after_s` ends the task.
 
         "No progress" is judged on the backend's own time when its reports carry it
-        (`Progress.at`, the simulator's): a robot is stuck when its motion spanned
-        `stuck_after_s` without advancing. A process too busy to step the simulator
-        delays the motion and its time alike, so it never makes a robot look stuck. A
-        backend without that time (ROS) is watched on the clock instead.
+        (`Progress.at`, the simulator's): a robot is stuck when its reports stayed still
+        from the first still one for `stuck_after_s`. A process too busy to step the
+        simulator delays the motion and its reports alike, and the next step covers the
+        time lost, so a busy process never makes a robot look stuck. A backend without
+        that time (ROS) is watched on the clock instead.
         """
         loop = asyncio.get_running_loop()
         last_advance = self.clock.monotonic()
@@ -300,10 +304,14 @@ class Executor:
         # Settled when the backend's timed reports show no progress for `stuck_after`.
         stalled: asyncio.Future[None] = loop.create_future()
         timed = False
+        # The time of the first of the latest run of timed reports that did not advance.
+        # Not the last advance: the time between that and the first still report may be
+        # time nothing was simulated in (the process was busy), not time standing still.
+        still_since: float | None = None
         active = True
 
         def on_progress(progress: Progress) -> None:
-            nonlocal last_advance, last_progress, last_report, last_fraction, timed
+            nonlocal last_advance, last_progress, last_report, last_fraction, timed, still_since
             if not active or self._current is not command:
                 # Feedback a backend queued before the goal ended (ROS threads) comes late;
                 # after `cancelled` or `arrived` the task has nothing more to say.
@@ -313,9 +321,12 @@ class Executor:
             else:
                 now, timed = progress.at, True
             if last_progress is None or _advanced(last_progress, progress):
-                last_advance = now
-            elif timed and now - last_advance > stuck_after and not stalled.done():
-                stalled.set_result(None)
+                last_advance, still_since = now, None
+            elif timed:
+                if still_since is None:
+                    still_since = now
+                elif now - still_since > stuck_after and not stalled.done():
+                    stalled.set_result(None)
             last_progress = progress
             fraction = min(max(progress.fraction, 0.0), 1.0)
             # Both bounds must hold (see ExecutorSettings); `step` is compared with a little

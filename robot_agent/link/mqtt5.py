@@ -67,6 +67,7 @@ class Mqtt5Link:
         self._wildcards: list[tuple[str, Callable[[str, bytes], None]]] = []
         self._filters: list[str] = []
         self._known_filters: set[str] = set()
+        self._no_local: set[str] = set()
         self._connected_callbacks: list[Callable[[bool], None]] = []
         self._disconnected_callbacks: list[Callable[[str], None]] = []
         self._connected = threading.Event()
@@ -90,7 +91,13 @@ class Mqtt5Link:
             self._pending.add(future)
         future.add_done_callback(self._published)
 
-    def add_route(self, topic_filter: str, handler: Callable[[str, bytes], None]) -> None:
+    def add_route(
+        self, topic_filter: str, handler: Callable[[str, bytes], None], *, no_local: bool = False
+    ) -> None:
+        """`no_local`: the broker does not send back what this connection published itself
+        (MQTT 5), e.g. a swarm's own robots' events, which it already knows."""
+        if no_local:
+            self._no_local.add(topic_filter)
         if "+" in topic_filter or "#" in topic_filter:
             self._wildcards.append((topic_filter, handler))
         else:
@@ -222,7 +229,9 @@ class Mqtt5Link:
         sent = []
         for start in range(0, len(filters), SUBSCRIBE_CHUNK):
             subscriptions = [
-                mqtt5.Subscription(topic_filter=f, qos=mqtt5.QoS.AT_LEAST_ONCE)
+                mqtt5.Subscription(
+                    topic_filter=f, qos=mqtt5.QoS.AT_LEAST_ONCE, no_local=f in self._no_local
+                )
                 for f in filters[start : start + SUBSCRIBE_CHUNK]
             ]
             future = self._client.subscribe(mqtt5.SubscribePacket(subscriptions=subscriptions))

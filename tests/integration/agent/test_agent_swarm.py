@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import threading
+from datetime import UTC, datetime
 from typing import TYPE_CHECKING
 
 import pytest
 
-from robot_agent.core.executor import ExecutorSettings
 from tests.integration.agent.harness import command
 from tests.support.swarm import SwarmThread, swarm_fleet
 from vahr.errors import VahrError
@@ -17,10 +17,6 @@ if TYPE_CHECKING:
     from vahr.local.broker import Mosquitto
 
 COUNT = 25
-# At 50x, the default 10 simulated seconds without progress are 0.2 s of wall time: a busy
-# machine starves the simulator that long and a robot would report `stuck`. These tests
-# are about the swarm, not stuck detection, so they allow 2.4 s.
-PATIENT = ExecutorSettings(stuck_after_s=120)
 
 
 def test_swarm_fleet_names_robots_in_order_and_keeps_the_zones() -> None:
@@ -41,9 +37,7 @@ def test_a_swarm_that_cannot_be_built_leaves_no_thread_behind() -> None:
 def test_one_fleet_command_reaches_every_robot_of_the_swarm(
     mosquitto: Mosquitto, tap: WireTap, shadows: ShadowResponder
 ) -> None:
-    with SwarmThread(
-        broker=str(mosquitto.plain_url), count=COUNT, speed_factor=50, settings=PATIENT
-    ) as swarm:
+    with SwarmThread(broker=str(mosquitto.plain_url), count=COUNT, speed_factor=50) as swarm:
         assert swarm.things[0] == "swarm0001" and len(swarm.things) == COUNT
         for thing in swarm.things:
             tap.reported(thing, lambda r: r["connected"] is True)
@@ -78,9 +72,7 @@ def test_one_fleet_command_reaches_every_robot_of_the_swarm(
 def test_swarm_robots_coordinate_a_sequential_delivery(
     mosquitto: Mosquitto, tap: WireTap, shadows: ShadowResponder
 ) -> None:
-    with SwarmThread(
-        broker=str(mosquitto.plain_url), count=2, speed_factor=50, settings=PATIENT
-    ) as swarm:
+    with SwarmThread(broker=str(mosquitto.plain_url), count=2, speed_factor=50) as swarm:
         first, second = swarm.things
         tap.reported(second, lambda r: r["connected"] is True)
         tap.publish(
@@ -92,3 +84,32 @@ def test_swarm_robots_coordinate_a_sequential_delivery(
         delivered_first = tap.event(first, "delivered", "s1", timeout_s=30)
         delivered_second = tap.event(second, "delivered", "s2", timeout_s=30)
         assert delivered_first["at"] < delivered_second["at"]
+
+
+def test_a_swarm_robot_hears_a_peer_outside_its_swarm_deliver(
+    mosquitto: Mosquitto, tap: WireTap, shadows: ShadowResponder
+) -> None:
+    # Given a swarm running only the second robot of a two-robot fleet, waiting for the
+    # first, which runs elsewhere (another connection)
+    with SwarmThread(
+        broker=str(mosquitto.plain_url), count=2, things=["swarm0002"], speed_factor=50
+    ) as swarm:
+        assert swarm.things == ["swarm0002"]
+        tap.reported("swarm0002", lambda r: r["connected"] is True)
+        tap.publish(
+            "vahr/robots/swarm0002/cmd",
+            command("w2", "sequential_delivery", {"zone": "B", "after": "swarm0001"}),
+        )
+        tap.event("swarm0002", "waiting", "w2")
+        # When the first robot says it delivered
+        delivered = {
+            "event": "delivered",
+            "thing": "swarm0001",
+            "at": datetime.now(UTC).isoformat().replace("+00:00", "Z"),
+            "command_id": "w1",
+            "action": "deliver",
+            "zone": "A",
+        }
+        tap.publish("vahr/robots/swarm0001/events", delivered)
+        # Then the second goes on and delivers in its turn
+        tap.event("swarm0002", "delivered", "w2", timeout_s=30)
