@@ -177,7 +177,7 @@ CONFIRM_OTHER_ROBOT = "{robot} instead?"
 WEATHER_HAS_NO_ZONE = (
     "{robot} delivers where the weather says, so there is no zone to change; I changed nothing."
 )
-INTENT_DENIED = "Okay, I sent nothing."
+INTENT_DENIED = "Okay, I sent nothing. Please say it again."
 
 # Fleet dispatch (skill.handlers.dispatch, skill.task_speech): tasks without a robot's name.
 TASK_NAMES = {"navigate": "the trip to {zone}", "deliver": "the delivery to {zone}"}

@@ -1,5 +1,6 @@
 """A "no" to Dialog.ConfirmIntent ("Send placebot one to zone B?" "No."): whatever the
-intent, nothing is sent, and the reply says so."""
+intent, nothing is sent, the reply says so and the session stays open for the request
+said again (the simulator confirms a reading it is unsure of this way)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_request_type
 
 from skill import prompts
-from skill.responses import answer
+from skill.responses import ask
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
@@ -27,4 +28,4 @@ class DeniedIntentHandler(AbstractRequestHandler):
         return status is not None and status.value == "DENIED"
 
     def handle(self, handler_input: HandlerInput) -> Response:
-        return answer(handler_input, prompts.INTENT_DENIED)
+        return ask(handler_input, prompts.INTENT_DENIED, prompts.FALLBACK_REPROMPT)

@@ -113,5 +113,6 @@ def test_an_answer_carrying_new_values_is_acted_on_with_them(skill: Any, robots:
 
 def test_a_denied_intent_sends_nothing(skill: Any, aws: None) -> None:
     response = skill(load_event("alexa_dialog_confirm_intent_denied"), None)
-    assert speech(response) == "Okay, I sent nothing."
+    assert speech(response) == "Okay, I sent nothing. Please say it again."
+    assert response["response"]["shouldEndSession"] is False
     assert published() == []

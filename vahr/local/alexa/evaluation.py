@@ -10,7 +10,9 @@ sentences the skill should not act on. Each utterance ends in one of four outcom
   custom intent);
 - fallback: AMAZON.FallbackIntent (what an out-of-domain sentence should get);
 - asks: the right intent with a slot missing, unresolved or heard as several values, so the
-  skill asks for it (for an out-of-domain sentence, a built-in intent such as help).
+  skill asks for it (for an out-of-domain sentence, a built-in intent such as help); or any
+  intent whose slot roles are too unsure to act on (`Understanding.needs_confirmation`),
+  which the simulator asks the person to confirm before the skill hears of it.
 """
 
 from __future__ import annotations
@@ -70,6 +72,7 @@ class Scored:
                 "intent": self.understood.intent,
                 "slots": {name: value.id for name, value in self.understood.slots.items()},
                 "confidence": round(self.understood.confidence, 3),
+                "roles_confidence": round(self.understood.roles_confidence, 3),
             },
             "outcome": self.outcome,
         }
@@ -108,6 +111,8 @@ class Report:
 def outcome(model: InteractionModel, item: LabelledUtterance, got: Understanding) -> str:
     if got.intent == FALLBACK:
         return "fallback"
+    if got.needs_confirmation:
+        return "asks"
     if item.intent == FALLBACK:
         return "asks" if got.intent.startswith("AMAZON.") else "wrong"
     if got.intent != item.intent:

@@ -27,6 +27,7 @@ wait for it; the first utterance does.
 
 from __future__ import annotations
 
+import copy
 import json
 import threading
 from dataclasses import dataclass, field, replace
@@ -49,6 +50,7 @@ from vahr.speech.text_classifier import TextClassifier, default_cache_dir
 
 __all__ = [
     "CONFIDENCE_THRESHOLD",
+    "ROLES_CONFIDENCE_THRESHOLD",
     "DEFAULT_MODEL",
     "FALLBACK",
     "InteractionModel",
@@ -70,6 +72,11 @@ SLOT_ANSWER = "vahr.SlotAnswer"
 # the hearing's thresholds follow (the most utterances right less three times the wrong
 # ones, of 0.5, 0.55, 0.6, 0.65, 0.7 and 0.75); docs/history/nlu-tuning.md has the sweeps.
 CONFIDENCE_THRESHOLD = 0.6
+# A reading of which value fills which slot ("placebot one first, then placebot two") is
+# acted on only when the roles tagger's posterior of it reaches this; below, the simulator
+# asks the person to confirm the reading (`Understanding.needs_confirmation`). Chosen on the
+# tuning set by the same rule, over 0.5 to 0.95 (docs/history/nlu-tuning.md).
+ROLES_CONFIDENCE_THRESHOLD = 0.5
 # How long the first utterance may wait for a classifier still training in the background.
 BUILD_TIMEOUT_S = 300.0
 
@@ -106,6 +113,17 @@ class Understanding:
     confidence: float = 1.0
     # What the classifier would have chosen, when it fell short of the threshold.
     best_guess: str | None = None
+    # The roles tagger's posterior of which value fills which slot (1.0 for an intent
+    # with no slot roles to read, or values of one slot each), and the slots whose value's
+    # role is below `ROLES_CONFIDENCE_THRESHOLD` on its own.
+    roles_confidence: float = 1.0
+    unsure_slots: tuple[str, ...] = ()
+
+    @property
+    def needs_confirmation(self) -> bool:
+        """Whether the reading is too unsure to act on: the person is asked to confirm it
+        first (the simulator's Dialog.ConfirmIntent), and a "no" sends nothing."""
+        return self.intent != FALLBACK and self.roles_confidence < ROLES_CONFIDENCE_THRESHOLD
 
 
 class InteractionModel:
@@ -185,6 +203,9 @@ class InteractionModel:
             if slots
         }
         self._taggers: dict[str, roles.RolesTagger] = {}
+        # What each intent's roles tagger learns from, and the words it reads weather in.
+        self.role_training = role_sequences
+        self.role_lexicon = lexicon
         self.training = (texts, labels)
         self.cached: bool | None = None
         self._classifier: TextClassifier | None = None
@@ -262,6 +283,21 @@ class InteractionModel:
             raise VahrError(f"the intent classifier could not be built: {self._failure}")
         return self._classifier
 
+    @property
+    def taggers(self) -> dict[str, roles.RolesTagger]:
+        """Each intent's roles tagger, once built."""
+        self.wait_ready()
+        return dict(self._taggers)
+
+    def with_taggers(self, taggers: dict[str, roles.RolesTagger]) -> InteractionModel:
+        """This model reading slot roles with `taggers` instead of its own (the same
+        classifier and slot finder): a cross-validation retrains the taggers without the
+        sentences it holds out."""
+        self.wait_ready()
+        clone = copy.copy(self)
+        clone._taggers = {**self._taggers, **taggers}
+        return clone
+
     def find_slots(self, utterance: str) -> tuple[list[str], list[SlotMatch]]:
         words = normalize_utterance(utterance, self._understanding.locale).split()
         return words, self._finder.find(words)
@@ -277,8 +313,9 @@ class InteractionModel:
         intent, confidence = classifier.scores(abstracted).without(SLOT_ANSWER).best
         declared = self.intent_slots.get(intent, {})
         assigned: dict[str, SlotMatch] | None = {}
+        reading = None
         if intent != FALLBACK and confidence >= CONFIDENCE_THRESHOLD:
-            assigned = self._assign(intent, matches, words)
+            assigned, reading = self._assign(intent, matches, words)
         if (
             intent == FALLBACK
             or confidence < CONFIDENCE_THRESHOLD
@@ -295,17 +332,20 @@ class InteractionModel:
             tuple(declared),
             self.nearest_sample(intent, abstracted),
             confidence,
+            roles_confidence=reading.confidence if reading else 1.0,
+            unsure_slots=_unsure_slots(reading, declared) if reading else (),
         )
 
     def _assign(
         self, intent: str, matches: list[SlotMatch], words: list[str]
-    ) -> dict[str, SlotMatch] | None:
-        """The values given to the intent's slots; None when the words do not fit it."""
+    ) -> tuple[dict[str, SlotMatch] | None, roles.RolesReading | None]:
+        """The values given to the intent's slots (None when the words do not fit it), and
+        the tagger's reading they came from."""
         declared = self.intent_slots.get(intent, {})
         if intent not in self._taggers:
-            return {}
-        labels = self._taggers[intent].labels(words, matches)
-        return roles.assign(declared, matches, labels, self._fleet)
+            return {}, None
+        reading = self._taggers[intent].read(words, matches)
+        return roles.assign(declared, matches, reading.labels, self._fleet), reading
 
     def _with_alternatives(
         self,
@@ -408,6 +448,18 @@ def _values_said(value: SlotValue, matches: list[SlotMatch]) -> list[tuple[str, 
         if m.type == value.type and m.id is not None and m.spoken in parts
     }
     return list(said.items())
+
+
+def _unsure_slots(reading: roles.RolesReading, declared: dict[str, str]) -> tuple[str, ...]:
+    """The declared slots named by a label whose marginal is below the roles threshold."""
+    unsure: list[str] = []
+    for label, marginal in zip(reading.labels, reading.marginals, strict=True):
+        if marginal >= ROLES_CONFIDENCE_THRESHOLD:
+            continue
+        for slot in label.lstrip(roles.LISTED + roles.CHOICE).split(roles.BOTH):
+            if slot in declared and slot not in unsure:
+                unsure.append(slot)
+    return tuple(unsure)
 
 
 def _slot_value(name: str, slot_type: str, match: SlotMatch) -> SlotValue:

@@ -234,9 +234,27 @@ class RolesTagger:
     def labels(self, words: Sequence[str], matches: Sequence[SlotMatch]) -> list[str]:
         """A label for each of `matches`: a slot name (marked "+" or "?"), or `NO_SLOT` for
         a value of a type the intent does not take or one the tagger gives no slot."""
+        return self.read(words, matches).labels
+
+    def read(self, words: Sequence[str], matches: Sequence[SlotMatch]) -> RolesReading:
+        """The labels of `labels` with how sure the tagger is of them (`RolesReading`)."""
         taken = [match for match in matches if match.type in self._allowed]
         if not taken:
-            return [NO_SLOT] * len(matches)
+            return RolesReading([NO_SLOT] * len(matches), 1.0, [1.0] * len(matches))
+        self._tagger.set(self.features(words, taken))
+        best, confidence, marginals = self._best_sequence(
+            [self._allowed[match.type] for match in taken]
+        )
+        by_match = {
+            id(match): (label, marginal)
+            for match, label, marginal in zip(taken, best, marginals, strict=True)
+        }
+        read = [by_match.get(id(match), (NO_SLOT, 1.0)) for match in matches]
+        return RolesReading([label for label, _ in read], confidence, [m for _, m in read])
+
+    def features(self, words: Sequence[str], matches: Sequence[SlotMatch]) -> list[list[str]]:
+        """What the CRF reads of the values of `matches` whose type the intent takes."""
+        taken = [match for match in matches if match.type in self._allowed]
         # Each value stands as one word of its type, as `{slot}` does in the samples.
         abstracted: list[str] = []
         spans: list[Span] = []
@@ -249,22 +267,48 @@ class RolesTagger:
             abstracted.append(f"<{match.type}>")
             index = match.end
         abstracted += words[index:]
-        self._tagger.set(value_features(abstracted, spans, self.lexicon))
-        best = self._best_sequence([self._allowed[match.type] for match in taken])
-        by_match = {id(match): label for match, label in zip(taken, best, strict=True)}
-        return [by_match.get(id(match), NO_SLOT) for match in matches]
+        return value_features(abstracted, spans, self.lexicon)
 
-    def _best_sequence(self, allowed: list[list[str]]) -> list[str]:
+    def _best_sequence(self, allowed: list[list[str]]) -> tuple[list[str], float, list[float]]:
         """The most probable labels with each value's label one its type allows (a value of
-        one type never takes another type's slot). The sequences are few (a sentence names
-        two to four values), so each is scored; a longer one is decoded unconstrained."""
+        one type never takes another type's slot), their probability among the allowed
+        sequences, and each label's marginal probability among them. The sequences are few
+        (a sentence names two to four values), so each is scored; a longer one is decoded
+        unconstrained, its probability then among all sequences."""
         if math.prod(len(labels) for labels in allowed) > MAX_SEQUENCES:
-            return list(self._tagger.tag())
-        scored = (
+            best = list(self._tagger.tag())
+            confidence = self._tagger.probability(best)
+            marginals = [self._tagger.marginal(label, at) for at, label in enumerate(best)]
+            return best, confidence, marginals
+        scored = [
             (self._tagger.probability(list(labels)), labels)
             for labels in itertools.product(*allowed)
-        )
-        return list(max(scored, key=lambda pair: pair[0])[1])
+        ]
+        # CRFsuite's probability is among every label sequence; what the tagger may choose
+        # is among the allowed ones only, so that is what it is normalised over.
+        total = sum(probability for probability, _ in scored)
+        top, best_labels = max(scored, key=lambda pair: pair[0])
+        if total <= 0.0:
+            return list(best_labels), 0.0, [0.0] * len(best_labels)
+        marginals = [
+            sum(p for p, labels in scored if labels[at] == label) / total
+            for at, label in enumerate(best_labels)
+        ]
+        return list(best_labels), top / total, marginals
+
+
+@dataclass(frozen=True)
+class RolesReading:
+    """The tagger's labels for the values of an utterance, with how sure it is of them.
+
+    `confidence` is the posterior probability of the whole label sequence among the
+    sequences the values' types allow; `marginals` is, for each value, the probability of
+    its label summed over those sequences (a value whose label the runner-up sequences
+    share is sure even when the sequence is not)."""
+
+    labels: list[str]
+    confidence: float
+    marginals: list[float]
 
 
 def training_sequences(

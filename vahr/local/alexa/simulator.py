@@ -14,7 +14,13 @@ The dialog is kept as Alexa keeps it (`dialogState` STARTED, then IN_PROGRESS):
   is another request starts that intent instead;
 - after Dialog.ConfirmSlot or Dialog.ConfirmIntent a yes or a no comes back as the same
   intent with the slot's or the intent's confirmationStatus CONFIRMED or DENIED; anything
-  else is a request of its own.
+  else is a request of its own;
+- a request whose slot roles the NLU is unsure of (`Understanding.needs_confirmation`:
+  which robot goes first, which zone is for sunny weather) is confirmed by the simulator
+  itself before the skill hears of it, as Alexa says an intent's confirmation prompt under
+  auto-delegation ("Placebot one to zone d, then placebot two to zone d: is that right?");
+  the yes or no then reaches the skill as the intent CONFIRMED or DENIED. This is the
+  simulator's NLU only: on AWS, Alexa's own NLU decides what it is sure of.
 
 Silence is answered by the device itself (nothing reaches the skill); a ramble longer than
 any request the model knows reaches it as AMAZON.FallbackIntent, so nothing moves. The
@@ -50,6 +56,7 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 _TAGS = re.compile(r"<[^>]+>")
+_PLACEHOLDER = re.compile(r"\{(\w+)\}")
 _CONFIRMATION_PHRASES = Path(__file__).with_name("data") / "confirmation-en-US.yaml"
 # What the device says when it heard nothing: Alexa answers silence itself, the skill never
 # hears of it.
@@ -123,12 +130,32 @@ class _Session:
 
 
 @cache
+def _confirmation_document() -> dict[str, Any]:
+    document: dict[str, Any] = yaml.safe_load(_CONFIRMATION_PHRASES.read_text())
+    return document
+
+
+@cache
 def _confirmation_phrases() -> dict[str, frozenset[str]]:
-    document = yaml.safe_load(_CONFIRMATION_PHRASES.read_text())
+    document = _confirmation_document()
     return {
         "CONFIRMED": frozenset(normalize_utterance(p) for p in document["confirmed"]),
         "DENIED": frozenset(normalize_utterance(p) for p in document["denied"]),
     }
+
+
+def confirmation_prompt(understanding: Understanding) -> str:
+    """What the simulated Echo says to confirm `understanding`, its values by name."""
+    document = _confirmation_document()
+    names = {name: value.canonical or value.spoken for name, value in understanding.slots.items()}
+    template = document["readings"].get(understanding.intent)
+    if template is None:
+        heard = [names[name] for name in understanding.declared or names if name in names]
+        return str(document["any"]).format(names=", ".join(heard))
+    missing = str(document["missing"])
+    filled = {name: names.get(name, missing) for name in _PLACEHOLDER.findall(str(template))}
+    sentence = " ".join(str(template).format_map(filled).split())
+    return sentence[:1].upper() + sentence[1:]
 
 
 def confirmation_of(text: str) -> str | None:
@@ -287,7 +314,26 @@ class AlexaSimulator:
             self._session = self._new_session()
         pending, self._session.pending = self._session.pending, None
         request, understanding = self._request(text, pending, given)
+        answered = request.intent.confirmation_status.value != "NONE"
+        if understanding.needs_confirmation and not answered:
+            return self._confirm(self._session, utterance, understanding)
         return self._send(utterance, request, understanding)
+
+    def _confirm(self, session: _Session, utterance: str, understanding: Understanding) -> Turn:
+        """Ask the person to confirm a reading too unsure to act on; nothing is sent yet."""
+        session.pending = PendingDialog(understanding, CONFIRM_INTENT, None)
+        prompt = confirmation_prompt(understanding)
+        return Turn(
+            utterance=utterance,
+            speech=prompt,
+            intent=understanding.intent,
+            slots=_slots_said(understanding),
+            commands=[],
+            latency_ms=0.0,
+            session_open=True,
+            request_type=CONFIRM_INTENT,
+            reprompt=prompt,
+        )
 
     def _request(
         self, text: str, pending: PendingDialog | None, given: Understanding | None
@@ -377,10 +423,7 @@ class AlexaSimulator:
             session.turns += 1
             session.attributes = attributes
             session.pending = _pending(body, understanding, self.model)
-        slots = {
-            name: {"value": value.spoken, "id": value.id}
-            for name, value in (understanding.slots.items() if understanding else ())
-        }
+        slots = _slots_said(understanding) if understanding else {}
         reprompt = speech_text((body.get("reprompt") or {}).get("outputSpeech"))
         return Turn(
             utterance=utterance,
@@ -394,6 +437,12 @@ class AlexaSimulator:
             reprompt=reprompt or None,
             card=body.get("card"),
         )
+
+
+def _slots_said(understanding: Understanding) -> dict[str, dict[str, str | None]]:
+    return {
+        name: {"value": value.spoken, "id": value.id} for name, value in understanding.slots.items()
+    }
 
 
 def _pending(
