@@ -62,6 +62,9 @@ class IntentSpec:
     essentials: tuple[str, ...] = ()
     # Robot-command intents need at least 60 varied samples (a test holds them to it).
     commands_robots: bool = False
+    # How many samples it keeps at most: more for an intent said in many more ways, so that
+    # templates added for a new way do not crowd out the ways it had.
+    max_samples: int = MAX_SAMPLES_PER_INTENT
 
     @cached_property
     def samples(self) -> list[str]:
@@ -78,9 +81,9 @@ class IntentSpec:
             rng.shuffle(expansions)
             pools.append(expansions)
         chosen: dict[str, None] = dict.fromkeys(self.essentials)
-        while len(chosen) < MAX_SAMPLES_PER_INTENT and any(pools):
+        while len(chosen) < self.max_samples and any(pools):
             for pool in pools:
-                if pool and len(chosen) < MAX_SAMPLES_PER_INTENT:
+                if pool and len(chosen) < self.max_samples:
                     chosen.setdefault(pool.pop(), None)
         return list(chosen)
 
@@ -92,6 +95,10 @@ NAVIGATE = IntentSpec(
     name="NavigateIntent",
     slots=(ROBOT, ZONE),
     commands_robots=True,
+    # The templates for a robot meant but not named ("move the robot to zone b") came
+    # last, and the cap grew by their share of the draw (seven of 50 templates), so that
+    # they add to the samples rather than take the places of the other ways of saying it.
+    max_samples=MAX_SAMPLES_PER_INTENT + 40,
     essentials=(
         "send {robot} to {zone}",
         "move {robot} to {zone}",
@@ -141,6 +148,18 @@ NAVIGATE = IntentSpec(
         "{robot} <go> <way> <to> {zone} (to|and) (pick up|get|collect|grab|fetch) (the|a|its|your) "
         "(package|box|parcel|load)",
         "(and|and then|then) {robot} <to> {zone} [as well|too|please]",
+        # A robot meant but not named ("move the robot to zone b"): one robot, still to be
+        # asked for, unlike "a robot" (the fleet picks) or "the robots in zone a" (those).
+        "<ask> <send> (the|my|that|this|your) (robot|bot) <way> <to> {zone} <end>",
+        "<ask> (move|relocate|reposition|drive) (the|my|that|this) (robot|bot) (over|across) "
+        "<to> {zone}",
+        "(the|my|that|this) (robot|bot) (should|needs to|has to|can|please) <go> <way> <to> "
+        "{zone} <end>",
+        "<ask> (tell|ask|get) (the|my|that|this) (robot|bot) to <go> <way> <to> {zone} <end>",
+        "<ask> (have|let|make) (the|my|that|this) (robot|bot) <go> <way> <to> {zone} <end>",
+        "(i want|i need|i'd like|put|park) (the|my|that|this) (robot|bot) (in|at|over at) "
+        "{zone} <end>",
+        "(the|my|that|this) (robot|bot) <to> {zone} <end>",
     ),
 )
 

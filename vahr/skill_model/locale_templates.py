@@ -18,7 +18,7 @@ from pathlib import Path
 import msgspec
 
 from vahr.errors import VahrError
-from vahr.skill_model.intents import CUSTOM_INTENTS, IntentSpec, SlotSpec
+from vahr.skill_model.intents import CUSTOM_INTENTS, MAX_SAMPLES_PER_INTENT, IntentSpec, SlotSpec
 
 LOCALES_DIR = Path(__file__).resolve().parent / "locales"
 _RULE = re.compile(r"<([a-z_]+)>")
@@ -111,6 +111,9 @@ def locale_intents(
                 slots=tuple(slots),
                 essentials=tuple(words.essentials),
                 templates=tuple(inline_rules(t, data.rules) for t in words.templates),
+                # The locale's own templates, with the usual cap (an English intent's larger
+                # cap is for English templates added later).
+                max_samples=MAX_SAMPLES_PER_INTENT,
             )
         )
     return tuple(intents)
