@@ -15,6 +15,7 @@ import os
 import socket
 import threading
 import time
+from collections import deque
 from concurrent import futures
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +36,8 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 SUBSCRIBE_CHUNK = 100
+# Handlers run between two yields to the event loop when received messages are handled.
+DISPATCH_CHUNK = 200
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -42,6 +45,17 @@ class Will:
     topic: str
     payload: bytes
     retain: bool = True
+
+
+@dataclass(slots=True)
+class _Received:
+    """A received message waiting for its handlers; `next` is the first not yet run."""
+
+    handlers: list[Callable[[str, bytes], None]]
+    topic: str
+    payload: bytes
+    handle: mqtt5.PublishAcknowledgementControlHandle | None
+    next: int = 0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -76,6 +90,10 @@ class Mqtt5Link:
         self._stopped = threading.Event()
         self._lock = threading.Lock()
         self._pending: set[Future[mqtt5.PublishCompletionData]] = set()
+        # Received messages not yet handled, in arrival order (see `_drain`).
+        self._inbox: deque[_Received] = deque()
+        self._dispatching: _Received | None = None
+        self._draining = False
         self.connections = 0
         self._stopping = False
         self._client = self._build_client()
@@ -299,18 +317,41 @@ class Mqtt5Link:
         # again. Now the broker redelivers it when the robot is back, and it runs once.
         acquire = getattr(data, "acquire_publish_acknowledgement_control", None)
         handle = acquire() if acquire is not None else None  # None: awscrt before 0.36
-        self._loop.call_soon_threadsafe(
-            self._dispatch_and_acknowledge, handlers, topic, payload, handle
-        )
+        # Messages queue in arrival order for the event loop, which is woken once for a
+        # burst rather than once per message.
+        with self._lock:
+            self._inbox.append(_Received(handlers, topic, payload, handle))
+            if self._draining:
+                return
+            self._draining = True
+        self._loop.call_soon_threadsafe(self._drain)
 
-    def _dispatch_and_acknowledge(
-        self,
-        handlers: list[Callable[[str, bytes], None]],
-        topic: str,
-        payload: bytes,
-        handle: mqtt5.PublishAcknowledgementControlHandle | None,
+    def _drain(self) -> None:
+        """Run the handlers of the queued messages in order, acknowledging each message
+        after its last handler. After `DISPATCH_CHUNK` handlers it yields to the event loop
+        and goes on later: a fleet command to a swarm of 10,000 robots has 10,000 handlers,
+        which in one go held the loop (and every robot's timing) for seconds."""
+        budget = DISPATCH_CHUNK
+        while budget > 0:
+            if self._dispatching is None:
+                with self._lock:
+                    if not self._inbox:
+                        self._draining = False
+                        return
+                    self._dispatching = self._inbox.popleft()
+            message = self._dispatching
+            end = min(len(message.handlers), message.next + budget)
+            _dispatch(message.handlers[message.next : end], message.topic, message.payload)
+            budget -= end - message.next
+            message.next = end
+            if end == len(message.handlers):
+                self._dispatching = None
+                self._acknowledge(message.topic, message.handle)
+        self._loop.call_soon(self._drain)
+
+    def _acknowledge(
+        self, topic: str, handle: mqtt5.PublishAcknowledgementControlHandle | None
     ) -> None:
-        _dispatch(handlers, topic, payload)
         if handle is None:
             return
         try:
