@@ -365,6 +365,8 @@ class LanguageModelRecognizer:
         best: dict[str, float] = {}
         best_text = _clean(decoder.hyp().hypstr)
         for found in itertools.islice(decoder.nbest(), NBEST_PATHS):
+            if found is None:
+                break  # the A* search ran out of paths (a clip of a word or two)
             if found.score <= 0.0:
                 continue
             text = _clean(found.hypstr)
