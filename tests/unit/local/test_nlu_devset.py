@@ -76,10 +76,10 @@ def test_no_evaluation_sentence_is_trained_on(devset: LabelledSet) -> None:
 # were met by the English rules (157 right, 1 wrong; 59 of 61 falling back); they are
 # missed now by one to two utterances each (docs/skill.md, "Development set"), since en-US
 # takes its slot roles from the tagger and the fleet's dispatch intents joined the model.
-# Since the roles' confidence is asked about below 0.5, one reading that was right is asked
-# about instead (155 right, 4 asks); the same 3 are wrong (docs/skill.md).
+# Since readings below a roles confidence of 0.5 are confirmed and listed values are read as
+# one by the classifier: 155 right, 2 wrong, 4 fallback, 4 asks (docs/skill.md).
 def test_understanding_stays_at_the_measured_figures(report: Report) -> None:
     assert report.in_domain.counts["right"] >= 155, report.table()
-    assert report.in_domain.counts["wrong"] <= 3, report.table()
+    assert report.in_domain.counts["wrong"] <= 2, report.table()
     assert report.out_of_domain.counts["fallback"] >= 57, report.table()
     assert report.out_of_domain.counts["wrong"] <= 2, report.table()

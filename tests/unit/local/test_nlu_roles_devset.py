@@ -60,9 +60,9 @@ def test_roles_stay_at_the_measured_figures(report: Report) -> None:
     # Scored once with the tagger (docs/skill.md): 118 of 156 right, 16 wrong; out of
     # domain 17 of 19 falling back. The English rules it replaced, on the same build: 116
     # right and 10 wrong. With the intents added since (fleet commands, task queue,
-    # corrections), 16 of 19 out-of-domain sentences fall back. Scored once more with the
-    # readings below a roles confidence of 0.5 confirmed instead of acted on: 116 right, 10
-    # wrong, 16 asked; 17 of 19 out-of-domain sentences falling back.
-    assert report.in_domain.counts["right"] >= 116, report.table()
+    # corrections), 16 of 19 out-of-domain sentences fall back. With readings below a roles
+    # confidence of 0.5 confirmed instead of acted on, and listed values read as one by the
+    # classifier: 121 right, 10 wrong, 17 asked; 17 of 19 out of domain falling back.
+    assert report.in_domain.counts["right"] >= 121, report.table()
     assert report.in_domain.counts["wrong"] <= 10, report.table()
     assert report.out_of_domain.counts["fallback"] >= 17, report.table()

@@ -6,14 +6,19 @@ Understanding an utterance takes three steps, each from the same generated model
    misheard words matched approximately, and unknown names ("robot nine") kept unresolved.
 2. The intent is chosen by a classifier (`intent_classifier`) trained on the expanded sample
    utterances with the slots abstracted, plus the simulator's stand-ins for Alexa's own data
-   (`background`: built-in intents and out-of-domain requests). Its confidence is calibrated;
-   below `CONFIDENCE_THRESHOLD` the answer is AMAZON.FallbackIntent.
+   (`background`: built-in intents and out-of-domain requests). Values of one type listed
+   with a joiner of the language ("ROBOT and ROBOT") are read as one, in training and in
+   use alike: a sample names each slot once, so no sample shows a list for one slot. Its
+   confidence is calibrated; below `CONFIDENCE_THRESHOLD` the answer is
+   AMAZON.FallbackIntent.
 3. The intent is held to the values found (`consistency`): an intent that takes no slot is
    not chosen when a robot or zone was named, nor one whose samples never name as many
    values of its types together; either way the answer is the fallback.
 4. The values found are given to the intent's slots by a tagger trained on the same samples
    with their slots labelled (`roles`); a type the intent takes that is named but given
-   no slot is words that do not fit the intent, and the answer is the fallback.
+   no slot is words that do not fit the intent, and the answer is the fallback. The
+   tagger's posterior of its reading is `Understanding.roles_confidence`; below
+   `ROLES_CONFIDENCE_THRESHOLD` the reading is confirmed before it is acted on.
 
 What the NLU knows of the language beyond the model (the built-in intents' phrases, the
 out-of-domain sentences, the function words around names, the role examples) is the
@@ -41,7 +46,7 @@ from vahr.local.alexa import roles
 from vahr.local.alexa.ambiguity import SlotAmbiguity
 from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
 from vahr.local.alexa.consistency import SlotConsistency
-from vahr.local.alexa.intent_classifier import load_or_train
+from vahr.local.alexa.intent_classifier import MARKERS, load_or_train
 from vahr.local.alexa.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize_utterance
 from vahr.local.alexa.understanding import LanguageUnderstanding, load_understanding
 from vahr.protocol import FLEET_GROUP
@@ -144,6 +149,10 @@ class InteractionModel:
     ) -> None:
         """`understanding` is the locale's data beyond the model (en-US's by default)."""
         self._understanding = understanding or load_understanding()
+        self._joiners = {
+            normalize_utterance(word, self._understanding.locale)
+            for word in self._understanding.finder.joiners
+        }
         try:
             language = document["interactionModel"]["languageModel"]
             self.invocation_name: str = language["invocationName"]
@@ -308,7 +317,7 @@ class InteractionModel:
         words, matches = self.find_slots(utterance)
         if not words:
             return Understanding(FALLBACK, confidence=1.0)
-        abstracted = _abstract(words, matches)
+        abstracted = self._listed_as_one(_abstract(words, matches))
         # Outside a dialog there is no question to answer: the answer reading is set aside.
         intent, confidence = classifier.scores(abstracted).without(SLOT_ANSWER).best
         declared = self.intent_slots.get(intent, {})
@@ -386,7 +395,7 @@ class InteractionModel:
         values = [match for match in matches if match.type == slot_type]
         if not values:
             return None
-        best, confidence = classifier.scores(_abstract(words, matches)).best
+        best, confidence = classifier.scores(self._listed_as_one(_abstract(words, matches))).best
         request = best not in (SLOT_ANSWER, FALLBACK, intent)
         if request and confidence >= CONFIDENCE_THRESHOLD:
             return None
@@ -423,7 +432,19 @@ class InteractionModel:
             types.get(word[1:-1], word) if word.startswith("{") else normalize_utterance(word)
             for word in sample.split()
         ]
-        return " ".join(word for word in words if word)
+        return self._listed_as_one(" ".join(word for word in words if word))
+
+    def _listed_as_one(self, abstracted: str) -> str:
+        """`abstracted` with values of one type listed ("ROBOT and ROBOT") as one value, as
+        the classifier reads them: a list of robots for one slot is one robot slot's words,
+        which no sample can show (a sample names each slot once)."""
+        out: list[str] = []
+        for word in abstracted.split():
+            if word in MARKERS and len(out) >= 2 and out[-1] in self._joiners and out[-2] == word:
+                out.pop()
+                continue
+            out.append(word)
+        return " ".join(out)
 
 
 def _slot_type(document: dict[str, Any], locale: str) -> SlotTypeValues:
