@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 from skill_testkit import published
 
-from vahr.local.alexa.nlu import InteractionModel
+from vahr.local.alexa.nlu import InteractionModel, SlotValue, Understanding
 from vahr.local.alexa.simulator import CONFIRM_INTENT, AlexaSimulator
 
 if TYPE_CHECKING:
@@ -105,3 +105,25 @@ def test_another_request_instead_of_an_answer_is_a_request_of_its_own(
     instead = alexa.say("send placebot two to zone a")
     assert instead.intent == "NavigateIntent"
     assert commands() == [("vahr/robots/placebot2/cmd", "navigate", {"zone": "A"})]
+
+
+def test_a_german_echo_says_the_reading_back_and_hears_ja(
+    model: InteractionModel, skill: Callable[..., Any], robots: Any
+) -> None:
+    # What push-to-talk hands in when the roles of its best hearing are a guess
+    unsure = Understanding(
+        "NavigateIntent",
+        {
+            "robot": SlotValue("robot", "ROBOT", "placebot eins", "placebot1", "placebot eins"),
+            "zone": SlotValue("zone", "ZONE", "zone b", "B", "zone b"),
+        },
+        ("robot", "zone"),
+        roles_confidence=0.3,
+    )
+    alexa = AlexaSimulator(model, skill, locale="de-DE")
+    asked = alexa.say("placebot eins zone b", understanding=unsure)
+    assert asked.speech == "Placebot eins nach zone b: ist das richtig?"
+    assert published() == []
+    done = alexa.say("ja")
+    assert commands() == [("vahr/robots/placebot1/cmd", "navigate", {"zone": "B"})]
+    assert done.speech.startswith("Placebot eins")

@@ -49,7 +49,7 @@ from vahr.local.alexa.nlu import FALLBACK, Understanding, normalize_utterance
 from vahr.protocol.conversation import CORRECTION_WINDOW_S, LAST_COMMAND_ATTRIBUTE
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Mapping
 
     from vahr.local.alexa.nlu import InteractionModel
 
@@ -57,7 +57,10 @@ log = logging.getLogger(__name__)
 
 _TAGS = re.compile(r"<[^>]+>")
 _PLACEHOLDER = re.compile(r"\{(\w+)\}")
-_CONFIRMATION_PHRASES = Path(__file__).with_name("data") / "confirmation-en-US.yaml"
+# How a person answers yes or no, and how the device says a reading back, per locale
+# ("confirmation-<locale>.yaml"; a locale without one is read with en-US's).
+_DATA = Path(__file__).with_name("data")
+_DEFAULT_LOCALE = "en-US"
 # What the device says when it heard nothing: Alexa answers silence itself, the skill never
 # hears of it.
 SILENCE = "I didn't hear anything, so I sent nothing to the robots."
@@ -130,38 +133,51 @@ class _Session:
 
 
 @cache
-def _confirmation_document() -> dict[str, Any]:
-    document: dict[str, Any] = yaml.safe_load(_CONFIRMATION_PHRASES.read_text())
+def _confirmation_document(locale: str) -> dict[str, Any]:
+    file = _DATA / f"confirmation-{locale}.yaml"
+    if not file.is_file():
+        file = _DATA / f"confirmation-{_DEFAULT_LOCALE}.yaml"
+    document: dict[str, Any] = yaml.safe_load(file.read_text(encoding="utf-8"))
     return document
 
 
 @cache
-def _confirmation_phrases() -> dict[str, frozenset[str]]:
-    document = _confirmation_document()
+def _confirmation_phrases(locale: str) -> dict[str, frozenset[str]]:
+    document = _confirmation_document(locale)
     return {
-        "CONFIRMED": frozenset(normalize_utterance(p) for p in document["confirmed"]),
-        "DENIED": frozenset(normalize_utterance(p) for p in document["denied"]),
+        status: frozenset(normalize_utterance(p, locale) for p in document[key])
+        for status, key in (("CONFIRMED", "confirmed"), ("DENIED", "denied"))
     }
 
 
-def confirmation_prompt(understanding: Understanding) -> str:
-    """What the simulated Echo says to confirm `understanding`, its values by name."""
-    document = _confirmation_document()
+def confirmation_prompt(
+    understanding: Understanding,
+    slot_types: Mapping[str, str] | None = None,
+    locale: str = _DEFAULT_LOCALE,
+) -> str:
+    """What the simulated Echo says to confirm `understanding`, its values by name (a slot
+    with no value by the words for its type in `slot_types`, slot name -> type)."""
+    document = _confirmation_document(locale)
     names = {name: value.canonical or value.spoken for name, value in understanding.slots.items()}
     template = document["readings"].get(understanding.intent)
     if template is None:
         heard = [names[name] for name in understanding.declared or names if name in names]
         return str(document["any"]).format(names=", ".join(heard))
-    missing = str(document["missing"])
-    filled = {name: names.get(name, missing) for name in _PLACEHOLDER.findall(str(template))}
+    missing: dict[str, str] = document["missing"]
+    types = slot_types or {}
+    filled = {
+        name: names.get(name) or missing.get(types.get(name, ""), missing["any"])
+        for name in _PLACEHOLDER.findall(str(template))
+    }
     sentence = " ".join(str(template).format_map(filled).split())
     return sentence[:1].upper() + sentence[1:]
 
 
-def confirmation_of(text: str) -> str | None:
+def confirmation_of(text: str, locale: str = _DEFAULT_LOCALE) -> str | None:
     """CONFIRMED for a yes, DENIED for a no, None for anything else."""
-    said = normalize_utterance(text)
-    return next((status for status, ps in _confirmation_phrases().items() if said in ps), None)
+    said = normalize_utterance(text, locale)
+    phrases = _confirmation_phrases(locale)
+    return next((status for status, ps in phrases.items() if said in ps), None)
 
 
 def speech_text(output: dict[str, Any] | None) -> str:
@@ -263,6 +279,18 @@ class AlexaSimulator:
             self._announce(turn)
             return turn
 
+    def reading(self, utterance: str) -> Understanding:
+        """What `utterance` would be understood as if said now, without saying it: while
+        the skill asks for a slot, as the answer to that question (as `say` reads it),
+        else as a request (the invocation taken off). Push-to-talk weighs each of its N
+        best this way, so an answer ("zone b" to "Zone B or zone D?") is weighed as one."""
+        with self._lock:
+            pending = self.pending
+        text = strip_invocation(self.model.invocation_name, utterance)
+        if pending is not None and pending.directive == ELICIT and pending.slot is not None:
+            return self._answer(text, pending.understanding, pending.slot)
+        return self.model.understand(text)
+
     def end_session(self) -> Turn | None:
         """End an open session as the user walking away would (reason USER_INITIATED)."""
         with self._lock:
@@ -322,7 +350,8 @@ class AlexaSimulator:
     def _confirm(self, session: _Session, utterance: str, understanding: Understanding) -> Turn:
         """Ask the person to confirm a reading too unsure to act on; nothing is sent yet."""
         session.pending = PendingDialog(understanding, CONFIRM_INTENT, None)
-        prompt = confirmation_prompt(understanding)
+        slot_types = self.model.intent_slots.get(understanding.intent, {})
+        prompt = confirmation_prompt(understanding, slot_types, self.locale)
         return Turn(
             utterance=utterance,
             speech=prompt,
@@ -340,7 +369,7 @@ class AlexaSimulator:
     ) -> tuple[Any, Understanding]:
         """The IntentRequest for `text`, read as the answer to `pending` when it is one."""
         if pending is not None and pending.directive in (CONFIRM_SLOT, CONFIRM_INTENT):
-            status = confirmation_of(text)
+            status = confirmation_of(text, self.locale)
             if status is not None:
                 so_far = pending.understanding
                 if pending.directive == CONFIRM_INTENT:
