@@ -34,7 +34,7 @@ from vahr.speech.errors import SpeechError
 from vahr.station.errors import RequestError
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Mapping
 
     from vahr.local.alexa import InteractionModel
     from vahr.local.client import Assistant
@@ -76,15 +76,19 @@ def read_clip(data: bytes) -> Audio:
     return audio
 
 
-def ask_back(weighed: Weighed) -> str | None:
+def ask_back(weighed: Weighed, slot_types: Mapping[str, str]) -> str | None:
     """The station's own question when a remote assistant cannot be given the weighed
-    understanding: which value of an unsure robot or zone slot was meant; None when sure."""
-    for value in weighed.understanding.slots.values():
+    understanding: which value of an unsure robot or zone slot was meant; None when sure.
+    `slot_types` are the intent's slots and their types."""
+    slots = weighed.understanding.slots
+    for value in slots.values():
         if value.alternatives and value.canonical:
             options = [value.canonical, *(name for _, name in value.alternatives)]
             return f"Did you say {' or '.join(options)}? Please say it again."
-        if not value.resolved and value.name in weighed.slot_confidence:
-            return f"I'm not sure which {value.type.lower()} you said. Please say it again."
+    for name in weighed.slot_confidence:
+        if name not in slots:  # heard by too few of the readings to act on
+            kind = slot_types.get(name, name).lower()
+            return f"I'm not sure which {kind} you said. Please say it again."
     return None
 
 
@@ -136,7 +140,12 @@ class PushToTalk:
             return self._model
 
     def weigh(self, recognition: Recognition) -> Weighed:
-        """The understanding of a recognition's N best (its transcript alone without)."""
+        """The understanding of a recognition's N best (its transcript alone without); with
+        the simulator in this process each reading is read in the dialog under way, so an
+        answer to the skill's question ("zone b" to "Zone B or zone D?") is weighed as one."""
+        if isinstance(self.assistant, SimulatorAssistant):
+            simulator = self.assistant.simulator
+            return weigh_recognition(simulator.model, recognition, reading=simulator.reading)
         return weigh_recognition(self.model(), recognition)
 
     def handle(self, wav: bytes) -> dict[str, Any]:
@@ -173,16 +182,13 @@ class PushToTalk:
 
     def _ask(self, text: str, heard: dict[str, Any], weighed: Weighed) -> dict[str, Any]:
         if isinstance(self.assistant, SimulatorAssistant):
-            simulator = self.assistant.simulator
-            if simulator.pending is None:
-                turn = simulator.say(
-                    text, origin=ORIGIN, heard=heard, understanding=weighed.understanding
-                )
-                return {**turn.to_json(), "utterance": text}
-            # An answer to the skill's question is read against the question: the words go.
-            return self.assistant.ask(text, origin=ORIGIN, heard=heard)
-        question = ask_back(weighed)
+            # The weighed understanding already reads an answer against the question.
+            turn = self.assistant.simulator.say(
+                text, origin=ORIGIN, heard=heard, understanding=weighed.understanding
+            )
+            return {**turn.to_json(), "utterance": text}
+        intent = weighed.understanding.intent
+        question = ask_back(weighed, self.model().intent_slots.get(intent, {}))
         if question is not None:
-            intent = weighed.understanding.intent
             return {"speech": question, "intent": intent, "commands": [], "utterance": text}
         return self.assistant.ask(text, origin=ORIGIN, heard=heard)

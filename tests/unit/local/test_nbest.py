@@ -72,6 +72,23 @@ def test_with_higher_thresholds_a_split_robot_is_asked_about(understand: object)
     assert robot.id == "placebot1" and [v for v, _ in robot.alternatives] == ["placebot2"]
 
 
+def test_a_zone_only_some_readings_hear_is_asked_for(understand: object) -> None:
+    weighed = weigh(
+        [
+            Hypothesis("send placebot one to zone a", 0.0),
+            Hypothesis("send placebot one to zone hey", -50.0),
+            Hypothesis("send placebot one to the zone", -80.0),
+        ],
+        understand,  # type: ignore[arg-type]
+    )
+    # No rival zone was heard, so the skill is to ask for one ("To which zone?"), not be
+    # handed "zone a" without its resolution (it would answer it knows no such zone)
+    assert weighed.understanding.intent == "NavigateIntent"
+    assert "zone" not in weighed.understanding.slots
+    assert weighed.slot_confidence["zone"] < MIN_SLOT_CONFIDENCE
+    assert weighed.understanding.slots["robot"].id == "placebot1"
+
+
 @pytest.mark.parametrize(
     "readings",
     [

@@ -164,6 +164,25 @@ def test_a_remote_assistant_is_not_sent_a_zone_the_hearing_is_unsure_of() -> Non
     assert result["heard"]["weighed"]["slots"]["zone"] < 0.9
 
 
+def test_a_remote_assistant_is_not_sent_a_zone_too_few_readings_hear() -> None:
+    # Only the best reading names a zone; the others lack one. Sent the words, the
+    # assistant would act on zone a, so the station asks for the zone itself.
+    assistant = Assistant("NavigateIntent")
+    heard = Recognition(
+        "send placebot one to zone a",
+        0.6,
+        True,
+        hypotheses=(
+            Hypothesis("send placebot one to zone a", 0.0),
+            Hypothesis("send placebot one to zone hey", -50.0),
+            Hypothesis("send placebot one to the zone", -80.0),
+        ),
+    )
+    result = PushToTalk(assistant, lambda: Heard(heard)).handle(wav())
+    assert assistant.asked == []
+    assert result["speech"] == "I'm not sure which zone you said. Please say it again."
+
+
 def test_a_thousand_robots_share_out_their_names_and_each_is_heard() -> None:
     from vahr.local.robots import generated_fleet
     from vahr.skill_model.generator import build_interaction_model

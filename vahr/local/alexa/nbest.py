@@ -138,15 +138,23 @@ def weigh(
         confidence[name] = shares.get(value.id, 0.0)
         # A value the NLU already asks about stays a question, with its own rivals.
         if confidence[name] < weighing.min_slot_confidence and not value.alternatives:
-            slots[name] = _unsure(value, shares, names)
+            unsure = _unsure(value, shares, names)
+            if unsure is None:
+                del slots[name]  # asked for, as if it had not been said
+            else:
+                slots[name] = unsure
     return Weighed(replace(lead, slots=slots), intent_confidence, confidence, len(readings))
 
 
 def weigh_recognition(
-    model: InteractionModel, recognition: Recognition, weighing: Weighing = Weighing()
+    model: InteractionModel,
+    recognition: Recognition,
+    weighing: Weighing = Weighing(),
+    reading: Callable[[str], Understanding] | None = None,
 ) -> Weighed:
     """`weigh` over a recognition's N best (its transcript alone when it has none), each
-    read by `model` as the simulator reads a request (the invocation taken off)."""
+    read by `reading` (the simulator's, in the dialog under way), else by `model` as the
+    simulator reads a request (the invocation taken off)."""
     from vahr.local.alexa.simulator import strip_invocation
 
     def understand(text: str) -> Understanding:
@@ -156,7 +164,7 @@ def weigh_recognition(
         nothing = Understanding(FALLBACK, confidence=1.0)
         return Weighed(nothing, 0.0, {}, 0)
     hypotheses = recognition.hypotheses or (Hypothesis(recognition.text, 0.0),)
-    return weigh(hypotheses, understand, weighing)
+    return weigh(hypotheses, reading or understand, weighing)
 
 
 def _value_shares(
@@ -182,14 +190,15 @@ def _value_shares(
     return ({key: share / total for key, share in shares.items()} if total else {}), names
 
 
-def _unsure(value: SlotValue, shares: dict[str | None, float], names: dict[str, str]) -> SlotValue:
+def _unsure(
+    value: SlotValue, shares: dict[str | None, float], names: dict[str, str]
+) -> SlotValue | None:
     """`value` not to be acted on: with the rival values heard as alternatives (asked
-    about), or emptied (asked for) when no rival value was heard."""
+    about), or None (the slot is asked for) when no rival value was heard. Not a value
+    without its resolution: the skill would answer that it knows no zone called that."""
     rivals = tuple(
         (value_id, names.get(value_id, value_id))
         for value_id, share in sorted(shares.items(), key=lambda item: -item[1])
         if value_id is not None and value_id != value.id and share >= MIN_RIVAL_SHARE
     )
-    if rivals:
-        return replace(value, alternatives=rivals)
-    return replace(value, id=None, canonical=None, alternatives=())
+    return replace(value, alternatives=rivals) if rivals else None

@@ -1,0 +1,123 @@
+"""The dialog through push-to-talk (`POST /api/voice` on a running `vahr up`), spoken by flite
+voices built from recordings of people: a whole command answering "which robot?" never
+keeps the old zone (the hearing, unsure, asks "Zone A or zone D?"); "no, zone a" turns
+the robot the last command sent and "cancel that" stops only it; an answer to "Zone B or
+zone D?" is weighed as an answer; a correction with nothing to correct, and a chord of music, move nothing and
+say so. The same cases typed are in tests/integration/local/test_dialog_corrections.py."""
+
+from __future__ import annotations
+
+import json
+import time
+import urllib.request
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pytest
+
+from tests.support.push_to_talk import clip
+from tests.support.push_to_talk import talk as talk_to
+from tests.support.vahr_up import Up, start_up, stop_up
+from vahr.local.ports import free_port
+from vahr.speech.audio import Audio
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+
+WAIT_S = 30.0
+
+
+@pytest.fixture
+def up(tmp_path: Any) -> Iterator[Up]:
+    # A stack of its own for each test: a correction reaches back to the last command of
+    # the same speaker, which must be this test's.
+    running = start_up(tmp_path, "--station-port", str(free_port()), "--sim-speed-factor", "4")
+    try:
+        yield running
+    finally:
+        stop_up(running.process)
+
+
+def talk(up: Up, voice: str, text: str) -> dict[str, Any]:
+    return talk_to(up.endpoints["station"], clip(voice, text))
+
+
+def robots(up: Up) -> dict[str, dict[str, Any]]:
+    with urllib.request.urlopen(up.endpoints["api"] + "/vahr/status", timeout=10) as answer:
+        found: dict[str, dict[str, Any]] = json.loads(answer.read())["robots"]
+        return found
+
+
+def eventually(up: Up, thing: str, **wanted: Any) -> dict[str, Any]:
+    deadline = time.monotonic() + WAIT_S
+    while True:
+        state = robots(up)[thing]
+        if all(state.get(key) == value for key, value in wanted.items()):
+            return state
+        if time.monotonic() > deadline:
+            pytest.fail(f"{thing} is {state}, not {wanted}, after {WAIT_S:g} s")
+        time.sleep(0.2)
+
+
+def test_a_whole_command_answering_which_robot_is_acted_on_with_its_own_zone(up: Up) -> None:
+    # Given the station asked which robot should drive to zone D
+    asked = talk(up, "flite:rms", "drive over to zone d")
+    assert asked["speech"].startswith("Which robot"), asked
+    # When the answer is a whole command naming another zone
+    answer = talk(up, "flite:rms", "robot two please go to zone a")
+    # Then the old zone does not win: some of the hearing's readings lack a zone (and so
+    # keep D), so the station asks which of the two was meant
+    assert answer["speech"] == "Zone A or zone D?", answer
+    assert answer["turn"]["commands"] == []
+    # (nothing moved meanwhile: neither the old zone nor a guess)
+    assert all(state.get("last_command") is None for state in robots(up).values())
+    # And a whole command that the hearing is sure of is acted on with its own zone
+    done = talk(up, "flite:rms", "placebot two go to zone a")
+    assert done["speech"].startswith("Placebot two is on its way to zone A."), done
+    eventually(up, "placebot2", zone="A", status="idle")
+    assert robots(up)["placebot1"].get("last_command") is None
+
+
+def test_no_zone_a_turns_the_robot_and_cancel_that_stops_only_it(up: Up) -> None:
+    sent = talk(up, "flite:rms", "send placebot one to zone c")
+    assert sent["speech"].startswith("Placebot one is on its way to zone C."), sent
+    corrected = talk(up, "flite:rms", "no, zone a")
+    assert corrected["speech"].startswith(
+        "Okay, not zone C. Placebot one is on its way to zone A."
+    ), corrected
+    eventually(up, "placebot1", destination="A")
+    undone = talk(up, "flite:rms", "cancel that")
+    assert undone["speech"].startswith("Okay, I cancelled that. Placebot one has stopped."), undone
+    eventually(up, "placebot1", status="stopped")
+    # Placebot two, never named, was never sent anywhere
+    assert robots(up)["placebot2"].get("last_command") is None
+
+
+def test_an_answer_to_zone_b_or_zone_d_is_weighed_as_an_answer(up: Up) -> None:
+    sent = talk(up, "flite:awb", "send placebot one to zone c")
+    assert sent["speech"].startswith("Placebot one is on its way to zone C."), sent
+    # "no, zone b": B and D are the letters the hearing confuses, so it asks
+    asked = talk(up, "flite:awb", "no, zone b")
+    assert asked["speech"] == "Zone B or zone D?", asked
+    # The answer is weighed as an answer to that question (not as a request of its own,
+    # which "zone b" alone is not): still unsure between the two, it asks again
+    again = talk(up, "flite:awb", "zone b")
+    assert again["speech"] == "Zone B or zone D?", again
+    assert again["heard"]["weighed"]["intent"] == "CorrectionIntent"
+    assert robots(up)["placebot1"]["destination"] == "C"
+
+
+def test_a_correction_with_nothing_to_correct_says_so(up: Up) -> None:
+    answer = talk(up, "flite:awb", "i meant placebot two")
+    assert answer["speech"] == "There is no command of mine to correct, so I changed nothing."
+    assert answer["turn"]["commands"] == []
+
+
+def test_music_moves_nothing_and_says_so(up: Up) -> None:
+    seconds = np.arange(3 * 16_000) / 16_000
+    chord = sum(np.sin(2 * np.pi * f * seconds) for f in (261.6, 329.6, 392.0, 523.3))
+    beat = (np.sin(2 * np.pi * 2 * seconds) > 0) * 0.5 + 0.5
+    answer = talk_to(up.endpoints["station"], Audio.from_samples(chord * beat * 4000))
+    assert answer["understood"] is False
+    assert "sent nothing to the robots" in answer["speech"]
+    assert all(state.get("last_command") is None for state in robots(up).values())
