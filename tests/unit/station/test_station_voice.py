@@ -145,42 +145,35 @@ def test_made_up_words_are_pronounced_two_ways() -> None:
     assert arpabet("tS'A@li") == "CH AA R L IY"
 
 
-def test_a_remote_assistant_is_not_sent_a_zone_the_hearing_is_unsure_of() -> None:
-    # The N best split between zone d and zone b; the assistant (over HTTP) would re-read
-    # the words and act on zone d, so the station asks back itself.
-    assistant = Assistant("NavigateIntent")
-    heard = Recognition(
-        "send placebot two to zone d",
-        0.6,
-        True,
-        hypotheses=(
-            Hypothesis("send placebot two to zone d", 0.0),
-            Hypothesis("send placebot two to zone b", -100.0),
+@pytest.mark.parametrize(
+    ("readings", "question"),
+    [
+        # The N best split between zone d and zone b
+        (
+            ["send placebot two to zone d", "send placebot two to zone b"],
+            "Did you say zone d or zone b? Please say it again.",
         ),
-    )
+        # Only the best reading names a zone; the others lack one
+        (
+            ["send placebot one to zone a", "send placebot one to zone hey",
+             "send placebot one to the zone"],
+            "I'm not sure which zone you said. Please say it again.",
+        ),
+    ],
+    ids=["rival zones", "zone heard by too few"],
+)  # fmt: skip
+def test_a_remote_assistant_is_not_sent_a_zone_the_hearing_is_unsure_of(
+    readings: list[str], question: str
+) -> None:
+    # The assistant (over HTTP) would re-read the best transcript's words and act on its
+    # zone, so the station asks back itself.
+    assistant = Assistant("NavigateIntent")
+    hypotheses = tuple(Hypothesis(text, -60.0 * rank) for rank, text in enumerate(readings))
+    heard = Recognition(readings[0], 0.6, True, hypotheses=hypotheses)
     result = PushToTalk(assistant, lambda: Heard(heard)).handle(wav())
     assert assistant.asked == []
-    assert result["speech"] == "Did you say zone d or zone b? Please say it again."
+    assert result["speech"] == question
     assert result["heard"]["weighed"]["slots"]["zone"] < 0.9
-
-
-def test_a_remote_assistant_is_not_sent_a_zone_too_few_readings_hear() -> None:
-    # Only the best reading names a zone; the others lack one. Sent the words, the
-    # assistant would act on zone a, so the station asks for the zone itself.
-    assistant = Assistant("NavigateIntent")
-    heard = Recognition(
-        "send placebot one to zone a",
-        0.6,
-        True,
-        hypotheses=(
-            Hypothesis("send placebot one to zone a", 0.0),
-            Hypothesis("send placebot one to zone hey", -50.0),
-            Hypothesis("send placebot one to the zone", -80.0),
-        ),
-    )
-    result = PushToTalk(assistant, lambda: Heard(heard)).handle(wav())
-    assert assistant.asked == []
-    assert result["speech"] == "I'm not sure which zone you said. Please say it again."
 
 
 def test_a_thousand_robots_share_out_their_names_and_each_is_heard() -> None:
