@@ -2,8 +2,8 @@
 "stuck" without being stuck.
 
 For each size, a real mosquitto on a free loopback port and the product's swarm
-(`robot_agent.swarm`) of that many robots in this process, with the settings `vahr up`
-gives its robots (a progress report every simulated second). Every `LEG_S` wall seconds
+(`robot_agent.swarm`) of that many robots in this process, with the settings `vahr up
+--swarm` gives its robots (a progress report every wall-clock second). Every `LEG_S` wall seconds
 one fleet-wide `navigate` sends every robot to zone A or D in turn (as bench/station.py
 does), so every robot is always driving; nothing obstructs any of them, so every `stuck`
 is a false one. Then, with `--arrive`, one last `navigate` to LOADING and the time until
@@ -30,6 +30,7 @@ from collections import Counter
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 from _results import percentile, write_section
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -39,6 +40,7 @@ from robot_agent.swarm import Swarm  # noqa: E402
 from tests.support.swarm import swarm_fleet  # noqa: E402
 from vahr.local.broker import BrokerConfig, Mosquitto  # noqa: E402
 from vahr.local.ports import free_port  # noqa: E402
+from vahr.local.robots import swarm_agent_config  # noqa: E402
 from vahr.protocol import encode, new_command, topics  # noqa: E402
 
 if TYPE_CHECKING:
@@ -46,8 +48,15 @@ if TYPE_CHECKING:
 
 LEG_S = 4.0  # wall seconds between fleet commands, as in bench/station.py
 LAG_PROBE_S = 0.05
-# The agent settings of `vahr up` (vahr/local/robots.py LOCAL_AGENT_CONFIG).
-LOCAL_SETTINGS = ExecutorSettings(peer_clock_skew_s=0, progress_interval_s=1, progress_step=0)
+
+
+def swarm_settings(speed_factor: float) -> tuple[ExecutorSettings, SimSettings]:
+    """The settings `vahr up --swarm` gives its robots (vahr.local.robots)."""
+    config = msgspec.yaml.decode(swarm_agent_config(speed_factor))
+    return (
+        msgspec.convert(config.get("executor", {}), ExecutorSettings),
+        msgspec.convert(config.get("sim", {}), SimSettings),
+    )
 
 
 class Tally:
@@ -85,12 +94,13 @@ async def measure(size: int, args: argparse.Namespace, broker: str) -> dict[str,
     tally = Tally()
     fleet = swarm_fleet(size)
     started = time.monotonic()
+    settings, sim = swarm_settings(args.speed_factor)
     swarm = Swarm(
         fleet=fleet,
         broker=broker,
         speed_factor=args.speed_factor,
-        settings=LOCAL_SETTINGS,
-        sim=SimSettings(accept_faults=True),
+        settings=settings,
+        sim=sim,
         on_event=tally.on_event,
     )
     await swarm.start(timeout_s=60 + size / 100)
@@ -214,7 +224,7 @@ def _table(results: list[dict[str, Any]], args: argparse.Namespace) -> str:
         )
     return (
         f"Every robot driving for {args.seconds:g} s at {args.speed_factor:g} times real "
-        f"time, a fleet `navigate` every {LEG_S:g} s, progress every simulated second.\n\n"
+        f"time, a fleet `navigate` every {LEG_S:g} s, progress every wall-clock second.\n\n"
         + "\n".join(rows)
     )
 
