@@ -67,7 +67,7 @@ def eventually_at(up: Up, thing: str, zone: str) -> None:
 @pytest.mark.parametrize(
     ("voice", "text", "thing", "zone"),
     [
-        ("flite:rms", "placebot one go to zone d", "placebot1", "D"),
+        ("flite:rms", "move placebot one to zone d", "placebot1", "D"),
         ("festival:cmu_us_slt_arctic_hts", "send placebot one to zone c", "placebot1", "C"),
     ],
 )
