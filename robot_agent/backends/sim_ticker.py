@@ -58,6 +58,11 @@ class SimTicker:
 
     def discard(self, drive: Drive) -> None:
         self._drives.pop(drive, None)
+        if not self._drives and self._task is not None:
+            # Nothing left to step: stop now rather than a tick later, so that a robot
+            # shutting down leaves no task of the ticker's behind on its event loop.
+            self._task.cancel()
+            self._task = None
 
     @property
     def driving(self) -> int:
