@@ -12,6 +12,7 @@ import time
 from datetime import datetime
 from typing import TYPE_CHECKING, Any
 
+import boto3
 import pytest
 
 from tests.support.vahr_up import ROOT, VAHR, Up, clean_env, say, start_up, stop_up
@@ -122,6 +123,35 @@ def test_a_robot_of_the_swarm_reports_its_progress_once_a_second(up: Up) -> None
     assert [line["event"] for line in drive].count("progress") >= 1, drive
     gaps = [later - earlier for earlier, later in itertools.pairwise(times)]
     assert min(gaps) >= 0.9, gaps
+
+
+def test_the_whole_swarm_sent_across_the_floor_at_once_arrives_and_none_is_stuck(
+    up: Up, aws_credentials: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Given the 200 robots at 20 times real time, where the 10 simulated seconds a robot
+    # may go without progress before it is stuck are half a second of a busy machine
+    api = up.endpoints["api"]
+    monkeypatch.setenv("AWS_ENDPOINT_URL_IOT", api)
+    iot = boto3.client("iot")
+
+    def count_by(field: str) -> dict[str, int]:
+        answer = iot.get_buckets_aggregation(
+            queryString="thingName:rover*",
+            aggregationField=field,
+            bucketsAggregationType={"termsAggregation": {"maxBuckets": 10}},
+        )
+        return {bucket["keyValue"]: bucket["count"] for bucket in answer["buckets"]}
+
+    # When every one of them is sent to zone D at once
+    turn = say(api, "Alexa, ask robot fleet to send all robots to zone d")
+    assert turn["commands"], turn
+    # Then every robot arrives there, and none was stuck on the way (a stuck robot stays
+    # `stuck` where it stopped)
+    assert eventually(lambda: count_by("shadow.reported.zone") == {"D": SIZE}, 90), (
+        count_by("shadow.reported.zone"),
+        count_by("shadow.reported.status"),
+    )
+    assert count_by("shadow.reported.status") == {"idle": SIZE}
 
 
 @pytest.mark.parametrize(
