@@ -22,9 +22,9 @@ all robots to the other end of the floor.
 Run: `.venv/bin/python bench/station.py [--minutes 10] [--robots 1000] [--beside 100 ...]
 [--presses 5] [--no-voice]`. It prints its figures and ends with one JSON line: `{"robots":
 N, "paint_p50_ms": ..., "paint_p95_ms": ..., ..., "beside": [{"robots": 100, ...}]}`.
-`--no-voice` runs the station without push-to-talk, whose recognizer is built on a thread of
-the station's process for the first minute or so with 1,000 robots (docs/station.md), to
-see the intake without it; it writes nothing to docs/benchmarks.md.
+`--no-voice` runs the station without push-to-talk, whose language model is built in a
+child process (half a minute with 1,000 robots the first time, seconds from its cache;
+docs/station.md), to see the intake without it; it writes nothing to docs/benchmarks.md.
 """
 
 from __future__ import annotations
