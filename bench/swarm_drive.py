@@ -130,6 +130,9 @@ async def measure(size: int, args: argparse.Namespace, broker: str) -> dict[str,
             "robots": size,
             "speed_factor": args.speed_factor,
             "ready_s": round(ready_s, 1),
+            # Commands the robots took (accepted) per second, against what was sent.
+            "accepted_per_s": round(kinds.get("accepted", 0) / window),
+            "sent_per_s": round(size / LEG_S),
             "updates_per_s": round(updates / window),
             "events_per_s": round(sum(kinds.values()) / window),
             "progress_per_s": round(kinds.get("progress", 0) / window),
@@ -212,21 +215,35 @@ def main() -> None:
 
 def _table(results: list[dict[str, Any]], args: argparse.Namespace) -> str:
     rows = [
-        "| robots | shadow updates/s | events/s (progress) | false stuck | failed "
-        "| loop lag p50 / p99 / max ms | CPU cores | load |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| robots | commands taken/s (sent) | shadow updates/s | events/s (progress) "
+        "| false stuck | failed | loop lag p50 / p99 / max ms | CPU cores | load |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for r in results:
         rows.append(
-            f"| {r['robots']:,} | {r['updates_per_s']:,} | {r['events_per_s']:,} "
+            f"| {r['robots']:,} | {r['accepted_per_s']:,} ({r['sent_per_s']:,}) "
+            f"| {r['updates_per_s']:,} | {r['events_per_s']:,} "
             f"({r['progress_per_s']:,}) | {r['stuck']} | {r['failed']} | {r['lag_p50_ms']} / "
             f"{r['lag_p99_ms']} / {r['lag_max_ms']} | {r['cpu_cores']} | {r['load']} |"
         )
-    return (
+    text = (
         f"Every robot driving for {args.seconds:g} s at {args.speed_factor:g} times real "
-        f"time, a fleet `navigate` every {LEG_S:g} s, progress every wall-clock second.\n\n"
-        + "\n".join(rows)
+        f"time, a fleet `navigate` every {LEG_S:g} s, progress every wall-clock second "
+        "(`vahr up --swarm`'s rate). Nothing obstructs any robot, so every `stuck` is false. "
+        "CPU cores: what the one process got of the shared machine.\n\n" + "\n".join(rows)
     )
+    arrivals = [r for r in results if "arrived" in r]
+    if arrivals:
+        text += (
+            "\n\nThen one `navigate` to LOADING for all: "
+            + "; ".join(
+                f"{r['robots']:,} robots: {r['arrived']:,} arrived in {r['arrive_s']} s "
+                f"(straight-line ideal {r['arrive_ideal_s']} s), {r['arrive_stuck']} stuck"
+                for r in arrivals
+            )
+            + "."
+        )
+    return text
 
 
 if __name__ == "__main__":
