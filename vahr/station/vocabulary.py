@@ -6,7 +6,8 @@ copies of the sample (so every value appears in every sample's context once, wit
 multiplying out samples with several slots; past `MAX_COPIES` names, as in a fleet of a
 thousand robots, the samples share the names out between them instead, each name still in
 many contexts), plus the built-in intents' phrases (those the simulator knows them by,
-`vahr.local.alexa.built_in_phrases`) and the invocation forms ("ask robot fleet to ...").
+`vahr.local.alexa.built_in_phrases`), the invocation forms ("ask robot fleet to ...") and
+the yes and no that answer a yes-or-no question.
 The interaction model is generated from `fleet.yaml`, so the robots' and zones' names follow
 the fleet. Numbers are spelled out, as people say them.
 
@@ -27,7 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from vahr.errors import VahrError
-from vahr.local.alexa import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases
+from vahr.local.alexa import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases, confirmation_phrases
 from vahr.protocol.text import normalize, spell_numbers
 
 if TYPE_CHECKING:
@@ -83,6 +84,9 @@ def sentences(document: dict[str, Any]) -> list[str]:
                 found.append(f"ask {invocation} to {filled[0]}")
     except (KeyError, TypeError) as err:
         raise VahrError(f"the interaction model lacks {err}") from err
+    # The yes and no that answer the skill's yes-or-no questions ("Placebot two instead?"),
+    # which no sample holds.
+    found += [_phrase(phrase) for phrase in confirmation_phrases()]
     found += [f"open {invocation}", f"alexa open {invocation}", *EXITS]
     return list(dict.fromkeys(s for s in found if s))
 

@@ -27,7 +27,7 @@ import wave
 from typing import TYPE_CHECKING, Any
 
 from vahr.errors import VahrError
-from vahr.local.alexa import Weighed, weigh_recognition
+from vahr.local.alexa import Weighed, Weighing, weigh_recognition
 from vahr.local.client import SimulatorAssistant
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio
 from vahr.speech.errors import SpeechError
@@ -145,6 +145,12 @@ class PushToTalk:
         answer to the skill's question ("zone b" to "Zone B or zone D?") is weighed as one."""
         if isinstance(self.assistant, SimulatorAssistant):
             simulator = self.assistant.simulator
+            answer = simulator.yes_or_no(recognition.text)
+            if answer is not None and recognition.confidence >= Weighing().min_word_posterior:
+                # A yes or a no to the skill's yes-or-no question, which said back all it
+                # would do: taken from the best transcript, as the N best of one short word
+                # are mostly that word with noise around it ("yes it", "yes you").
+                return Weighed(answer, recognition.confidence, {}, 1)
             return weigh_recognition(simulator.model, recognition, reading=simulator.reading)
         return weigh_recognition(self.model(), recognition)
 

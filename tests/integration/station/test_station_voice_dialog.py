@@ -121,3 +121,16 @@ def test_music_moves_nothing_and_says_so(up: Up) -> None:
     assert answer["understood"] is False
     assert "sent nothing to the robots" in answer["speech"]
     assert all(state.get("last_command") is None for state in robots(up).values())
+
+
+def test_not_that_robot_is_confirmed_with_a_spoken_yes(up: Up) -> None:
+    sent = talk(up, "flite:rms", "send placebot one to zone c")
+    assert sent["speech"].startswith("Placebot one is on its way to zone C."), sent
+    asked = talk(up, "flite:rms", "not that robot")
+    assert asked["speech"] == "Placebot two instead?", asked
+    # A yes to the skill's yes-or-no question is weighed as the answer (alone it is no
+    # request at all)
+    confirmed = talk(up, "flite:rms", "yes")
+    assert "Placebot two is on its way to zone C" in confirmed["speech"], confirmed
+    eventually(up, "placebot1", status="stopped")
+    eventually(up, "placebot2", destination="C")

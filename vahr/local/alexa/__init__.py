@@ -10,8 +10,9 @@ experiment out of them (pyproject.toml, docs/architecture.md):
   that ships with the package), `load_skill_handler` (the skill's Lambda handler
   in-process) and `CommandLog` (the commands the skill published during a turn): what a
   simulator is built from;
-- `built_in_phrases` (what the simulator knows Alexa's built-in intents by) and
-  `RULE_SLOTS` (the weather rule's slots): what a vocabulary of the model is made from;
+- `built_in_phrases` (what the simulator knows Alexa's built-in intents by),
+  `confirmation_phrases` (the yes and no it takes) and `RULE_SLOTS` (the weather rule's
+  slots): what a vocabulary of the model is made from;
 - `weigh_recognition`, `Weighed` and `Weighing` (`nbest`): a recognizer's N best weighed
   into one understanding, unsure robots and zones asked about.
 """
@@ -20,7 +21,7 @@ from vahr.local.alexa.background import built_in_phrases
 from vahr.local.alexa.commands_seen import CommandLog
 from vahr.local.alexa.nbest import Weighed, Weighing, weigh_recognition
 from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel
-from vahr.local.alexa.simulator import AlexaSimulator, Turn
+from vahr.local.alexa.simulator import AlexaSimulator, Turn, confirmation_phrases
 from vahr.local.alexa.skill import load_skill_handler
 from vahr.skill_model.intents import RAINY_ZONE, SUNNY_ZONE
 
@@ -37,6 +38,7 @@ __all__ = [
     "Weighed",
     "Weighing",
     "built_in_phrases",
+    "confirmation_phrases",
     "load_skill_handler",
     "weigh_recognition",
 ]

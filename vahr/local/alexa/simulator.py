@@ -150,6 +150,13 @@ def _confirmation_phrases(locale: str) -> dict[str, frozenset[str]]:
     }
 
 
+def confirmation_phrases(locale: str = _DEFAULT_LOCALE) -> list[str]:
+    """Every yes and no the simulated Echo takes as an answer to a yes-or-no question (as
+    a vocabulary of what people say to it)."""
+    document = _confirmation_document(locale)
+    return [str(phrase) for key in ("confirmed", "denied") for phrase in document[key]]
+
+
 def confirmation_prompt(
     understanding: Understanding,
     slot_types: Mapping[str, str] | None = None,
@@ -281,15 +288,33 @@ class AlexaSimulator:
 
     def reading(self, utterance: str) -> Understanding:
         """What `utterance` would be understood as if said now, without saying it: while
-        the skill asks for a slot, as the answer to that question (as `say` reads it),
-        else as a request (the invocation taken off). Push-to-talk weighs each of its N
-        best this way, so an answer ("zone b" to "Zone B or zone D?") is weighed as one."""
+        the skill asks for a slot, as the answer to that question (as `say` reads it); while
+        it asks a yes-or-no question, a yes as the intent it confirms and a no as
+        AMAZON.NoIntent; else as a request (the invocation taken off). Push-to-talk weighs
+        each of its N best this way, so an answer ("zone b" to "Zone B or zone D?", "yes" to
+        "Placebot two instead?") is weighed as one, and readings split between yes and no
+        are not sure of either."""
         with self._lock:
             pending = self.pending
         text = strip_invocation(self.model.invocation_name, utterance)
         if pending is not None and pending.directive == ELICIT and pending.slot is not None:
             return self._answer(text, pending.understanding, pending.slot)
-        return self.model.understand(text)
+        return self.yes_or_no(text) or self.model.understand(text)
+
+    def yes_or_no(self, utterance: str) -> Understanding | None:
+        """`utterance` as the answer to the yes-or-no question under way: a yes as the
+        intent it confirms, a no as AMAZON.NoIntent; None when no such question is asked or
+        `utterance` is neither."""
+        with self._lock:
+            pending = self.pending
+        if pending is None or pending.directive not in (CONFIRM_SLOT, CONFIRM_INTENT):
+            return None
+        status = confirmation_of(
+            strip_invocation(self.model.invocation_name, utterance), self.locale
+        )
+        if status is None:
+            return None
+        return pending.understanding if status == "CONFIRMED" else Understanding("AMAZON.NoIntent")
 
     def end_session(self) -> Turn | None:
         """End an open session as the user walking away would (reason USER_INITIATED)."""
