@@ -9,6 +9,7 @@ waiting later still sees it) and states (the shadow).
 
 from __future__ import annotations
 
+import functools
 import json
 import logging
 from typing import TYPE_CHECKING, Any
@@ -19,12 +20,14 @@ from robot_agent.link.shadow import ShadowSync
 from vahr.protocol import Presence, ProtocolError, decode_command, decode_event, encode, topics
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from robot_agent.backends.port import NavigationBackend
     from robot_agent.clock import Clock
     from robot_agent.core.executor import ExecutorSettings
     from robot_agent.core.recent_ids import RecentIds
     from robot_agent.voice.port import Voice
-    from vahr.protocol import Event, Fleet, Reported
+    from vahr.protocol import Command, Event, Fleet, Reported
     from vahr.protocol.link import Link
 
 log = logging.getLogger(__name__)
@@ -53,8 +56,12 @@ class RobotAgent:
         settings: ExecutorSettings | None = None,
         listen_to_peers: bool = True,
         in_flight: InFlight | None = None,
+        decode: Callable[[bytes], Command] | None = None,
     ) -> None:
+        """`decode` turns a command payload into a command (default: `decode_command` for
+        `fleet`); a swarm passes one shared by its robots, which all get each fleet command."""
         self.thing = thing
+        self._decode = decode or functools.partial(decode_command, fleet=fleet)
         self.fleet = fleet
         self.link = link
         self.clock = clock
@@ -93,7 +100,7 @@ class RobotAgent:
 
     def _on_command_payload(self, payload: bytes) -> None:
         try:
-            command = decode_command(payload, self.fleet)
+            command = self._decode(payload)
         except ProtocolError as err:
             command_id, action = _best_effort_identity(payload)
             self.executor.reject(command_id, action, str(err))

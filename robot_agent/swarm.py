@@ -29,7 +29,7 @@ from robot_agent.config import ExecutorSettings, MqttSettings, SimSettings
 from robot_agent.core.recent_ids import RecentIds
 from robot_agent.dev_faults import DevFaults
 from vahr.errors import VahrError
-from vahr.protocol import ProtocolError, decode_event, topics
+from vahr.protocol import ProtocolError, decode_command, decode_event, topics
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -37,7 +37,7 @@ if TYPE_CHECKING:
     from types import TracebackType
 
     from robot_agent.link.mqtt5 import Mqtt5Link
-    from vahr.protocol import Event, Fleet, Reported
+    from vahr.protocol import Command, Event, Fleet, Reported
     from vahr.protocol.broker import ClientCredentials
 
 CONNECT_TIMEOUT_S = 10.0
@@ -114,6 +114,7 @@ class Swarm:
         self.link = link
         # Looked up once: Fleet.robot is a linear search, quadratic over 10,000 robots.
         starts = {robot.thing: robot.start for robot in self.fleet.robots}
+        decode = _DecodedOnce(self.fleet)
         for thing in self.things:
             recent = RecentIds(
                 self._state_dir / thing / "recent-ids.json" if self._state_dir else None
@@ -133,6 +134,7 @@ class Swarm:
                 settings=self._settings,
                 # One shared route decodes each peer event once for every robot.
                 listen_to_peers=False,
+                decode=decode,
             )
             agent.attach()
             if self._sim.accept_faults:
@@ -185,6 +187,29 @@ class Swarm:
         tb: TracebackType | None,
     ) -> None:
         await self.stop()
+
+
+class _DecodedOnce:
+    """Decodes command payloads for every robot of a swarm: a fleet command reaches each
+    of them with the same bytes, one after another, and is decoded (and validated) once.
+    Commands are frozen, so the robots can share one."""
+
+    def __init__(self, fleet: Fleet) -> None:
+        self._fleet = fleet
+        self._payload: bytes | None = None
+        self._outcome: Command | ProtocolError | None = None
+
+    def __call__(self, payload: bytes) -> Command:
+        if payload != self._payload or self._outcome is None:
+            try:
+                self._outcome = decode_command(payload, self._fleet)
+            except ProtocolError as err:
+                self._outcome = err
+            self._payload = payload
+        if isinstance(self._outcome, ProtocolError):
+            # Without its last traceback: raised for every robot, it would grow one.
+            raise self._outcome.with_traceback(None)
+        return self._outcome
 
 
 class _LoggedAgent(RobotAgent):

@@ -113,3 +113,22 @@ def test_a_swarm_robot_hears_a_peer_outside_its_swarm_deliver(
         tap.publish("vahr/robots/swarm0001/events", delivered)
         # Then the second goes on and delivers in its turn
         tap.event("swarm0002", "delivered", "w2", timeout_s=30)
+
+
+def test_a_bad_fleet_command_is_rejected_by_every_robot_with_the_reason(
+    mosquitto: Mosquitto, tap: WireTap, shadows: ShadowResponder
+) -> None:
+    with SwarmThread(broker=str(mosquitto.plain_url), count=COUNT, speed_factor=50) as swarm:
+        for thing in swarm.things:
+            tap.reported(thing, lambda r: r["connected"] is True)
+        # When one fleet-wide command names a zone the fleet does not have, then a good one
+        tap.publish("vahr/fleet/cmd", command("bad-zone", "navigate", {"zone": "Z"}))
+        tap.publish("vahr/fleet/cmd", command("good-ping", "ping"))
+        # Then every robot rejects the first with the reason, and takes the second
+        for thing in swarm.things:
+            rejected = tap.event(thing, "rejected", "bad-zone")
+            assert "params.zone" in rejected["reason"], rejected
+            state = tap.reported(
+                thing, lambda r: (r["last_command"] or {}).get("id") == "good-ping"
+            )
+            assert state["last_command"]["result"] == "done"
