@@ -161,7 +161,7 @@ class _Drive:
             self.halt_at = self.travelled
         # Integrate over the simulated time that really passed since the last step, so a
         # busy process changes how often the pose is updated, never the robot's speed.
-        elapsed, self.last = now - self.last, now
+        elapsed, self.last = max(0.0, now - self.last), now
         total = self.total
         if (self.stuck or self.failure) and self.travelled >= self.halt_at:
             if self.failure:
