@@ -419,7 +419,10 @@ def figures(
 TARGETS = {1000: 100.0, 10000: 250.0}
 
 
-def report(args: argparse.Namespace, runs: list[dict[str, Any]]) -> None:
+def report(args: argparse.Namespace, measured: list[dict[str, Any]]) -> None:
+    # The fleet sizes side by side, smallest first; push-to-talk is the main run's (the last).
+    runs = sorted(measured, key=lambda run: run["robots"])
+
     def target(robots: int) -> str:
         limit = next((ms for size, ms in sorted(TARGETS.items()) if robots <= size), None)
         return f" (target under {limit:g} ms)" if limit else ""
@@ -456,7 +459,7 @@ def report(args: argparse.Namespace, runs: list[dict[str, Any]]) -> None:
             f"{'/'.join(map(str, run['load_before']))} / {'/'.join(map(str, run['load_after']))}"
             for run in runs) + " |",
     ]  # fmt: skip
-    main_run = runs[-1]
+    main_run = measured[-1]
     talk = ""
     if main_run["ptt_reply_shown_ms"] is not None:
         talk = (
