@@ -36,7 +36,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         type=int,
         metavar="N",
         help="N simulated robots (rover1..) in one process, on a floor sized for them"
-        " (1 to 5,000; the zones are --fleet's)",
+        " (1 to 4,000; the zones are --fleet's)",
     )
     parser.add_argument(
         "--state-dir", type=Path, default=DEFAULT_STATE_DIR, help="local state (default .state)"

@@ -157,9 +157,9 @@ def test_the_whole_swarm_sent_across_the_floor_at_once_arrives_and_none_is_stuck
 @pytest.mark.parametrize(
     ("value", "error"),
     [
-        ("0", "--swarm 0: give 1 to 5,000 robots"),
-        ("-3", "--swarm -3: give 1 to 5,000 robots"),
-        ("5001", "--swarm 5001: give 1 to 5,000 robots"),
+        ("0", "--swarm 0: give 1 to 4,000 robots"),
+        ("-3", "--swarm -3: give 1 to 4,000 robots"),
+        ("4001", "--swarm 4001: give 1 to 4,000 robots"),
     ],
 )
 def test_a_bad_swarm_size_is_one_line_and_starts_nothing(
