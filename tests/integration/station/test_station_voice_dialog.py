@@ -59,6 +59,12 @@ def eventually(up: Up, thing: str, **wanted: Any) -> dict[str, Any]:
         time.sleep(0.2)
 
 
+def send_placebot_one_to_c(up: Up, voice: str) -> None:
+    """The command the corrections below correct, spoken and acted on."""
+    sent = talk(up, voice, "send placebot one to zone c")
+    assert sent["speech"].startswith("Placebot one is on its way to zone C."), sent
+
+
 def test_a_whole_command_answering_which_robot_is_acted_on_with_its_own_zone(up: Up) -> None:
     # Given the station asked which robot should drive to zone D
     asked = talk(up, "flite:rms", "drive over to zone d")
@@ -79,8 +85,7 @@ def test_a_whole_command_answering_which_robot_is_acted_on_with_its_own_zone(up:
 
 
 def test_no_zone_a_turns_the_robot_and_cancel_that_stops_only_it(up: Up) -> None:
-    sent = talk(up, "flite:rms", "send placebot one to zone c")
-    assert sent["speech"].startswith("Placebot one is on its way to zone C."), sent
+    send_placebot_one_to_c(up, "flite:rms")
     corrected = talk(up, "flite:rms", "no, zone a")
     assert corrected["speech"].startswith(
         "Okay, not zone C. Placebot one is on its way to zone A."
@@ -94,8 +99,7 @@ def test_no_zone_a_turns_the_robot_and_cancel_that_stops_only_it(up: Up) -> None
 
 
 def test_an_answer_to_zone_b_or_zone_d_is_weighed_as_an_answer(up: Up) -> None:
-    sent = talk(up, "flite:awb", "send placebot one to zone c")
-    assert sent["speech"].startswith("Placebot one is on its way to zone C."), sent
+    send_placebot_one_to_c(up, "flite:awb")
     # "no, zone b": B and D are the letters the hearing confuses, so it asks
     asked = talk(up, "flite:awb", "no, zone b")
     assert asked["speech"] == "Zone B or zone D?", asked
@@ -124,8 +128,7 @@ def test_music_moves_nothing_and_says_so(up: Up) -> None:
 
 
 def test_not_that_robot_is_confirmed_with_a_spoken_yes(up: Up) -> None:
-    sent = talk(up, "flite:rms", "send placebot one to zone c")
-    assert sent["speech"].startswith("Placebot one is on its way to zone C."), sent
+    send_placebot_one_to_c(up, "flite:rms")
     asked = talk(up, "flite:rms", "not that robot")
     assert asked["speech"] == "Placebot two instead?", asked
     # A yes to the skill's yes-or-no question is weighed as the answer (alone it is no
