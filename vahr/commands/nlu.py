@@ -75,6 +75,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"best guess  {understood.best_guess} (below the threshold)")
     if understood.sample:
         print(f"nearest     {understood.sample}")
+    if understood.needs_confirmation:
+        print(
+            f"roles       unsure (confidence {understood.roles_confidence:.2f}): "
+            "the simulator asks to confirm the reading before acting"
+        )
     for name, slot in printed["slots"].items():
         if slot["value"] is None:
             print(f"slot        {name}: (empty)")
@@ -105,7 +110,9 @@ def _model(args: argparse.Namespace) -> InteractionModel:
 
 def describe(understood: Understanding) -> dict[str, Any]:
     """The JSON of `vahr nlu --json`: `intent` and `slots` {NAME: {value, id}} (a contract in
-    DESIGN.md), plus each slot's resolution, the confidence and the nearest sample."""
+    DESIGN.md), plus each slot's resolution, the confidence, the nearest sample and how sure
+    the reading of which value fills which slot is (`roles_confidence`; below the threshold
+    the simulator confirms the reading before acting: `needs_confirmation`)."""
     slots: dict[str, dict[str, Any]] = {}
     for name in understood.declared or tuple(understood.slots):
         value = understood.slots.get(name)
@@ -125,6 +132,8 @@ def describe(understood: Understanding) -> dict[str, Any]:
         "confidence": round(understood.confidence, 4),
         "best_guess": understood.best_guess,
         "sample": understood.sample,
+        "roles_confidence": round(understood.roles_confidence, 4),
+        "needs_confirmation": understood.needs_confirmation,
     }
 
 

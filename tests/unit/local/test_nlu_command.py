@@ -56,6 +56,22 @@ def test_nlu_json_for_the_fallback_shows_the_guess_it_set_aside(
     assert printed["sample"] is None
 
 
+def test_nlu_says_when_the_simulator_would_confirm_the_reading_first(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # Nothing says which zone is for sunny weather and which for rain
+    utterance = "weather delivery for placebot one zone a zone c"
+    assert main(["nlu", utterance, "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert printed["needs_confirmation"] is True
+    assert printed["roles_confidence"] < 0.5
+    assert main(["nlu", utterance]) == 0
+    assert "roles       unsure (confidence " in capsys.readouterr().out
+    # A plain request is sure of its roles
+    assert main(["nlu", "send placebot one to zone a", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["needs_confirmation"] is False
+
+
 def test_an_empty_utterance_is_one_line_and_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["nlu", "  "]) == 2
     assert capsys.readouterr().err == "vahr nlu: error: the utterance is empty\n"
