@@ -9,6 +9,7 @@ module without AWS settings (the local stack, the tests) do not fail or pay for 
 
 from __future__ import annotations
 
+import contextvars
 import logging
 from typing import TYPE_CHECKING, Any
 
@@ -141,7 +142,11 @@ def _answering_malformed(
 
     def lambda_handler(event: dict[str, Any], context: Any) -> dict[str, Any]:
         try:
-            return handler(event, context)
+            # In a context of its own, so that what a request sets for itself (its
+            # language, `skill.catalog.use_locale`) ends with it: the local stack and the
+            # tests run many requests in one thread, and a German one must not leave the
+            # next English one speaking German.
+            return contextvars.copy_context().run(handler, event, context)
         except SerializationException as err:
             log_event("malformed_request", logging.ERROR, error=str(err)[:300])
             return _safe_answer()

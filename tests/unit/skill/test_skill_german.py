@@ -61,6 +61,15 @@ def test_a_german_launch_is_welcomed_in_german_and_an_english_one_in_english(ski
     assert speech(skill(load_event("alexa_launch"), None)).startswith("Welcome to robot fleet.")
 
 
+def test_a_german_request_leaves_the_next_words_english(skill: Any) -> None:
+    # The local stack answers many requests in one thread; what a German one set for
+    # itself ends with it
+    catalog.use_locale("en-US")
+    speech(skill(load_event("alexa_launch_de"), None))
+    assert catalog.current_locale() == "en-US"
+    assert prompts.WELCOME.startswith("Welcome to robot fleet.")
+
+
 def test_a_german_command_moves_the_robot_and_is_confirmed_in_german(
     skill: Any, robots: RobotDoubles
 ) -> None:
