@@ -15,6 +15,7 @@ from robot_agent.config import ExecutorSettings, SimSettings
 from robot_agent.core.executor import Executor
 
 if TYPE_CHECKING:
+    from robot_agent.backends.sim_ticker import SimTicker
     from robot_agent.voice.port import Voice
     from vahr.protocol import Event, Fleet, Reported
 
@@ -85,9 +86,13 @@ def make_executor(
     sim: SimSettings | None = None,
     settings: ExecutorSettings | None = None,
     speed: float = SPEED,
+    clock: ScaledClock | None = None,
+    ticker: SimTicker | None = None,
 ) -> tuple[Executor, Recorder, SimBackend]:
-    clock = ScaledClock(speed)
-    backend = SimBackend(start=fleet.robot(thing).start, clock=clock, settings=sim)
+    """A robot's executor on the simulator; robots given one `clock` and `ticker` share them
+    (as a swarm's do)."""
+    clock = clock or ScaledClock(speed)
+    backend = SimBackend(start=fleet.robot(thing).start, clock=clock, settings=sim, ticker=ticker)
     recorder = Recorder()
     executor = Executor(
         thing=thing,

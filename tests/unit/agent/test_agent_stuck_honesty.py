@@ -9,12 +9,10 @@ import contextlib
 import time
 from typing import TYPE_CHECKING
 
-from robot_agent.backends.sim import SimBackend
 from robot_agent.backends.sim_ticker import SimTicker
 from robot_agent.clock import ScaledClock
 from robot_agent.config import ExecutorSettings, SimSettings
-from robot_agent.core.executor import Executor
-from tests.unit.agent.conftest import SPEED, Recorder, make_executor, until_moved
+from tests.unit.agent.conftest import SPEED, make_executor, until_moved
 from vahr.protocol import new_command
 
 if TYPE_CHECKING:
@@ -119,24 +117,19 @@ async def test_a_stuck_robot_is_stuck_after_the_simulated_time_not_before(fleet:
 
 
 async def test_robots_sharing_a_ticker_are_stepped_by_one_timer(fleet: Fleet) -> None:
-    # Given three robots on one event loop with one ticker
+    # Given two robots on one event loop with one ticker
     clock = ScaledClock(SPEED)
     ticker = SimTicker(clock=clock, tick_s=SimSettings().tick_s)
-    recorders, executors = [], []
+    executors, recorders = [], []
     for thing in ("placebot1", "placebot2"):
-        backend = SimBackend(start=fleet.robot(thing).start, clock=clock, ticker=ticker)
-        recorder = Recorder()
-        executors.append(
-            Executor(
-                thing=thing,
-                fleet=fleet,
-                backend=backend,
-                clock=clock,
-                publish_state=recorder.states.append,
-                publish_event=recorder.events.append,
-                settings=ExecutorSettings(stuck_after_s=STUCK_AFTER_S),
-            )
+        executor, recorder, _ = make_executor(
+            fleet,
+            thing=thing,
+            clock=clock,
+            ticker=ticker,
+            settings=ExecutorSettings(stuck_after_s=STUCK_AFTER_S),
         )
+        executors.append(executor)
         recorders.append(recorder)
     # When both drive at once
     executors[0].execute(navigate("A", "t1"))
