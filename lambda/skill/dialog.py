@@ -1,7 +1,10 @@
 """Reading ROBOT and ZONE slots against the fleet, and asking again when they fall short.
 
 A value the words fit several ways ("zone b" heard as B or D) is asked about by name
-("Zone B or zone D?") rather than acted on; the answer fills the slot afresh.
+("Zone B or zone D?") rather than acted on; the answer fills the slot afresh. Zones named by
+letters that sound alike may also be answered by their spelling-alphabet words, which the
+reprompt offers ("You can also say bravo or delta."), as does the question when the skill
+has asked about the same command before.
 """
 
 from __future__ import annotations
@@ -9,7 +12,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from skill import prompts
-from skill.responses import answer, elicit, may_ask_again
+from skill.responses import answer, elicit, may_ask_again, questions_asked
 from skill.slots import read_slot
 from skill.vocabulary import LOADING, capitalise, join_choices
 
@@ -58,11 +61,17 @@ def ask_robot(
     return _ask(handler_input, runtime, reading.name, preface + question.format(choices=choices))
 
 
-def _ask(handler_input: HandlerInput, runtime: SkillRuntime, slot: str, question: str) -> Response:
+def _ask(
+    handler_input: HandlerInput, runtime: SkillRuntime, slot: str, question: str, hint: str = ""
+) -> Response:
+    """Elicit `slot` with `question`; `hint` (how else to answer) is in the reprompt, and in
+    the question itself once this command was asked about before."""
     # A person who keeps being misheard needs a way out, not a fourth question.
     if not may_ask_again(handler_input):
         return answer(handler_input, prompts.GIVE_UP.format(**runtime.vocabulary.examples()))
-    return elicit(handler_input, slot, question)
+    helped = f"{question} {hint}" if hint else question
+    asked_before = questions_asked(handler_input) > 1
+    return elicit(handler_input, slot, helped if asked_before else question, helped)
 
 
 def delivery_zone_problem(reading: SlotReading) -> bool:
@@ -84,13 +93,23 @@ def ask_zone(
     heard_as = [z for z in reading.choices if not (deliverable and z == LOADING)]
     if len(heard_as) > 1:
         names = [runtime.vocabulary.zone(zone_id) for zone_id in heard_as]
-        return _ask(handler_input, runtime, reading.name, which_of(names))
+        hint = spelled_choices(runtime, heard_as)
+        return _ask(handler_input, runtime, reading.name, which_of(names), hint)
     if reading.unresolved and not preface:
         preface = prompts.UNKNOWN_ZONE.format(heard=reading.heard)
     robot_name = runtime.vocabulary.robot(robot_id) if robot_id else ""
     choices = runtime.vocabulary.zone_choices(deliverable=deliverable)
     text = question.format(choices=choices, robot=robot_name)
     return _ask(handler_input, runtime, reading.name, preface + text)
+
+
+def spelled_choices(runtime: SkillRuntime, zone_ids: list[str]) -> str:
+    """"You can also say bravo or delta." when every zone of the choice answers to a
+    spelling-alphabet word, else ""."""
+    words = [runtime.vocabulary.spelled(zone_id) for zone_id in zone_ids]
+    if not all(words):
+        return ""
+    return prompts.SPELLED_CHOICES.format(choices=join_choices([str(word) for word in words]))
 
 
 def which_of(names: list[str]) -> str:

@@ -56,6 +56,9 @@ OTHER_WEATHER_RULE = (
 )
 # A value heard several ways is asked about by name: "Zone B or zone D?".
 ASK_WHICH_OF = "{choices}?"
+# Letters that sound alike (B, C, D) are told apart by their spelling-alphabet words, which
+# the question then offers: "Zone B or zone D? You can also say bravo or delta."
+SPELLED_CHOICES = "You can also say {choices}."
 GIVE_UP = (
     "Sorry, I still did not get that, so I sent nothing. Try, for example: send {robot} to {zone}."
 )

@@ -80,9 +80,15 @@ def may_ask_again(handler_input: HandlerInput) -> bool:
     attributes = _attributes(handler_input)
     if attributes is None:
         return True
-    asked = int(str(attributes.get(QUESTIONS, 0))) + 1
+    asked = questions_asked(handler_input) + 1
     attributes[QUESTIONS] = asked
     return asked <= MAX_QUESTIONS
+
+
+def questions_asked(handler_input: HandlerInput) -> int:
+    """How many questions the skill has asked for this command so far."""
+    attributes = _attributes(handler_input) or {}
+    return int(str(attributes.get(QUESTIONS, 0)))
 
 
 def _intent_with_slot(handler_input: HandlerInput, slot_name: str) -> tuple[Intent, Slot]:
@@ -99,15 +105,18 @@ def _intent_with_slot(handler_input: HandlerInput, slot_name: str) -> tuple[Inte
     return intent, slot
 
 
-def elicit(handler_input: HandlerInput, slot_name: str, question: str) -> Response:
-    """Ask for one slot (Dialog.ElicitSlot), forgetting any value that did not resolve."""
+def elicit(
+    handler_input: HandlerInput, slot_name: str, question: str, reprompt: str | None = None
+) -> Response:
+    """Ask for one slot (Dialog.ElicitSlot), forgetting any value that did not resolve; the
+    reprompt (what Alexa says when it did not get the answer) is the question unless given."""
     intent, slot = _intent_with_slot(handler_input, slot_name)
     slot.value = None
     slot.resolutions = None
     slot.slot_value = None
     return (
         handler_input.response_builder.speak(plain_text(question))
-        .ask(plain_text(question))
+        .ask(plain_text(reprompt or question))
         .add_directive(ElicitSlotDirective(updated_intent=intent, slot_to_elicit=slot_name))
         .response
     )

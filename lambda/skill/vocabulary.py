@@ -26,6 +26,15 @@ FLEET = FLEET_GROUP
 DEFAULT_FLEET_NAMES = FLEET_GROUP_NAMES
 # Packages are picked up here, so it is never a delivery destination.
 LOADING = "LOADING"
+# The ICAO spelling alphabet, by letter: radio operators say "bravo" for B because the
+# letters' own names (B, C, D, E...) are the hardest words for a listener to tell apart.
+SPELLING_ALPHABET = {
+    word[0]: word
+    for word in (
+        "alpha bravo charlie delta echo foxtrot golf hotel india juliett kilo lima mike "
+        "november oscar papa quebec romeo sierra tango uniform victor whiskey x-ray yankee zulu"
+    ).split()
+}
 
 
 def _upper_letters(name: str) -> str:
@@ -118,6 +127,17 @@ class Vocabulary:
             zone = next(zone for zone in self.fleet.zones if zone.id == zone_id)
             return _named_in_locale(spoken_in(zone, locale))
         return self._zone_names.get(zone_id, f"zone {zone_id}")
+
+    def spelled(self, zone_id: str) -> str | None:
+        """The spelling-alphabet word a zone named by a letter answers to ("bravo" for
+        zone B), when the fleet file lists it among the zone's names in this language."""
+        zone = next((zone for zone in self.fleet.zones if zone.id == zone_id), None)
+        if zone is None:
+            return None
+        names = {normalize(name) for name in spoken_in(zone, current_locale())}
+        letters = {name.split()[-1] for name in names if len(name.split()[-1]) == 1}
+        words = [SPELLING_ALPHABET.get(letter) for letter in sorted(letters)]
+        return next((word for word in words if word in names), None)
 
     def robot_id(self, heard: str) -> str | None:
         """The id for a spoken robot name (or thing name), if the fleet has one."""

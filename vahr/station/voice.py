@@ -10,7 +10,8 @@ weight is not acted on, and a robot or zone the hearing is unsure of is asked ab
 the best transcript (origin `station-voice`) and what the recognizer heard alongside.
 
 A clip with no speech, or speech understood as nothing the skill does (out of domain,
-music, noise, a ramble) changes nothing and gets `SORRY`, which says so.
+music, noise, a ramble) changes nothing and gets `SORRY`, which says so; while the skill
+waits for an answer, followed by the skill's reprompt, as an Echo does.
 
 With the simulator in this process (`vahr up`) the weighed understanding is handed to it
 as is. An assistant reached over HTTP re-reads words, so it gets the best transcript only
@@ -173,17 +174,27 @@ class PushToTalk:
             "turn": None,
         }
         if not recognition.accepted or not recognition.text:
-            return result
+            return self._not_caught(result)
         weighed = self.weigh(recognition)
         heard["weighed"] = weighed.to_json()
         understanding = weighed.understanding
         if understanding.intent == FALLBACK:
-            return result
+            return self._not_caught(result)
         heard["accepted"] = True
         turn = self._ask(recognition.text, heard, weighed)
         result["turn"] = turn
         if turn.get("intent") not in (None, FALLBACK):
             result.update(understood=True, speech=turn.get("speech") or "")
+        return result
+
+    def _not_caught(self, result: dict[str, Any]) -> dict[str, Any]:
+        """`result` (SORRY); while the skill waits for an answer, with its reprompt after,
+        as an Echo says it when it did not catch the answer ("Zone B or zone D? You can
+        also say bravo or delta."): the question is still open."""
+        if isinstance(self.assistant, SimulatorAssistant):
+            pending = self.assistant.simulator.pending
+            if pending is not None and pending.reprompt:
+                result["speech"] = f"{SORRY} {pending.reprompt}"
         return result
 
     def _ask(self, text: str, heard: dict[str, Any], weighed: Weighed) -> dict[str, Any]:

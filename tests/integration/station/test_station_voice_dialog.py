@@ -2,7 +2,8 @@
 voices built from recordings of people: a whole command answering "which robot?" never
 keeps the old zone (the hearing, unsure, asks "Zone A or zone D?"); "no, zone a" turns
 the robot the last command sent and "cancel that" stops only it; an answer to "Zone B or
-zone D?" is weighed as an answer; a correction with nothing to correct, and a chord of music, move nothing and
+zone D?" is weighed as an answer, and asked again it offers "bravo or delta", which the
+hearing tells apart; an answer not caught gets the question again; a correction with nothing to correct, and a chord of music, move nothing and
 say so. The same cases typed are in tests/integration/local/test_dialog_corrections.py."""
 
 from __future__ import annotations
@@ -59,6 +60,26 @@ def eventually(up: Up, thing: str, **wanted: Any) -> dict[str, Any]:
         time.sleep(0.2)
 
 
+def type_in(up: Up, text: str) -> dict[str, Any]:
+    """`text` typed at the station (`POST /api/say`), in the same conversation as its voice."""
+    request = urllib.request.Request(
+        up.endpoints["station"] + "/api/say",
+        data=json.dumps({"utterance": text}).encode(),
+        headers={"Content-Type": "application/json"},
+    )
+    with urllib.request.urlopen(request, timeout=30) as answer:
+        reply: dict[str, Any] = json.loads(answer.read())
+        return reply
+
+
+def music() -> Audio:
+    """Three seconds of a chord on a beat: nothing a recognizer of commands can catch."""
+    seconds = np.arange(3 * 16_000) / 16_000
+    chord = sum(np.sin(2 * np.pi * f * seconds) for f in (261.6, 329.6, 392.0, 523.3))
+    beat = (np.sin(2 * np.pi * 2 * seconds) > 0) * 0.5 + 0.5
+    return Audio.from_samples(chord * beat * 4000)
+
+
 def send_placebot_one_to_c(up: Up, voice: str) -> None:
     """The command the corrections below correct, spoken and acted on."""
     sent = talk(up, voice, "send placebot one to zone c")
@@ -72,8 +93,9 @@ def test_a_whole_command_answering_which_robot_is_acted_on_with_its_own_zone(up:
     # When the answer is a whole command naming another zone
     answer = talk(up, "flite:rms", "robot two please go to zone a")
     # Then the old zone does not win: some of the hearing's readings lack a zone (and so
-    # keep D), so the station asks which of the two was meant
-    assert answer["speech"] == "Zone A or zone D?", answer
+    # keep D), so the station asks which of the two was meant (the second question about
+    # this command, so with the letters' spelling-alphabet words)
+    assert answer["speech"] == "Zone A or zone D? You can also say alpha or delta.", answer
     assert answer["turn"]["commands"] == []
     # (nothing moved meanwhile: neither the old zone nor a guess)
     assert all(state.get("last_command") is None for state in robots(up).values())
@@ -104,11 +126,35 @@ def test_an_answer_to_zone_b_or_zone_d_is_weighed_as_an_answer(up: Up) -> None:
     asked = talk(up, "flite:awb", "no, zone b")
     assert asked["speech"] == "Zone B or zone D?", asked
     # The answer is weighed as an answer to that question (not as a request of its own,
-    # which "zone b" alone is not): still unsure between the two, it asks again
+    # which "zone b" alone is not): still unsure between the two, it asks again, now
+    # offering the spelling-alphabet words
     again = talk(up, "flite:awb", "zone b")
-    assert again["speech"] == "Zone B or zone D?", again
+    assert again["speech"] == "Zone B or zone D? You can also say bravo or delta.", again
     assert again["heard"]["weighed"]["intent"] == "CorrectionIntent"
     assert robots(up)["placebot1"]["destination"] == "C"
+    # which the hearing tells apart
+    done = talk(up, "flite:awb", "bravo")
+    assert done["speech"].startswith("Okay, not zone C. Placebot one is on its way to zone B."), done
+    eventually(up, "placebot1", destination="B")
+
+
+def test_an_answer_not_caught_gets_the_question_again(up: Up) -> None:
+    # Given the question typed into being (the station's typing and its voice share the
+    # conversation)
+    assert type_in(up, "send placebot one to zone c")["commands"]
+    asked = type_in(up, "no, zone b or zone d")
+    assert asked["speech"] == "Zone B or zone D?", asked
+    # A clip heard as nothing: the question is still open, so it is asked again, with how
+    # else to answer it (as an Echo speaks the skill's reprompt)
+    answer = talk_to(up.endpoints["station"], music())
+    assert answer["speech"] == (
+        "Sorry, I didn't catch that. I sent nothing to the robots. "
+        "Zone B or zone D? You can also say bravo or delta."
+    ), answer
+    assert robots(up)["placebot1"]["destination"] == "C"
+    done = talk(up, "flite:rms", "delta")
+    assert done["speech"].startswith("Okay, not zone C. Placebot one is on its way to zone D."), done
+    eventually(up, "placebot1", destination="D")
 
 
 def test_a_correction_with_nothing_to_correct_says_so(up: Up) -> None:
@@ -118,10 +164,7 @@ def test_a_correction_with_nothing_to_correct_says_so(up: Up) -> None:
 
 
 def test_music_moves_nothing_and_says_so(up: Up) -> None:
-    seconds = np.arange(3 * 16_000) / 16_000
-    chord = sum(np.sin(2 * np.pi * f * seconds) for f in (261.6, 329.6, 392.0, 523.3))
-    beat = (np.sin(2 * np.pi * 2 * seconds) > 0) * 0.5 + 0.5
-    answer = talk_to(up.endpoints["station"], Audio.from_samples(chord * beat * 4000))
+    answer = talk_to(up.endpoints["station"], music())
     assert answer["understood"] is False
     assert "sent nothing to the robots" in answer["speech"]
     assert all(state.get("last_command") is None for state in robots(up).values())

@@ -99,10 +99,38 @@ def test_a_zone_heard_as_b_or_d_is_asked_about_instead_of_acted_on(skill: Any, a
     elicit = directive(response)
     assert (elicit["type"], elicit["slotToElicit"]) == ("Dialog.ElicitSlot", "zone")
     assert speech(response) == "Zone B or zone D?"
+    # Should the answer not be caught, the reprompt offers the letters' spelling-alphabet
+    # words, which are far easier to tell apart than B and D.
+    assert reprompt(response) == "Zone B or zone D? You can also say bravo or delta."
     # The robot already said is kept; the zone is asked afresh.
     assert elicit["updatedIntent"]["slots"]["robot"]["value"] == "placebot one"
     assert "value" not in elicit["updatedIntent"]["slots"]["zone"]
     assert published() == []
+
+
+def test_asked_again_about_b_or_d_the_question_offers_bravo_or_delta(skill: Any, aws: None) -> None:
+    # Given the skill already asked a question about this command
+    event = load_event("alexa_dialog_zone_ambiguous")
+    event["session"]["new"] = False
+    event["session"]["attributes"] = {"questions": 1}
+    # When the zone is still heard as B or D
+    response = skill(event, None)
+    # Then the question itself says how else to answer
+    assert speech(response) == "Zone B or zone D? You can also say bravo or delta."
+    assert directive(response)["slotToElicit"] == "zone"
+    assert published() == []
+
+
+def test_bravo_answers_the_zone_question(skill: Any, robots: Any) -> None:
+    event = load_event("alexa_dialog_zone_ambiguous")
+    zone = event["request"]["intent"]["slots"]["zone"]
+    # "bravo", read by the skill's own vocabulary (no entity resolution given)
+    zone["value"] = "bravo"
+    zone.pop("resolutions")
+    zone.pop("slotValue")
+    response = skill(event, None)
+    assert commands() == [("vahr/robots/placebot1/cmd", "navigate", {"zone": "B"})]
+    assert speech(response).startswith("Placebot one is on its way to zone B.")
 
 
 def test_an_answer_carrying_new_values_is_acted_on_with_them(skill: Any, robots: Any) -> None:

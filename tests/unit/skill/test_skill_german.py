@@ -8,7 +8,7 @@ import string
 from typing import Any
 
 import pytest
-from skill_testkit import RobotDoubles, speech
+from skill_testkit import RobotDoubles, reprompt, speech
 
 from skill import catalog, prompts
 from tests.conftest import load_event
@@ -85,3 +85,12 @@ def test_a_locale_without_a_catalog_is_answered_in_english(skill: Any) -> None:
     event = load_event("alexa_launch")
     event["request"]["locale"] = "fr-FR"
     assert speech(skill(event, None)).startswith("Welcome to robot fleet.")
+
+
+@pytest.mark.usefixtures("aws")
+def test_a_german_zone_question_offers_the_spelling_alphabet_in_german(skill: Any) -> None:
+    event = load_event("alexa_dialog_zone_ambiguous")
+    event["request"]["locale"] = "de-DE"
+    response = skill(event, None)
+    assert speech(response) == "Zone B oder Zone D?"
+    assert reprompt(response) == "Zone B oder Zone D? Du kannst auch bravo oder delta sagen."

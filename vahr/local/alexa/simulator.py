@@ -117,11 +117,13 @@ class Turn:
 @dataclass(frozen=True)
 class PendingDialog:
     """What the skill asked last: the intent so far (as its updatedIntent left it), the
-    directive, and the slot asked about (None for Dialog.ConfirmIntent)."""
+    directive, the slot asked about (None for Dialog.ConfirmIntent), and the reprompt, what
+    the device says when it did not catch the answer."""
 
     understanding: Understanding
     directive: str
     slot: str | None
+    reprompt: str | None = None
 
 
 @dataclass
@@ -374,9 +376,9 @@ class AlexaSimulator:
 
     def _confirm(self, session: _Session, utterance: str, understanding: Understanding) -> Turn:
         """Ask the person to confirm a reading too unsure to act on; nothing is sent yet."""
-        session.pending = PendingDialog(understanding, CONFIRM_INTENT, None)
         slot_types = self.model.intent_slots.get(understanding.intent, {})
         prompt = confirmation_prompt(understanding, slot_types, self.locale)
+        session.pending = PendingDialog(understanding, CONFIRM_INTENT, None, prompt)
         return Turn(
             utterance=utterance,
             speech=prompt,
@@ -527,5 +529,6 @@ def _pending(
                     kept[name] = value
         so_far = Understanding(understanding.intent, kept, understanding.declared, None)
         slot = directive.get("slotToElicit") or directive.get("slotToConfirm")
-        return PendingDialog(so_far, str(kind), str(slot) if slot else None)
+        reprompt = speech_text((body.get("reprompt") or {}).get("outputSpeech")) or None
+        return PendingDialog(so_far, str(kind), str(slot) if slot else None, reprompt)
     return None
