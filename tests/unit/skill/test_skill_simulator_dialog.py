@@ -102,3 +102,19 @@ def test_a_correction_reaches_a_one_shot_command_only_within_the_window(
     late = alexa.say("Alexa, ask robot fleet no, zone a")
     assert late.speech == "There is no command of mine to correct, so I changed nothing."
     assert [action for _, action, _ in commands()] == ["navigate", "navigate"]
+
+
+def test_the_station_corrects_by_typing_what_it_said_by_voice(
+    alexa: AlexaSimulator, robots: Any, clock: Clock
+) -> None:
+    # The operator at the station says a command into push-to-talk, then types its
+    # correction: one person at one station
+    alexa.say("Alexa, ask robot fleet to send placebot one to zone c", origin="station-voice")
+    clock.now += 5
+    corrected = alexa.say("Alexa, ask robot fleet no, zone b", origin="station")
+    assert corrected.speech.startswith("Okay, not zone C. Placebot one is on its way to zone B.")
+    # Someone else (the command line) has nothing of theirs to correct
+    clock.now += 5
+    other = alexa.say("Alexa, ask robot fleet cancel that", origin="say")
+    assert other.speech.startswith("There is no command of mine to cancel, so I changed nothing.")
+    assert [action for _, action, _ in commands()] == ["navigate", "navigate"]

@@ -46,7 +46,7 @@ import yaml
 from vahr.local.alexa import envelope
 from vahr.local.alexa.localized import invocation_patterns
 from vahr.local.alexa.nlu import FALLBACK, Understanding, normalize_utterance
-from vahr.protocol.conversation import CORRECTION_WINDOW_S, LAST_COMMAND_ATTRIBUTE
+from vahr.protocol.conversation import CORRECTION_WINDOW_S, LAST_COMMAND_ATTRIBUTE, speaker
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
@@ -247,7 +247,7 @@ class AlexaSimulator:
         self._session: _Session | None = None
         self._lock = threading.Lock()
         self._clock = clock
-        # origin -> (when, the skill's last command) of that origin's latest turn.
+        # speaker -> (when, the skill's last command) of that speaker's latest turn.
         self._recent: dict[str, tuple[float, Any]] = {}
         self._origin = "say"
         longest = max((len(text.split()) for text in model.training[0]), default=0)
@@ -338,7 +338,7 @@ class AlexaSimulator:
     def _new_session(self) -> _Session:
         """A fresh session, holding the speaker's last command while it may be corrected."""
         session = _Session()
-        recent = self._recent.get(self._origin)
+        recent = self._recent.get(speaker(self._origin))
         if recent is not None and self._clock() - recent[0] <= CORRECTION_WINDOW_S:
             session.attributes[LAST_COMMAND_ATTRIBUTE] = recent[1]
         return session
@@ -472,7 +472,10 @@ class AlexaSimulator:
         ended = request.object_type == "SessionEndedRequest" or body.get("shouldEndSession", True)
         attributes = response.get("sessionAttributes") or {}
         if LAST_COMMAND_ATTRIBUTE in attributes:
-            self._recent[self._origin] = (self._clock(), attributes[LAST_COMMAND_ATTRIBUTE])
+            self._recent[speaker(self._origin)] = (
+                self._clock(),
+                attributes[LAST_COMMAND_ATTRIBUTE],
+            )
         if ended:
             self._session = None
         else:
