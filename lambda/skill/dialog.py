@@ -55,7 +55,13 @@ def ask_robot(
     if reading.choices:
         names = [runtime.vocabulary.robot(thing) for thing in reading.choices]
         return _ask(handler_input, runtime, reading.name, which_of(names))
-    if reading.unresolved and not preface:
+    # A name the fleet has left unresolved was withheld (the words did not say whose it
+    # is), not unknown: the question alone says what is needed.
+    if (
+        reading.unresolved
+        and not preface
+        and runtime.vocabulary.robot_id(str(reading.heard)) is None
+    ):
         preface = prompts.UNKNOWN_ROBOT.format(heard=reading.heard)
     choices = runtime.vocabulary.robot_choices(include_fleet=include_fleet)
     return _ask(handler_input, runtime, reading.name, preface + question.format(choices=choices))
@@ -95,7 +101,11 @@ def ask_zone(
         names = [runtime.vocabulary.zone(zone_id) for zone_id in heard_as]
         hint = spelled_choices(runtime, heard_as)
         return _ask(handler_input, runtime, reading.name, which_of(names), hint)
-    if reading.unresolved and not preface:
+    if (
+        reading.unresolved
+        and not preface
+        and runtime.vocabulary.zone_id(str(reading.heard)) is None
+    ):
         preface = prompts.UNKNOWN_ZONE.format(heard=reading.heard)
     robot_name = runtime.vocabulary.robot(robot_id) if robot_id else ""
     choices = runtime.vocabulary.zone_choices(deliverable=deliverable)
@@ -104,7 +114,7 @@ def ask_zone(
 
 
 def spelled_choices(runtime: SkillRuntime, zone_ids: list[str]) -> str:
-    """"You can also say bravo or delta." when every zone of the choice answers to a
+    """ "You can also say bravo or delta." when every zone of the choice answers to a
     spelling-alphabet word, else ""."""
     words = [runtime.vocabulary.spelled(zone_id) for zone_id in zone_ids]
     if not all(words):

@@ -158,3 +158,17 @@ def test_a_slot_left_out_of_the_request_is_added_to_the_updated_intent(
     slot, updated_intent = elicited(skill(request, None))
     assert slot == "zone"
     assert updated_intent["slots"]["zone"] == {"name": "zone", "confirmationStatus": "NONE"}
+
+
+def test_a_robot_the_fleet_has_but_left_unresolved_is_asked_for_without_calling_it_unknown(
+    skill: Any, aws: None
+) -> None:
+    # "placebot one" was said, but the words did not say whose it is (the NLU withheld it),
+    # so it comes unresolved: the skill asks, and does not claim not to know placebot one
+    request = load_event("alexa_navigate_robot_no_match")
+    robot = request["request"]["intent"]["slots"]["robot"]
+    robot["value"] = robot["slotValue"]["value"] = "placebot one"
+    response = skill(request, None)
+    assert elicited(response)[0] == "robot"
+    assert speech(response) == f"Which robot: {ROBOTS}?"
+    assert published() == []
