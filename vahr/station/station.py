@@ -13,6 +13,7 @@ start-up; it subscribes the feed, reads every robot's shadow once, and serves th
 from __future__ import annotations
 
 import logging
+import os
 import shutil
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -35,6 +36,10 @@ if TYPE_CHECKING:
     from vahr.station.voice import PushToTalk
 
 log = logging.getLogger(__name__)
+
+# `VAHR_WHISPER=off` leaves push-to-talk to pocketsphinx alone (no second ear: a smaller,
+# quicker station on a machine that has little to spare).
+WHISPER_ENV = "VAHR_WHISPER"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -89,11 +94,18 @@ class Station:
         self.link.publish(topic, payload, qos=1)
 
     def _push_to_talk(self, assistant: Assistant) -> PushToTalk:
-        from vahr.station.vocabulary import command_recognizer
+        from vahr.station.vocabulary import command_recognizer, whisper_prompt
         from vahr.station.voice import PushToTalk
 
         model_file, fleet = self.config.model_file, self.fleet
-        return PushToTalk(assistant, lambda: command_recognizer(model_file, fleet))
+        second_ear = None
+        if os.environ.get(WHISPER_ENV, "on") != "off":
+            from vahr.speech.whisper_stt import WhisperTranscriber
+
+            def second_ear() -> WhisperTranscriber:
+                return WhisperTranscriber(whisper_prompt(fleet))
+
+        return PushToTalk(assistant, lambda: command_recognizer(model_file, fleet), second_ear)
 
     @property
     def url(self) -> str:

@@ -25,10 +25,11 @@ import logging
 import threading
 import time
 import wave
-from typing import TYPE_CHECKING, Any
+from concurrent.futures import ThreadPoolExecutor
+from typing import TYPE_CHECKING, Any, Protocol
 
 from vahr.errors import VahrError
-from vahr.local.alexa import Weighed, Weighing, weigh_recognition
+from vahr.local.alexa import Weighed, Weighing, agreement, weigh_recognition
 from vahr.local.client import SimulatorAssistant
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio
 from vahr.speech.errors import SpeechError
@@ -40,6 +41,13 @@ if TYPE_CHECKING:
     from vahr.local.alexa import InteractionModel
     from vahr.local.client import Assistant
     from vahr.speech.stt import Recognition, Recognizer
+
+
+class Transcriber(Protocol):
+    """A second recognizer: what it heard in a clip, as text (`WhisperTranscriber`)."""
+
+    def transcribe(self, audio: Audio) -> str: ...
+
 
 log = logging.getLogger(__name__)
 
@@ -105,12 +113,24 @@ class PushToTalk:
     ships with the package (built on first use).
     """
 
-    def __init__(self, assistant: Assistant, recognizer: Callable[[], Recognizer]) -> None:
+    def __init__(
+        self,
+        assistant: Assistant,
+        recognizer: Callable[[], Recognizer],
+        second_ear: Callable[[], Transcriber] | None = None,
+    ) -> None:
+        """`second_ear` makes a second recognizer (Whisper) whose transcript, where it
+        agrees with the first's, is acted on at once; without it, or when it cannot be
+        made (said once in the log), the N best alone decide."""
         self.assistant = assistant
         self._make = recognizer
         self._recognizer: Recognizer | None = None
+        self._make_second = second_ear
+        self._second: Transcriber | None = None
         self._model: InteractionModel | None = None
         self._lock = threading.Lock()
+        # The second ear listens while the first does.
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="station-second-ear")
 
     def warm_up(self) -> threading.Thread:
         thread = threading.Thread(target=self._warm, name="station-recognizer", daemon=True)
@@ -118,6 +138,7 @@ class PushToTalk:
         return thread
 
     def _warm(self) -> None:
+        self.second_ear()
         try:
             self.recognizer()
         except (VahrError, SpeechError) as err:
@@ -130,6 +151,32 @@ class PushToTalk:
                 self._recognizer = self._make()
             return self._recognizer
 
+    def second_ear(self) -> Transcriber | None:
+        """The second recognizer, made on first use; None without one (or when it could
+        not be made: said once, then push-to-talk hears with the first alone)."""
+        with self._lock:
+            make, self._make_second = self._make_second, None
+            if make is not None:
+                try:
+                    self._second = make()
+                except SpeechError as err:
+                    log.warning("push-to-talk hears with pocketsphinx alone: %s", err)
+            return self._second
+
+    def _listen_twice(self, audio: Audio) -> tuple[Recognition, str | None]:
+        """The first recognizer's recognition and the second ear's transcript (None
+        without one), heard at the same time."""
+        second = self.second_ear()
+        heard_too = self._pool.submit(second.transcribe, audio) if second else None
+        recognition = self.recognizer().recognize(audio)
+        if heard_too is None:
+            return recognition, None
+        try:
+            return recognition, heard_too.result()
+        except Exception:  # the second ear is a help: never the reason a press fails
+            log.exception("push-to-talk: the second recognizer failed on a clip")
+            return recognition, None
+
     def model(self) -> InteractionModel:
         if isinstance(self.assistant, SimulatorAssistant):
             return self.assistant.simulator.model
@@ -140,12 +187,18 @@ class PushToTalk:
                 self._model = InteractionModel.load()
             return self._model
 
-    def weigh(self, recognition: Recognition) -> Weighed:
+    def weigh(self, recognition: Recognition, second: str | None = None) -> Weighed:
         """The understanding of a recognition's N best (its transcript alone without); with
         the simulator in this process each reading is read in the dialog under way, so an
-        answer to the skill's question ("zone b" to "Zone B or zone D?") is weighed as one."""
+        answer to the skill's question ("zone b" to "Zone B or zone D?") is weighed as one.
+        A second ear's transcript (`second`) read alike to the best transcript is acted on
+        as heard (`agreement`)."""
         if isinstance(self.assistant, SimulatorAssistant):
             simulator = self.assistant.simulator
+            if second:
+                both = agreement(simulator.model, second, recognition.text, simulator.reading)
+                if both is not None:
+                    return both
             answer = simulator.yes_or_no(recognition.text)
             if answer is not None and recognition.confidence >= Weighing().min_word_posterior:
                 # A yes or a no to the skill's yes-or-no question, which said back all it
@@ -153,12 +206,14 @@ class PushToTalk:
                 # are mostly that word with noise around it ("yes it", "yes you").
                 return Weighed(answer, recognition.confidence, {}, 1)
             return weigh_recognition(simulator.model, recognition, reading=simulator.reading)
-        return weigh_recognition(self.model(), recognition)
+        model = self.model()
+        both = agreement(model, second, recognition.text) if second else None
+        return both or weigh_recognition(model, recognition)
 
     def handle(self, wav: bytes) -> dict[str, Any]:
         audio = read_clip(wav)
         started = time.perf_counter()
-        recognition = self.recognizer().recognize(audio)
+        recognition, second = self._listen_twice(audio)
         recognizer_ms = round((time.perf_counter() - started) * 1000, 1)
         heard: dict[str, Any] = {
             "transcript": recognition.text,
@@ -166,6 +221,8 @@ class PushToTalk:
             "accepted": False,
             "seconds": round(audio.seconds, 2),
         }
+        if second is not None:
+            heard["second"] = second
         result: dict[str, Any] = {
             "heard": heard,
             "recognizer_ms": recognizer_ms,
@@ -175,7 +232,7 @@ class PushToTalk:
         }
         if not recognition.accepted or not recognition.text:
             return self._not_caught(result)
-        weighed = self.weigh(recognition)
+        weighed = self.weigh(recognition, second)
         heard["weighed"] = weighed.to_json()
         understanding = weighed.understanding
         if understanding.intent == FALLBACK:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from vahr.local.alexa.nbest import MIN_SLOT_CONFIDENCE, Weighing, posteriors, weigh
+from vahr.local.alexa.nbest import MIN_SLOT_CONFIDENCE, Weighing, agreement, posteriors, weigh
 from vahr.local.alexa.nlu import FALLBACK, InteractionModel, Understanding
 from vahr.speech.stt import Hypothesis
 
@@ -104,3 +104,36 @@ def test_speech_about_something_else_moves_nothing(understand: object, readings:
 
 def test_no_reading_at_all_is_the_fallback(understand: object) -> None:
     assert weigh([], understand).understanding.intent == FALLBACK  # type: ignore[arg-type]
+
+
+@pytest.fixture(scope="module")
+def model() -> InteractionModel:
+    return InteractionModel.load()
+
+
+def test_two_hearings_read_alike_are_acted_on(model: InteractionModel) -> None:
+    # Written apart by two recognizers (punctuation and capitals are Whisper's), read alike
+    both = agreement(model, "Send placebot one to zone C.", "send placebot one to zone c")
+    assert both is not None and both.agreed
+    assert both.understanding.intent == "NavigateIntent"
+    assert {name: value.id for name, value in both.understanding.slots.items()} == {
+        "robot": "placebot1",
+        "zone": "C",
+    }
+    assert both.slot_confidence == {"robot": 1.0, "zone": 1.0}
+
+
+@pytest.mark.parametrize(
+    ("heard", "confirming"),
+    [
+        ("Send placebot one to zone G.", "send placebot one to zone d"),  # another zone
+        ("Send placebot one to zone B.", "send placebot one to zone d"),  # the classic pair
+        ("Send placebot two to zone D.", "send placebot one to zone d"),  # another robot
+        ("Send placebot one to zone D.", "send placebot one"),  # the zone heard by one only
+        ("What is a conveyor belt?", "what is a conveyor belt"),  # alike, but no request
+    ],
+)
+def test_two_hearings_that_differ_in_what_moves_a_robot_are_weighed_instead(
+    model: InteractionModel, heard: str, confirming: str
+) -> None:
+    assert agreement(model, heard, confirming) is None

@@ -12,6 +12,7 @@ import pytest
 from vahr.protocol.text import spell_numbers
 from vahr.speech.pronounce import arpabet, compound_phones
 from vahr.speech.stt import NOTHING_HEARD, Hypothesis, Recognition
+from vahr.speech.errors import SpeechError
 from vahr.station.errors import RequestError
 from vahr.station.vocabulary import load_model, sentences
 from vahr.station.voice import SORRY, PushToTalk, read_clip
@@ -191,3 +192,67 @@ def test_a_thousand_robots_share_out_their_names_and_each_is_heard() -> None:
     for value in robots["values"]:
         name = spell_numbers(value["name"]["value"].lower())
         assert heard.count(f" {name} ") >= 2, name
+
+
+class SecondEar:
+    """A second recognizer that hears what it is told to, or fails."""
+
+    def __init__(self, text: str | Exception) -> None:
+        self.text = text
+
+    def transcribe(self, audio: Audio) -> str:
+        if isinstance(self.text, Exception):
+            raise self.text
+        return self.text
+
+
+def split_b_and_d() -> Recognition:
+    """The N best split between zone B and zone D: weighed alone, it is asked about."""
+    readings = ["send placebot one to zone b", "send placebot one to zone d"]
+    hypotheses = tuple(Hypothesis(text, -60.0 * rank) for rank, text in enumerate(readings))
+    return Recognition(readings[0], 0.6, True, hypotheses=hypotheses)
+
+
+def test_a_second_ear_that_agrees_with_the_best_transcript_is_acted_on() -> None:
+    assistant = Assistant("NavigateIntent")
+    ears = PushToTalk(
+        assistant,
+        lambda: Heard(split_b_and_d()),
+        lambda: SecondEar("Send placebot one to zone B."),
+    )
+    result = ears.handle(wav())
+    ((utterance, _, sent),) = assistant.asked
+    assert utterance == "send placebot one to zone b"
+    assert sent is not None and sent["second"] == "Send placebot one to zone B."
+    assert sent["weighed"]["agreed"] is True
+    assert result["understood"] is True
+
+
+@pytest.mark.parametrize(
+    "second",
+    [
+        "Send placebot one to zone D.",  # it hears the other zone
+        RuntimeError("the model crashed"),  # it fails on this clip
+    ],
+)
+def test_without_agreement_the_n_best_decide(second: str | Exception) -> None:
+    assistant = Assistant("NavigateIntent")
+    ears = PushToTalk(assistant, lambda: Heard(split_b_and_d()), lambda: SecondEar(second))
+    result = ears.handle(wav())
+    # The zone is asked about, as the first recognizer's N best alone would have it
+    assert assistant.asked == []
+    assert result["speech"] == "Did you say zone b or zone d? Please say it again."
+    assert result["heard"]["weighed"]["agreed"] is False
+
+
+def test_a_second_ear_that_cannot_be_made_leaves_the_first_alone(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    def missing() -> SecondEar:
+        raise SpeechError("Whisper's weights are not installed: run `make setup`")
+
+    assistant = Assistant("NavigateIntent")
+    heard = Recognition("send placebot two to zone c", 0.81, True)
+    result = PushToTalk(assistant, lambda: Heard(heard), missing).handle(wav())
+    assert result["understood"] is True and "second" not in result["heard"]
+    assert "pocketsphinx alone: Whisper's weights are not installed" in caplog.text

@@ -14,12 +14,13 @@ experiment out of them (pyproject.toml, docs/architecture.md):
   `confirmation_phrases` (the yes and no it takes) and `RULE_SLOTS` (the weather rule's
   slots): what a vocabulary of the model is made from;
 - `weigh_recognition`, `Weighed` and `Weighing` (`nbest`): a recognizer's N best weighed
-  into one understanding, unsure robots and zones asked about.
+  into one understanding, unsure robots and zones asked about; `agreement`: two
+  recognizers' readings acted on when they agree.
 """
 
 from vahr.local.alexa.background import built_in_phrases
 from vahr.local.alexa.commands_seen import CommandLog
-from vahr.local.alexa.nbest import Weighed, Weighing, weigh_recognition
+from vahr.local.alexa.nbest import Weighed, Weighing, agreement, weigh_recognition
 from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel
 from vahr.local.alexa.simulator import AlexaSimulator, Turn, confirmation_phrases
 from vahr.local.alexa.skill import load_skill_handler
@@ -37,6 +38,7 @@ __all__ = [
     "Turn",
     "Weighed",
     "Weighing",
+    "agreement",
     "built_in_phrases",
     "confirmation_phrases",
     "load_skill_handler",

@@ -74,6 +74,8 @@ class Weighed:
     # Slot name -> P(the value acted on or asked about), for the robot and zone slots.
     slot_confidence: dict[str, float]
     readings: int
+    # Heard alike by two recognizers (`agreement`) rather than weighed from the N best.
+    agreed: bool = False
 
     def to_json(self) -> dict[str, object]:
         return {
@@ -81,6 +83,7 @@ class Weighed:
             "intent_confidence": round(self.intent_confidence, 3),
             "slots": {name: round(p, 3) for name, p in self.slot_confidence.items()},
             "readings": self.readings,
+            "agreed": self.agreed,
         }
 
 
@@ -157,16 +160,56 @@ def weigh_recognition(
     """`weigh` over a recognition's N best (its transcript alone when it has none), each
     read by `reading` (the simulator's, in the dialog under way), else by `model` as the
     simulator reads a request (the invocation taken off)."""
+    if not recognition.accepted or recognition.confidence < weighing.min_word_posterior:
+        nothing = Understanding(FALLBACK, confidence=1.0)
+        return Weighed(nothing, 0.0, {}, 0)
+    hypotheses = recognition.hypotheses or (Hypothesis(recognition.text, 0.0),)
+    return weigh(hypotheses, reading or _request_reader(model), weighing)
+
+
+def agreement(
+    model: InteractionModel,
+    heard: str,
+    confirming: str,
+    reading: Callable[[str], Understanding] | None = None,
+) -> Weighed | None:
+    """The reading of `heard` to act on at once, when it is a request and a second,
+    independent hearing of the same clip (`confirming`) reads as the same intent with the
+    same robots and zones, each heard as one value; None otherwise (the N best are weighed
+    instead). Each is read by `reading` (the simulator's, in the dialog under way), else as
+    a request. Two recognizers that err differently rarely make the same mistake: on the
+    development voices, of the requests both heard alike none moved a robot other than
+    said (docs/voice.md)."""
+    read = reading or _request_reader(model)
+    first, second = read(heard), read(confirming)
+    if first.intent == FALLBACK or _moving(model, first) != _moving(model, second):
+        return None
+    confidence = {name: 1.0 for name, _ in _moving(model, first)[1]}
+    return Weighed(first, 1.0, confidence, 2, agreed=True)
+
+
+def _request_reader(model: InteractionModel) -> Callable[[str], Understanding]:
+    """Words read as the simulator reads a request: the invocation taken off."""
     from vahr.local.alexa.simulator import strip_invocation
 
     def understand(text: str) -> Understanding:
         return model.understand(strip_invocation(model.invocation_name, text))
 
-    if not recognition.accepted or recognition.confidence < weighing.min_word_posterior:
-        nothing = Understanding(FALLBACK, confidence=1.0)
-        return Weighed(nothing, 0.0, {}, 0)
-    hypotheses = recognition.hypotheses or (Hypothesis(recognition.text, 0.0),)
-    return weigh(hypotheses, reading or understand, weighing)
+    return understand
+
+
+def _moving(
+    model: InteractionModel, understanding: Understanding
+) -> tuple[str, tuple[tuple[str, str | None], ...]]:
+    """The intent and its robot and zone values (None for one asked about or unresolved):
+    what two hearings must share to be acted on."""
+    types = model.intent_slots.get(understanding.intent, {})
+    values = (
+        (name, None if value.alternatives else value.id)
+        for name, value in understanding.slots.items()
+        if types.get(name) in MOVING_TYPES
+    )
+    return understanding.intent, tuple(sorted(values))
 
 
 def _value_shares(

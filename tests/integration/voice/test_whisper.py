@@ -1,0 +1,61 @@
+"""Whisper, push-to-talk's second ear, on this machine: its weights are checked before they
+are loaded, and it writes a spoken command with the fleet's names as the skill spells them."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import pytest
+
+from tests.support.push_to_talk import clip
+from vahr.protocol.fleet import load_fleet
+from vahr.speech.errors import SpeechError
+from vahr.speech.whisper_stt import MODEL_ENV, WhisperTranscriber, check_weights, model_directory
+from vahr.station.vocabulary import whisper_prompt
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+
+@pytest.fixture(scope="module")
+def whisper() -> WhisperTranscriber:
+    return WhisperTranscriber(whisper_prompt(load_fleet()))
+
+
+def test_the_prompt_names_every_robot_and_zone_of_the_fleet() -> None:
+    assert whisper_prompt(load_fleet()) == (
+        "Robot fleet: send placebot one to zone A. Placebot two, go to the loading zone. "
+        "Deliver to zone A, zone B, zone C or zone D."
+    )
+
+
+def test_a_command_in_a_voice_built_from_a_person_is_written_with_the_fleets_names(
+    whisper: WhisperTranscriber,
+) -> None:
+    heard = whisper.transcribe(clip("flite:rms", "send placebot two to the loading zone"))
+    assert heard.lower().rstrip(".") == "send placebot two to the loading zone"
+
+
+def test_silence_is_written_as_nothing_a_robot_could_act_on(whisper: WhisperTranscriber) -> None:
+    from vahr.speech.audio import Audio
+
+    heard = whisper.transcribe(Audio.silence(2.0))
+    assert "placebot" not in heard.lower()
+
+
+def test_weights_that_are_not_tiny_ens_are_refused(tmp_path: Path) -> None:
+    with pytest.raises(SpeechError, match="does not exist"):
+        check_weights(tmp_path)
+    (tmp_path / "model.bin").write_bytes(b"not the weights")
+    with pytest.raises(SpeechError, match="is not tiny.en's"):
+        check_weights(tmp_path)
+
+
+def test_the_weights_come_from_the_setting_when_given(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv(MODEL_ENV, str(tmp_path))
+    assert model_directory() == tmp_path
+    with pytest.raises(SpeechError, match="is not tiny.en's"):
+        (tmp_path / "model.bin").write_bytes(b"x")
+        WhisperTranscriber("Robot fleet.")
