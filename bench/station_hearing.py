@@ -19,6 +19,11 @@ An outcome is `right` (intent and slots as labelled), `wrong` (another robot com
 any robot command for an out-of-domain sentence), `asks` (the right intent with a robot
 or zone asked about or for) or `no action` (nothing heard, or the fallback).
 
+With the second ear (Whisper, `vahr/speech/whisper_stt.py`): the development clips are
+also transcribed by Whisper told the fleet's names (`whisper_prompt`), and scored as the
+station decides: a request Whisper and pocketsphinx's best transcript read alike is acted
+on, anything else is weighed as above (`agreement`). Nothing of it is tuned.
+
 Bad input (silence, white noise, a synthetic chord as music, a 19 s ramble of
 out-of-domain sentences) is heard too: none may move a robot. The time from the end of a
 clip to the understanding (recognizer plus weighing) is taken for the clips of 2.5 to 3.5 s.
@@ -48,13 +53,21 @@ from vahr.local.alexa.evaluation import (  # noqa: E402
     LabelledUtterance,
     outcome,
 )
-from vahr.local.alexa.nbest import MOVING_TYPES, Weighing, posteriors, weigh  # noqa: E402
+from vahr.local.alexa.nbest import (  # noqa: E402
+    MOVING_TYPES,
+    Weighing,
+    agreement,
+    posteriors,
+    weigh,
+)
 from vahr.local.alexa.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
 from vahr.local.alexa.simulator import strip_invocation  # noqa: E402
+from vahr.protocol.fleet import load_fleet  # noqa: E402
 from vahr.speech.audio import Audio, concatenate  # noqa: E402
 from vahr.speech.stt import Hypothesis, Recognition  # noqa: E402
 from vahr.speech.tts import engine_of, make_synthesizer  # noqa: E402
-from vahr.station.vocabulary import command_recognizer  # noqa: E402
+from vahr.speech.whisper_stt import WhisperTranscriber  # noqa: E402
+from vahr.station.vocabulary import command_recognizer, whisper_prompt  # noqa: E402
 
 TUNING_SET = DEVELOPMENT_SET.with_name("tuning-en-US.yaml")
 TUNING_EVERY = 12
@@ -136,6 +149,36 @@ def hear(recognizer: object, items: list[tuple[LabelledUtterance, str]]) -> list
     return clips
 
 
+def hear_again(whisper: WhisperTranscriber, clips: list[Clip]) -> dict[int, tuple[str, float]]:
+    """Whisper's transcript and seconds for each clip (by its index), kept beside the clip
+    (keyed by the prompt too), so a second run only re-reads."""
+    prompt_key = hashlib.sha256(whisper.prompt.encode()).hexdigest()[:12]
+    found = {}
+    for n, clip in enumerate(clips):
+        key = hashlib.sha256(f"{clip.voice}\n{clip.item.text}".encode()).hexdigest()[:24]
+        kept = CACHE / f"{key}.whisper-{prompt_key}.json"
+        if kept.is_file():
+            saved = json.loads(kept.read_text())
+        else:
+            started = time.perf_counter()
+            text = whisper.transcribe(spoken(clip.voice, clip.item.text))
+            saved = {"text": text, "seconds": time.perf_counter() - started}
+            kept.write_text(json.dumps(saved))
+        found[n] = (saved["text"], saved["seconds"])
+    return found
+
+
+def decide_with_second_ear(
+    clip: Clip, second: str, read: Reader, weighing: Weighing
+) -> Understanding:
+    """What the station acts on with its second ear: the agreement, else the weighing."""
+    if second and clip.recognition.text:
+        both = agreement(read.model, second, clip.recognition.text, read)
+        if both is not None:
+            return both.understanding
+    return decide(clip, read, weighing)
+
+
 class Reader:
     """The NLU's reading of each transcript, each read once."""
 
@@ -160,10 +203,21 @@ def decide(clip: Clip, read: Reader, weighing: Weighing) -> Understanding:
     return weigh(hypotheses, read, weighing).understanding
 
 
-def tally(clips: list[Clip], read: Reader, weighing: Weighing) -> dict[str, int]:
+def tally(
+    clips: list[Clip],
+    read: Reader,
+    weighing: Weighing,
+    seconds: dict[int, str] | None = None,
+) -> dict[str, int]:
+    """Outcomes of `clips`; with `seconds` (the second ear's transcript of each clip, by
+    index), as the station decides with it."""
     counts = {"right": 0, "wrong": 0, "asks": 0, "no action": 0, "ood": 0, "ood acted": 0}
-    for clip in clips:
-        result = outcome(read.model, clip.item, decide(clip, read, weighing))
+    for n, clip in enumerate(clips):
+        if seconds is None:
+            got = decide(clip, read, weighing)
+        else:
+            got = decide_with_second_ear(clip, seconds[n], read, weighing)
+        result = outcome(read.model, clip.item, got)
         if clip.item.intent == FALLBACK:
             counts["ood"] += 1
             counts["ood acted"] += result == "wrong"
@@ -291,6 +345,25 @@ def main() -> int:
     best_only = row(
         "human-like voices, acting on every reading (thresholds 0)", tally(human_like, read, single)
     )
+    whisper = WhisperTranscriber(whisper_prompt(load_fleet()))
+    second_ear = {voice: hear_again(whisper, clips) for voice, clips in development.items()}
+    second_rows = "\n".join(
+        row(v, tally(c, read, used, {n: t for n, (t, _) in second_ear[v].items()}))
+        for v, c in development.items()
+    )
+    human_second: dict[int, str] = {}
+    for voice in development:
+        if engine_of(voice) != "espeak-ng":
+            offset = len(human_second)
+            human_second.update({offset + n: t for n, (t, _) in second_ear[voice].items()})
+    second_human = row("human-like voices together", tally(human_like, read, used, human_second))
+    station_human = row("human-like voices together", tally(human_like, read, used))
+    whisper_3s = [
+        second_ear[v][n][1]
+        for v, clips in development.items()
+        for n, c in enumerate(clips)
+        if 2.5 <= c.seconds <= 3.5
+    ]
     near_3s = [
         c.recognizer_s for cs in (tuning, *development.values()) for c in cs
         if 2.5 <= c.seconds <= 3.5
@@ -334,6 +407,23 @@ were not among the tuning voices):
 {header}
 {engine_rows}
 {best_only}
+
+**With the second ear** (Whisper tiny.en told "{whisper.prompt}"; a request it and
+pocketsphinx's best transcript read alike is acted on, anything else weighed as above; the
+same development clips, nothing tuned):
+
+{header}
+{second_rows}
+{second_human}
+
+and, for comparison, the N best alone over the same human-like clips:
+
+{header}
+{station_human}
+
+Whisper takes median {median(whisper_3s) * 1000:.0f} ms, p95
+{percentile(whisper_3s, 95) * 1000:.0f} ms for the clips of 2.5 to 3.5 s, beside pocketsphinx
+(both at once on the station).
 
 Bad input, none of which may move a robot:
 

@@ -6,8 +6,10 @@ by a recognizer whose vocabulary comes from the skill's interaction model
 (`vocabulary.py`). Its N best transcripts are each understood by the simulator's NLU and
 weighed into one understanding (`vahr.local.alexa.nbest`): an intent heard with too little of the
 weight is not acted on, and a robot or zone the hearing is unsure of is asked about
-("Zone B or zone D?") instead of acted on. The understanding goes to the assistant with
-the best transcript (origin `station-voice`) and what the recognizer heard alongside.
+("Zone B or zone D?") instead of acted on. A second ear (Whisper, made by the station)
+transcribes the clip at the same time; a request it and the best transcript read alike is
+acted on at once (`agreement`). The understanding goes to the assistant with the best
+transcript (origin `station-voice`) and what was heard alongside.
 
 A clip with no speech, or speech understood as nothing the skill does (out of domain,
 music, noise, a ramble) changes nothing and gets `SORRY`, which says so; while the skill

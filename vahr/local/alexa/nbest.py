@@ -21,6 +21,9 @@ the fallback. Then:
 
 The four constants are chosen on the tuning voices only (`bench/station_hearing.py`,
 docs/voice.md "Push-to-talk: asking when unsure").
+
+A second recognizer that errs differently (Whisper, beside pocketsphinx) is used by
+`agreement`: a request both transcripts read alike is acted on without weighing.
 """
 
 from __future__ import annotations
