@@ -299,10 +299,17 @@ def test_a_precompiled_bundle_loads_from_byte_code_and_stays_under_the_limit(
     compiled = lambda_asset.build(tmp_path / "compiled", compile_with=lambda_python())
     assert compiled.size_bytes < MAX_UNZIPPED_BYTES
     # When a clean 3.12 that may not write byte code imports the handler
-    script = "import skill.app, ask_sdk_model, sys; print(skill.app.__cached__)"
+    script = (
+        "import skill.app, ask_sdk_model, marshal, sys; print(skill.app.__cached__); "
+        "print(marshal.loads(open(skill.app.__cached__, 'rb').read()[16:]).co_filename)"
+    )
     result = run_in_lambda_python(compiled.out_dir, script)
     # Then it loads, and its byte code is the bundle's own
     assert result.returncode == 0, result.stderr
-    cached = Path(result.stdout.strip())
+    cached_line, compiled_as = result.stdout.split()
+    cached = Path(cached_line)
     assert cached.name == "app.cpython-312.pyc" and cached.is_file()
     assert cached.is_relative_to(compiled.out_dir)
+    # and names its source where Lambda puts it, not where it was built (so the bundle's
+    # bytes, and its size, do not depend on the build directory)
+    assert compiled_as == "/var/task/skill/app.py"
