@@ -217,6 +217,9 @@ class _Handler(QuietHandler):
         if not station.open_stream():
             self.refuse(503, f"at most {MAX_STREAMS} pages at once")
             return
+        if station.app.push_to_talk is not None:
+            # Someone is at the page and may talk: Whisper's weights are loaded now.
+            station.app.push_to_talk.warm_second_ear()
         feed = station.app.feed
         subscriber = feed.subscribe()
         self.close_connection = True

@@ -107,7 +107,8 @@ class PushToTalk:
     """Recognize a clip, weigh its readings, and pass the understanding to the assistant.
 
     The recognizer is built on first use, or ahead of it in the background with `warm_up`
-    (building one takes a moment; the first press should not wait for it). The recognizer
+    (building one takes a moment; the first press should not wait for it); the second ear
+    likewise, ahead of it with `warm_second_ear`. The recognizer
     that `vocabulary.command_recognizer` makes has its language model made in a child
     process, so the warm-up thread mostly waits, leaving the interpreter lock to the
     station's MQTT intake. The NLU is the
@@ -131,6 +132,8 @@ class PushToTalk:
         self._second: Transcriber | None = None
         self._model: InteractionModel | None = None
         self._lock = threading.Lock()
+        self._second_lock = threading.Lock()
+        self._warming_second = False
         # The second ear listens while the first does.
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="station-second-ear")
 
@@ -139,8 +142,16 @@ class PushToTalk:
         thread.start()
         return thread
 
+    def warm_second_ear(self) -> None:
+        """Make the second ear in the background, once (the station asks when a page
+        opens: a stack nobody talks to never loads Whisper's weights)."""
+        with self._second_lock:
+            if self._make_second is None or self._warming_second:
+                return
+            self._warming_second = True
+        threading.Thread(target=self.second_ear, name="station-second-ear", daemon=True).start()
+
     def _warm(self) -> None:
-        self.second_ear()
         try:
             self.recognizer()
         except (VahrError, SpeechError) as err:
@@ -156,7 +167,7 @@ class PushToTalk:
     def second_ear(self) -> Transcriber | None:
         """The second recognizer, made on first use; None without one (or when it could
         not be made: said once, then push-to-talk hears with the first alone)."""
-        with self._lock:
+        with self._second_lock:
             make, self._make_second = self._make_second, None
             if make is not None:
                 try:

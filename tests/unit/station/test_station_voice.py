@@ -4,6 +4,7 @@ words are pronounced, and what the page is answered for speech, silence and nons
 from __future__ import annotations
 
 import io
+import threading
 import wave
 from typing import TYPE_CHECKING, Any
 
@@ -256,3 +257,22 @@ def test_a_second_ear_that_cannot_be_made_leaves_the_first_alone(
     result = PushToTalk(assistant, lambda: Heard(heard), missing).handle(wav())
     assert result["understood"] is True and "second" not in result["heard"]
     assert "pocketsphinx alone: Whisper's weights are not installed" in caplog.text
+
+
+def test_the_second_ear_is_made_once_in_the_background_when_asked() -> None:
+    made: list[SecondEar] = []
+    ready = threading.Event()
+
+    def make() -> SecondEar:
+        made.append(SecondEar("Send placebot two to zone C."))
+        ready.set()
+        return made[-1]
+
+    heard = Recognition("send placebot two to zone c", 0.81, True)
+    ears = PushToTalk(Assistant("NavigateIntent"), lambda: Heard(heard), make)
+    assert made == []  # nothing loaded until someone may talk
+    ears.warm_second_ear()
+    ears.warm_second_ear()
+    assert ready.wait(5)
+    result = ears.handle(wav())
+    assert len(made) == 1 and result["heard"]["second"] == "Send placebot two to zone C."
