@@ -172,7 +172,7 @@ def decide_with_second_ear(
     clip: Clip, second: str, read: Reader, weighing: Weighing
 ) -> Understanding:
     """What the station acts on with its second ear: the agreement, else the weighing."""
-    if second and clip.recognition.text:
+    if second and clip.recognition.accepted and clip.recognition.text:
         both = agreement(read.model, second, clip.recognition.text, read)
         if both is not None:
             return both.understanding

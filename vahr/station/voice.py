@@ -7,8 +7,8 @@ by a recognizer whose vocabulary comes from the skill's interaction model
 weighed into one understanding (`vahr.local.alexa.nbest`): an intent heard with too little of the
 weight is not acted on, and a robot or zone the hearing is unsure of is asked about
 ("Zone B or zone D?") instead of acted on. A second ear (Whisper, made by the station)
-transcribes the clip at the same time; a request it and the best transcript read alike is
-acted on at once (`agreement`). The understanding goes to the assistant with the best
+transcribes the clip too when the best transcript reads as a request; a request both read
+alike is acted on at once (`agreement`). The understanding goes to the assistant with the best
 transcript (origin `station-voice`) and what was heard alongside.
 
 A clip with no speech, or speech understood as nothing the skill does (out of domain,
@@ -27,11 +27,10 @@ import logging
 import threading
 import time
 import wave
-from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any, Protocol
 
 from vahr.errors import VahrError
-from vahr.local.alexa import Weighed, Weighing, agreement, weigh_recognition
+from vahr.local.alexa import Weighed, Weighing, agreement, request_reader, weigh_recognition
 from vahr.local.client import SimulatorAssistant
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio
 from vahr.speech.errors import SpeechError
@@ -40,7 +39,7 @@ from vahr.station.errors import RequestError
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
 
-    from vahr.local.alexa import InteractionModel
+    from vahr.local.alexa import InteractionModel, Understanding
     from vahr.local.client import Assistant
     from vahr.speech.stt import Recognition, Recognizer
 
@@ -134,8 +133,6 @@ class PushToTalk:
         self._lock = threading.Lock()
         self._second_lock = threading.Lock()
         self._warming_second = False
-        # The second ear listens while the first does.
-        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="station-second-ear")
 
     def warm_up(self) -> threading.Thread:
         thread = threading.Thread(target=self._warm, name="station-recognizer", daemon=True)
@@ -177,18 +174,27 @@ class PushToTalk:
             return self._second
 
     def _listen_twice(self, audio: Audio) -> tuple[Recognition, str | None]:
-        """The first recognizer's recognition and the second ear's transcript (None
-        without one), heard at the same time."""
-        second = self.second_ear()
-        heard_too = self._pool.submit(second.transcribe, audio) if second else None
+        """The first recognizer's recognition, and the second ear's transcript when it can
+        matter: only a best transcript that reads as a request can be agreed with, so
+        silence, noise and talk of other things never wait for Whisper (which spends
+        seconds writing nothing for them)."""
         recognition = self.recognizer().recognize(audio)
-        if heard_too is None:
+        second = self.second_ear()
+        if second is None or not recognition.accepted or not recognition.text:
+            return recognition, None
+        if self._read(recognition.text).intent == FALLBACK:
             return recognition, None
         try:
-            return recognition, heard_too.result()
+            return recognition, second.transcribe(audio)
         except Exception:  # the second ear is a help: never the reason a press fails
             log.exception("push-to-talk: the second recognizer failed on a clip")
             return recognition, None
+
+    def _read(self, text: str) -> Understanding:
+        """`text` as the weighing reads it: in the dialog under way, or as a request."""
+        if isinstance(self.assistant, SimulatorAssistant):
+            return self.assistant.simulator.reading(text)
+        return request_reader(self.model())(text)
 
     def model(self) -> InteractionModel:
         if isinstance(self.assistant, SimulatorAssistant):

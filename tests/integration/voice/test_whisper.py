@@ -36,13 +36,6 @@ def test_a_command_in_a_voice_built_from_a_person_is_written_with_the_fleets_nam
     assert heard.lower().rstrip(".") == "send placebot two to the loading zone"
 
 
-def test_silence_is_written_as_nothing_a_robot_could_act_on(whisper: WhisperTranscriber) -> None:
-    from vahr.speech.audio import Audio
-
-    heard = whisper.transcribe(Audio.silence(2.0))
-    assert "placebot" not in heard.lower()
-
-
 def test_weights_that_are_not_tiny_ens_are_refused(tmp_path: Path) -> None:
     with pytest.raises(SpeechError, match="does not exist"):
         check_weights(tmp_path)

@@ -167,7 +167,7 @@ def weigh_recognition(
         nothing = Understanding(FALLBACK, confidence=1.0)
         return Weighed(nothing, 0.0, {}, 0)
     hypotheses = recognition.hypotheses or (Hypothesis(recognition.text, 0.0),)
-    return weigh(hypotheses, reading or _request_reader(model), weighing)
+    return weigh(hypotheses, reading or request_reader(model), weighing)
 
 
 def agreement(
@@ -183,7 +183,7 @@ def agreement(
     a request. Two recognizers that err differently rarely make the same mistake: on the
     development voices, of the requests both heard alike none moved a robot other than
     said (docs/voice.md)."""
-    read = reading or _request_reader(model)
+    read = reading or request_reader(model)
     first, second = read(heard), read(confirming)
     if first.intent == FALLBACK or _moving(model, first) != _moving(model, second):
         return None
@@ -191,8 +191,9 @@ def agreement(
     return Weighed(first, 1.0, confidence, 2, agreed=True)
 
 
-def _request_reader(model: InteractionModel) -> Callable[[str], Understanding]:
-    """Words read as the simulator reads a request: the invocation taken off."""
+def request_reader(model: InteractionModel) -> Callable[[str], Understanding]:
+    """Words read as the simulator reads a request (the invocation taken off), as the
+    N best are read without a simulator's dialog."""
     from vahr.local.alexa.simulator import strip_invocation
 
     def understand(text: str) -> Understanding:
