@@ -124,8 +124,8 @@ def table(tallies: dict[str, dict[str, Counter[str]]]) -> str:
 def main() -> int:
     tallies = run()
     body = (
-        "Each voice answers \"Zone B or zone D?\", \"Zone C or zone D?\" and \"Zone B or "
-        "zone C?\" for each of the two zones, in each form, on `vahr up` (station "
+        'Each voice answers "Zone B or zone D?", "Zone C or zone D?" and "Zone B or '
+        'zone C?" for each of the two zones, in each form, on `vahr up` (station '
         "constants as shipped, nothing tuned here). Repeating the letter in the same voice "
         "is decoded the same way, so it ends as the letter once did.\n\n" + table(tallies)
     )

@@ -11,9 +11,9 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from vahr.protocol.text import spell_numbers
+from vahr.speech.errors import SpeechError
 from vahr.speech.pronounce import arpabet, compound_phones
 from vahr.speech.stt import NOTHING_HEARD, Hypothesis, Recognition
-from vahr.speech.errors import SpeechError
 from vahr.station.errors import RequestError
 from vahr.station.vocabulary import load_model, sentences
 from vahr.station.voice import SORRY, PushToTalk, read_clip
