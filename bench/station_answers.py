@@ -18,10 +18,8 @@ Run: `.venv/bin/python bench/station_answers.py`.
 
 from __future__ import annotations
 
-import json
 import sys
 import tempfile
-import urllib.request
 from collections import Counter
 from pathlib import Path
 
@@ -32,6 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from station_hearing import spoken  # noqa: E402
 
 from tests.support.push_to_talk import talk  # noqa: E402
+from tests.support.push_to_talk import type_in as typed  # noqa: E402
 from tests.support.vahr_up import Up, start_up, stop_up  # noqa: E402
 from vahr.local.ports import free_port  # noqa: E402
 
@@ -56,13 +55,7 @@ def said(form: str, zone: str) -> str:
 
 
 def type_in(up: Up, text: str) -> str:
-    request = urllib.request.Request(
-        up.endpoints["station"] + "/api/say",
-        data=json.dumps({"utterance": text}).encode(),
-        headers={"Content-Type": "application/json"},
-    )
-    with urllib.request.urlopen(request, timeout=30) as answer:
-        return str(json.loads(answer.read())["speech"])
+    return str(typed(up.endpoints["station"], text)["speech"])
 
 
 def answer_once(up: Up, voice: str, pair: tuple[str, str], zone: str, form: str) -> str:

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from skill import prompts
 from skill.catalog import current_locale
 from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
-from vahr.protocol.fleet import SPOKEN_LOCALE, names_by_locale, spoken_in
+from vahr.protocol.fleet import SPOKEN_LOCALE, names_by_locale, spoken_in, zone_phrase
 from vahr.protocol.text import normalize
 
 if TYPE_CHECKING:
@@ -35,23 +35,6 @@ SPELLING_ALPHABET = {
         "november oscar papa quebec romeo sierra tango uniform victor whiskey x-ray yankee zulu"
     ).split()
 }
-
-
-def _upper_letters(name: str) -> str:
-    # "zone a" must be spoken as the letter, so single letters become capitals.
-    return " ".join(word.upper() if len(word) == 1 else word for word in name.split())
-
-
-def zone_phrase(zone: Zone) -> str:
-    """The zone's name as it reads inside a sentence: "zone A", "the loading zone"."""
-    names = [normalize(name) for name in zone.spoken]
-    with_zone = [name for name in names if "zone" in name.split()]
-    preferred = [name for name in with_zone if name.startswith("the ")] or with_zone
-    if preferred:
-        return _upper_letters(preferred[0])
-    if len(zone.id) <= 2:
-        return f"zone {zone.id}"
-    return _upper_letters(names[0] if names[0].startswith("the ") else f"the {names[0]}")
 
 
 def capitalise(sentence: str) -> str:

@@ -17,6 +17,7 @@ from typing import Annotated, Literal
 import msgspec
 
 from vahr.protocol.errors import ProtocolError, from_validation_error
+from vahr.protocol.text import normalize
 from vahr.protocol.topics import check_thing
 
 # The bundled fleet definition, next to this module: in a checkout a link to the repository's
@@ -312,6 +313,24 @@ def spoken_in(entry: Robot | Zone | Group, locale: str = SPOKEN_LOCALE) -> list[
             locale,
         )
     return entry.spoken
+
+
+def zone_phrase(zone: Zone) -> str:
+    """The zone's name as it reads inside a sentence, in en-US: "zone A", "the loading
+    zone" (its first name with "zone" in it, "the ..." preferred; single letters capitals,
+    as they are spoken as letters)."""
+    names = [normalize(name) for name in zone.spoken]
+    with_zone = [name for name in names if "zone" in name.split()]
+    preferred = [name for name in with_zone if name.startswith("the ")] or with_zone
+    if preferred:
+        return _upper_letters(preferred[0])
+    if len(zone.id) <= 2:
+        return f"zone {zone.id}"
+    return _upper_letters(names[0] if names[0].startswith("the ") else f"the {names[0]}")
+
+
+def _upper_letters(name: str) -> str:
+    return " ".join(word.upper() if len(word) == 1 else word for word in name.split())
 
 
 def _derived_floor(fleet: Fleet) -> Floor:

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 from vahr.errors import VahrError
 from vahr.local.alexa import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases, confirmation_phrases
+from vahr.protocol.fleet import zone_phrase
 from vahr.protocol.text import normalize, spell_numbers
 
 if TYPE_CHECKING:
@@ -192,7 +193,7 @@ def whisper_prompt(fleet: Fleet, invocation: str = "robot fleet") -> str:
     bar 1" and "zone be". For the default fleet: "Robot fleet: send placebot one to zone A.
     Placebot two, go to the loading zone. Deliver to zone A, zone B, zone C or zone D."."""
     robots = [fleet.spoken_name(thing) for thing in fleet.robot_things[:PROMPT_ROBOTS]]
-    zones = {zone.id: _zone_phrase(zone.spoken) for zone in fleet.zones}
+    zones = {zone.id: zone_phrase(zone) for zone in fleet.zones}
     loading = zones.pop("LOADING")
     delivery = list(zones.values()) or [loading]
     sentences = [f"send {robots[0]} to {delivery[0]}."]
@@ -200,12 +201,3 @@ def whisper_prompt(fleet: Fleet, invocation: str = "robot fleet") -> str:
     listed = ", ".join(delivery[:-1]) + f" or {delivery[-1]}" if len(delivery) > 1 else delivery[0]
     sentences.append(f"Deliver to {listed}.")
     return f"{invocation[:1].upper()}{invocation[1:]}: " + " ".join(sentences)
-
-
-def _zone_phrase(spoken: list[str]) -> str:
-    """A zone as a sentence names it: its first name with "zone" in it ("zone B", "the
-    loading zone"), else its first name; letters written as capitals."""
-    names = [normalize(name) for name in spoken]
-    with_zone = [name for name in names if "zone" in name.split()]
-    preferred = [name for name in with_zone if name.startswith("the ")] or with_zone or names
-    return " ".join(w.upper() if len(w) == 1 else w for w in preferred[0].split())

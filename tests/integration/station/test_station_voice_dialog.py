@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pytest
 
-from tests.support.push_to_talk import clip
+from tests.support.push_to_talk import clip, type_in
 from tests.support.push_to_talk import talk as talk_to
 from tests.support.vahr_up import Up, start_up, stop_up
 from vahr.local.ports import free_port
@@ -60,18 +60,6 @@ def eventually(up: Up, thing: str, **wanted: Any) -> dict[str, Any]:
         time.sleep(0.2)
 
 
-def type_in(up: Up, text: str) -> dict[str, Any]:
-    """`text` typed at the station (`POST /api/say`), in the same conversation as its voice."""
-    request = urllib.request.Request(
-        up.endpoints["station"] + "/api/say",
-        data=json.dumps({"utterance": text}).encode(),
-        headers={"Content-Type": "application/json"},
-    )
-    with urllib.request.urlopen(request, timeout=30) as answer:
-        reply: dict[str, Any] = json.loads(answer.read())
-        return reply
-
-
 def music() -> Audio:
     """Three seconds of a chord on a beat: nothing a recognizer of commands can catch."""
     seconds = np.arange(3 * 16_000) / 16_000
@@ -83,6 +71,14 @@ def music() -> Audio:
 def heading(state: dict[str, Any]) -> str | None:
     """Where a robot is going, or, arrived, where it is."""
     return state.get("destination") or state.get("zone")
+
+
+def answer_turns_placebot_one(up: Up, voice: str, answer: str, zone: str) -> None:
+    """`answer` to "Zone B or zone D?" turns placebot one from zone C to `zone`."""
+    done = talk(up, voice, answer)
+    turned = f"Okay, not zone C. Placebot one is on its way to zone {zone}."
+    assert done["speech"].startswith(turned), done
+    eventually(up, "placebot1", destination=zone)
 
 
 def send_placebot_one_to_c(up: Up, voice: str) -> None:
@@ -132,17 +128,14 @@ def test_an_answer_to_zone_b_or_zone_d_is_weighed_as_an_answer(up: Up) -> None:
     assert again["heard"]["weighed"]["intent"] == "CorrectionIntent"
     assert heading(robots(up)["placebot1"]) == "C"
     # which the hearing tells apart
-    done = talk(up, "flite:awb", "bravo")
-    turned = "Okay, not zone C. Placebot one is on its way to zone B."
-    assert done["speech"].startswith(turned), done
-    eventually(up, "placebot1", destination="B")
+    answer_turns_placebot_one(up, "flite:awb", "bravo", "B")
 
 
 def test_an_answer_not_caught_gets_the_question_again(up: Up) -> None:
     # Given the question typed into being (the station's typing and its voice share the
     # conversation)
-    assert type_in(up, "send placebot one to zone c")["commands"]
-    asked = type_in(up, "no, zone b or zone d")
+    assert type_in(up.endpoints["station"], "send placebot one to zone c")["commands"]
+    asked = type_in(up.endpoints["station"], "no, zone b or zone d")
     assert asked["speech"] == "Zone B or zone D?", asked
     # A clip heard as nothing: the question is still open, so it is asked again, with how
     # else to answer it (as an Echo speaks the skill's reprompt)
@@ -152,10 +145,7 @@ def test_an_answer_not_caught_gets_the_question_again(up: Up) -> None:
         "Zone B or zone D? You can also say bravo or delta."
     ), answer
     assert heading(robots(up)["placebot1"]) == "C"
-    done = talk(up, "flite:rms", "delta")
-    turned = "Okay, not zone C. Placebot one is on its way to zone D."
-    assert done["speech"].startswith(turned), done
-    eventually(up, "placebot1", destination="D")
+    answer_turns_placebot_one(up, "flite:rms", "delta", "D")
 
 
 def test_a_correction_with_nothing_to_correct_says_so(up: Up) -> None:
