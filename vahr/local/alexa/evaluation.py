@@ -23,12 +23,12 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
-from vahr.local.alexa.nlu import FALLBACK
+from vahr.local.alexa.nlu import FALLBACK, Understanding
 from vahr.local.alexa.simulator import strip_invocation
 from vahr.speech.scoring import OutcomeTally, read_labelled_set
 
 if TYPE_CHECKING:
-    from vahr.local.alexa.nlu import InteractionModel, Understanding
+    from vahr.local.alexa.nlu import InteractionModel
 
 DEVELOPMENT_SET = Path(__file__).resolve().parent / "data" / "devset-en-US.yaml"
 OUTCOMES = ("right", "wrong", "fallback", "asks")
@@ -125,6 +125,14 @@ def outcome(model: InteractionModel, item: LabelledUtterance, got: Understanding
     if all(said.get(name) == item.slots.get(name) for name in declared):
         return "right"
     return "asks"
+
+
+def labelled_understanding(model: InteractionModel, item: LabelledUtterance) -> Understanding:
+    """What `item` means, as an understanding: its intent and slots, each value said by its
+    canonical name (for the skill to be handed what the label means)."""
+    slots = {name: model.slot_value(item.intent, name, value) for name, value in item.slots.items()}
+    declared = tuple(model.intent_slots.get(item.intent, {}))
+    return Understanding(item.intent, slots, declared)
 
 
 def evaluate(model: InteractionModel, labelled: LabelledSet) -> Report:

@@ -284,6 +284,18 @@ class InteractionModel:
         `Understanding`, which is what it made of one utterance)."""
         return self._understanding
 
+    def slot_value(self, intent: str, slot: str, value_id: str) -> SlotValue:
+        """The slot `slot` of `intent` filled with the value `value_id`, said by its
+        canonical name (as a labelled set means it); raises VahrError for an unknown one."""
+        type_name = self.intent_slots.get(intent, {}).get(slot)
+        for slot_type in self._slot_types:
+            if slot_type.name != type_name:
+                continue
+            for found_id, canonical in slot_type.names.values():
+                if found_id == value_id:
+                    return SlotValue(slot, slot_type.name, canonical, found_id, canonical)
+        raise VahrError(f"{intent} has no slot {slot} with a value {value_id!r}")
+
     def wait_ready(self, timeout_s: float = BUILD_TIMEOUT_S) -> TextClassifier:
         """The classifier, once built; raises VahrError if building failed or timed out."""
         if not self._ready.wait(timeout_s):
