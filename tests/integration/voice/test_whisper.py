@@ -3,6 +3,7 @@ are loaded, and it writes a spoken command with the fleet's names as the skill s
 
 from __future__ import annotations
 
+import hashlib
 from typing import TYPE_CHECKING
 
 import pytest
@@ -10,7 +11,13 @@ import pytest
 from tests.support.push_to_talk import clip
 from vahr.protocol.fleet import load_fleet
 from vahr.speech.errors import SpeechError
-from vahr.speech.whisper_stt import MODEL_ENV, WhisperTranscriber, check_weights, model_directory
+from vahr.speech.whisper_stt import (
+    MODEL_ENV,
+    SHA256_ENV,
+    WhisperTranscriber,
+    check_weights,
+    model_directory,
+)
 from vahr.station.vocabulary import whisper_prompt
 
 if TYPE_CHECKING:
@@ -52,3 +59,26 @@ def test_the_weights_come_from_the_setting_when_given(
     with pytest.raises(SpeechError, match="is not tiny.en's"):
         (tmp_path / "model.bin").write_bytes(b"x")
         WhisperTranscriber("Robot fleet.")
+
+
+def test_other_weights_load_only_with_their_own_hash_given(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Given another model's directory (here tiny.en's files beside a model.bin of other bytes)
+    for name in ("config.json", "tokenizer.json", "vocabulary.txt"):
+        (tmp_path / name).symlink_to(model_directory() / name)
+    (tmp_path / "model.bin").write_bytes(b"a larger model")
+    monkeypatch.setenv(MODEL_ENV, str(tmp_path))
+    # Then without its hash it is refused as not tiny.en's, with a hash of other bytes too
+    with pytest.raises(SpeechError, match="is not tiny.en's"):
+        check_weights(model_directory())
+    monkeypatch.setenv(SHA256_ENV, "0" * 64)
+    with pytest.raises(SpeechError, match=f"does not have the SHA-256 in {SHA256_ENV}"):
+        check_weights(model_directory())
+    # And a setting that is no hash is named
+    monkeypatch.setenv(SHA256_ENV, "small.en")
+    with pytest.raises(SpeechError, match="is not a SHA-256"):
+        check_weights(model_directory())
+    # And with its own hash its weights pass the check
+    monkeypatch.setenv(SHA256_ENV, hashlib.sha256(b"a larger model").hexdigest().upper())
+    check_weights(model_directory())
