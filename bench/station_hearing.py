@@ -57,6 +57,7 @@ from vahr.local.alexa.nbest import (  # noqa: E402
     MOVING_TYPES,
     Weighing,
     agreement,
+    disputed,
     posteriors,
     weigh,
 )
@@ -171,12 +172,16 @@ def hear_again(whisper: WhisperTranscriber, clips: list[Clip]) -> dict[int, tupl
 def decide_with_second_ear(
     clip: Clip, second: str, read: Reader, weighing: Weighing
 ) -> Understanding:
-    """What the station acts on with its second ear: the agreement, else the weighing."""
-    if second and clip.recognition.accepted and clip.recognition.text:
-        both = agreement(read.model, second, clip.recognition.text, read)
-        if both is not None:
-            return both.understanding
-    return decide(clip, read, weighing)
+    """What the station acts on with its second ear: the agreement, else the weighing with
+    the values the two heard differently asked about. The station asks the second ear only
+    when the best transcript reads as a request (`PushToTalk._listen_twice`)."""
+    best = clip.recognition.text if clip.recognition.accepted else ""
+    if not second or not best or read(best).intent == FALLBACK:
+        return decide(clip, read, weighing)
+    both = agreement(read.model, second, best, read)
+    if both is not None:
+        return both.understanding
+    return disputed(read.model, decide(clip, read, weighing), read(second))
 
 
 class Reader:

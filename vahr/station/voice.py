@@ -27,10 +27,18 @@ import logging
 import threading
 import time
 import wave
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any, Protocol
 
 from vahr.errors import VahrError
-from vahr.local.alexa import Weighed, Weighing, agreement, request_reader, weigh_recognition
+from vahr.local.alexa import (
+    Weighed,
+    Weighing,
+    agreement,
+    disputed,
+    request_reader,
+    weigh_recognition,
+)
 from vahr.local.client import SimulatorAssistant
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio
 from vahr.speech.errors import SpeechError
@@ -211,23 +219,27 @@ class PushToTalk:
         the simulator in this process each reading is read in the dialog under way, so an
         answer to the skill's question ("zone b" to "Zone B or zone D?") is weighed as one.
         A second ear's transcript (`second`) read alike to the best transcript is acted on
-        as heard (`agreement`)."""
-        if isinstance(self.assistant, SimulatorAssistant):
-            simulator = self.assistant.simulator
-            if second:
-                both = agreement(simulator.model, second, recognition.text, simulator.reading)
-                if both is not None:
-                    return both
-            answer = simulator.yes_or_no(recognition.text)
-            if answer is not None and recognition.confidence >= Weighing().min_word_posterior:
-                # A yes or a no to the skill's yes-or-no question, which said back all it
-                # would do: taken from the best transcript, as the N best of one short word
-                # are mostly that word with noise around it ("yes it", "yes you").
-                return Weighed(answer, recognition.confidence, {}, 1)
-            return weigh_recognition(simulator.model, recognition, reading=simulator.reading)
-        model = self.model()
-        both = agreement(model, second, recognition.text) if second else None
-        return both or weigh_recognition(model, recognition)
+        as heard (`agreement`); a robot or zone it heard otherwise is asked about
+        (`disputed`)."""
+        simulator = (
+            self.assistant.simulator if isinstance(self.assistant, SimulatorAssistant) else None
+        )
+        model = simulator.model if simulator else self.model()
+        read = simulator.reading if simulator else request_reader(model)
+        if second:
+            both = agreement(model, second, recognition.text, read)
+            if both is not None:
+                return both
+        answer = simulator.yes_or_no(recognition.text) if simulator else None
+        if answer is not None and recognition.confidence >= Weighing().min_word_posterior:
+            # A yes or a no to the skill's yes-or-no question, which said back all it
+            # would do: taken from the best transcript, as the N best of one short word
+            # are mostly that word with noise around it ("yes it", "yes you").
+            return Weighed(answer, recognition.confidence, {}, 1)
+        weighed = weigh_recognition(model, recognition, reading=read)
+        if not second:
+            return weighed
+        return replace(weighed, understanding=disputed(model, weighed.understanding, read(second)))
 
     def handle(self, wav: bytes) -> dict[str, Any]:
         audio = read_clip(wav)

@@ -6,7 +6,15 @@ from __future__ import annotations
 
 import pytest
 
-from vahr.local.alexa.nbest import MIN_SLOT_CONFIDENCE, Weighing, agreement, posteriors, weigh
+from vahr.local.alexa.nbest import (
+    MIN_SLOT_CONFIDENCE,
+    Weighing,
+    agreement,
+    disputed,
+    posteriors,
+    request_reader,
+    weigh,
+)
 from vahr.local.alexa.nlu import FALLBACK, InteractionModel, Understanding
 from vahr.speech.stt import Hypothesis
 
@@ -137,3 +145,31 @@ def test_two_hearings_that_differ_in_what_moves_a_robot_are_weighed_instead(
     model: InteractionModel, heard: str, confirming: str
 ) -> None:
     assert agreement(model, heard, confirming) is None
+
+
+@pytest.mark.parametrize(
+    ("decided", "second", "asked"),
+    [
+        # The second ear heard zone B where the N best decided zone D: asked between the two
+        ("send placebot one to zone d", "Send placebot one to zone B.", {"zone": ("D", ["B"])}),
+        # ...or another robot: asked about the robot, the zone both heard stays
+        ("send placebot one to zone d", "Send placebot two to zone D.",
+         {"robot": ("placebot1", ["placebot2"])}),
+        # The same values, another intent, or a value it did not hear: nothing asked
+        ("send placebot one to zone d", "Send placebot one to zone D.", {}),
+        ("send placebot one to zone d", "What is a conveyor belt?", {}),
+        ("send placebot one to zone d", "Send placebot one.", {}),
+    ],
+)  # fmt: skip
+def test_a_value_two_hearings_dispute_is_asked_about(
+    model: InteractionModel, decided: str, second: str, asked: dict[str, object]
+) -> None:
+    read = request_reader(model)
+    found = disputed(model, read(decided), read(second))
+    questions = {
+        name: (value.id, [rival for rival, _ in value.alternatives])
+        for name, value in found.slots.items()
+        if value.alternatives
+    }
+    assert questions == asked
+    assert found.intent == read(decided).intent

@@ -246,6 +246,33 @@ def test_without_agreement_the_n_best_decide(second: str | Exception) -> None:
     assert result["heard"]["weighed"]["agreed"] is False
 
 
+@pytest.mark.parametrize(
+    ("second", "asked"),
+    [
+        # It hears the same command with zone B: the two ears dispute the zone
+        ("Send placebot one to zone B.", "Did you say zone d or zone b? Please say it again."),
+        # It hears something else altogether: the N best decide alone
+        ("What's the weather like?", None),
+    ],
+    ids=["another zone", "another intent"],
+)
+def test_a_zone_the_second_ear_heard_otherwise_is_asked_about(
+    second: str, asked: str | None
+) -> None:
+    # The N best alone are sure of zone D and would send the robot there
+    assistant = Assistant("NavigateIntent")
+    sure_of_d = Recognition("send placebot one to zone d", 0.9, True,
+                            hypotheses=(Hypothesis("send placebot one to zone d", 0.0),))  # fmt: skip
+    result = PushToTalk(assistant, lambda: Heard(sure_of_d), lambda: SecondEar(second)).handle(
+        wav()
+    )
+    if asked is None:
+        ((utterance, _, _),) = assistant.asked
+        assert utterance == "send placebot one to zone d" and result["understood"] is True
+    else:
+        assert assistant.asked == [] and result["speech"] == asked
+
+
 def test_a_second_ear_that_cannot_be_made_leaves_the_first_alone(
     caplog: pytest.LogCaptureFixture,
 ) -> None:

@@ -15,13 +15,21 @@ experiment out of them (pyproject.toml, docs/architecture.md):
   slots): what a vocabulary of the model is made from;
 - `weigh_recognition`, `Weighed` and `Weighing` (`nbest`): a recognizer's N best weighed
   into one understanding, unsure robots and zones asked about; `agreement`: two
-  recognizers' readings acted on when they agree; `request_reader` reads words as a
+  recognizers' readings acted on when they agree, and `disputed`: the values they heard
+  differently asked about; `request_reader` reads words as a
   request, and `Understanding` is what any reading gives.
 """
 
 from vahr.local.alexa.background import built_in_phrases
 from vahr.local.alexa.commands_seen import CommandLog
-from vahr.local.alexa.nbest import Weighed, Weighing, agreement, request_reader, weigh_recognition
+from vahr.local.alexa.nbest import (
+    Weighed,
+    Weighing,
+    agreement,
+    disputed,
+    request_reader,
+    weigh_recognition,
+)
 from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel, Understanding
 from vahr.local.alexa.simulator import AlexaSimulator, Turn, confirmation_phrases
 from vahr.local.alexa.skill import load_skill_handler
@@ -41,6 +49,7 @@ __all__ = [
     "Weighed",
     "Weighing",
     "agreement",
+    "disputed",
     "request_reader",
     "built_in_phrases",
     "confirmation_phrases",

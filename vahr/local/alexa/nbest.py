@@ -191,6 +191,27 @@ def agreement(
     return Weighed(first, 1.0, confidence, 2, agreed=True)
 
 
+def disputed(
+    model: InteractionModel, decided: Understanding, second: Understanding
+) -> Understanding:
+    """`decided` (weighed from the N best) with each robot or zone that a second hearing of
+    the same clip, read as the same intent, heard as another value made a question between
+    the two ("Zone B or zone D?"): two recognizers that disagree on a value are sure of
+    neither. Nothing is asked when the second hearing is of another intent, since then it
+    is the one more likely to have misheard the whole."""
+    if decided.intent == FALLBACK or second.intent != decided.intent:
+        return decided
+    types = model.intent_slots.get(decided.intent, {})
+    slots = dict(decided.slots)
+    for name, value in decided.slots.items():
+        other = second.slots.get(name)
+        if types.get(name) not in MOVING_TYPES or value.alternatives or other is None:
+            continue
+        if value.id is not None and other.id is not None and other.id != value.id:
+            slots[name] = replace(value, alternatives=((other.id, other.canonical or other.id),))
+    return replace(decided, slots=slots) if slots != decided.slots else decided
+
+
 def request_reader(model: InteractionModel) -> Callable[[str], Understanding]:
     """Words read as the simulator reads a request (the invocation taken off), as the
     N best are read without a simulator's dialog."""
