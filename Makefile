@@ -5,6 +5,9 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
+# pytest's workers. Three on two cores: much of the suite waits on brokers, stacks and
+# browsers, and a third worker fills that time (8.5 minutes against 10).
+WORKERS ?= 3
 # Debian packages the project runs: the MQTT broker, speech (sphinxtrain's tools remake the
 # hearing's acoustic adaptation), ROS 1 for the ros1 backend, and chromium for the operator
 # station's browser tests.
@@ -74,10 +77,10 @@ jstest: setup
 typecheck: setup
 	$(BIN)/mypy
 
-# Two workers, one per core: each test file runs whole on one worker, the longest files
-# first (tests/support/scheduling.py). The 90 s soak is not among them: `make soak-test`.
+# Each test file runs whole on one of $(WORKERS) workers, the longest files first
+# (tests/support/scheduling.py). The 90 s soak is not among them: `make soak-test`.
 pytest: setup
-	$(BIN)/pytest -q -n 2 --dist loadgroup -m "not soak"
+	$(BIN)/pytest -q -n $(WORKERS) --dist loadgroup -m "not soak"
 
 # The 90 s soak (docs/reliability.md): every fault under load. Not part of `make test`.
 soak-test: setup
@@ -87,7 +90,7 @@ soak-test: setup
 # passes only most of the time fails here (see docs/reliability.md).
 test-repeat: setup
 	for run in 1 2 3 4 5; do echo "integration run $$run of 5"; \
-		$(BIN)/pytest -q -n 2 --dist loadgroup -m "not soak" tests/integration || exit 1; done
+		$(BIN)/pytest -q -n $(WORKERS) --dist loadgroup -m "not soak" tests/integration || exit 1; done
 
 bench: setup
 	for script in bench/*.py; do case $$script in */_*) continue;; esac; $(BIN)/python $$script || exit 1; done

@@ -33,7 +33,7 @@ def pytest_configure() -> None:
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """The longest files run first, so that the two workers finish close together."""
+    """The longest files run first, so that the workers finish close together."""
     longest_files_first(items)
 
 

@@ -1,4 +1,4 @@
-"""How `pytest -n 2 --dist loadgroup` shares the suite between its two workers.
+"""How `pytest -n 3 --dist loadgroup` shares the suite between its workers.
 
 Each test file is one unit of work and runs whole on one worker, so its module fixtures (a
 stack, `vahr up`, a browser, a trained model) start once; every infra test is one unit,
@@ -12,7 +12,7 @@ read from the node id here, in the scheduler, instead.
 Units are handed out in collection order, which `longest_files_first` sets: the files whose
 tests declare a longer timeout of their own (the hearing acceptance, the installed package)
 go first, then the files with a test marked `slow`, so that no long file is left to start
-when the other worker has run out of work.
+when the other workers have run out of work.
 """
 
 from __future__ import annotations
