@@ -41,7 +41,7 @@ def test_every_listed_voice_names_its_engine() -> None:
     ],
 )
 def test_an_unknown_voice_is_refused_in_one_line(voice: str, says: str) -> None:
-    with pytest.raises(SpeechError, match="") as caught:
+    with pytest.raises(SpeechError) as caught:
         make_synthesizer(voice).synthesize("zone b")
     assert says in str(caught.value)
     assert "\n" not in str(caught.value)
