@@ -66,9 +66,9 @@ def expected_sha256() -> str:
     return configured
 
 
-def check_weights(directory: Path) -> None:
-    """SpeechError unless `directory` holds the expected model.bin (`expected_sha256`),
-    byte for byte."""
+def check_weights(directory: Path) -> str:
+    """The SHA-256 of `directory`'s model.bin; SpeechError unless it is the expected one
+    (`expected_sha256`)."""
     expected = expected_sha256()
     weights = directory / "model.bin"
     if not weights.is_file():
@@ -78,7 +78,7 @@ def check_weights(directory: Path) -> None:
         for block in iter(lambda: stream.read(1 << 20), b""):
             digest.update(block)
     if digest.hexdigest() == expected:
-        return
+        return expected
     if expected == MODEL_SHA256:
         raise SpeechError(f"{weights} is not tiny.en's (its SHA-256 differs): not loaded")
     raise SpeechError(f"{weights} does not have the SHA-256 in {SHA256_ENV}: not loaded")
@@ -93,7 +93,8 @@ class WhisperTranscriber:
         except ImportError as err:
             raise SpeechError("faster-whisper is not installed: run `make setup`") from err
         directory = directory or model_directory()
-        check_weights(directory)
+        # Which weights hear: what a measurement of this ear is kept under.
+        self.weights_sha256 = check_weights(directory)
         self.prompt = prompt
         self._model = WhisperModel(
             str(directory), device="cpu", compute_type="int8", cpu_threads=THREADS
