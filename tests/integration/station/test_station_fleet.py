@@ -165,16 +165,18 @@ def test_the_map_draws_the_fleet_on_a_canvas_in_clusters_and_a_click_selects_a_r
     page.evaluate("() => window.vahrStation.map.select(null)")
     box = page.locator("canvas.robot-layer").bounding_box()
     assert box is not None
-    single = eventually(
-        lambda: next(
-            (m for m in page.evaluate("() => window.vahrStation.map.layer.marks")
-             if len(m["things"]) == 1), None,
-        ),
-        "a robot drawn alone",
-    )  # fmt: skip
-    page.mouse.click(box["x"] + single["x"], box["y"] + single["y"])
-    # (it may have moved a little since: the nearest robot under the pointer is taken)
-    chosen = eventually(lambda: selected(page), "a robot selected by a click on the map")
+
+    def click_a_robot_drawn_alone() -> str | None:
+        # Where it is drawn now: the robots are driving, and on a busy machine one read a
+        # while ago may be out of the pointer's reach by the time of the click.
+        marks = page.evaluate("() => window.vahrStation.map.layer.marks")
+        single = next((m for m in marks if len(m["things"]) == 1), None)
+        if single is None:
+            return None
+        page.mouse.click(box["x"] + single["x"], box["y"] + single["y"])
+        return selected(page)
+
+    chosen = eventually(click_a_robot_drawn_alone, "a robot drawn alone, selected by a click")
     assert chosen.startswith("swarm")
     page.locator(f'.robot-row.selected[data-thing="{chosen}"]').wait_for(timeout=10_000)
 
