@@ -153,9 +153,8 @@ def hear(recognizer: object, items: list[tuple[LabelledUtterance, str]]) -> list
 def hear_again(whisper: WhisperTranscriber, clips: list[Clip]) -> dict[int, tuple[str, float]]:
     """Whisper's transcript and seconds for each clip (by its index), kept beside the clip
     (keyed by the prompt and the weights too), so a second run only re-reads."""
-    prompt_key = hashlib.sha256(f"{whisper.weights_sha256}\n{whisper.prompt}".encode()).hexdigest()[
-        :12
-    ]
+    heard_by = f"{whisper.weights_sha256}\n{whisper.prompt}"
+    prompt_key = hashlib.sha256(heard_by.encode()).hexdigest()[:12]
     found = {}
     for n, clip in enumerate(clips):
         key = hashlib.sha256(f"{clip.voice}\n{clip.item.text}".encode()).hexdigest()[:24]

@@ -55,7 +55,7 @@ HEADER = (
 )
 
 
-class Tally:
+class EffectTally:
     """Verdicts for requests and for out-of-domain sentences, and the wrong ones' texts."""
 
     def __init__(self) -> None:
@@ -74,6 +74,11 @@ class Tally:
             said_by = f" ({voice})" if voice else ""
             self.wrong.append(f'"{item.text}"{said_by}: {sent}')
 
+    def absorb(self, other: EffectTally) -> None:
+        self.requests.update(other.requests)
+        self.out_of_domain.update(other.out_of_domain)
+        self.wrong.extend(other.wrong)
+
     def row(self, name: str) -> str:
         asked = sum(self.requests.values())
         ood = sum(self.out_of_domain.values())
@@ -87,30 +92,30 @@ class Tally:
         )
 
 
-def typed(model: InteractionModel, effects: SkillEffects, file: Path) -> Tally:
-    tally, read = Tally(), Reader(model)
+def typed(model: InteractionModel, effects: SkillEffects, file: Path) -> EffectTally:
+    tally, read = EffectTally(), Reader(model)
     for item in LabelledSet.load(file).items():
         tally.add(effects, item, read(item.text))
     return tally
 
 
-def spoken(model: InteractionModel, effects: SkillEffects) -> dict[str, Tally]:
+def spoken(model: InteractionModel, effects: SkillEffects) -> dict[str, EffectTally]:
     """Per development voice, and the human-like voices together."""
     read, weighing = Reader(model), Weighing()
     recognizer = command_recognizer()
     whisper = WhisperTranscriber(whisper_prompt(load_fleet()))
     items = LabelledSet.load(DEVELOPMENT_SET).items()
-    tallies: dict[str, Tally] = {}
-    together = Tally()
+    tallies: dict[str, EffectTally] = {}
+    together = EffectTally()
     for voice in DEVELOPMENT_VOICES:
         clips = hear(recognizer, [(item, voice) for item in items])
         second = hear_again(whisper, clips)
-        tally = tallies[voice] = Tally()
+        tally = tallies[voice] = EffectTally()
         for n, clip in enumerate(clips):
             got = decide_with_second_ear(clip, second[n][0], read, weighing)
             tally.add(effects, clip.item, got, voice)
-            if engine_of(voice) != "espeak-ng":
-                together.add(effects, clip.item, got, voice)
+        if engine_of(voice) != "espeak-ng":
+            together.absorb(tally)
     tallies["human-like voices together"] = together
     return tallies
 
@@ -123,22 +128,23 @@ def main() -> int:
             f"typed: {ROLES_SET.name}": typed(model, effects, ROLES_SET),
         }
         heard = spoken(model, effects)
-    both = Tally()
+    both = EffectTally()
     for tally in text.values():
-        both.requests.update(tally.requests)
-        both.out_of_domain.update(tally.out_of_domain)
+        both.absorb(tally)
     text_rows = "\n".join(tally.row(name) for name, tally in text.items())
     heard_rows = "\n".join(tally.row(name) for name, tally in heard.items())
-    text_wrong = "\n".join(f"- {line}" for t in text.values() for line in t.wrong) or "- none"
+    text_wrong = "\n".join(f"- {line}" for line in both.wrong) or "- none"
     heard_wrong = "\n".join(
         f"- {line}" for line in heard["human-like voices together"].wrong
     ) or "- none"  # fmt: skip
     body = f"""
 Each reading handed to the real skill (the Alexa simulator, ask-sdk-core under moto, a
 fresh session, idle robots at the loading zone, a sunny experiment) and its commands
-compared with the label's (`bench/wrong_actions.py`). *Wrong actions* are requests that
-sent any command other than the label's; *nothing sent*, requests where the skill asked
-which robot or zone, asked to confirm, refused, or the station did not catch the words.
+compared with the label's (`bench/wrong_actions.py`). *Moved wrongly*: a request that sent
+a motion command the label does not (a robot sent where nobody asked); *stopped wrongly*:
+one that sent another command the label does not (a stop); *less or nothing sent*: the
+skill asked which robot or zone, asked to confirm, refused, or the station did not catch
+the words.
 
 Typed text, as the simulator understands it:
 
@@ -150,8 +156,9 @@ The wrong actions:
 
 {text_wrong}
 
-Push-to-talk, the development set spoken and decided as the station decides (its second
-ear, else the N best weighed with the station's constants):
+Push-to-talk, the development set spoken and decided as the station decides (what its two
+ears agree on, else the N best weighed with the station's constants, a robot or zone the
+ears dispute asked about):
 
 {HEADER}
 {heard_rows}

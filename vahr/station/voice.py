@@ -190,7 +190,7 @@ class PushToTalk:
         second = self.second_ear()
         if second is None or not recognition.accepted or not recognition.text:
             return recognition, None
-        if self._read(recognition.text).intent == FALLBACK:
+        if self._reader()(recognition.text).intent == FALLBACK:
             return recognition, None
         try:
             return recognition, second.transcribe(audio)
@@ -198,11 +198,12 @@ class PushToTalk:
             log.exception("push-to-talk: the second recognizer failed on a clip")
             return recognition, None
 
-    def _read(self, text: str) -> Understanding:
-        """`text` as the weighing reads it: in the dialog under way, or as a request."""
+    def _reader(self) -> Callable[[str], Understanding]:
+        """How the weighing reads words: in the dialog under way (the simulator in this
+        process), else as a request."""
         if isinstance(self.assistant, SimulatorAssistant):
-            return self.assistant.simulator.reading(text)
-        return request_reader(self.model())(text)
+            return self.assistant.simulator.reading
+        return request_reader(self.model())
 
     def model(self) -> InteractionModel:
         if isinstance(self.assistant, SimulatorAssistant):
@@ -224,8 +225,7 @@ class PushToTalk:
         simulator = (
             self.assistant.simulator if isinstance(self.assistant, SimulatorAssistant) else None
         )
-        model = simulator.model if simulator else self.model()
-        read = simulator.reading if simulator else request_reader(model)
+        model, read = self.model(), self._reader()
         if second:
             both = agreement(model, second, recognition.text, read)
             if both is not None:
