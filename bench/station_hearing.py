@@ -22,7 +22,8 @@ or zone asked about or for) or `no action` (nothing heard, or the fallback).
 With the second ear (Whisper, `vahr/speech/whisper_stt.py`): the development clips are
 also transcribed by Whisper told the fleet's names (`whisper_prompt`), and scored as the
 station decides: a request Whisper and pocketsphinx's best transcript read alike is acted
-on, anything else is weighed as above (`agreement`). Nothing of it is tuned.
+on (`agreement`), anything else is weighed as above, with a robot or zone the two heard
+differently asked about (`disputed`). Nothing of it is tuned.
 
 Bad input (silence, white noise, a synthetic chord as music, a 19 s ramble of
 out-of-domain sentences) is heard too: none may move a robot. The time from the end of a
@@ -415,8 +416,9 @@ were not among the tuning voices):
 {best_only}
 
 **With the second ear** (Whisper tiny.en told "{whisper.prompt}"; a request it and
-pocketsphinx's best transcript read alike is acted on, anything else weighed as above; the
-same development clips, nothing tuned):
+pocketsphinx's best transcript read alike is acted on, anything else weighed as above with
+a robot or zone the two heard differently asked about; the same development clips, nothing
+tuned):
 
 {header}
 {second_rows}
