@@ -31,9 +31,9 @@ from paho.mqtt.enums import CallbackAPIVersion, MQTTProtocolVersion
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from vahr.local.broker import BrokerConfig, Mosquitto  # noqa: E402
-from vahr.local.ports import free_port  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
 from vahr.protocol import topics  # noqa: E402
+from vahr.twin.broker import BrokerConfig, Mosquitto  # noqa: E402
 
 THING = "placebot1"
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")

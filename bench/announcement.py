@@ -41,10 +41,11 @@ from playwright.sync_api import sync_playwright  # noqa: E402
 from tests.support.browser import launch  # noqa: E402
 from tests.support.vahr_up import start_up, stop_up  # noqa: E402
 from vahr.announce import AnnounceSettings  # noqa: E402
-from vahr.local.client import call  # noqa: E402
-from vahr.local.mqtt import MqttClient, MqttEndpoint  # noqa: E402
-from vahr.local.ports import free_port  # noqa: E402
-from vahr.protocol import decode_event, load_fleet, topics  # noqa: E402
+from vahr.domain import load_fleet
+from vahr.plumbing.client import call  # noqa: E402
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
+from vahr.protocol import decode_event, topics
 from vahr.protocol.announcements import decode_announcement  # noqa: E402
 from vahr.protocol.broker import parse_broker_url  # noqa: E402
 

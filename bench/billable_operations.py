@@ -46,8 +46,8 @@ from infra.cost_estimate import (  # noqa: E402
     monthly_cost,
     operation_cost,
 )
-from vahr.local.ports import free_port  # noqa: E402
 from vahr.local.system import LocalSystem, SystemConfig  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
 
 if TYPE_CHECKING:
     from vahr.local.robots import ProgressRate

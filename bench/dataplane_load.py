@@ -26,8 +26,8 @@ from _results import percentile, write_section
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from vahr.local.ports import free_port  # noqa: E402
-from vahr.local.stack import LocalStack, StackConfig  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
+from vahr.twin.stack import LocalStack, StackConfig  # noqa: E402
 
 OPERATIONS = ("publish", "get", "update")
 THREADS_PER_PROCESS = 10

@@ -26,15 +26,19 @@ import random
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import msgspec
 
 from bench._results import median, percentile, write_section
+from vahr.dispatch.core import Dispatcher, Order, Task, rank
+from vahr.domain import Fleet, Pose, Robot, load_fleet
 from vahr.local.dispatcher import IndexCandidates
-from vahr.local.fleet_index import FleetIndex
 from vahr.local.task_store import SqliteTaskStore
-from vahr.protocol import Command, Fleet, Pose, Robot, load_fleet
-from vahr.protocol.dispatch import Dispatcher, Order, Task, rank
+from vahr.twin.fleet_index import FleetIndex
+
+if TYPE_CHECKING:
+    from vahr.protocol import Command
 
 TARGET_P95_MS = 50.0
 # The share of robots in each state: most idle, some busy on commands given by name.

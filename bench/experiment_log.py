@@ -19,6 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from _results import median, percentile, write_section  # noqa: E402
 
+from vahr.domain import load_fleet
 from vahr.experiment.eventlog import EventLog, Kind  # noqa: E402
 from vahr.experiment.judge import judge_session  # noqa: E402
 from vahr.experiment.measure import measure_session  # noqa: E402
@@ -26,7 +27,6 @@ from vahr.experiment.report import build_report, write_report  # noqa: E402
 from vahr.experiment.results import ResultRow  # noqa: E402
 from vahr.experiment.tasks import draw_plan  # noqa: E402
 from vahr.experiment.tlx import ITEMS, TlxAnswers  # noqa: E402
-from vahr.protocol import load_fleet  # noqa: E402
 
 
 def append_ms(folder: Path, synchronous: str, count: int = 400) -> list[float]:

@@ -29,10 +29,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import boto3  # noqa: E402
 
-from vahr.local.mqtt import MqttClient  # noqa: E402
-from vahr.local.ports import free_port  # noqa: E402
-from vahr.local.stack import LocalStack, StackConfig  # noqa: E402
+from vahr.plumbing.mqtt import MqttClient  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
 from vahr.protocol import encode, new_command, topics  # noqa: E402
+from vahr.twin.stack import LocalStack, StackConfig  # noqa: E402
 
 ACK_TIMEOUT_S = 120.0
 SETTLE_TIMEOUT_S = 120.0

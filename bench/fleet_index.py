@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from vahr.local.shadow_store import ShadowStore
+from vahr.twin.shadow_store import ShadowStore
 
 if TYPE_CHECKING:
     from collections.abc import Callable

@@ -55,7 +55,8 @@ def import_ms_in_bundle(runs: int) -> list[float] | None:
 
 
 def decode_rate(seconds: float = 2.0) -> tuple[float, float]:
-    from vahr.protocol import decode_command, encode, load_fleet, new_command
+    from vahr.domain import load_fleet
+    from vahr.protocol import decode_command, encode, new_command
 
     fleet = load_fleet()
     payload = encode(new_command("deliver", {"zone": "B"}, source="alexa"))

@@ -23,10 +23,10 @@ from _results import median, percentile, write_section
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from vahr.local.client import say  # noqa: E402
-from vahr.local.mqtt import MqttClient  # noqa: E402
-from vahr.local.ports import free_port  # noqa: E402
 from vahr.local.system import LocalSystem, SystemConfig  # noqa: E402
+from vahr.plumbing.client import say  # noqa: E402
+from vahr.plumbing.mqtt import MqttClient  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
 from vahr.protocol import topics  # noqa: E402
 
 ZONES = ("zone b", "zone c", "zone d", "zone a")

@@ -26,8 +26,8 @@ from _results import median, write_section
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from vahr.local.ports import free_port  # noqa: E402
-from vahr.local.stack import LocalStack, StackConfig  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
+from vahr.twin.stack import LocalStack, StackConfig  # noqa: E402
 
 TARGET_PER_S = 5000
 BEFORE = "about 700 acknowledgments per second (issue 17, measured through `bench/fanout.py`)"
@@ -47,7 +47,7 @@ def _report(thing: str, sequence: int) -> bytes:
 def load_process(mqtt_url: str, things: int, updates: int, runs: int, results: Any) -> None:
     """Publish the updates and time them to the last accepted answer, `runs` times."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from vahr.local.mqtt import MqttClient, MqttEndpoint
+    from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
     from vahr.protocol import topics
 
     port = int(mqtt_url.rsplit(":", 1)[1])

@@ -113,7 +113,7 @@ def warm_invocations(rounds: int) -> dict[str, tuple[list[float], list[float]]]:
 
     from skill.app import make_lambda_handler
     from skill.config import SkillConfig
-    from vahr.protocol import load_fleet
+    from vahr.domain import load_fleet
 
     logging.getLogger("skill").disabled = True  # measure the skill, not the log handler
     gateway = InstantRobots(load_fleet().robot_things)

@@ -52,9 +52,10 @@ from playwright.sync_api import sync_playwright  # noqa: E402
 
 from tests.support.browser import launch  # noqa: E402
 from tests.support.swarm import swarm_fleet  # noqa: E402
-from vahr.local.lifetime import spawn  # noqa: E402
-from vahr.local.mqtt import MqttClient, MqttEndpoint  # noqa: E402
-from vahr.local.ports import free_port  # noqa: E402
+from vahr.local.alexa_host import serve_alexa
+from vahr.plumbing.lifetime import spawn  # noqa: E402
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
 from vahr.protocol import encode, new_command, topics  # noqa: E402
 from vahr.protocol.broker import parse_broker_url  # noqa: E402
 from vahr.speech.audio import Audio  # noqa: E402
@@ -86,12 +87,12 @@ class BrokerClock:
 def stack_process(state: str, ports: tuple[int, int, int], ready: Any, stop: Any) -> None:
     """The local stack with the Alexa simulator, in its own process."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from vahr.local.stack import LocalStack, StackConfig
+    from vahr.twin.stack import LocalStack, StackConfig
 
     mqtts, mqtt, api = ports
     config = StackConfig(state_dir=Path(state), mqtts_port=mqtts, mqtt_port=mqtt, api_port=api)
     with LocalStack(config) as stack:
-        stack.attach_alexa()
+        serve_alexa(stack)
         ready.set()
         stop.wait(7200)
 
@@ -111,7 +112,7 @@ def feed_cost(robots: int, rounds: int = 5) -> dict[str, float]:
     with one page takes `rounds` shadow documents and progress events of every robot (as
     the broker hands them over), and the page takes them once per round. Microseconds per
     document and per event, on one core; the best of three, as the least disturbed."""
-    from vahr.protocol import Event, EventPose, utc_now
+    from vahr.protocol import Event, ReportedPose, utc_now
     from vahr.station.feed import Feed
 
     fleet = swarm_fleet(robots)
@@ -131,7 +132,7 @@ def feed_cost(robots: int, rounds: int = 5) -> dict[str, float]:
             }
             documents.append((topics.shadow(thing, "update/documents"), json.dumps(document)))
             event = Event(event="progress", thing=thing, at=utc_now(), progress=0.5,
-                          pose=EventPose(1.0, 2.0))  # fmt: skip
+                          pose=ReportedPose(1.0, 2.0))  # fmt: skip
             events.append((topics.robot_events(thing), encode(event)))
     best = {"document_us": float("inf"), "event_us": float("inf")}
     for _ in range(3):

@@ -32,7 +32,7 @@ from station_hearing import spoken  # noqa: E402
 from tests.support.push_to_talk import talk  # noqa: E402
 from tests.support.push_to_talk import type_in as typed  # noqa: E402
 from tests.support.vahr_up import Up, start_up, stop_up  # noqa: E402
-from vahr.local.ports import free_port  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
 
 ENGINES = {
     "flite (slt, rms, awb, kal)": ("flite:slt", "flite:rms", "flite:awb", "flite:kal"),

@@ -2,7 +2,7 @@
 weighed by the simulator's NLU (`vahr.station.confidence`), on sets and voices kept apart.
 
 Tuning: every 12th utterance and out-of-domain sentence of the NLU's tuning set
-(`vahr/local/alexa/data/tuning-en-US.yaml`), spoken in turn by the TUNING voices. On it,
+(`vahr/assistant/data/tuning-en-US.yaml`), spoken in turn by the TUNING voices. On it,
 and on it only, the three constants of `vahr.station.confidence` are chosen:
 
 1. SHARPNESS by temperature scaling: the value of the grid that gives the labelled robot
@@ -48,13 +48,13 @@ from _results import median, percentile, write_section
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from vahr.local.alexa.evaluation import (  # noqa: E402
+from vahr.assistant.evaluation import (  # noqa: E402
     DEVELOPMENT_SET,
     LabelledSet,
     LabelledUtterance,
     outcome,
 )
-from vahr.local.alexa.nbest import (  # noqa: E402
+from vahr.assistant.nbest import (  # noqa: E402
     MOVING_TYPES,
     Weighing,
     agreement,
@@ -62,9 +62,9 @@ from vahr.local.alexa.nbest import (  # noqa: E402
     posteriors,
     weigh,
 )
-from vahr.local.alexa.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
-from vahr.local.alexa.simulator import strip_invocation  # noqa: E402
-from vahr.protocol.fleet import load_fleet  # noqa: E402
+from vahr.assistant.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
+from vahr.assistant.simulator import strip_invocation  # noqa: E402
+from vahr.domain.fleet import load_fleet  # noqa: E402
 from vahr.speech.audio import Audio, concatenate  # noqa: E402
 from vahr.speech.stt import Hypothesis, Recognition  # noqa: E402
 from vahr.speech.tts import engine_of, make_synthesizer  # noqa: E402
@@ -385,7 +385,7 @@ def main() -> int:
     body = f"""
 Spoken requests heard by the station's recognizer; its N best transcripts (at most 10)
 understood by the simulator's NLU and weighed into one understanding
-(`vahr/local/alexa/nbest.py`). Load average {" ".join(load)} (the machine is shared).
+(`vahr/assistant/nbest.py`). Load average {" ".join(load)} (the machine is shared).
 
 **Tuning** ({len(tuning)} clips: every {TUNING_EVERY}th sentence of {TUNING_SET.name},
 spoken in turn by {", ".join(TUNING_VOICES)}). Mean negative log-likelihood of the labelled

@@ -27,8 +27,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from station_hearing import spoken  # noqa: E402
 
 from tests.support.vahr_up import start_up, stop_up  # noqa: E402
-from vahr.local.alexa.evaluation import DEVELOPMENT_SET, LabelledSet  # noqa: E402
-from vahr.local.ports import free_port  # noqa: E402
+from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
 
 VOICES = ("flite:slt", "flite:rms", "festival:cmu_us_slt_arctic_hts")
 

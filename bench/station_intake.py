@@ -35,12 +35,12 @@ from _results import median, percentile
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from tests.support.swarm import swarm_fleet  # noqa: E402
-from vahr.local.broker import BrokerConfig, Mosquitto  # noqa: E402
-from vahr.local.mqtt import MqttClient, MqttEndpoint  # noqa: E402
-from vahr.local.ports import free_port  # noqa: E402
-from vahr.protocol import Event, EventPose, encode, topics, utc_now  # noqa: E402
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
+from vahr.protocol import Event, ReportedPose, encode, topics, utc_now  # noqa: E402
+from vahr.station.assembly import Station, StationConfig  # noqa: E402
 from vahr.station.feed import Feed  # noqa: E402
-from vahr.station.station import Station, StationConfig  # noqa: E402
+from vahr.twin.broker import BrokerConfig, Mosquitto  # noqa: E402
 
 
 def burst_payloads(things: list[str], version: int, progress: int) -> list[tuple[str, bytes]]:
@@ -65,7 +65,7 @@ def burst_payloads(things: list[str], version: int, progress: int) -> list[tuple
         for step in range(progress):
             share = (step + 1) / (progress + 1)
             event = Event(
-                event="progress", thing=thing, at=utc_now(), progress=share, pose=EventPose(1, 2)
+                event="progress", thing=thing, at=utc_now(), progress=share, pose=ReportedPose(1, 2)
             )
             found.append((topics.robot_events(thing), encode(event)))
     return found

@@ -22,8 +22,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from vahr.local.client import call
-from vahr.local.ports import free_port
+from vahr.plumbing.client import call
+from vahr.plumbing.ports import free_port
 
 
 def _p95(values: list[float]) -> float:

@@ -21,7 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from vahr.local.ports import free_port
+from vahr.plumbing.ports import free_port
 
 IDLE_S = 10.0
 TICKS = os.sysconf("SC_CLK_TCK")

@@ -29,9 +29,9 @@ from _results import median, percentile, write_section
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from vahr.local.alexa.evaluation import DEVELOPMENT_SET, LabelledSet  # noqa: E402
-from vahr.local.alexa.nlu import InteractionModel  # noqa: E402
-from vahr.local.ports import free_port  # noqa: E402
+from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet  # noqa: E402
+from vahr.assistant.nlu import InteractionModel  # noqa: E402
+from vahr.plumbing.ports import free_port  # noqa: E402
 
 # The last commit whose simulator matched samples literally (before issue 13's NLU).
 BEFORE = "74f297b"
@@ -39,7 +39,7 @@ BUILD_PROBE = """
 import sys, time
 started = time.perf_counter()
 from pathlib import Path
-from vahr.local.alexa.nlu import InteractionModel
+from vahr.assistant.nlu import InteractionModel
 model = InteractionModel.load(cache_dir=Path(sys.argv[1]))
 model.understand("send robot one to zone b")
 print(time.perf_counter() - started, model.cached)

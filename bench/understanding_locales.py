@@ -22,15 +22,15 @@ from _results import median, percentile, write_section
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from vahr.local.alexa.evaluation import DEVELOPMENT_SET, LabelledSet  # noqa: E402
-from vahr.local.alexa.localized import load_model  # noqa: E402
+from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet  # noqa: E402
+from vahr.assistant.localized import load_model  # noqa: E402
 
 LOCALES = ("en-US", "de-DE")
 BUILD_PROBE = """
 import sys, time
 started = time.perf_counter()
 from pathlib import Path
-from vahr.local.alexa.localized import load_model
+from vahr.assistant.localized import load_model
 model = load_model(sys.argv[2], cache_dir=Path(sys.argv[1]))
 model.understand("placebot eins fahr in zone b")
 print(time.perf_counter() - started)

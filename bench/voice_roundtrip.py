@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from robot_agent.voice.answers import WeatherAnswers  # noqa: E402
 from robot_agent.voice.hearing import offline_hearing, weather_recognizer  # noqa: E402
 from robot_agent.voice.interpreter import LocalInterpreter  # noqa: E402
-from vahr.local.room import QUESTIONS  # noqa: E402
+from vahr.local.room_assistant import QUESTIONS  # noqa: E402
 from vahr.speech.audio import add_white_noise  # noqa: E402
 from vahr.speech.stt import GrammarRecognizer  # noqa: E402
 from vahr.speech.tts import EspeakSynthesizer  # noqa: E402
@@ -79,10 +79,10 @@ def stages(runs: int) -> dict[str, list[float]]:
 def room_round_trip(runs: int) -> list[float]:
     from robot_agent.config import AgentConfig
     from robot_agent.voice.factories import room
-    from vahr.local.broker import BrokerConfig, Mosquitto
-    from vahr.local.mqtt import MqttClient, MqttEndpoint
-    from vahr.local.ports import free_port
-    from vahr.local.room import offline_room_assistant
+    from vahr.local.room_assistant import offline_room_assistant
+    from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
+    from vahr.plumbing.ports import free_port
+    from vahr.twin.broker import BrokerConfig, Mosquitto
 
     with tempfile.TemporaryDirectory() as state:
         port = free_port()

@@ -39,10 +39,10 @@ from station_hearing import (  # noqa: E402
 )
 
 from tests.support.skill_effects import VERDICTS, SkillEffects  # noqa: E402
-from vahr.local.alexa.evaluation import DEVELOPMENT_SET, LabelledSet, LabelledUtterance  # noqa: E402
-from vahr.local.alexa.nbest import Weighing  # noqa: E402
-from vahr.local.alexa.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
-from vahr.protocol.fleet import load_fleet  # noqa: E402
+from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet, LabelledUtterance  # noqa: E402
+from vahr.assistant.nbest import Weighing  # noqa: E402
+from vahr.assistant.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
+from vahr.domain.fleet import load_fleet  # noqa: E402
 from vahr.speech.tts import engine_of  # noqa: E402
 from vahr.speech.whisper_stt import WhisperTranscriber  # noqa: E402
 from vahr.station.vocabulary import command_recognizer, whisper_prompt  # noqa: E402

@@ -20,8 +20,9 @@ from cdk_nag import AwsSolutionsChecks
 
 from infra.config import InfraConfig
 from infra.stacks.vahr_stack import VahrStack
+from vahr.domain import load_fleet
 from vahr.errors import VahrError
-from vahr.protocol import ProtocolError, load_fleet
+from vahr.protocol import ProtocolError
 
 
 def build_app(app: cdk.App) -> VahrStack:

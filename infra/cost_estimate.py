@@ -306,7 +306,7 @@ def dispatch_billable(
     )
 
 
-# The skill's status summary on fleet indexing (lambda/skill/fleet_index.py): counts by
+# The skill's status summary on fleet indexing (lambda/skill/iot_fleet_index.py): counts by
 # status (GetBucketsAggregation), robots offline (GetStatistics) and one page of the robots
 # it names (SearchIndex).
 STATUS_INDEX_QUERIES = 3
@@ -352,7 +352,7 @@ def dynamodb_units(operation: str, request: dict[str, object]) -> tuple[float, f
 
 
 def operation_cost(kind: str, units: int, usage: LabUsage, prices: Prices) -> float:
-    """USD for `units` billing units of one kind the local meter counts (vahr.local.meter),
+    """USD for `units` billing units of one kind the local meter counts (vahr.twin.meter),
     with the metering rules `estimate` applies: a QoS 1 delivery counts twice (the PUBLISH
     out and the PUBACK in); a shadow request over MQTT is a message in besides the shadow
     operation, and a get's answer a delivery to the robot."""

@@ -7,8 +7,10 @@ The bundle holds three functions' code roots: `skill/` (from `lambda/skill`, han
 `skill.app.lambda_handler`), `announcer/` (from `lambda/announcer`, handler
 `announcer.app.lambda_handler`) and `dispatcher/` (from `lambda/dispatcher`, handler
 `dispatcher.app.lambda_handler`); the parts of `vahr` they import (`vahr/__init__.py`,
-`vahr/errors.py`, `vahr/protocol`, and `vahr/announce` for the announcer), `fleet.yaml` as
-`vahr/protocol/fleet.yaml` (where `vahr.protocol.fleet` looks for it), and the runtime
+`vahr/errors.py`, the wire contract `vahr/protocol`, the domain `vahr/domain`, the dispatch
+core `vahr/dispatch` for the skill and the dispatcher, and `vahr/announce` for the
+announcer), `fleet.yaml` as
+`vahr/domain/fleet.yaml` (where `vahr.domain.fleet` looks for it), and the runtime
 dependencies installed from wheels built for the Lambda runtime (CPython 3.12 on Amazon
 Linux), so no Docker is needed. boto3 comes from the Lambda runtime and awscrt must stay
 out: botocore imports awscrt whenever it is present, which costs cold start.
@@ -55,9 +57,9 @@ RUNTIME_PROVIDED = ("boto3",)
 # client's import; awsiot is the robots' SDK).
 FORBIDDEN_TOP_LEVEL = ("awscrt", "awsiot", "boto3", "botocore", "s3transfer")
 # The project files the functions need, relative to the repository root (vahr.announce
-# for the announcer only).
+# for the announcer only, vahr.dispatch for the skill and the dispatcher).
 VAHR_FILES = ("vahr/__init__.py", "vahr/errors.py")
-VAHR_PACKAGES = ("vahr/protocol", "vahr/announce")
+VAHR_PACKAGES = ("vahr/protocol", "vahr/domain", "vahr/dispatch", "vahr/announce")
 SKILL_DIR = "lambda/skill"
 # Each function's code root: its package name in the bundle, and where it lives here.
 CODE_ROOTS = {
@@ -65,9 +67,9 @@ CODE_ROOTS = {
     "announcer": "lambda/announcer",
     "dispatcher": "lambda/dispatcher",
 }
-# Where `vahr.protocol.fleet` looks for the bundled fleet definition.
-FLEET_IN_BUNDLE = "vahr/protocol/fleet.yaml"
-LOCALES_IN_BUNDLE = "vahr/protocol/locales"
+# Where `vahr.domain.fleet` looks for the bundled fleet definition.
+FLEET_IN_BUNDLE = "vahr/domain/fleet.yaml"
+LOCALES_IN_BUNDLE = "vahr/domain/locales"
 _IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".mypy_cache", ".pytest_cache")
 _REQUIREMENT = re.compile(r"^\s*([A-Za-z0-9][A-Za-z0-9._-]*)\s*==\s*([^\s;#]+)")
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
@@ -129,7 +131,7 @@ def _source_files(fleet_file: Path) -> list[tuple[Path, str]]:
         for path in sorted((REPO_ROOT / package).rglob("*.py")):
             if "__pycache__" not in path.parts:
                 pairs.append((path, path.relative_to(REPO_ROOT).as_posix()))
-    # Each locale's words and message catalog (vahr.protocol.locale reads them).
+    # Each locale's words and message catalog (vahr.domain.locale reads them).
     for path in sorted((REPO_ROOT / LOCALES_IN_BUNDLE).rglob("*.yaml")):
         pairs.append((path, path.relative_to(REPO_ROOT).as_posix()))
     pairs.append((fleet_file, FLEET_IN_BUNDLE))

@@ -27,7 +27,8 @@ if TYPE_CHECKING:
     from robot_agent.core.executor import ExecutorSettings
     from robot_agent.core.recent_ids import RecentIds
     from robot_agent.voice.port import Voice
-    from vahr.protocol import Command, Event, Fleet, Reported
+    from vahr.domain import Fleet
+    from vahr.protocol import Command, Event, Reported
     from vahr.protocol.link import Link
 
 log = logging.getLogger(__name__)

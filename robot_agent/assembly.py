@@ -15,8 +15,9 @@ from robot_agent.agent import RobotAgent
 from robot_agent.backends.sim import SimBackend
 from robot_agent.core.in_flight import InFlight
 from robot_agent.core.recent_ids import RecentIds
+from vahr.domain import load_fleet
 from vahr.errors import VahrError
-from vahr.protocol import Presence, encode, load_fleet, topics
+from vahr.protocol import Presence, encode, topics
 from vahr.protocol.broker import ClientCredentials, plaintext_loopback
 from vahr.speech.errors import SpeechError
 
@@ -28,7 +29,7 @@ if TYPE_CHECKING:
     from robot_agent.config import AgentConfig
     from robot_agent.link.mqtt5 import Mqtt5Link
     from robot_agent.voice.port import Voice
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
     from vahr.protocol.link import Link
 
 

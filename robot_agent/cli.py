@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from vahr.cli_dispatch import Subcommands, dispatch
+from vahr.cli_router import Subcommands, dispatch
 
 if TYPE_CHECKING:
     from collections.abc import Sequence

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 from robot_agent.backends.sim import SimBackend
 from vahr.protocol import ProtocolError, encode, topics
-from vahr.protocol.faults import FaultAnswer, decode_fault_request
+from vahr.protocol.fault_request import FaultAnswer, decode_fault_request
 
 if TYPE_CHECKING:
     from robot_agent.backends.port import NavigationBackend

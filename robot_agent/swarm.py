@@ -37,7 +37,8 @@ if TYPE_CHECKING:
     from types import TracebackType
 
     from robot_agent.link.mqtt5 import Mqtt5Link
-    from vahr.protocol import Command, Event, Fleet, Reported
+    from vahr.domain import Fleet
+    from vahr.protocol import Command, Event, Reported
     from vahr.protocol.broker import ClientCredentials
 
 CONNECT_TIMEOUT_S = 10.0

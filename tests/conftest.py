@@ -10,10 +10,10 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from tests.support.scheduling import FileGroupScheduling, longest_files_first
-from vahr.local.broker import BrokerConfig, Mosquitto
-from vahr.local.ports import free_port
-from vahr.local.stack import LocalStack, StackConfig
-from vahr.protocol import Fleet, load_fleet
+from vahr.domain import Fleet, load_fleet
+from vahr.plumbing.ports import free_port
+from vahr.twin.broker import BrokerConfig, Mosquitto
+from vahr.twin.stack import LocalStack, StackConfig
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

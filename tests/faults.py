@@ -16,12 +16,12 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from vahr.local.recovery import Leftover, started_for
+from vahr.twin.recovery import Leftover, started_for
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 
 def alive(pid: int) -> bool:

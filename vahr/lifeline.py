@@ -2,7 +2,7 @@
 
 Run as a script: `python -I -S lifeline.py PARENT_PID SIGNAL -- COMMAND [ARG...]`, the
 command line `lifeline_command` writes. The lab side's children start through it
-(`vahr.local.lifetime`), and so do the robot's long batch tools (sphinxtrain, in
+(`vahr.plumbing.lifetime`), and so do the robot's long batch tools (sphinxtrain, in
 `robot_agent.voice.adaptation`); it sits at the top of the `vahr` package so that both may
 use it. It arms the parent-death signal, checks that the parent is still the
 process that asked (it may have died between fork and `prctl`, and then nothing would ever
@@ -31,7 +31,7 @@ CANNOT_EXEC = 127
 
 def lifeline_command(command: list[str], death_signal: int) -> list[str]:
     """`command` prefixed with this wrapper, tied to the calling process's life (to the
-    thread that forks it, strictly: see `vahr.local.lifetime`)."""
+    thread that forks it, strictly: see `vahr.plumbing.lifetime`)."""
     # os.path, not pathlib: the wrapper imports as little as it can, it starts every child.
     return [
         sys.executable, "-I", "-S", os.path.abspath(__file__),  # noqa: PTH100

@@ -31,15 +31,15 @@ from constructs import Construct
 from infra.constructs.fleet_indexing import INDEX_NAME
 from infra.constructs.python_function import python_function
 from infra.constructs.topic_rule import lambda_topic_rule
+from vahr.dispatch.core import IDLE_STATUSES
 from vahr.protocol import topics
-from vahr.protocol.dispatch import IDLE_STATUSES
 
 if TYPE_CHECKING:
     from aws_cdk import aws_dynamodb as dynamodb
     from aws_cdk import aws_lambda as lambda_
 
     from infra.config import InfraConfig
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 HANDLER = "dispatcher.app.lambda_handler"
 # A rule's event waits for nothing but AWS calls; a submit over 10,000 free robots reads

@@ -14,7 +14,7 @@ from constructs import Construct
 if TYPE_CHECKING:
     from aws_cdk import aws_logs as logs
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 def thing_arn(scope: Construct, thing: str) -> str:

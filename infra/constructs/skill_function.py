@@ -23,7 +23,7 @@ from vahr.protocol import topics
 
 if TYPE_CHECKING:
     from infra.config import InfraConfig
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 HANDLER = "skill.app.lambda_handler"
 # Alexa gives a skill 8 s per answer; the handler bounds its own waits well inside that.

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from constructs import Construct
 
     from infra.config import InfraConfig
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 class VahrStack(cdk.Stack):

@@ -26,7 +26,8 @@ from announcer.errors import AnnouncerError, DeliveryFailed, StateConflict
 from announcer.proactive_events import ProactiveEvents
 from vahr.announce import AnnouncePolicy, signals_from_event, signals_from_presence
 from vahr.announce.speech import Names
-from vahr.protocol import Event, Presence, load_fleet
+from vahr.domain import load_fleet
+from vahr.protocol import Event, Presence
 
 if TYPE_CHECKING:
     from vahr.announce import Signal

@@ -35,8 +35,8 @@ from dispatcher.requests import (
 )
 from dispatcher.robot_updates import robot_freed
 from dispatcher.task_table import TaskTable
-from vahr.protocol import load_fleet
-from vahr.protocol.dispatch import Dispatcher, DispatchError
+from vahr.dispatch.core import Dispatcher, DispatchError
+from vahr.domain import load_fleet
 from vahr.protocol.errors import ProtocolError, from_validation_error
 
 log = logging.getLogger("dispatcher")

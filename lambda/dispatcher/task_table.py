@@ -1,4 +1,4 @@
-"""The task queue in DynamoDB: `vahr.protocol.dispatch.TaskStore` with conditional writes.
+"""The task queue in DynamoDB: `vahr.dispatch.core.TaskStore` with conditional writes.
 
 One table, keyed by `section` (partition) and `id` (sort):
 
@@ -30,10 +30,10 @@ from botocore.config import Config
 from botocore.exceptions import BotoCoreError, ClientError
 
 from dispatcher.errors import StoreError
-from vahr.protocol.dispatch import Task
+from vahr.dispatch.core import Task
 
 if TYPE_CHECKING:
-    from vahr.protocol.dispatch import Outcome
+    from vahr.dispatch.core import Outcome
 
 CLIENT_CONFIG = Config(
     connect_timeout=2.0, read_timeout=3.0, retries={"mode": "standard", "total_max_attempts": 3}

@@ -31,7 +31,8 @@ from skill.handlers.catch_all import CatchAllExceptionHandler
 from skill.handlers.confirmation import DeniedIntentHandler
 from skill.handlers.correction import CorrectionIntentHandler, UndoIntentHandler
 from skill.handlers.deliver import DeliverIntentHandler
-from skill.handlers.dispatch import (
+from skill.handlers.emergency_stop import EmergencyStopIntentHandler
+from skill.handlers.fleet_tasks import (
     CancelTaskIntentHandler,
     FleetDeliverHandler,
     FleetNavigateIntentHandler,
@@ -39,12 +40,11 @@ from skill.handlers.dispatch import (
     TaskQueueIntentHandler,
     ZoneRobotsIntentHandler,
 )
-from skill.handlers.emergency_stop import EmergencyStopIntentHandler
 from skill.handlers.navigate import NavigateIntentHandler
 from skill.handlers.sequential_delivery import SequentialDeliveryIntentHandler
 from skill.handlers.status import ProblemRobotsIntentHandler, StatusIntentHandler
-from skill.handlers.weather import WeatherIntentHandler
 from skill.handlers.weather_delivery import WeatherDeliveryIntentHandler
+from skill.handlers.weather_question import WeatherIntentHandler
 from skill.interceptors import (
     CorrelationIdInterceptor,
     LocaleInterceptor,

@@ -1,7 +1,7 @@
 """The skill's replies in the request's language: one message catalog per locale.
 
 `skill.prompts` is the en-US catalog and names every message; another locale's catalog is
-`vahr/protocol/locales/<locale>/replies.yaml`, the same names with the same placeholders.
+`vahr/domain/locales/<locale>/replies.yaml`, the same names with the same placeholders.
 `LocaleInterceptor` sets the request's locale (`request.locale`, as ASK skills read it)
 with `use_locale`; from then on, for that request, `prompts.NAME` is the locale's message,
 so the handlers keep writing `prompts.WELCOME` and need not know the language. A locale the
@@ -15,7 +15,7 @@ import functools
 import types
 from typing import Any
 
-from vahr.protocol.locale import (
+from vahr.domain.locale import (
     DEFAULT_LOCALE,
     SUPPORTED_LOCALES,
     locale_file,

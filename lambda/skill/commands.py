@@ -14,7 +14,8 @@ from skill.vocabulary import FLEET
 from vahr.protocol import check_against_fleet, new_command, topics
 
 if TYPE_CHECKING:
-    from vahr.protocol import Command, Fleet
+    from vahr.domain import Fleet
+    from vahr.protocol import Command
 
 SOURCE = "alexa"
 

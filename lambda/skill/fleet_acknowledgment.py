@@ -15,14 +15,14 @@ import time
 from typing import TYPE_CHECKING
 
 from skill.acknowledgment import FIRST_DELAY_S, MAX_DELAY_S, RobotAnswer, classify
-from skill.fleet_index import IotFleetIndex
+from skill.iot_fleet_index import IotFleetIndex
 from vahr.protocol import RobotShadow
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
 
     from skill.config import SkillConfig
-    from skill.fleet_index import FleetIndex
+    from skill.iot_fleet_index import FleetIndex
 
 # Above this many recipients of one command, acknowledgments are counted by the index (the
 # same bound as a status question's shadow reads, skill.handlers.status.SHADOW_READ_MAX).

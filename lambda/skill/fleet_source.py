@@ -14,9 +14,10 @@ import os
 import msgspec
 
 from skill.logs import log_event
-from vahr.protocol import DEFAULT_FLEET_FILE, Fleet, ProtocolError, load_fleet
+from vahr.domain import DEFAULT_FLEET_FILE, Fleet, load_fleet
+from vahr.protocol import ProtocolError
 
-# os.path rather than pathlib: this runs on the cold-start path (see vahr.protocol.fleet).
+# os.path rather than pathlib: this runs on the cold-start path (see vahr.domain.fleet).
 TWIN_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fleet.json")  # noqa: PTH100, PTH118, PTH120
 
 

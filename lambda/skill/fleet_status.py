@@ -13,12 +13,12 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from skill.fleet_index import IndexedRobot
+from skill.iot_fleet_index import IndexedRobot
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from skill.fleet_index import FleetIndex
+    from skill.iot_fleet_index import FleetIndex
     from skill.robots import ShadowRead
 
 _NUMBERS = re.compile(r"(\d+)")

@@ -9,8 +9,8 @@ from __future__ import annotations
 import sys
 
 from skill.catalog import localise
-from vahr.protocol.assistant import INVOCATION_NAME
-from vahr.protocol.weather import WEATHERS
+from vahr.domain.invocation import INVOCATION_NAME
+from vahr.domain.weather import WEATHERS
 
 SKILL_NAME = INVOCATION_NAME
 
@@ -182,7 +182,7 @@ WEATHER_HAS_NO_ZONE = (
 )
 INTENT_DENIED = "Okay, I sent nothing. Please say it again."
 
-# Fleet dispatch (skill.handlers.dispatch, skill.task_speech): tasks without a robot's name.
+# Fleet dispatch (skill.handlers.fleet_tasks, skill.task_speech): tasks without a robot's name.
 TASK_NAMES = {"navigate": "the trip to {zone}", "deliver": "the delivery to {zone}"}
 TASK_NAMES_PLURAL = {"navigate": "trips to {zone}", "deliver": "deliveries to {zone}"}
 DISPATCHED = {
@@ -238,6 +238,6 @@ ASK_ORIGIN = "From which zone: {choices}?"
 OR = "or"
 AND = "and"
 
-# Every other locale's sentences are vahr/protocol/locales/<locale>/replies.yaml, under these
+# Every other locale's sentences are vahr/domain/locales/<locale>/replies.yaml, under these
 # names; the request's locale chooses (skill.catalog).
 localise(sys.modules[__name__])

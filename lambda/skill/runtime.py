@@ -15,7 +15,7 @@ from skill.vocabulary import Vocabulary
 if TYPE_CHECKING:
     from skill.config import SkillConfig
     from skill.gateway import RobotGateway
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 class SkillRuntime(msgspec.Struct, frozen=True):

@@ -15,8 +15,8 @@ if TYPE_CHECKING:
 
     from skill.acknowledgment import RobotAnswer
     from skill.commands import Dispatch
-    from skill.fleet_index import IndexedRobot
     from skill.fleet_status import FleetState
+    from skill.iot_fleet_index import IndexedRobot
     from skill.robots import ShadowRead
     from skill.vocabulary import Vocabulary
     from vahr.protocol import Reported

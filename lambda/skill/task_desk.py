@@ -27,7 +27,7 @@ from urllib.parse import quote
 import msgspec
 
 from skill.errors import GatewayError, SkillError
-from vahr.protocol.dispatch import Order, Submission, Task
+from vahr.dispatch.core import Order, Submission, Task
 
 if TYPE_CHECKING:
     from skill.config import SkillConfig

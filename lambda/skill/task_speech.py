@@ -10,13 +10,13 @@ from typing import TYPE_CHECKING
 
 from skill import prompts
 from skill.vocabulary import capitalise
-from vahr.protocol.text import number_in_words
+from vahr.domain.text import number_in_words
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from skill.vocabulary import Vocabulary
-    from vahr.protocol.dispatch import Order, Submission, Task
+    from vahr.dispatch.core import Order, Submission, Task
 
 # The queue is read out to this many tasks; the rest are counted.
 QUEUE_READ_MAX = 5

@@ -3,7 +3,7 @@
 Everything comes from fleet.yaml: a robot is called by its first spoken name ("placebot
 one"), a zone by the spoken name that reads well in a sentence ("zone A", "the loading
 zone"), and the whole fleet by the `all` group's names. In another locale than en-US the
-names are those of `spoken_by_locale` (`vahr.protocol.fleet.spoken_in`), read for the
+names are those of `spoken_by_locale` (`vahr.domain.fleet.spoken_in`), read for the
 request's locale (`skill.catalog`): "placebot eins", "Zone A", "Ladezone". Names heard are
 looked up in every language the fleet file gives.
 """
@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING
 
 from skill import prompts
 from skill.catalog import current_locale
-from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
-from vahr.protocol.fleet import SPOKEN_LOCALE, names_by_locale, spoken_in, zone_phrase
-from vahr.protocol.text import normalize
+from vahr.domain import FLEET_GROUP, FLEET_GROUP_NAMES
+from vahr.domain.fleet import SPOKEN_LOCALE, names_by_locale, spoken_in, zone_phrase
+from vahr.domain.text import normalize
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet, Group, Robot, Zone
+    from vahr.domain import Fleet, Group, Robot, Zone
 
 # The ROBOT slot value (and target) that means every robot; it matches the generator's id.
 FLEET = FLEET_GROUP

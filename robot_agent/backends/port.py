@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Protocol
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.protocol import Pose, Zone
+    from vahr.domain import Pose, Zone
 
 
 @dataclass(frozen=True)

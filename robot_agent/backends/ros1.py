@@ -25,14 +25,14 @@ from actionlib_msgs.msg import GoalStatus
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 
 from robot_agent.backends.port import NavigationFailed, Progress
+from vahr.domain import Pose
 from vahr.errors import VahrError
-from vahr.protocol import Pose
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from robot_agent.config import Ros1Settings
-    from vahr.protocol import Zone
+    from vahr.domain import Zone
 
 _STATUS_NAMES = {
     GoalStatus.PREEMPTED: "preempted",

@@ -16,13 +16,13 @@ from typing import TYPE_CHECKING
 from robot_agent.backends.port import NavigationFailed, Progress
 from robot_agent.backends.sim_ticker import SimTicker
 from robot_agent.config import SimSettings
-from vahr.protocol import Pose
+from vahr.domain import Pose
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from robot_agent.clock import Clock
-    from vahr.protocol import Zone
+    from vahr.domain import Zone
 
 
 @dataclass

@@ -9,7 +9,7 @@ import signal
 from typing import TYPE_CHECKING
 
 from robot_agent.config import load_config, printable
-from vahr.cli_dispatch import setup_logging
+from vahr.cli_router import setup_logging
 
 if TYPE_CHECKING:
     import argparse

@@ -18,16 +18,16 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from robot_agent.config import load_config
-from vahr.cli_dispatch import setup_logging
+from vahr.cli_router import setup_logging
+from vahr.domain import load_fleet
 from vahr.errors import VahrError
-from vahr.protocol import load_fleet
 from vahr.protocol.broker import ClientCredentials
 
 if TYPE_CHECKING:
     import argparse
 
     from robot_agent.config import AgentConfig
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 log = logging.getLogger("robot_agent")
 

@@ -20,21 +20,20 @@ import msgspec
 from robot_agent.backends.port import NavigationFailed
 from robot_agent.config import ExecutorSettings
 from robot_agent.core.peers import PeerDeliveries
+from vahr.domain.invocation import WEATHER_QUESTION
+from vahr.domain.weather import WEATHER_ZONES
 from vahr.protocol import (
     Deliver,
     Event,
-    EventPose,
     LastCommand,
     Navigate,
     Ping,
     Reported,
+    ReportedPose,
     SequentialDelivery,
-    ShadowPose,
     Stop,
     WeatherDelivery,
 )
-from vahr.protocol.assistant import WEATHER_QUESTION
-from vahr.protocol.weather import WEATHER_ZONES
 from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
@@ -43,7 +42,8 @@ if TYPE_CHECKING:
     from robot_agent.backends.port import NavigationBackend, Progress
     from robot_agent.clock import Clock
     from robot_agent.voice.port import Voice
-    from vahr.protocol import Command, Fleet, Pose, Result, Status, Zone
+    from vahr.domain import Fleet, Pose, Zone
+    from vahr.protocol import Command, Result, Status
 
 log = logging.getLogger(__name__)
 
@@ -521,7 +521,7 @@ class Executor:
             at=self.clock.now(),
             command_id=command.id,
             action=command.action,
-            pose=EventPose(pose.x, pose.y, pose.theta) if pose is not None else None,
+            pose=ReportedPose(pose.x, pose.y, pose.theta) if pose is not None else None,
             **fields,
         )
         self._publish_event(event)
@@ -533,8 +533,8 @@ def _destination(command: Command) -> str | None:
     return zone if isinstance(zone, str) else None
 
 
-def _pose(pose: Pose) -> ShadowPose:
-    return ShadowPose(round(pose.x, 3), round(pose.y, 3), round(pose.theta, 3))
+def _pose(pose: Pose) -> ReportedPose:
+    return ReportedPose(round(pose.x, 3), round(pose.y, 3), round(pose.theta, 3))
 
 
 def _advanced(before: Progress, after: Progress) -> bool:

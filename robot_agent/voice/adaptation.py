@@ -43,8 +43,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from vahr.domain.text import normalize
 from vahr.lifeline import lifeline_command
-from vahr.protocol.text import normalize
 from vahr.speech.audio import SAMPLE_RATE, add_white_noise
 from vahr.speech.errors import SpeechError
 

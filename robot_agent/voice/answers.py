@@ -2,7 +2,7 @@
 
 The same file feeds the offline recognizer's language model (every sentence in it), the
 local interpreter (the cues and the rules for what is no answer; the negations are
-`vahr.protocol.weather.NEGATIONS`) and the CDK Lex bot (the intents' sentences), so what the
+`vahr.domain.weather.NEGATIONS`) and the CDK Lex bot (the intents' sentences), so what the
 robot can hear and what it understands never drift apart.
 """
 
@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING, Any, cast
 
 import yaml
 
-from vahr.protocol.text import normalize
-from vahr.protocol.weather import NEGATIONS, WEATHERS
+from vahr.domain.text import normalize
+from vahr.domain.weather import NEGATIONS, WEATHERS
 from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
@@ -182,9 +182,7 @@ def _cues(document: dict[str, Any], source: str) -> Cues:
     denied = cues.get("denied", {})
     said = _phrase_lists({k: v for k, v in cues.items() if k != "denied"}, "cues", source)
     if "negations" in document:
-        raise SpeechError(
-            f"{source}: negations are vahr.protocol.weather.NEGATIONS, not listed here"
-        )
+        raise SpeechError(f"{source}: negations are vahr.domain.weather.NEGATIONS, not listed here")
     lists = {key: frozenset(_sentences(document.get(key, []), key, source)) for key in _WORD_LISTS}
     reach = document.get("negation_reach", 3)
     if not isinstance(reach, int) or not 1 <= reach <= 8:

@@ -27,8 +27,8 @@ from typing import TYPE_CHECKING, Any
 import msgspec
 import numpy as np
 
+from vahr.domain.text import normalize
 from vahr.errors import VahrError
-from vahr.protocol.text import normalize
 from vahr.speech.audio import Audio, add_white_noise
 from vahr.speech.scoring import OutcomeTally, read_labelled_set
 

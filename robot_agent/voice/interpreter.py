@@ -30,7 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
-from vahr.protocol.text import normalize
+from vahr.domain.text import normalize
 
 if TYPE_CHECKING:
     from robot_agent.voice.answers import Cues, WeatherAnswers

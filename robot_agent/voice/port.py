@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
-# A weather word (`vahr.protocol.weather`), or `unknown` when the answer was not understood.
+# A weather word (`vahr.domain.weather`), or `unknown` when the answer was not understood.
 WeatherIntent = Literal["sunny", "rainy", "unknown"]
 
 

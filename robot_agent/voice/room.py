@@ -1,5 +1,5 @@
 """The robot's side of the room channel: a `Voice` whose speaker and microphone are the
-room's MQTT topics (`vahr.speech.room`), carried by the robot's own link.
+room's MQTT topics (`vahr.speech.room_channel`), carried by the robot's own link.
 
 `say` renders speech and speaks it into the room; `listen` waits for the assistant's answer
 to that question and understands it with the same recognizer and interpreter a microphone
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from robot_agent.voice.port import Heard
 from vahr.protocol import topics
-from vahr.speech.room import RoomChannel, Utterance
+from vahr.speech.room_channel import RoomChannel, Utterance
 
 if TYPE_CHECKING:
     from robot_agent.voice.hearing import Hearing

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from robot_agent.voice.answers import read_yaml
-from vahr.protocol.text import normalize
+from vahr.domain.text import normalize
 from vahr.speech.errors import SpeechError
 from vahr.speech.text_classifier import default_cache_dir, load_or_train, ngram_features
 

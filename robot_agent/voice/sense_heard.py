@@ -28,7 +28,7 @@ import yaml
 from robot_agent.voice.adaptation import VOICES
 from robot_agent.voice.answers import WeatherAnswers
 from robot_agent.voice.sense import HEARD_FILE, SENSE_FILE, training_sentences
-from vahr.protocol.text import normalize
+from vahr.domain.text import normalize
 from vahr.speech.audio import add_white_noise
 from vahr.speech.errors import SpeechError
 

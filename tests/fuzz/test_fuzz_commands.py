@@ -27,12 +27,13 @@ from robot_agent.core.recent_ids import RecentIds
 from tests.fuzz.strategies import command_payloads
 from tests.fuzz.tally import TALLY, budget
 from tests.integration.agent.harness import AgentProcess, WireTap, command
-from vahr.protocol import ProtocolError, decode_command, load_fleet, topics
+from vahr.domain import load_fleet
+from vahr.protocol import ProtocolError, decode_command, topics
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 FLEET = load_fleet()
 # A field is a dotted path of names and indexes, or the whole `payload`.
@@ -192,8 +193,8 @@ def _expected(topic: str, raw: bytes) -> ProtocolError | str | None:
 
 @pytest.fixture(scope="module")
 def wire(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[WireTap, AgentProcess]]:
-    from vahr.local.broker import BrokerConfig, Mosquitto
-    from vahr.local.ports import free_port
+    from vahr.plumbing.ports import free_port
+    from vahr.twin.broker import BrokerConfig, Mosquitto
 
     base = tmp_path_factory.mktemp("fuzz-agent")
     broker: Mosquitto = Mosquitto(BrokerConfig(state_dir=base / "broker", plain_port=free_port()))

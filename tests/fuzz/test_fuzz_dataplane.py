@@ -21,11 +21,12 @@ from hypothesis import strategies as st
 
 from tests.fuzz.strategies import command_payloads, shadow_payloads, text
 from tests.fuzz.tally import TALLY, budget
+from vahr.local.alexa_host import serve_alexa
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 SEGMENTS = st.one_of(
     st.sampled_from(
@@ -123,8 +124,8 @@ def _request(port: int, method: str, target: str, headers: list[tuple[str, str]]
 
 @pytest.fixture(scope="module")
 def api(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[LocalStack, list[str]]]:
-    from vahr.local.ports import free_port
-    from vahr.local.stack import LocalStack, StackConfig
+    from vahr.plumbing.ports import free_port
+    from vahr.twin.stack import LocalStack, StackConfig
 
     config = StackConfig(
         state_dir=tmp_path_factory.mktemp("fuzz-api"),
@@ -133,7 +134,7 @@ def api(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[LocalStack, 
         api_port=free_port(),
     )
     with LocalStack(config) as stack:
-        stack.attach_alexa(ack_timeout_s=0.05)
+        serve_alexa(stack, ack_timeout_s=0.05)
         published: list[str] = []
         assert stack.dataplane is not None
         stack.dataplane.publish_observers.append(lambda topic, _: published.append(topic))

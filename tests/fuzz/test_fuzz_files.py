@@ -20,10 +20,11 @@ from hypothesis import strategies as st
 
 from tests.fuzz.strategies import json_values, paths_in, scalars, text
 from tests.fuzz.tally import TALLY, budget
+from vahr.domain import Fleet
 from vahr.errors import VahrError
 from vahr.experiment.report import build_report
 from vahr.experiment.results import COLUMNS, read_csv
-from vahr.protocol import Fleet, ProtocolError
+from vahr.protocol import ProtocolError
 
 if TYPE_CHECKING:
     import pytest

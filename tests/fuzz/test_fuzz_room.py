@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from tests.fuzz.strategies import deep_arrays, encode, json_values, text
 from tests.fuzz.tally import TALLY, budget
 from vahr.speech.errors import SpeechError
-from vahr.speech.room import Utterance
+from vahr.speech.room_channel import Utterance
 
 WAV = base64.b64encode(
     b"RIFF$\x00\x00\x00WAVEfmt \x10\x00\x00\x00\x01\x00\x01\x00\x80>\x00\x00\x00}\x00\x00"

@@ -20,8 +20,8 @@ from hypothesis import strategies as st
 
 from tests.fuzz.strategies import shadow_payloads
 from tests.fuzz.tally import TALLY, budget
-from vahr.local.mqtt import MqttClient
-from vahr.local.shadow_store import (
+from vahr.plumbing.mqtt import MqttClient
+from vahr.twin.shadow_store import (
     MAX_STATE_BYTES,
     ShadowError,
     ShadowStore,
@@ -31,7 +31,7 @@ from vahr.local.shadow_store import (
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 AWS_CODES = {400, 404, 409, 413, 415}
 NAMES = st.sampled_from([None, "arm", "named-1"])
@@ -118,8 +118,8 @@ class Answers:
 def service(
     tmp_path_factory: pytest.TempPathFactory,
 ) -> Iterator[tuple[LocalStack, MqttClient, Answers]]:
-    from vahr.local.ports import free_port
-    from vahr.local.stack import LocalStack, StackConfig
+    from vahr.plumbing.ports import free_port
+    from vahr.twin.stack import LocalStack, StackConfig
 
     config = StackConfig(
         state_dir=tmp_path_factory.mktemp("fuzz-shadow"),

@@ -26,8 +26,9 @@ from skill.errors import GatewayError, ShadowConflict
 from tests.fuzz.strategies import json_values, paths_in, text
 from tests.fuzz.tally import TALLY, budget
 from tests.unit.skill.skill_testkit import check_response
-from vahr.local.shadow_store import ShadowError, ShadowStore
-from vahr.protocol import Reported, decode_command, load_fleet, topics
+from vahr.domain import load_fleet
+from vahr.protocol import Reported, decode_command, topics
+from vahr.twin.shadow_store import ShadowError, ShadowStore
 
 EVENTS = sorted((Path(__file__).parents[1] / "events").glob("alexa_*.json"))
 ENVELOPES = {path.stem: json.loads(path.read_text()) for path in EVENTS}

@@ -27,7 +27,7 @@ from hypothesis import strategies as st
 from tests.fuzz.strategies import THINGS, ZONES, encode, json_values, text
 from tests.fuzz.tally import TALLY, budget
 from tests.support.station import RecordingAssistant, Wire
-from vahr.local.ports import free_port
+from vahr.plumbing.ports import free_port
 from vahr.protocol import decode_command
 from vahr.speech.stt import NOTHING_HEARD
 from vahr.station.app import StationApp
@@ -40,7 +40,7 @@ from vahr.station.voice import PushToTalk
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
     from vahr.speech.audio import Audio
     from vahr.speech.stt import Recognition
 

@@ -19,7 +19,7 @@ from infra.app import build_app
 from vahr.errors import VahrError
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 OPTIONAL_TYPES = ("Alexa::ASK::Skill", "AWS::Lex::Bot", "AWS::Lex::BotAlias", "AWS::IoT::RoleAlias")
 

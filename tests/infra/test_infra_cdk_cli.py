@@ -56,7 +56,7 @@ def test_cdk_synth_works_offline_without_credentials_with_and_without_options(
         if f["source"]["path"].startswith("asset.")
     ]
     skill_bundle = next(path for path in bundles if (path / "skill" / "app.py").exists())
-    assert (skill_bundle / "vahr" / "protocol" / "fleet.yaml").is_file()
+    assert (skill_bundle / "vahr" / "domain" / "fleet.yaml").is_file()
     assert (skill_bundle / "vahr" / "protocol" / "__init__.py").is_file()
     # And cdk-nag passed with only acknowledged findings
     reports = json.loads((outdir / "validation-report.json").read_text())["pluginReports"]

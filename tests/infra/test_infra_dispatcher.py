@@ -21,7 +21,7 @@ from infra.config import InfraConfig
 from infra.constructs.dispatcher import Dispatcher, freed_sql
 from infra.constructs.fleet_indexing import FleetIndexing
 from infra.constructs.task_table import TaskTable
-from vahr.protocol import load_fleet
+from vahr.domain import load_fleet
 
 if TYPE_CHECKING:
     from conftest import Synthesized

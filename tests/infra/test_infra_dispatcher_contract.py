@@ -16,7 +16,7 @@ from infra.config import InfraConfig
 from infra.constructs.dispatcher import Dispatcher
 from infra.constructs.task_table import TaskTable
 from tests.support.dispatch_meter import measure_dispatch
-from vahr.protocol import load_fleet
+from vahr.domain import load_fleet
 
 if TYPE_CHECKING:
     from pathlib import Path

@@ -12,7 +12,7 @@ from template_tools import bare_stack, grants, only, resources, role_grants
 
 from infra.constructs.iot_fleet import IotFleet
 from infra.constructs.presence_rule import PresenceRule
-from vahr.protocol import Fleet
+from vahr.domain import Fleet
 
 if TYPE_CHECKING:
     from pathlib import Path

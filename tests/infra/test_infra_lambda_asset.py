@@ -21,7 +21,7 @@ from template_tools import REPO_ROOT
 
 from infra import lambda_asset
 from vahr.errors import VahrError
-from vahr.local.ports import free_port
+from vahr.plumbing.ports import free_port
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -73,7 +73,7 @@ def test_the_bundle_holds_the_skill_the_announcer_the_protocol_and_the_fleet(
     assert (root / "vahr" / "announce" / "policy.py").is_file()
     assert (root / "vahr" / "protocol" / "topics.py").is_file()
     assert (root / "vahr" / "errors.py").is_file()
-    fleet = root / "vahr" / "protocol" / "fleet.yaml"
+    fleet = root / "vahr" / "domain" / "fleet.yaml"
     assert fleet.read_bytes() == (REPO_ROOT / "fleet.yaml").read_bytes()
     assert not (root / "vahr" / "local").exists()  # only what the skill needs
 
@@ -100,7 +100,7 @@ def test_a_clean_python_3_12_imports_the_handler_from_the_bundle_alone(
     bundle: lambda_asset.BuildResult,
 ) -> None:
     script = (
-        "import json, sys, skill.app, ask_sdk_core, msgspec, yaml, vahr.protocol as p\n"
+        "import json, sys, skill.app, ask_sdk_core, msgspec, yaml, vahr.domain as p\n"
         "print(json.dumps({'handler': callable(skill.app.lambda_handler),"
         " 'files': [m.__file__ for m in (skill.app, ask_sdk_core, msgspec, yaml, p)],"
         " 'fleet': p.DEFAULT_FLEET_FILE, 'awscrt': 'awscrt' in sys.modules,"
@@ -112,7 +112,7 @@ def test_a_clean_python_3_12_imports_the_handler_from_the_bundle_alone(
     assert seen["handler"] is True
     assert seen["version"] == [3, 12]
     assert all(file.startswith(str(bundle.out_dir)) for file in seen["files"]), seen["files"]
-    assert seen["fleet"] == str(bundle.out_dir / "vahr" / "protocol" / "fleet.yaml")
+    assert seen["fleet"] == str(bundle.out_dir / "vahr" / "domain" / "fleet.yaml")
     assert seen["awscrt"] is False
 
 
@@ -146,7 +146,7 @@ def test_the_dispatcher_loads_from_the_same_bundle_and_answers_in_one_line(
         "answer = dispatcher.app.lambda_handler({'operation': 'launch'}, None)\n"
         "print(json.dumps({'answer': answer, 'file': dispatcher.app.__file__,"
         " 'loaded': sorted(m for m in ('skill', 'ask_sdk_core', 'announcer', 'awscrt',"
-        " 'vahr.announce', 'vahr.protocol.dispatch') if m in sys.modules)}))"
+        " 'vahr.announce', 'vahr.dispatch.core') if m in sys.modules)}))"
     )
     result = run_in_lambda_python(bundle.out_dir, script, VAHR_TASK_TABLE="vahr-tasks")
     assert result.returncode == 0, result.stderr
@@ -161,7 +161,7 @@ def test_the_dispatcher_loads_from_the_same_bundle_and_answers_in_one_line(
             "message": "operation: 'launch' is not one of submit, tasks, pending, cancel",
         },
     }
-    assert seen["loaded"] == ["vahr.protocol.dispatch"]
+    assert seen["loaded"] == ["vahr.dispatch.core"]
 
 
 class IotDataRecorder(BaseHTTPRequestHandler):

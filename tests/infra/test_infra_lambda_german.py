@@ -22,7 +22,7 @@ def bundle(tmp_path_factory: pytest.TempPathFactory) -> lambda_asset.BuildResult
 def test_the_bundle_carries_each_locales_words_and_replies(
     bundle: lambda_asset.BuildResult,
 ) -> None:
-    locales = bundle.out_dir / "vahr" / "protocol" / "locales"
+    locales = bundle.out_dir / "vahr" / "domain" / "locales"
     assert sorted(p.relative_to(locales).as_posix() for p in locales.rglob("*.yaml")) == [
         "de-DE/language.yaml",
         "de-DE/replies.yaml",

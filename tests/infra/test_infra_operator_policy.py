@@ -13,7 +13,7 @@ from infra.constructs.operator_policy import OperatorPolicy
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 @pytest.fixture(scope="module")

@@ -28,7 +28,7 @@ from vahr.protocol import encode, new_command, topics
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 THING = "placebot1"
 

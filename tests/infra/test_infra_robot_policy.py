@@ -15,7 +15,7 @@ from vahr.protocol import topics
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 PREFIX = "arn:aws:iot:us-east-1:123456789012"
 ROLE_ALIAS_ARN = f"{PREFIX}:rolealias/vahr-robot-lex"

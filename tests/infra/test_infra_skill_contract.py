@@ -26,7 +26,7 @@ from skill.iot_data import IotDataGateway
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 EVENTS = sorted((REPO_ROOT / "tests" / "events").glob("alexa_*.json"))
 PREFIX = f"arn:aws:iot:{REGION}:{ACCOUNT}"

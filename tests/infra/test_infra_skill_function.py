@@ -14,7 +14,7 @@ from infra.config import InfraConfig
 from infra.constructs.skill_function import SkillFunction
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 PREFIX = "arn:aws:iot:us-east-1:123456789012"
 SKILL_ID = "amzn1.ask.skill.0d5c1d3e-52b4-4a53-9f0e-6f1a2b3c4d5e"

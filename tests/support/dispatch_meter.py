@@ -27,12 +27,12 @@ from dispatcher.command_channel import CommandChannel
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
 from infra.cost_estimate import dynamodb_units
-from vahr.local.dataplane import DataPlane, DataPlaneServer
-from vahr.local.meter import Meter
-from vahr.local.shadow_service import ShadowService
-from vahr.local.shadow_store import ShadowStore
-from vahr.protocol import load_fleet
-from vahr.protocol.dispatch import Dispatcher
+from vahr.dispatch.core import Dispatcher
+from vahr.domain import load_fleet
+from vahr.twin.dataplane import DataPlane, DataPlaneServer
+from vahr.twin.meter import Meter
+from vahr.twin.shadow_service import ShadowService
+from vahr.twin.shadow_store import ShadowStore
 
 REGION = "us-east-1"
 TABLE = "vahr-tasks"

@@ -1,6 +1,6 @@
 """What a reading does: the robot commands the real skill sends for an understanding.
 
-A reading other than the label ("wrong" in `vahr.local.alexa.evaluation.outcome`) is not
+A reading other than the label ("wrong" in `vahr.assistant.evaluation.outcome`) is not
 always a robot sent where nobody asked: the skill may ask which robot is meant, refuse, or
 send what the label means in other words. The issue's targets count wrong *actions*, so the
 benches count them here by effect too. The understanding is handed to the Alexa simulator
@@ -22,16 +22,11 @@ from unittest import mock
 # The skill's package, for benchmarks (pytest puts it on the path itself).
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "lambda"))
 
-from vahr.local.alexa.evaluation import LabelledUtterance, labelled_understanding  # noqa: E402
-from vahr.local.alexa.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
-from vahr.local.alexa.simulator import AlexaSimulator  # noqa: E402
-from vahr.protocol import (  # noqa: E402
-    MOTION_ACTIONS,
-    ExperimentState,
-    Reported,
-    load_fleet,
-    topics,
-)
+from vahr.assistant.evaluation import LabelledUtterance, labelled_understanding  # noqa: E402
+from vahr.assistant.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
+from vahr.assistant.simulator import AlexaSimulator  # noqa: E402
+from vahr.domain import load_fleet
+from vahr.protocol import MOTION_ACTIONS, ExperimentState, Reported, topics
 
 if TYPE_CHECKING:
     from types import TracebackType

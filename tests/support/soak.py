@@ -45,10 +45,10 @@ from tests.support.soak_ledger import Ledger, Record, Sent, Verdict, read_agent_
 from tests.support.swarm import SwarmThread
 from tests.support.vahr_up import start_up, stop_up
 from vahr.errors import VahrError
-from vahr.local.client import call, say
-from vahr.local.mqtt import MqttClient, MqttEndpoint, PublishUnconfirmed
-from vahr.local.ports import free_port
 from vahr.pki import LocalCA
+from vahr.plumbing.client import call, say
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint, PublishUnconfirmed
+from vahr.plumbing.ports import free_port
 from vahr.protocol import encode, new_command, topics
 
 if TYPE_CHECKING:

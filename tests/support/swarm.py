@@ -23,8 +23,8 @@ from typing import TYPE_CHECKING, Any
 
 from robot_agent.swarm import CONNECT_TIMEOUT_S, STOP_TIMEOUT_S
 from robot_agent.swarm import Swarm as ProductSwarm
+from vahr.domain import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
 from vahr.errors import VahrError
-from vahr.protocol import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
 
 if TYPE_CHECKING:
     from vahr.protocol import Reported

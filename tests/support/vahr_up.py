@@ -18,8 +18,8 @@ import time
 from pathlib import Path
 from typing import IO, Any
 
-from vahr.local.lifetime import spawn
-from vahr.local.ports import free_port
+from vahr.plumbing.lifetime import spawn
+from vahr.plumbing.ports import free_port
 
 ROOT = Path(__file__).resolve().parents[2]
 VAHR = [sys.executable, "-m", "vahr.cli"]

@@ -9,10 +9,11 @@ from pathlib import Path
 import pytest
 
 from vahr.cli import main as vahr_main
+from vahr.domain import Fleet
 from vahr.errors import VahrError
 from vahr.experiment.results import read_csv
-from vahr.local.shadow_store import ShadowError, ShadowStore
-from vahr.protocol import Fleet, ProtocolError, decode_command
+from vahr.protocol import ProtocolError, decode_command
+from vahr.twin.shadow_store import ShadowError, ShadowStore
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -86,7 +87,7 @@ def test_a_shadow_update_nested_deeper_than_the_parser_goes_is_a_400() -> None:
 
 def test_a_room_message_nested_deeper_than_the_parser_goes_is_not_speech() -> None:
     from vahr.speech.errors import SpeechError
-    from vahr.speech.room import Utterance
+    from vahr.speech.room_channel import Utterance
 
     with pytest.raises(SpeechError, match="^room message is not an utterance: "):
         Utterance.decode(b"[" * 4000 + b"]" * 4000)

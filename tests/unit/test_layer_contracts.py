@@ -27,7 +27,7 @@ def lint_imports(tree: Path) -> subprocess.CompletedProcess[str]:
 
 @pytest.fixture
 def tree(tmp_path: Path) -> Path:
-    """A copy of the four packages the contracts speak of (their Python files, which is
+    """A copy of the five packages the contracts speak of (their Python files, which is
     all the check reads), importable from `tmp_path`."""
 
     def ignore(directory: str, names: list[str]) -> set[str]:
@@ -42,6 +42,7 @@ def tree(tmp_path: Path) -> Path:
         ("robot_agent", "robot_agent"),
         ("skill", "lambda/skill"),
         ("announcer", "lambda/announcer"),
+        ("dispatcher", "lambda/dispatcher"),
     ):
         shutil.copytree(ROOT / source, tmp_path / package, ignore=ignore, symlinks=True)
     return tmp_path
@@ -56,23 +57,38 @@ def test_the_packages_keep_every_contract(tree: Path) -> None:
 @pytest.mark.parametrize(
     ("module", "line", "contract"),
     [
-        ("vahr/protocol/topics.py", "import vahr.local.mqtt", "The bottom layer"),
-        ("vahr/speech/audio.py", "import robot_agent.config", "The bottom layer"),
-        ("robot_agent/agent.py", "import vahr.local.room", "robot_agent never imports"),
+        ("vahr/protocol/topics.py", "import vahr.plumbing.mqtt", "The wire contract"),
+        ("vahr/protocol/topics.py", "import vahr.domain.fleet", "The wire contract"),
+        ("vahr/protocol/topics.py", "import yaml", "The wire contract"),
+        ("vahr/domain/fleet.py", "import vahr.assistant.nlu", "The domain and the dispatch"),
+        ("vahr/dispatch/core.py", "import boto3", "The domain and the dispatch"),
+        ("vahr/speech/audio.py", "import vahr.plumbing.mqtt", "Speech imports nothing"),
+        ("robot_agent/agent.py", "import vahr.local.room_assistant", "robot_agent never imports"),
+        ("robot_agent/agent.py", "import vahr.assistant.nlu", "robot_agent never imports"),
         ("vahr/local/system.py", "import robot_agent.assembly", "vahr never imports robot_agent"),
-        ("skill/app.py", "import vahr.speech.tts", "The skill imports only the protocol"),
-        ("skill/app.py", "import vahr.announce", "The skill imports only the protocol"),
-        ("skill/app.py", "import announcer.app", "The skill imports only the protocol"),
-        ("announcer/app.py", "import vahr.local.mqtt", "The announcer imports only"),
+        ("skill/app.py", "import vahr.speech.tts", "The skill imports only"),
+        ("skill/app.py", "import vahr.announce", "The skill imports only"),
+        ("skill/app.py", "import vahr.assistant", "The skill imports only"),
+        ("skill/app.py", "import announcer.app", "The skill imports only"),
+        ("announcer/app.py", "import vahr.plumbing.mqtt", "The announcer imports only"),
         ("announcer/app.py", "import skill.iot_data", "The announcer imports only"),
         ("announcer/app.py", "import boto3", "Only the announcer's data-access module"),
+        ("dispatcher/app.py", "import vahr.twin.fleet_index", "The dispatcher imports only"),
+        ("dispatcher/app.py", "import boto3", "Only the dispatcher's three adapters"),
         ("vahr/announce/policy.py", "import vahr.errors", "The announcement policy imports"),
         ("vahr/announce/speech.py", "import vahr.skill_model", "The announcement policy"),
-        # The local stack starting the station itself again: a package cycle in the top layer.
+        # The local stack starting the station itself: the station is handed to it from above.
         ("vahr/local/system.py", "import vahr.station.deployment", "The top layer is one-way"),
-        ("vahr/local/system.py", "import vahr.station.deployment", "No import cycle"),
+        ("vahr/plumbing/mqtt.py", "import vahr.twin.broker", "No import cycle"),
         ("vahr/experiment/bus.py", "import vahr.station.desk", "The top layer is one-way"),
-        ("vahr/station/vocabulary.py", "import vahr.local.alexa.nlu", "The station and the"),
+        ("vahr/twin/stack.py", "import vahr.local.system", "The top layer is one-way"),
+        # The plumbing and the assistant are siblings: neither knows the other.
+        ("vahr/plumbing/client.py", "import vahr.assistant.nlu", "The top layer is one-way"),
+        # The station serves any deployment: nothing of the twin or the local hosts.
+        ("vahr/station/voice.py", "import vahr.twin.dataplane", "The station and the experiment know"),
+        ("vahr/station/app.py", "import vahr.local.system", "The station and the experiment know"),
+        ("vahr/experiment/bus.py", "import vahr.twin.broker", "The station and the experiment know"),
+        ("vahr/station/vocabulary.py", "import vahr.assistant.nlu", "The station and the"),
         ("robot_agent/link/shadow.py", "import robot_agent.voice.port", "robot_agent's adapters"),
         # Cycles no layer names: two modules of one package, two packages of robot_agent.
         ("vahr/experiment/tlx.py", "import vahr.experiment.results", "No import cycle"),

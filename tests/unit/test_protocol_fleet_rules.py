@@ -7,10 +7,10 @@ import pytest
 
 from tests.support.fleets import BAD_FLEETS, SIX_ROBOTS, bad_fleet
 from vahr.commands.fleet_flag import read_fleet
+from vahr.domain.fleet import Fleet, Floor, Point, Pose
 from vahr.errors import VahrError
 from vahr.local.robots import fleet_of
 from vahr.protocol import ProtocolError
-from vahr.protocol.fleet import Fleet, Floor, Point, Pose
 
 ROBOT = "robots: [{thing: r, spoken: [r], start: {x: 1, y: 1}}]\n"
 ZONES = "zones: [{id: LOADING, spoken: [l], pose: {x: 2, y: 2}}]\n"

@@ -7,9 +7,10 @@ import logging
 
 import pytest
 
-from vahr.protocol import Fleet, load_fleet, text, weather
-from vahr.protocol.fleet import spoken_in
-from vahr.protocol.locale import SUPPORTED_LOCALES, LocaleError, check_locale, load_language
+from vahr.domain import Fleet, load_fleet
+from vahr.domain.fleet import spoken_in
+from vahr.domain.locale import SUPPORTED_LOCALES, LocaleError, check_locale, load_language
+from vahr.domain import text, weather
 
 
 def test_the_shipped_locales_are_english_and_german() -> None:
@@ -71,7 +72,7 @@ def test_a_fleet_without_a_locales_names_falls_back_to_english_and_warns_once(
         b"zones: [{id: LOADING, spoken: [loading zone], pose: {x: 3, y: 1, theta: 0}}]\n"
     )
     # When names are asked for in German
-    with caplog.at_level(logging.WARNING, logger="vahr.protocol.fleet"):
+    with caplog.at_level(logging.WARNING, logger="vahr.domain.fleet"):
         robot = spoken_in(english_only.robots[0], "xx-XX")
         zone = spoken_in(english_only.zones[0], "xx-XX")
     # Then the English names serve, with one warning for the locale

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from datetime import UTC, datetime
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -11,11 +12,10 @@ from vahr.protocol import (
     MAX_PAYLOAD_BYTES,
     Deliver,
     Event,
-    EventPose,
-    Fleet,
     Navigate,
     Presence,
     ProtocolError,
+    ReportedPose,
     SequentialDelivery,
     Stop,
     decode_command,
@@ -24,6 +24,9 @@ from vahr.protocol import (
     encode,
     new_command,
 )
+
+if TYPE_CHECKING:
+    from vahr.domain import Fleet
 
 AT = "2026-11-22T10:00:00Z"
 
@@ -85,7 +88,7 @@ def test_event_and_presence_round_trip() -> None:
         command_id="c-1",
         action="navigate",
         zone="A",
-        pose=EventPose(x=9.0, y=7.0),
+        pose=ReportedPose(x=9.0, y=7.0),
     )
     wire = json.loads(encode(event))
     assert "reason" not in wire  # only the fields that apply are sent

@@ -13,22 +13,24 @@ import pytest
 from tests.conftest import load_event
 from vahr.protocol import EventKind, ProtocolError
 from vahr.protocol.announcements import decode_announcement
-from vahr.protocol.station import (
+from vahr.protocol.station_topics import (
+    ExperimentStatus,
+    Interaction,
+    decode_experiment_status,
+    decode_station_input,
+    decode_turn,
+    on_clock,
+    turn_from_message,
+)
+from vahr.station.page_messages import (
     DRIVE_ENDS,
     EXCHANGE_EVENTS,
     AckMessage,
     AlertAcknowledgedMessage,
     AnnouncementMessage,
     EventMessage,
-    ExperimentStatus,
-    Interaction,
     PageMessage,
-    decode_experiment_status,
-    decode_station_input,
-    decode_turn,
     encode_page_message,
-    on_clock,
-    turn_from_message,
 )
 
 NOW = datetime(2026, 11, 23, 10, 0, 0, tzinfo=UTC)

@@ -1,8 +1,8 @@
-"""How spoken phrases are compared, and numbers spelled, everywhere (`vahr.protocol.text`)."""
+"""How spoken phrases are compared, and numbers spelled, everywhere (`vahr.domain.text`)."""
 
 from __future__ import annotations
 
-from vahr.protocol.text import normalize, number_in_words, spell_numbers
+from vahr.domain.text import normalize, number_in_words, spell_numbers
 
 
 def test_a_phrase_is_compared_in_lower_case_without_punctuation() -> None:

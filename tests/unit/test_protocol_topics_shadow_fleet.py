@@ -6,18 +6,18 @@ import json
 
 import pytest
 
+from vahr.domain import load_fleet
+from vahr.domain.fleet import Fleet, Pose
 from vahr.protocol import (
     ExperimentState,
     LastCommand,
     ProtocolError,
     Reported,
-    ShadowPose,
+    ReportedPose,
     experiment_state_from_payload,
-    load_fleet,
     robot_shadow_from_payload,
     topics,
 )
-from vahr.protocol.fleet import Fleet, Pose
 
 
 def test_topics_match_the_contract() -> None:
@@ -59,7 +59,7 @@ def test_reported_state_round_trips_through_a_shadow_document() -> None:
         connected=True,
         destination="B",
         task="deliver",
-        pose=ShadowPose(x=1.0, y=2.0, theta=0.5),
+        pose=ReportedPose(x=1.0, y=2.0, theta=0.5),
     )
     body = json.loads(state.to_payload(client_token="t-1"))
     assert body["clientToken"] == "t-1"

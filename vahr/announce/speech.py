@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
     from vahr.protocol.announcements import AnnouncementKind
 
 PROMPTS: dict[AnnouncementKind, str] = {

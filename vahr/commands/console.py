@@ -27,8 +27,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from vahr.local.alexa.localized import supported
-    from vahr.local.client import call, default_api
+    from vahr.assistant.localized import supported
+    from vahr.plumbing.client import call, default_api
 
     supported(args.locale)
     api = args.api or default_api()
@@ -47,8 +47,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _announcements(api: str, *, speak: bool) -> Any:
     """Say each new announcement (a robot stuck, failed, offline) as the Echo would."""
-    from vahr.local.announcement_feed import AnnouncementFeed
-    from vahr.local.speaker import speak as say_aloud
+    from vahr.plumbing.announcement_feed import AnnouncementFeed
+    from vahr.speech.speaker import speak as say_aloud
 
     def tell(announcement: dict[str, Any]) -> None:
         print(f"\nalexa> {announcement['speech']}  [announcement: {announcement['kind']}]")
@@ -60,7 +60,7 @@ def _announcements(api: str, *, speak: bool) -> Any:
 
 def _converse(api: str, args: argparse.Namespace, interactive: bool) -> None:
     from vahr.errors import VahrError
-    from vahr.local.client import say
+    from vahr.plumbing.client import say
 
     for line in _lines(interactive):
         utterance = line.strip()
@@ -77,7 +77,7 @@ def _converse(api: str, args: argparse.Namespace, interactive: bool) -> None:
             f"{turn['latency_ms']:.0f} ms]"
         )
         if args.speak and turn["speech"]:
-            from vahr.local.speaker import speak, voice_for
+            from vahr.speech.speaker import speak, voice_for
 
             speak(turn["speech"], voice=voice_for(args.locale))
 

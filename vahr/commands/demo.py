@@ -17,13 +17,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from vahr.cli_dispatch import add_logging_flag, setup_logging
+from vahr.cli_router import add_logging_flag, setup_logging
 from vahr.commands.fleet_flag import add_fleet_flag, read_fleet
 
 if TYPE_CHECKING:
     import argparse
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 WAIT_TIMEOUT_S = 30.0
 
@@ -72,7 +72,7 @@ PAPER_NAMES = {
 
 def script_for(fleet: Fleet) -> list[Step]:
     """The scenario in the fleet's names, for a fleet fit for the paper's tasks."""
-    from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
+    from vahr.domain import FLEET_GROUP, FLEET_GROUP_NAMES
 
     def said(role: str, spoken: list[str] | tuple[str, ...]) -> str:
         return PAPER_NAMES[role] if PAPER_NAMES[role] in spoken else spoken[0]
@@ -147,8 +147,8 @@ class _Events:
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
     from vahr.experiment.tasks import require_fit_fleet
-    from vahr.local.ports import free_port
     from vahr.local.system import LocalSystem, SystemConfig
+    from vahr.plumbing.ports import free_port
 
     setup_logging(args.log_level)
     fleet = read_fleet(args.fleet)
@@ -201,11 +201,11 @@ def run(args: argparse.Namespace) -> int:
 
 def _experiment(system: Any, log_dir: Path, args: argparse.Namespace) -> list[str]:
     """The paper's tasks I-III, performed by the simulated participant with both methods."""
+    from vahr.experiment.demo_session import rehearse
     from vahr.experiment.eventlog import read_log
     from vahr.experiment.metrics import fan_out, rad
-    from vahr.experiment.rehearsal import rehearse
     from vahr.experiment.results import row_from_log
-    from vahr.local.client import HttpAssistant
+    from vahr.plumbing.client import HttpAssistant
 
     if not args.json:
         print("The paper's experiment, tasks I-III (simulated participant):\n")

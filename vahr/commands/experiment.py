@@ -157,11 +157,11 @@ def _show_plan(name: str, plan: dict[str, Any], resumed: bool, method: str) -> N
 
 
 def _run_session(args: argparse.Namespace, fleet: Any, session: Any) -> Any:
-    from vahr.experiment.rehearsal import run_live, simulated_performer
+    from vahr.experiment.demo_session import run_live, simulated_performer
 
     performer_for: Any
     if args.simulate:
-        from vahr.local.client import HttpAssistant, SayCommandAssistant
+        from vahr.plumbing.client import HttpAssistant, SayCommandAssistant
 
         assistant = HttpAssistant(args.api) if args.api else SayCommandAssistant(None)
         performer_for = simulated_performer(session, fleet, assistant)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 from typing import TYPE_CHECKING
 
-from vahr.protocol.faults import DEFAULT_OFFLINE_S, FAULT_KINDS
+from vahr.protocol.fault_request import DEFAULT_OFFLINE_S, FAULT_KINDS
 
 if TYPE_CHECKING:
     import argparse
@@ -39,7 +39,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
-    from vahr.local.client import call, default_api
+    from vahr.plumbing.client import call, default_api
 
     if not 0 < args.offline_s <= 3600:
         raise VahrError("--offline-s must be in (0, 3600]")

@@ -12,8 +12,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from vahr.domain import Fleet, load_fleet
 from vahr.errors import VahrError
-from vahr.protocol import Fleet, ProtocolError, load_fleet
+from vahr.protocol import ProtocolError
 
 if TYPE_CHECKING:
     import argparse
@@ -55,7 +56,7 @@ def served_fleet(api: str) -> Fleet | None:
     iot-data endpoint, a stack from before the route, nothing at all)."""
     import msgspec
 
-    from vahr.local.client import call
+    from vahr.plumbing.client import call
 
     try:
         answer = call(api, "GET", FLEET_ROUTE, timeout_s=SERVED_TIMEOUT_S)

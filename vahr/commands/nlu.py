@@ -10,11 +10,11 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     import argparse
 
-    from vahr.local.alexa.nlu import InteractionModel, Understanding
+    from vahr.assistant.nlu import InteractionModel, Understanding
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    from vahr.local.alexa.evaluation import DEVELOPMENT_SET
+    from vahr.assistant.evaluation import DEVELOPMENT_SET
 
     parser.add_argument(
         "utterance", nargs="?", help='what a person says, e.g. "send robot one to zone b"'
@@ -49,9 +49,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from vahr.assistant.evaluation import DEVELOPMENT_SET
+    from vahr.assistant.localized import strip_invocation, supported
     from vahr.errors import VahrError
-    from vahr.local.alexa.evaluation import DEVELOPMENT_SET
-    from vahr.local.alexa.localized import strip_invocation, supported
 
     supported(args.locale)
     if args.eval is not None:
@@ -92,9 +92,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _model(args: argparse.Namespace) -> InteractionModel:
-    from vahr.local.alexa.localized import load_model
-    from vahr.local.alexa.nlu import InteractionModel
-    from vahr.local.alexa.understanding import load_understanding
+    from vahr.assistant.localized import load_model
+    from vahr.assistant.nlu import InteractionModel
+    from vahr.assistant.understanding import load_understanding
 
     if args.fleet is None:
         return load_model(args.locale, args.model)
@@ -138,7 +138,7 @@ def describe(understood: Understanding) -> dict[str, Any]:
 
 
 def _evaluate(model: InteractionModel, file: Path, as_json: bool) -> int:
-    from vahr.local.alexa.evaluation import LabelledSet, evaluate
+    from vahr.assistant.evaluation import LabelledSet, evaluate
 
     report = evaluate(model, LabelledSet.load(file))
     if as_json:

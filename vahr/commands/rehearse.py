@@ -18,13 +18,13 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from vahr.cli_dispatch import add_logging_flag, setup_logging
+from vahr.cli_router import add_logging_flag, setup_logging
 from vahr.errors import VahrError
 
 if TYPE_CHECKING:
     import argparse
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 DEFAULT_OUT = Path("out") / "rehearsal"
 DEFAULT_SPEED = 30.0
@@ -104,7 +104,7 @@ def speed_factor(api: str | None, asked: float | None) -> float:
     """
     if api is None:
         return asked if asked is not None else DEFAULT_SPEED
-    from vahr.local.client import call
+    from vahr.plumbing.client import call
 
     running = call(api, "GET", "/vahr/health").get("sim_speed_factor")
     if not isinstance(running, int | float) or running <= 0:
@@ -159,8 +159,8 @@ def _on_own_stack(
     spec: Any, fleet: Fleet, args: argparse.Namespace, announce: Any
 ) -> dict[str, Any]:
     from vahr.experiment.study import run_study
-    from vahr.local.ports import free_port
     from vahr.local.system import LocalSystem, SystemConfig
+    from vahr.plumbing.ports import free_port
 
     with tempfile.TemporaryDirectory(prefix="vahr-rehearse-") as state:
         config = SystemConfig(

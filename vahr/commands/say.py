@@ -23,9 +23,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from vahr.assistant.localized import supported
     from vahr.errors import VahrError
-    from vahr.local.alexa.localized import supported
-    from vahr.local.client import default_api, say
+    from vahr.plumbing.client import default_api, say
 
     supported(args.locale)
     if not args.utterance.strip():
@@ -36,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(turn["speech"] or "(no answer)")
     if args.speak and turn.get("speech"):
-        from vahr.local.speaker import speak, voice_for
+        from vahr.speech.speaker import speak, voice_for
 
         speak(turn["speech"], voice=voice_for(args.locale))
     return 0

@@ -15,7 +15,7 @@ import threading
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from vahr.cli_dispatch import add_logging_flag, setup_logging
+from vahr.cli_router import add_logging_flag, setup_logging
 from vahr.commands.broker_flags import add_broker_flags, client_credentials
 from vahr.commands.fleet_flag import add_fleet_flag, fleet_for
 
@@ -53,8 +53,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
+    from vahr.station.assembly import StationConfig
     from vahr.station.deployment import Deployment, build_station
-    from vahr.station.station import StationConfig
 
     setup_logging(args.log_level)
     if not 0 <= args.port <= 65535:

@@ -9,13 +9,14 @@ import threading
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from vahr.cli_dispatch import add_logging_flag, setup_logging
+from vahr.cli_router import add_logging_flag, setup_logging
 from vahr.commands.fleet_flag import add_fleet_flag, read_fleet
 
 if TYPE_CHECKING:
     import argparse
 
-    from vahr.protocol import Event, Fleet
+    from vahr.domain import Fleet
+    from vahr.protocol import Event
 
 DEFAULT_API_PORT = 8180
 DEFAULT_STATION_PORT = 8181
@@ -81,8 +82,8 @@ def run(args: argparse.Namespace) -> int:
     from vahr.station.deployment import on_local_system
 
     setup_logging(args.log_level)
-    from vahr.local.alexa.localized import supported
-    from vahr.protocol.locale import load_language
+    from vahr.assistant.localized import supported
+    from vahr.domain.locale import load_language
 
     if not load_language(supported(args.locale)).speech.recognised:
         print(

@@ -1,6 +1,6 @@
 """The session's wire: records every command and robot event, and sends the console's commands.
 
-It is the lab's one MQTT client (`vahr.local.mqtt`) subscribed to every robot's events, to
+It is the lab's one MQTT client (`vahr.plumbing.mqtt`) subscribed to every robot's events, to
 every command topic (robot and fleet) and to what the participant does on the operator
 station (`topics.EXPERIMENT_INPUT`), handing each live message to a callback. The
 session is persistent (a client id fixed per experiment session, and a session expiry), so
@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from vahr.errors import VahrError
-from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
 from vahr.protocol.broker import parse_broker_url
 

@@ -17,7 +17,7 @@ from vahr.errors import VahrError
 from vahr.protocol import ExperimentState, experiment_state_from_payload
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 class ExperimentShadow:

@@ -26,10 +26,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from vahr.domain import WEATHERS
 from vahr.experiment.eventlog import Kind
 from vahr.experiment.metrics import rate
 from vahr.experiment.procedures import PROCEDURE, conformance, heard_weather, procedure_for
-from vahr.protocol import WEATHERS
 
 if TYPE_CHECKING:
     from datetime import datetime

@@ -39,20 +39,21 @@ import msgspec
 
 from vahr.announce import AnnouncePolicy, settings_from, signals_from_event
 from vahr.announce.speech import Names
+from vahr.domain import Pose
 from vahr.errors import VahrError
 from vahr.experiment import timing
 from vahr.experiment.eventlog import Kind
 from vahr.experiment.procedures import Observation, check_action, heard_weather, procedure_for
-from vahr.protocol import Event, Pose, ProtocolError, encode, new_command, topics
+from vahr.protocol import Event, ProtocolError, encode, new_command, topics
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from vahr.domain import Fleet
     from vahr.experiment.eventlog import EventLog, LogEntry
     from vahr.experiment.procedures import Procedure, Step
     from vahr.experiment.tasks import Plan
-    from vahr.local.client import Assistant
-    from vahr.protocol import Fleet
+    from vahr.plumbing.client import Assistant
     from vahr.protocol.announcements import Announcement
 
 # A question the assistant does not answer with a weather is asked again, up to this often.

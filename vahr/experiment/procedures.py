@@ -37,17 +37,17 @@ import re
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Literal
 
+from vahr.domain import WEATHER_ZONES
+from vahr.domain.invocation import INVOCATION_NAME
 from vahr.experiment.eventlog import Kind
 from vahr.experiment.tasks import SEQUENCE_ZONE
-from vahr.protocol import WEATHER_ZONES
-from vahr.protocol.assistant import INVOCATION_NAME
 
 if TYPE_CHECKING:
     from collections.abc import Collection, Iterable
 
+    from vahr.domain import Fleet
     from vahr.experiment.eventlog import LogEntry
     from vahr.experiment.tasks import Plan
-    from vahr.protocol import Fleet
 
 Method = Literal["vahr", "keyboard"]
 # Recorded in a session's header: the judge checks conformance only for sessions run with it.

@@ -9,7 +9,7 @@ such rather than dropped, so the log shows everything the participant caused.
 What the participant did on the operator station (`topics.EXPERIMENT_INPUT`: clicks, key
 presses, push-to-talk, the observer's puzzle count) is logged too, as interactions and
 observer input of this session, at the times the page measured moved onto this machine's
-clock (`vahr.protocol.station.on_clock`).
+clock (`vahr.protocol.station_topics.on_clock`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 from vahr.experiment.eventlog import Kind, now
 from vahr.protocol import ProtocolError, decode_command, decode_event, encode, topics
-from vahr.protocol.station import Interaction, decode_station_input, on_clock
+from vahr.protocol.station_topics import Interaction, decode_station_input, on_clock
 
 logger = logging.getLogger(__name__)
 # Interactions from the station are named apart from the observer's and the participant

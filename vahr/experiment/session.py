@@ -34,10 +34,10 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
+    from vahr.domain import Fleet
     from vahr.experiment.judge import SessionVerdict
     from vahr.experiment.recorder import Recorder
     from vahr.experiment.tasks import TaskGoal
-    from vahr.protocol import Fleet
 
 log = logging.getLogger(__name__)
 

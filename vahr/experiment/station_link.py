@@ -29,7 +29,7 @@ from vahr.experiment.judge import judge_task, score_goal, task_deliveries, task_
 from vahr.experiment.procedures import PROCEDURE, allowed_actions, conformance, procedure_for
 from vahr.experiment.tasks import TASK_TITLES, TASKS
 from vahr.protocol import topics
-from vahr.protocol.station import ExperimentStatus, TaskState, TaskStatus
+from vahr.protocol.station_topics import ExperimentStatus, ExperimentTaskStatus, TaskState
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -46,22 +46,24 @@ CHECK_S = 0.25
 WILL = (topics.EXPERIMENT_STATUS, b"")
 
 
-def task_statuses(entries: list[LogEntry], session: OpenSession) -> dict[str, TaskStatus]:
+def task_statuses(entries: list[LogEntry], session: OpenSession) -> dict[str, ExperimentTaskStatus]:
     """Each task's state and the judge's verdict so far."""
     plan = session.plan
     header = next((e.data for e in entries if e.kind == Kind.SESSION_STARTED), {})
     windows = task_windows(entries)
-    found: dict[str, TaskStatus] = {}
+    found: dict[str, ExperimentTaskStatus] = {}
     for task in TASKS:
         window = windows.get(task)
         title = TASK_TITLES[task]
         if window is None:
-            found[task] = TaskStatus("waiting", title=title)
+            found[task] = ExperimentTaskStatus("waiting", title=title)
             continue
         if window.end is not None:
             outcome = judge_task(window, plan.goal(task), plan, header)
             ended: TaskState = "success" if outcome.success else "failure"
-            found[task] = TaskStatus(ended, outcome.reason, title, window.start.at, window.end.at)
+            found[task] = ExperimentTaskStatus(
+                ended, outcome.reason, title, window.start.at, window.end.at
+            )
             continue
         verdict = score_goal(plan.goal(task), task_deliveries(window.entries))
         problems: list[str] = []
@@ -76,7 +78,7 @@ def task_statuses(entries: list[LogEntry], session: OpenSession) -> dict[str, Ta
             state, reason = "running", verdict.reason
         else:
             state, reason = ("success" if verdict.success else "failure"), verdict.reason
-        found[task] = TaskStatus(state, reason, title, window.start.at)
+        found[task] = ExperimentTaskStatus(state, reason, title, window.start.at)
     return found
 
 

@@ -25,20 +25,20 @@ import random
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from vahr.experiment.demo_session import rehearse
 from vahr.experiment.eventlog import Kind, read_log, session_file
 from vahr.experiment.paper import compare, render_comparison
-from vahr.experiment.rehearsal import rehearse
 from vahr.experiment.report import write_report
 from vahr.experiment.results import row_from_log, rows_from_logs
 from vahr.experiment.tasks import METHODS, default_seed
 from vahr.experiment.timing import Person
-from vahr.local.client import HttpAssistant
+from vahr.plumbing.client import HttpAssistant
 
 if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -18,11 +18,13 @@ import random
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
+from vahr.domain import WEATHER_ZONES, WEATHERS
 from vahr.errors import VahrError
-from vahr.protocol import WEATHER_ZONES, WEATHERS, ExperimentState
+from vahr.protocol import ExperimentState
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet, Weather
+    from vahr.domain import Fleet
+    from vahr.protocol import Weather
 
 TaskId = Literal["I", "II", "III"]
 TASKS: tuple[TaskId, ...] = ("I", "II", "III")

@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     import random
 
-    from vahr.protocol import Pose
+    from vahr.domain import Pose
 
 
 @dataclass(frozen=True)

@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING, Any
 from vahr.experiment.judge import Delivery, score_goal
 
 if TYPE_CHECKING:
+    from vahr.domain import Fleet
     from vahr.experiment.tasks import TaskGoal
-    from vahr.protocol import Fleet
 
 
 @dataclass

@@ -23,7 +23,7 @@ from vahr.announce import (
     signals_from_presence,
 )
 from vahr.announce.speech import Names
-from vahr.local.mqtt import MqttClient
+from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import ProtocolError, decode_event, decode_presence, encode, topics, utc_now
 from vahr.protocol.announcements import announcement_json
 
@@ -32,8 +32,8 @@ if TYPE_CHECKING:
     from datetime import datetime
 
     from vahr.announce import Signal
-    from vahr.local.mqtt import MqttEndpoint
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
+    from vahr.plumbing.mqtt import MqttEndpoint
     from vahr.protocol.announcements import Announcement
 
 log = logging.getLogger(__name__)

@@ -1,4 +1,4 @@
-"""The local stack's fleet dispatcher: the core of `vahr.protocol.dispatch` wired to `vahr up`.
+"""The local stack's fleet dispatcher: the core of `vahr.dispatch.core` wired to `vahr up`.
 
 - tasks: `SqliteTaskStore` in the state directory (the queue survives a restart);
 - candidates: the local fleet index the shadow store keeps (`IndexCandidates`), the twin
@@ -22,10 +22,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from vahr.local.mqtt import MqttClient
-from vahr.local.task_store import SqliteTaskStore
-from vahr.protocol import Pose, encode, topics
-from vahr.protocol.dispatch import (
+from vahr.dispatch.core import (
     BUSY_STATUSES,
     IDLE_STATUSES,
     Dispatcher,
@@ -33,14 +30,19 @@ from vahr.protocol.dispatch import (
     Order,
     RobotState,
 )
+from vahr.domain import Pose
+from vahr.local.task_store import SqliteTaskStore
+from vahr.plumbing.mqtt import MqttClient
+from vahr.protocol import encode, topics
 from vahr.protocol.errors import from_validation_error
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.local.fleet_index import FleetIndex, IndexedThing
-    from vahr.local.mqtt import MqttEndpoint
-    from vahr.protocol import Command, Fleet
+    from vahr.domain import Fleet
+    from vahr.plumbing.mqtt import MqttEndpoint
+    from vahr.protocol import Command
+    from vahr.twin.fleet_index import FleetIndex, IndexedThing
 
 log = logging.getLogger(__name__)
 

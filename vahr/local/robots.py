@@ -19,10 +19,10 @@ from typing import TYPE_CHECKING, Literal
 
 import msgspec
 
+from vahr.domain import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
+from vahr.domain.fleet import Conveyor, Floor, Point, Segment
 from vahr.errors import VahrError
-from vahr.local.lifetime import spawn
-from vahr.protocol import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
-from vahr.protocol.fleet import Conveyor, Floor, Point, Segment
+from vahr.plumbing.lifetime import spawn
 
 if TYPE_CHECKING:
     from pathlib import Path

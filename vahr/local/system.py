@@ -23,12 +23,12 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import msgspec
 
+from vahr.assistant import SimulatorAssistant
+from vahr.domain.fleet import SPOKEN_LOCALE
 from vahr.errors import VahrError
+from vahr.local.alexa_host import serve_alexa
 from vahr.local.announcer import LocalAnnouncer
-from vahr.local.client import SimulatorAssistant
 from vahr.local.dispatcher import TASKS_PATH, LocalDispatcher
-from vahr.local.mqtt import MqttClient
-from vahr.local.ports import ensure_free
 from vahr.local.robots import (
     ProgressRate,
     RobotProcesses,
@@ -37,19 +37,20 @@ from vahr.local.robots import (
     generated_fleet,
     write_fleet,
 )
-from vahr.local.shadow_store import ShadowError
-from vahr.local.stack import LocalStack, StackConfig
+from vahr.plumbing.mqtt import MqttClient
+from vahr.plumbing.ports import ensure_free
 from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
-from vahr.protocol.fleet import SPOKEN_LOCALE
 from vahr.skill_model.generator import build_interaction_model, build_locale_model, render
+from vahr.twin.shadow_store import ShadowError
+from vahr.twin.stack import LocalStack, StackConfig
 
 if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-    from vahr.local.alexa.simulator import AlexaSimulator
-    from vahr.local.client import Assistant
-    from vahr.protocol import Fleet
+    from vahr.assistant.simulator import AlexaSimulator
+    from vahr.domain import Fleet
+    from vahr.plumbing.client import Assistant
 
 log = logging.getLogger(__name__)
 
@@ -190,7 +191,8 @@ class LocalSystem:
             model_file = cfg.state_dir / "interaction-model.json"
             model_file.write_text(render(model), encoding="utf-8")
             self.stack.start()
-            self.alexa = self.stack.attach_alexa(
+            self.alexa = serve_alexa(
+                self.stack,
                 ack_timeout_s=cfg.ack_timeout_s,
                 model_file=model_file,
                 fleet_file=fleet_file,
@@ -239,7 +241,7 @@ class LocalSystem:
     def _start_announcer(self) -> None:
         """Robots' troubles told unprompted (`GET /vahr/announcements`); the running speed
         factor on `GET /vahr/health`, so a rehearsal against this stack can adopt it."""
-        from vahr.local.faults import FaultInjector
+        from vahr.twin.fault_injection import FaultInjector
 
         dataplane = self.stack.dataplane
         assert dataplane is not None and self._watcher is not None
@@ -266,9 +268,9 @@ class LocalSystem:
 
     def _start_room(self) -> None:
         """The assistant robots talk to: a second simulated Echo on the same skill."""
-        from vahr.local.alexa.nlu import InteractionModel
-        from vahr.local.alexa.simulator import AlexaSimulator
-        from vahr.local.room import offline_room_assistant
+        from vahr.assistant.nlu import InteractionModel
+        from vahr.assistant.simulator import AlexaSimulator
+        from vahr.local.room_assistant import offline_room_assistant
 
         assert self.alexa is not None
         model = self.alexa.model

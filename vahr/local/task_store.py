@@ -1,4 +1,4 @@
-"""The local stack's fleet task queue: `vahr.protocol.dispatch.TaskStore` over SQLite.
+"""The local stack's fleet task queue: `vahr.dispatch.core.TaskStore` over SQLite.
 
 One row per task, in `tasks.sqlite3` in the state directory, so the queue and who holds
 which task survive a restart of `vahr up`. Every conditional change is one SQL statement
@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from vahr.protocol.dispatch import Outcome, Task
+from vahr.dispatch.core import Outcome, Task
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

@@ -1,32 +1,19 @@
-"""The wire contract shared by the skill, the robots, the local stack and the experiment.
+"""The wire contract: what crosses MQTT between the skill, the robots, the station and the
+hosts, and nothing else.
 
-Import from here: topic builders (`topics`), messages (`Command`, `Event`, `Presence`),
-the reported shadow state (`Reported`), the fleet model (`Fleet`, `load_fleet`), the domain
-facts (`WEATHER_ZONES`; `assistant` for the invocation name), how spoken phrases are
-compared (`text`), and the one error type decoding raises (`ProtocolError`). `link` is the
-port MQTT adapters implement and `broker` how they reach the broker. This package ships in
-the Lambda, so it imports only msgspec (and PyYAML lazily, when a fleet file is read).
+Import from here: topic builders (`topics`), messages (`Command`, `Event`, `Presence`,
+`ReportedPose`), the reported shadow state (`Reported`), and the one error type decoding
+raises (`ProtocolError`). `link` is the port MQTT adapters implement, `broker` how they reach
+the broker, `announcements`, `fault_request` and `station_topics` the messages of the
+assistant's, the fault injector's and the station's topics, and `conversation` what the
+skill and the assistant keep of a conversation. Every Lambda and robot imports it, so it
+imports only msgspec; the domain (the fleet, its words) is `vahr.domain`.
 """
 
 from __future__ import annotations
 
 from vahr.protocol import topics
 from vahr.protocol.errors import ProtocolError
-from vahr.protocol.fleet import (
-    DEFAULT_FLEET_FILE,
-    FLEET_GROUP,
-    FLEET_GROUP_NAMES,
-    Conveyor,
-    Fleet,
-    Floor,
-    Group,
-    Point,
-    Pose,
-    Robot,
-    Segment,
-    Zone,
-    load_fleet,
-)
 from vahr.protocol.messages import (
     ACTIONS,
     MAX_PAYLOAD_BYTES,
@@ -35,11 +22,11 @@ from vahr.protocol.messages import (
     Deliver,
     Event,
     EventKind,
-    EventPose,
     Navigate,
     NoParams,
     Ping,
     Presence,
+    ReportedPose,
     SequentialDelivery,
     SequentialParams,
     Stop,
@@ -60,52 +47,37 @@ from vahr.protocol.shadow import (
     Reported,
     Result,
     RobotShadow,
-    ShadowPose,
     Status,
     Weather,
     experiment_state_from_payload,
     robot_shadow_from_payload,
 )
-from vahr.protocol.weather import WEATHER_ZONES, WEATHERS
 
 __all__ = [
     "ACTIONS",
-    "DEFAULT_FLEET_FILE",
-    "FLEET_GROUP",
-    "FLEET_GROUP_NAMES",
     "MAX_PAYLOAD_BYTES",
     "MOTION_ACTIONS",
     "Command",
-    "Conveyor",
     "Deliver",
     "Event",
     "EventKind",
-    "EventPose",
+    "ReportedPose",
     "ExperimentState",
-    "Fleet",
-    "Floor",
-    "Group",
     "LastCommand",
     "Navigate",
     "NoParams",
     "Ping",
-    "Point",
-    "Pose",
     "Presence",
     "ProtocolError",
     "Reported",
     "Result",
-    "Robot",
     "RobotShadow",
-    "Segment",
     "SequentialDelivery",
     "SequentialParams",
-    "ShadowPose",
     "Status",
     "Stop",
     "Weather",
     "WeatherDelivery",
-    "Zone",
     "ZoneParams",
     "check_against_fleet",
     "check_payload",
@@ -114,11 +86,8 @@ __all__ = [
     "decode_presence",
     "encode",
     "experiment_state_from_payload",
-    "load_fleet",
     "new_command",
     "robot_shadow_from_payload",
     "topics",
     "utc_now",
-    "WEATHERS",
-    "WEATHER_ZONES",
 ]

@@ -1,7 +1,7 @@
 """The `Link` port: publish and route MQTT messages, without saying which library does it.
 
 Robots implement it with awscrt (`robot_agent.link.mqtt5`), the lab side with paho
-(`vahr.local.mqtt`); the agent, the device shadow and the room channel speak through it.
+(`vahr.plumbing.mqtt`); the agent, the device shadow and the room channel speak through it.
 Every publish is QoS 1. Handlers run on one thread the adapter chooses (the agent's event
 loop for awscrt, paho's network thread for the lab): keep them short. One link can carry
 many robots (swarm mode): each adds its routes.

@@ -7,16 +7,28 @@ Commands are a tagged union on `action`, so each action carries exactly its own 
 
 from __future__ import annotations
 
+import math
 import uuid
 from datetime import UTC, datetime
-from typing import TYPE_CHECKING, Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal, Protocol
 
 import msgspec
 
 from vahr.protocol.errors import ProtocolError, from_validation_error, shown
 
 if TYPE_CHECKING:
-    from vahr.protocol.fleet import Fleet
+    from collections.abc import Collection
+
+
+class KnownNames(Protocol):
+    """What a command is checked against: the zones and robots that exist (a fleet)."""
+
+    @property
+    def zone_ids(self) -> Collection[str]: ...
+
+    @property
+    def robot_things(self) -> Collection[str]: ...
+
 
 MAX_PAYLOAD_BYTES = 8 * 1024
 
@@ -150,7 +162,9 @@ def check_payload(payload: bytes | bytearray | memoryview) -> bytes:
     return data
 
 
-def decode_command(payload: bytes | bytearray | memoryview, fleet: Fleet | None = None) -> Command:
+def decode_command(
+    payload: bytes | bytearray | memoryview, fleet: KnownNames | None = None
+) -> Command:
     """Decode and validate a command; with a fleet, zones and robots must exist in it."""
     data = check_payload(payload)
     try:
@@ -165,7 +179,7 @@ def decode_command(payload: bytes | bytearray | memoryview, fleet: Fleet | None 
     return command
 
 
-def check_against_fleet(command: Command, fleet: Fleet) -> None:
+def check_against_fleet(command: Command, fleet: KnownNames) -> None:
     """Zones and peer robots named in a command must exist in the fleet."""
     params = command.params
     if isinstance(params, ZoneParams | SequentialParams) and params.zone not in fleet.zone_ids:
@@ -202,10 +216,17 @@ EventKind = Literal[
 ]
 
 
-class EventPose(msgspec.Struct, frozen=True):
+class ReportedPose(msgspec.Struct, frozen=True):
+    """Where a robot says it is, in the `map` frame (metres, radians): in its events, its
+    shadow's `reported.pose` and the fleet index. Read tolerantly, as everything a robot
+    reports is; the fleet file's poses are `vahr.domain.Pose`, read strictly."""
+
     x: float
     y: float
     theta: float = 0.0
+
+    def distance_to(self, other: ReportedPose) -> float:
+        return math.hypot(self.x - other.x, self.y - other.y)
 
 
 class Event(msgspec.Struct, frozen=True, kw_only=True, omit_defaults=True):
@@ -224,7 +245,7 @@ class Event(msgspec.Struct, frozen=True, kw_only=True, omit_defaults=True):
     zone: str | None = None
     reason: str | None = None
     progress: float | None = None
-    pose: EventPose | None = None
+    pose: ReportedPose | None = None
     text: str | None = None
     intent: str | None = None
     confidence: float | None = None

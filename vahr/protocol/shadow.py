@@ -12,18 +12,14 @@ from typing import Any, Literal
 import msgspec
 
 from vahr.protocol.errors import ProtocolError, from_validation_error
-from vahr.protocol.weather import Weather
+from vahr.protocol.messages import ReportedPose
 
 Status = Literal[
     "idle", "navigating", "loading", "unloading", "waiting", "stopped", "stuck", "error"
 ]
 Result = Literal["accepted", "rejected", "done", "failed", "cancelled"]
-
-
-class ShadowPose(msgspec.Struct, frozen=True):
-    x: float
-    y: float
-    theta: float = 0.0
+# The experiment's weather (the paper's task II); its words and zones are `vahr.domain.weather`.
+Weather = Literal["sunny", "rainy"]
 
 
 class LastCommand(msgspec.Struct, frozen=True, omit_defaults=True):
@@ -46,7 +42,7 @@ class Reported(msgspec.Struct, frozen=True):
     # Where the current task is heading and what it is, so status can be spoken.
     destination: str | None = None
     task: str | None = None
-    pose: ShadowPose | None = None
+    pose: ReportedPose | None = None
 
     def to_payload(self, client_token: str | None = None) -> bytes:
         """The body of a shadow update reporting this whole state."""
@@ -157,7 +153,7 @@ __all__ = [
     "ProtocolError",
     "Reported",
     "RobotShadow",
-    "ShadowPose",
+    "ReportedPose",
     "Status",
     "Result",
     "Weather",

@@ -6,8 +6,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from vahr.domain import DEFAULT_FLEET_FILE, Fleet
 from vahr.errors import VahrError
-from vahr.protocol import DEFAULT_FLEET_FILE, Fleet, ProtocolError
+from vahr.protocol import ProtocolError
 from vahr.skill_model.generator import drift, write
 
 # In a checkout the bundled fleet is a link to the repository's fleet.yaml, at its root.

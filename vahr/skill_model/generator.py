@@ -15,12 +15,12 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from vahr.domain import FLEET_GROUP, FLEET_GROUP_NAMES
+from vahr.domain.fleet import spoken_in
+from vahr.domain.invocation import INVOCATION_NAME
+from vahr.domain.locale import load_language
+from vahr.domain.text import number_variants, spell_numbers
 from vahr.errors import VahrError
-from vahr.protocol import FLEET_GROUP, FLEET_GROUP_NAMES
-from vahr.protocol.assistant import INVOCATION_NAME
-from vahr.protocol.fleet import spoken_in
-from vahr.protocol.locale import load_language
-from vahr.protocol.text import number_variants, spell_numbers
 from vahr.skill_model.intents import (
     BUILT_IN_INTENTS,
     COUNT_TYPE,
@@ -35,7 +35,7 @@ from vahr.skill_model.locale_templates import locale_intents, template_locales
 from vahr.skill_model.manifest import build_manifest
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 # The ROBOT value that means every robot; the skill publishes once on the fleet topic for it.
 FLEET_ROBOT_ID = FLEET_GROUP

@@ -427,7 +427,7 @@ EMERGENCY_STOP = IntentSpec(
 
 WEATHER = IntentSpec(
     name="WeatherIntent",
-    # The robots' own question (vahr.protocol.assistant.WEATHER_QUESTION) and its variants.
+    # The robots' own question (vahr.domain.invocation.WEATHER_QUESTION) and its variants.
     essentials=("what is the weather", "what the weather is", "tell me what the weather is"),
     templates=(
         "[so|um|okay|hey] (what is|what's) the weather [like] [today|now|right now|outside|at the "

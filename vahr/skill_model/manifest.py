@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from vahr.protocol.assistant import INVOCATION_NAME
-from vahr.protocol.locale import load_language
+from vahr.domain.invocation import INVOCATION_NAME
+from vahr.domain.locale import load_language
 from vahr.skill_model.intents import LOCALE
 
 SKILL_NAME = "VAHR Robot Fleet"

@@ -8,7 +8,7 @@ Slot values (robot, zone and group names) never appear here: they live in fleet.
 
 from __future__ import annotations
 
-from vahr.protocol.weather import SAMPLED_WEATHER_WORDS
+from vahr.domain.weather import SAMPLED_WEATHER_WORDS
 
 _SUNNY, _RAINY = ("|".join(SAMPLED_WEATHER_WORDS[w]) for w in ("sunny", "rainy"))
 
@@ -41,7 +41,7 @@ RULES: dict[str, str] = {
     ),
     "weather_job": "the weather (delivery|task|navigation|run|job|mission|errand)",
     # A condition of the weather delivery's rule, in the words of
-    # vahr.protocol.weather.SAMPLED_WEATHER_WORDS.
+    # vahr.domain.weather.SAMPLED_WEATHER_WORDS.
     "if_sunny": f"(if|when|in case) [it's|it is|the weather is] ({_SUNNY})",
     "if_rainy": f"(if|when|in case) [it's|it is|the weather is] ({_RAINY})",
 }

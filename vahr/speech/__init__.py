@@ -11,7 +11,7 @@ station.
 - `room`: the room channel, speech as audio over a `vahr.protocol.link.Link`, and its message;
 - `errors`: `SpeechError`, the one error this package raises.
 
-Phrases are compared as `vahr.protocol.text.normalize` writes them. It imports
+Phrases are compared as `vahr.domain.text.normalize` writes them. It imports
 `vahr.protocol` and its own libraries (numpy, pocketsphinx, sox and espeak-ng as
 processes), nothing above them.
 """

@@ -11,7 +11,7 @@ scikit-learn takes 2-3 s to import on the lab machine, more than a start-up may 
 fitted model is exported as plain numbers (vocabulary, idf, weights, intercepts, inverse
 temperature) and cached on disk as JSON under a hash of the training data and the recipe;
 answering needs only this module, and scikit-learn is imported only when the cache is cold.
-The Alexa simulator's intent classifier (`vahr.local.alexa.intent_classifier`) and the
+The Alexa simulator's intent classifier (`vahr.assistant.intent_classifier`) and the
 robot's sense check of what it heard (`robot_agent.voice.sense`) are both this.
 `tests/unit/local/test_intent_classifier.py` (many classes) and `tests/unit/voice/
 test_sense.py` (two) hold the export to scikit-learn's own probabilities.

@@ -4,7 +4,7 @@ pocketsphinx hears the station's commands through a language model of them, and 
 what is not in it as the nearest command ("zone b" as "zone d"). Whisper was trained on
 680,000 hours of people and writes what it hears in open English, told the fleet's names
 by a prompt (`vahr.station.vocabulary.whisper_prompt`). The two err differently, so the
-station acts at once on what both hear alike (`vahr.local.alexa.nbest.agreement`).
+station acts at once on what both hear alike (`vahr.assistant.nbest.agreement`).
 
 The weights are SYSTRAN's CTranslate2 conversion of tiny.en (`Systran/faster-whisper-tiny.en`
 on Hugging Face), whose model.bin has the SHA-256 below. Hugging Face does not reach every

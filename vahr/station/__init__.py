@@ -11,12 +11,12 @@ conversation, the paper's keyboard-and-mouse panel, push-to-talk and the experim
 - `app`: the API's routes, apart from HTTP; `errors`: the one error a request is refused
   with;
 - `server`: the HTTP server (the page, its files, the API and the event stream);
-- `contract`: the page's side of the messages, written from `vahr.protocol.station`;
+- `contract`: the page's side of the messages, written from `vahr.station.page_messages`;
 - `station`: everything above wired together; `deployment`: a station built for `vahr up`
   (in its process) or for `vahr station` (against any deployment).
 
-Typed and spoken requests go to an assistant (`vahr.local.client.Assistant`). The station
+Typed and spoken requests go to an assistant (`vahr.plumbing.client.Assistant`). The station
 sits in the top layer above `vahr.experiment` and `vahr.local` (docs/architecture.md): it
 imports them, they never import it, and it reaches the Alexa simulator only through what
-`vahr.local.alexa` exports. It never imports `robot_agent`.
+`vahr.assistant` exports. It never imports `robot_agent`.
 """

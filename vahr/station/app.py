@@ -39,7 +39,7 @@ from vahr.station.errors import RequestError
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.local.client import Assistant
+    from vahr.plumbing.client import Assistant
     from vahr.station.controls import Controls
     from vahr.station.desk import Desk
     from vahr.station.feed import Feed

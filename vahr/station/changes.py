@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import msgspec
 
 if TYPE_CHECKING:
-    from vahr.protocol.station import RobotChange
+    from vahr.station.page_messages import RobotChange
 
 Json = dict[str, Any]
 _MISSING = object()

@@ -1,7 +1,7 @@
 """`python -m vahr.station.contract`: write the page's contract, or with `--check` report drift.
 
 The page's side of the station's contract is `static/contract.js`: JSDoc typedefs for every
-message the feed pushes (`vahr.protocol.station.PageMessage`), for what the page posts as a
+message the feed pushes (`vahr.protocol.station_topics.PageMessage`), for what the page posts as a
 participant's input (`StationInput`) and for a robot's reported state, made from the
 structs' JSON Schema (`msgspec.json.schema_components`), and the constants the page shares
 with the feed (`DRIVE_ENDS`, `EXCHANGE_EVENTS`, how many commands and conversation entries
@@ -26,14 +26,9 @@ from typing import Any
 import msgspec
 
 from vahr.protocol import EventKind, Reported
-from vahr.protocol.station import (
-    DRIVE_ENDS,
-    EXCHANGE_EVENTS,
-    ConversationEntry,
-    PageMessage,
-    StationInput,
-)
+from vahr.protocol.station_topics import StationInput
 from vahr.station.feed import COMMANDS_LIMIT, CONVERSATION_LIMIT
+from vahr.station.page_messages import DRIVE_ENDS, EXCHANGE_EVENTS, ConversationEntry, PageMessage
 
 CONTRACT_FILE = Path(__file__).with_name("static") / "contract.js"
 REF_PREFIX = "#/$defs/"
@@ -47,7 +42,7 @@ WIDTH = 96
 HEADER = """\
 // @ts-check
 // The station's page contract: the messages the page is sent and sends, and the constants
-// it shares with the station. Generated from vahr/protocol/station.py by
+// it shares with the station. Generated from vahr/station/page_messages.py by
 // `python -m vahr.station.contract`: do not edit; change the structs and run it again.
 """
 
@@ -204,7 +199,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.check:
         if drifted():
             print(
-                f"{CONTRACT_FILE} is out of date with vahr/protocol/station.py: run "
+                f"{CONTRACT_FILE} is out of date with vahr/station/page_messages.py: run "
                 "`python -m vahr.station.contract` and commit",
                 file=sys.stderr,
             )

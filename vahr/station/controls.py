@@ -16,7 +16,7 @@ from vahr.protocol import ProtocolError, encode, new_command, topics
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
     from vahr.station.desk import Desk
 
 SOURCE = "console"

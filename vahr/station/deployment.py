@@ -27,20 +27,21 @@ import uuid
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from vahr.assistant import SimulatorAssistant
 from vahr.errors import VahrError
-from vahr.local.client import HttpAssistant, SimulatorAssistant
-from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.client import HttpAssistant
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
 from vahr.protocol.broker import parse_broker_url
+from vahr.station.assembly import Station, StationConfig
 from vahr.station.feed import Feed
-from vahr.station.station import Station, StationConfig
 
 if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-    from vahr.local.client import Assistant
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
+    from vahr.plumbing.client import Assistant
     from vahr.protocol.broker import ClientCredentials
 
 log = logging.getLogger(__name__)
@@ -135,7 +136,7 @@ def _simulator_for(
     api: str, model_file: Path | None, deployment: Deployment, feed: Feed, link: MqttClient
 ) -> Assistant:
     """The Alexa simulator and the real skill in this process, for AWS's iot-data endpoint."""
-    from vahr.local.alexa import AlexaSimulator, CommandLog, InteractionModel, load_skill_handler
+    from vahr.assistant import AlexaSimulator, CommandLog, InteractionModel, load_skill_handler
 
     commands = CommandLog()
     # The skill publishes through iot-data; its commands are seen coming back from the broker.

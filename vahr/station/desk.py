@@ -18,7 +18,7 @@ import msgspec
 from vahr.experiment.procedures import ProcedureViolation, check_action
 from vahr.protocol import ProtocolError, topics
 from vahr.protocol.errors import from_validation_error
-from vahr.protocol.station import Interaction, PuzzleInput
+from vahr.protocol.station_topics import Interaction, PuzzleInput
 
 if TYPE_CHECKING:
     from collections.abc import Callable

@@ -3,7 +3,7 @@
 `Feed` is transport-free: an MQTT client routes messages to its `on_*` handlers (`routes`),
 and each page holds a `Subscriber` that receives first a snapshot of everything, then one
 message per change, in the order the feed saw them. Messages are JSON objects with a
-`type`, each a struct of `vahr.protocol.station` (`PageMessage`), which the page knows as
+`type`, each a struct of `vahr.station.page_messages` (`PageMessage`), which the page knows as
 the typedefs of `static/contract.js`:
 
 - `snapshot`: the fleet and its floor, every robot (reported shadow, presence, the last
@@ -51,29 +51,29 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
-from vahr.protocol import (
-    FLEET_GROUP,
-    ProtocolError,
-    decode_command,
-    decode_event,
-    decode_presence,
-    topics,
-)
+from vahr.domain import FLEET_GROUP
+from vahr.protocol import ProtocolError, decode_command, decode_event, decode_presence, topics
 from vahr.protocol.announcements import Announcement, decode_announcement
-from vahr.protocol.station import (
+from vahr.protocol.station_topics import (
+    AssistantTurn,
+    ExperimentStatus,
+    decode_experiment_status,
+    decode_turn,
+    turn_from_message,
+)
+from vahr.station.changes import merge, own, reported_change
+from vahr.station.page_messages import (
     DRIVE_ENDS,
     EXCHANGE_EVENTS,
     AckMessage,
     Acknowledgment,
     AlertAcknowledgedMessage,
     AnnouncementMessage,
-    AssistantTurn,
     CommandMessage,
     CommandParams,
     ConversationEntry,
     EventMessage,
     ExperimentMessage,
-    ExperimentStatus,
     FleetView,
     PageMessage,
     RobotChange,
@@ -84,17 +84,13 @@ from vahr.protocol.station import (
     TasksMessage,
     TurnMessage,
     ZoneEntry,
-    decode_experiment_status,
-    decode_turn,
     encode_page_message,
-    turn_from_message,
 )
-from vahr.station.changes import merge, own, reported_change
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 log = logging.getLogger(__name__)
 

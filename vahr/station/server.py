@@ -31,8 +31,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, urlsplit
 
-from vahr.local.ports import LOOPBACK
-from vahr.local.quiet_http import QuietHandler, QuietServer, ServerThread
+from vahr.plumbing.http_server import QuietHandler, QuietServer, ServerThread
+from vahr.plumbing.ports import LOOPBACK
 from vahr.station.app import Reply, error_reply, json_reply
 
 if TYPE_CHECKING:

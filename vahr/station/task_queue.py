@@ -19,8 +19,8 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from vahr.protocol.dispatch import Task  # noqa: TC001 (msgspec reads it at run time)
-from vahr.protocol.station import TasksMessage
+from vahr.dispatch.core import Task  # noqa: TC001 (msgspec reads it at run time)
+from vahr.station.page_messages import TasksMessage
 
 if TYPE_CHECKING:
     from vahr.station.feed import Feed

@@ -6,7 +6,7 @@ copies of the sample (so every value appears in every sample's context once, wit
 multiplying out samples with several slots; past `MAX_COPIES` names, as in a fleet of a
 thousand robots, the samples share the names out between them instead, each name still in
 many contexts), plus the built-in intents' phrases (those the simulator knows them by,
-`vahr.local.alexa.built_in_phrases`), the invocation forms ("ask robot fleet to ...") and
+`vahr.assistant.built_in_phrases`), the invocation forms ("ask robot fleet to ...") and
 the yes and no that answer a yes-or-no question.
 The interaction model is generated from `fleet.yaml`, so the robots' and zones' names follow
 the fleet. Numbers are spelled out, as people say them.
@@ -27,13 +27,13 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
+from vahr.assistant import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases, confirmation_phrases
+from vahr.domain.fleet import zone_phrase
+from vahr.domain.text import normalize, spell_numbers
 from vahr.errors import VahrError
-from vahr.local.alexa import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases, confirmation_phrases
-from vahr.protocol.fleet import zone_phrase
-from vahr.protocol.text import normalize, spell_numbers
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
     from vahr.speech.lm_stt import LanguageModel, LanguageModelRecognizer
 
 log = logging.getLogger(__name__)

@@ -4,7 +4,7 @@ The page records while the button (or the space bar) is held and uploads 16 kHz 
 16-bit WAV. The clip is checked (a WAV, at most `MAX_CLIP_S` long) and transcribed offline
 by a recognizer whose vocabulary comes from the skill's interaction model
 (`vocabulary.py`). Its N best transcripts are each understood by the simulator's NLU and
-weighed into one understanding (`vahr.local.alexa.nbest`): an intent heard with too little of the
+weighed into one understanding (`vahr.assistant.nbest`): an intent heard with too little of the
 weight is not acted on, and a robot or zone the hearing is unsure of is asked about
 ("Zone B or zone D?") instead of acted on. A second ear (Whisper, made by the station)
 transcribes the clip too when the best transcript reads as a request; a request both read
@@ -30,8 +30,8 @@ import wave
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any, Protocol
 
-from vahr.errors import VahrError
-from vahr.local.alexa import (
+from vahr.assistant import (
+    SimulatorAssistant,
     Weighed,
     Weighing,
     agreement,
@@ -39,7 +39,7 @@ from vahr.local.alexa import (
     request_reader,
     weigh_recognition,
 )
-from vahr.local.client import SimulatorAssistant
+from vahr.errors import VahrError
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio
 from vahr.speech.errors import SpeechError
 from vahr.station.errors import RequestError
@@ -47,8 +47,8 @@ from vahr.station.errors import RequestError
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
 
-    from vahr.local.alexa import InteractionModel, Understanding
-    from vahr.local.client import Assistant
+    from vahr.assistant import InteractionModel, Understanding
+    from vahr.plumbing.client import Assistant
     from vahr.speech.stt import Recognition, Recognizer
 
 
@@ -210,7 +210,7 @@ class PushToTalk:
             return self.assistant.simulator.model
         with self._lock:
             if self._model is None:
-                from vahr.local.alexa import InteractionModel
+                from vahr.assistant import InteractionModel
 
                 self._model = InteractionModel.load()
             return self._model

@@ -17,7 +17,7 @@ from ask_sdk_core.utils import is_intent_name
 
 from skill import dialog, fleet_status, speech
 from skill.errors import GatewayError
-from skill.fleet_index import IotFleetIndex
+from skill.iot_fleet_index import IotFleetIndex
 from skill.responses import answer
 from skill.vocabulary import FLEET
 
@@ -25,8 +25,8 @@ if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
     from ask_sdk_model import Response
 
-    from skill.fleet_index import FleetIndex
     from skill.fleet_status import FleetState
+    from skill.iot_fleet_index import FleetIndex
     from skill.robots import ShadowRead
     from skill.runtime import SkillRuntime
 

@@ -10,13 +10,14 @@ from ask_sdk_core.utils import is_intent_name
 from skill import dialog, prompts
 from skill.handlers.send import send_and_report
 from skill.responses import answer
-from vahr.protocol.weather import WEATHER_ZONES, Weather
+from vahr.domain.weather import WEATHER_ZONES
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
     from ask_sdk_model import Response
 
     from skill.runtime import SkillRuntime
+    from vahr.protocol.shadow import Weather
 
 # The zones a person may say with the request ("deliver to zone a if it's sunny and zone c
 # if it's rainy"), by the weather each is for.

@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
     from pathlib import Path
 
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 FAST = "50"  # simulated time runs 50x faster than the wall clock in these tests
 

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 import paho.mqtt.client as paho
 from paho.mqtt.enums import CallbackAPIVersion, MQTTProtocolVersion
 
-from vahr.local.lifetime import spawn
+from vahr.plumbing.lifetime import spawn
 
 if TYPE_CHECKING:
     from collections.abc import Callable

@@ -12,9 +12,9 @@ import yaml
 
 from robot_agent.cli import main
 from tests.integration.agent.harness import AgentProcess, ShadowResponder, WireTap, command
-from vahr.local.broker import BrokerConfig, Mosquitto, TlsListener
-from vahr.local.ports import free_port
 from vahr.pki import LocalCA
+from vahr.plumbing.ports import free_port
+from vahr.twin.broker import BrokerConfig, Mosquitto, TlsListener
 
 # Anonymous test clients on the plaintext listener may do anything; a robot known by its
 # certificate (username = CN) only its own topics, the fleet topic and its own shadow.

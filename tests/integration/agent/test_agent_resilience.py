@@ -15,7 +15,7 @@ if TYPE_CHECKING:
     from pathlib import Path
 
     from tests.integration.agent.harness import AgentProcess, WireTap
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 CMD = "vahr/robots/placebot1/cmd"
 
@@ -151,7 +151,7 @@ def test_the_broker_killed_mid_task_the_agent_reconnects_and_keeps_serving(
 
 def test_an_agent_that_never_reached_its_broker_stops_cleanly(tmp_path: Path) -> None:
     from tests.integration.agent.harness import AgentProcess
-    from vahr.local.ports import free_port
+    from vahr.plumbing.ports import free_port
 
     # Given an agent whose broker is not there, so its first reports are never sent
     agent = AgentProcess(

@@ -20,15 +20,15 @@ from robot_agent.clock import ScaledClock
 from robot_agent.config import ExecutorSettings
 from robot_agent.core.executor import Executor
 from tests.unit.agent.conftest import Recorder
-from vahr.local.lifetime import spawn
-from vahr.local.ports import free_port, wait_for_listener
+from vahr.plumbing.lifetime import spawn
+from vahr.plumbing.ports import free_port, wait_for_listener
 from vahr.protocol import new_command
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 pytestmark = pytest.mark.ros
 

@@ -14,7 +14,7 @@ from vahr.errors import VahrError
 
 if TYPE_CHECKING:
     from tests.integration.agent.harness import ShadowResponder, WireTap
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 COUNT = 25
 

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from pathlib import Path
 
     from tests.integration.agent.harness import AgentProcess
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 RESTARTS = 3
 # awscrt retries with full jitter between 250 ms and 30 s; three quick failures stay far

@@ -15,10 +15,10 @@ from awscrt import mqtt5
 from robot_agent.config import MqttSettings
 from robot_agent.link.mqtt5 import LinkSettings, Mqtt5Link
 from tests.faults import wait_until
-from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 
 if TYPE_CHECKING:
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 TOPIC = "vahr/robots/placebot1/cmd"
 BARRIER = "vahr/robots/placebot1/barrier"

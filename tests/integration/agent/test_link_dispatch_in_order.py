@@ -8,12 +8,12 @@ import asyncio
 from typing import TYPE_CHECKING
 
 from robot_agent.link.mqtt5 import LinkSettings, Mqtt5Link
-from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 FLEET = "vahr/fleet/cmd"
 ONE = "vahr/robots/swarm0001/cmd"

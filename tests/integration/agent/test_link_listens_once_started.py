@@ -13,10 +13,10 @@ from typing import TYPE_CHECKING
 
 from robot_agent.config import MqttSettings
 from robot_agent.link.mqtt5 import LinkSettings, Mqtt5Link
-from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 
 if TYPE_CHECKING:
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 ROBOTS = 500  # a swarm's worth of command topics: several SUBSCRIBE packets
 

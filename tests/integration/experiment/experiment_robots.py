@@ -16,17 +16,18 @@ from typing import TYPE_CHECKING
 import paho.mqtt.client as mqtt
 import pytest
 
-from vahr.local.lifetime import spawn
+from vahr.local.alexa_host import serve_alexa
 from vahr.local.robots import LOCAL_AGENT_CONFIG
+from vahr.plumbing.lifetime import spawn
 from vahr.protocol import decode_presence, topics
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
 
-    from vahr.local.broker import Mosquitto
-    from vahr.local.stack import LocalStack
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
+    from vahr.twin.broker import Mosquitto
+    from vahr.twin.stack import LocalStack
 
 SPEED = 50.0
 # These robots run as `vahr up` runs them (this machine's clock, so no tolerance for clocks
@@ -134,7 +135,7 @@ class Lab:
 
 @pytest.fixture
 def lab(fleet: Fleet, stack: LocalStack, tmp_path: Path) -> Iterator[Lab]:
-    stack.attach_alexa()
+    serve_alexa(stack)
     assert stack.mqtt_url is not None
     (tmp_path / "robots").mkdir()
     agents = RobotAgents(fleet, stack.mqtt_url, tmp_path / "robots", SPEED)

@@ -12,7 +12,7 @@ from vahr.experiment.bus import Bus
 from vahr.protocol import Event, encode, topics
 
 if TYPE_CHECKING:
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 
 def delivered(zone: str) -> bytes:

@@ -15,10 +15,10 @@ from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 
 from vahr.errors import VahrError
 from vahr.experiment.bus import Bus
-from vahr.local.broker import BrokerConfig, Mosquitto, TlsListener
-from vahr.local.ports import free_port
+from vahr.plumbing.ports import free_port
 from vahr.protocol import encode, new_command, topics
 from vahr.protocol.broker import ClientCredentials
+from vahr.twin.broker import BrokerConfig, Mosquitto, TlsListener
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

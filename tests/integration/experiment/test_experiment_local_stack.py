@@ -12,14 +12,15 @@ import pytest
 
 from tests.integration.experiment.experiment_robots import SPEED, RobotAgents
 from vahr.cli import main
-from vahr.local.ports import free_port
+from vahr.local.alexa_host import serve_alexa
+from vahr.plumbing.ports import free_port
 from vahr.protocol import experiment_state_from_payload, robot_shadow_from_payload
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.local.stack import LocalStack
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
+    from vahr.twin.stack import LocalStack
 
 
 def test_a_keyboard_session_through_the_local_stack(
@@ -33,7 +34,7 @@ def test_a_keyboard_session_through_the_local_stack(
         monkeypatch.delenv(name, raising=False)
     assert stack.mqtt_url is not None
     # The assistant answers the participant's weather questions in task II
-    stack.attach_alexa()
+    serve_alexa(stack)
     (tmp_path / "robots").mkdir()
     robots = RobotAgents(fleet, stack.mqtt_url, tmp_path / "robots", SPEED)
     robots.start()
@@ -97,7 +98,7 @@ def test_the_assistant_client_reports_a_missing_or_unreachable_assistant(
     stack: LocalStack,
 ) -> None:
     from vahr.errors import VahrError
-    from vahr.local.client import HttpAssistant
+    from vahr.plumbing.client import HttpAssistant
 
     # Given a data plane without the Alexa simulator attached, and a port nothing listens on
     missing = HttpAssistant(stack.api_url)

@@ -215,8 +215,8 @@ def test_an_observed_keyboard_session_with_a_person_at_the_console(
     import threading
     import time
 
+    from vahr.domain import load_fleet
     from vahr.experiment.tasks import draw_plan
-    from vahr.protocol import load_fleet
 
     logs = tmp_path / "logs"
     plan = draw_plan(load_fleet(), 21)

@@ -13,8 +13,8 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from vahr.cli import main
-from vahr.local.lifetime import spawn
-from vahr.local.ports import free_port
+from vahr.plumbing.lifetime import spawn
+from vahr.plumbing.ports import free_port
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

@@ -7,8 +7,8 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from vahr.local.ports import free_port
-from vahr.local.stack import LocalStack, StackConfig
+from vahr.plumbing.ports import free_port
+from vahr.twin.stack import LocalStack, StackConfig
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

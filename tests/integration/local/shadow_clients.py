@@ -15,7 +15,7 @@ from botocore.exceptions import ClientError
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
-    from vahr.local.mqtt import MqttClient
+    from vahr.plumbing.mqtt import MqttClient
 
 REPLY_TIMEOUT_S = 5.0
 

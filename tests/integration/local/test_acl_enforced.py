@@ -9,13 +9,13 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from vahr.local.mqtt import MqttClient, MqttEndpoint, PublishDenied
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint, PublishDenied
 from vahr.protocol import new_command, topics
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 
 def _robot(stack: LocalStack, thing: str, tmp_path: Path) -> MqttClient:

@@ -10,14 +10,15 @@ from typing import TYPE_CHECKING
 import pytest
 
 from vahr.errors import VahrError
-from vahr.local.client import call
-from vahr.local.mqtt import MqttClient
+from vahr.local.alexa_host import serve_alexa
+from vahr.plumbing.client import call
+from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import topics
-from vahr.protocol.station import AssistantTurn, decode_turn
+from vahr.protocol.station_topics import AssistantTurn, decode_turn
 
 if TYPE_CHECKING:
-    from vahr.local.alexa.simulator import AlexaSimulator
-    from vahr.local.stack import LocalStack
+    from vahr.assistant.simulator import AlexaSimulator
+    from vahr.twin.stack import LocalStack
 
 
 @pytest.fixture(scope="module")
@@ -27,7 +28,7 @@ def alexa(local_stack: LocalStack) -> AlexaSimulator:
         patch.setenv("AWS_ACCESS_KEY_ID", "testing")
         patch.setenv("AWS_SECRET_ACCESS_KEY", "testing")
         patch.setenv("AWS_DEFAULT_REGION", "us-east-1")
-        return local_stack.attach_alexa(ack_timeout_s=0.2)
+        return serve_alexa(local_stack, ack_timeout_s=0.2)
 
 
 def test_an_unknown_robot_is_asked_for_and_a_bare_answer_completes_it(

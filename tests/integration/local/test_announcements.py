@@ -12,7 +12,7 @@ import pytest
 from support.vahr_up import ROOT, VAHR, Up, clean_env, start_up, stop_up
 from support.vahr_up import say as say_to
 
-from vahr.local.client import call
+from vahr.plumbing.client import call
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator

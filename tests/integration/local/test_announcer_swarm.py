@@ -24,15 +24,15 @@ from tests.integration.agent.harness import ShadowResponder, WireTap, command
 from tests.support.swarm import SwarmThread, swarm_fleet
 from vahr.announce import settings_from
 from vahr.local.announcer import LocalAnnouncer
-from vahr.local.mqtt import MqttEndpoint
+from vahr.plumbing.mqtt import MqttEndpoint
 from vahr.protocol import topics
 from vahr.protocol.announcements import decode_announcement
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
-    from vahr.local.broker import Mosquitto
     from vahr.protocol.announcements import Announcement
+    from vahr.twin.broker import Mosquitto
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(240)]
 

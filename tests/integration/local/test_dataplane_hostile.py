@@ -9,7 +9,7 @@ import socket
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 
 def _raw(stack: LocalStack, request: bytes) -> tuple[int, dict[str, str], bytes]:

@@ -14,8 +14,8 @@ import pytest
 
 from tests.support.vahr_up import Up, start_up, stop_up
 from tests.support.vahr_up import say as say_to
-from vahr.local.client import call
-from vahr.local.ports import free_port
+from vahr.plumbing.client import call
+from vahr.plumbing.ports import free_port
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

@@ -13,11 +13,11 @@ import boto3
 import pytest
 
 from tests.integration.local.shadow_clients import unique_thing
-from vahr.local.mqtt import MqttClient
+from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 
 @pytest.fixture

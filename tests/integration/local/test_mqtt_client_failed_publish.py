@@ -14,10 +14,10 @@ import pytest
 
 from tests.faults import wait_until
 from vahr.errors import VahrError
-from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 
 if TYPE_CHECKING:
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 TOPIC = "vahr/robots/placebot1/cmd"
 # More than paho's 20 messages in flight, so a queue blocked by withdrawn messages shows.

@@ -20,10 +20,10 @@ from paho.mqtt.packettypes import PacketTypes
 from paho.mqtt.properties import Properties
 
 from tests.faults import wait_until
-from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 
 if TYPE_CHECKING:
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 TOPIC = "vahr/robots/swarm0001/events"
 

@@ -20,10 +20,10 @@ import pytest
 
 from tests.faults import alive, kill_hard, processes_of, wait_all_gone, wait_until
 from vahr.errors import VahrError
-from vahr.local.broker import BrokerConfig
-from vahr.local.lifetime import STARTED_FOR, spawn
-from vahr.local.ports import free_port
-from vahr.local.stack import LocalStack, StackConfig
+from vahr.plumbing.lifetime import STARTED_FOR, spawn
+from vahr.plumbing.ports import free_port
+from vahr.twin.broker import BrokerConfig
+from vahr.twin.stack import LocalStack, StackConfig
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -189,7 +189,7 @@ def test_shadows_written_before_a_crash_survive_and_the_journal_is_replayed(
         [sys.executable, "-c", textwrap.dedent(f"""
             import os
             from pathlib import Path
-            from vahr.local.shadow_store import ShadowStore
+            from vahr.twin.shadow_store import ShadowStore
             store = ShadowStore(Path({str(state / "shadows.sqlite3")!r}))
             store.update("placebot1", None, b'{{"state":{{"reported":{{"zone":"B"}}}}}}')
             os.kill(os.getpid(), 9)

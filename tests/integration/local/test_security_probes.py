@@ -24,16 +24,16 @@ from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 from paho.mqtt.enums import CallbackAPIVersion, MQTTProtocolVersion
 
-from vahr.local.mqtt import MqttClient
 from vahr.pki import LocalCA
+from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
 
-    from vahr.local.stack import LocalStack
     from vahr.pki import ClientCredentials
+    from vahr.twin.stack import LocalStack
 
 NOT_AUTHORIZED = 0x87
 

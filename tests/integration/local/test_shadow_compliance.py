@@ -14,13 +14,13 @@ from moto import mock_aws
 
 from tests.faults import wait_until
 from tests.integration.local.shadow_clients import Boto3Shadows, MqttShadows, Shadows, unique_thing
-from vahr.local.mqtt import MqttClient
+from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 TRANSPORTS = ["mqtt", "http", "moto"]
 

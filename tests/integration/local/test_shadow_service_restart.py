@@ -12,12 +12,12 @@ import time
 from typing import TYPE_CHECKING
 
 from tests.faults import crash_and_restart_broker, wait_until
-from vahr.local.mqtt import MqttClient, MqttEndpoint
-from vahr.local.shadow_store import ShadowError
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
+from vahr.twin.shadow_store import ShadowError
 
 if TYPE_CHECKING:
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 
 def _reported(stack: LocalStack, thing: str) -> dict[str, object] | None:

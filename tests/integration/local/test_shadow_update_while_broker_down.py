@@ -13,12 +13,12 @@ import time
 from typing import TYPE_CHECKING
 
 from tests.faults import wait_until
-from vahr.local.client import call
-from vahr.local.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.client import call
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 COMMAND = {"id": "desired-while-down", "action": "navigate", "params": {"zone": "B"}}
 

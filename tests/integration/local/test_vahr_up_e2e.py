@@ -15,7 +15,7 @@ import pytest
 
 from tests.support.vahr_up import ROOT, VAHR, Up, clean_env, start_up, stop_up
 from tests.support.vahr_up import say as say_to
-from vahr.local.ports import LOOPBACK, free_port
+from vahr.plumbing.ports import LOOPBACK, free_port
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

@@ -12,10 +12,10 @@ import pytest
 
 from tests.support.fleets import BAD_FLEETS, SIX_ROBOTS, bad_fleet
 from tests.support.vahr_up import ROOT, VAHR, Up, clean_env, say, start_up, stop_up
-from vahr.local.client import call
-from vahr.local.ports import free_port
-from vahr.local.recovery import started_for
-from vahr.protocol import load_fleet
+from vahr.domain import load_fleet
+from vahr.plumbing.client import call
+from vahr.plumbing.ports import free_port
+from vahr.twin.recovery import started_for
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator

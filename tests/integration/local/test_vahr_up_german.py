@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from tests.support.vahr_up import ROOT, VAHR, Up, clean_env, start_up, stop_up
-from vahr.local.client import call
+from vahr.plumbing.client import call
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

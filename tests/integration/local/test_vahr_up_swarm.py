@@ -16,7 +16,7 @@ import boto3
 import pytest
 
 from tests.support.vahr_up import ROOT, VAHR, Up, clean_env, say, start_up, stop_up
-from vahr.local.client import call
+from vahr.plumbing.client import call
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator

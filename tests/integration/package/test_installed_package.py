@@ -23,11 +23,11 @@ from typing import IO, TYPE_CHECKING
 
 import pytest
 
-from vahr.local.lifetime import spawn
-from vahr.local.ports import free_port
+from vahr.plumbing.lifetime import spawn
+from vahr.plumbing.ports import free_port
 
 if TYPE_CHECKING:
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 ROOT = Path(__file__).resolve().parents[3]
 INSTALL_TIMEOUT_S = 600
@@ -112,7 +112,7 @@ def test_the_installed_package_is_not_the_checkout(installed: Path, tmp_path: Pa
     # When the installed interpreter says where the packages come from
     where = subprocess.run(
         [str(installed / "python"), "-c",
-         "import vahr, robot_agent, skill, vahr.protocol.fleet as f; "
+         "import vahr, robot_agent, skill, vahr.domain.fleet as f; "
          "from robot_agent.voice.adaptation import BUNDLED; "
          "print(vahr.__file__, robot_agent.__file__, skill.__file__, f.DEFAULT_FLEET_FILE, "
          "BUNDLED / 'sendump')"],
@@ -127,7 +127,7 @@ def test_the_installed_package_is_not_the_checkout(installed: Path, tmp_path: Pa
 def test_robot_agent_runs_from_an_empty_directory(
     installed: Path, tmp_path: Path, mosquitto: Mosquitto
 ) -> None:
-    from vahr.local.mqtt import MqttClient, MqttEndpoint
+    from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
     from vahr.protocol import topics
 
     empty = tmp_path / "empty"

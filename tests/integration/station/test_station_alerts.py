@@ -22,8 +22,8 @@ from playwright.sync_api import sync_playwright
 from tests.support.browser import Watch, launch
 from tests.support.vahr_up import ROOT, VAHR, Up, clean_env, say, start_up, stop_up
 from vahr.experiment.eventlog import Kind, read_log
-from vahr.local.lifetime import spawn
-from vahr.local.ports import free_port
+from vahr.plumbing.lifetime import spawn
+from vahr.plumbing.ports import free_port
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator

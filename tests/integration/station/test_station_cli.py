@@ -12,11 +12,11 @@ from typing import TYPE_CHECKING
 import pytest
 
 from tests.support.vahr_up import ROOT, VAHR, clean_env
-from vahr.local.lifetime import spawn
-from vahr.local.ports import free_port
+from vahr.plumbing.lifetime import spawn
+from vahr.plumbing.ports import free_port
 
 if TYPE_CHECKING:
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 
 def test_vahr_station_serves_the_page_for_a_running_stack(stack: LocalStack) -> None:

@@ -26,11 +26,11 @@ from playwright.sync_api import sync_playwright
 from tests.support.browser import Watch, launch
 from tests.support.swarm import SwarmThread, swarm_fleet
 from tests.support.vahr_up import ROOT
-from vahr.local.lifetime import spawn
-from vahr.local.mqtt import MqttClient, MqttEndpoint
-from vahr.local.ports import free_port
-from vahr.local.stack import LocalStack, StackConfig
+from vahr.plumbing.lifetime import spawn
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.ports import free_port
 from vahr.protocol import encode, new_command, topics
+from vahr.twin.stack import LocalStack, StackConfig
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator

@@ -16,8 +16,8 @@ import pytest
 from tests.support.push_to_talk import clip
 from tests.support.push_to_talk import talk as talk_to
 from tests.support.vahr_up import Up, start_up, stop_up
-from vahr.local.alexa.nbest import MIN_SLOT_CONFIDENCE
-from vahr.local.ports import free_port
+from vahr.assistant.nbest import MIN_SLOT_CONFIDENCE
+from vahr.plumbing.ports import free_port
 from vahr.speech.audio import Audio
 
 if TYPE_CHECKING:

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from vahr.local.ports import free_port
+from vahr.plumbing.ports import free_port
 from vahr.station.app import StationApp
 from vahr.station.controls import Controls
 from vahr.station.desk import Desk
@@ -20,7 +20,7 @@ from vahr.station.server import MAX_AUDIO_BYTES, MAX_JSON_BYTES, StationServer
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 TOKEN = "a-token-of-twenty-characters"
 

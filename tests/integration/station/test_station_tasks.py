@@ -22,17 +22,17 @@ from playwright.sync_api import sync_playwright
 from tests.support.browser import Watch, launch
 from tests.support.station import RecordingAssistant
 from tests.support.vahr_up import ROOT
-from vahr.local.mqtt import MqttClient, MqttEndpoint
-from vahr.local.ports import LOOPBACK, free_port
-from vahr.station.station import Station, StationConfig
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.ports import LOOPBACK, free_port
+from vahr.station.assembly import Station, StationConfig
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
     from playwright.sync_api import Page, ViewportSize
 
-    from vahr.local.broker import Mosquitto
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
+    from vahr.twin.broker import Mosquitto
 
 pytestmark = pytest.mark.slow
 
@@ -69,7 +69,7 @@ class Dispatcher:
 
 
 def task(id: str, status: str, thing: str | None = None, zone: str = "C") -> dict[str, Any]:
-    """A task as `GET /vahr/tasks` serves it (`vahr.protocol.dispatch.Task`)."""
+    """A task as `GET /vahr/tasks` serves it (`vahr.dispatch.core.Task`)."""
     return {
         "id": id, "request": f"order-{id}", "kind": "deliver", "zone": zone,
         "pickup": "LOADING", "group": None, "robots": [], "status": status, "thing": thing,

@@ -13,7 +13,7 @@ import pytest
 
 from tests.support.push_to_talk import clip, talk
 from tests.support.vahr_up import Up, start_up, stop_up
-from vahr.local.ports import free_port
+from vahr.plumbing.ports import free_port
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

@@ -19,7 +19,7 @@ import pytest
 from tests.support.push_to_talk import clip, type_in
 from tests.support.push_to_talk import talk as talk_to
 from tests.support.vahr_up import Up, start_up, stop_up
-from vahr.local.ports import free_port
+from vahr.plumbing.ports import free_port
 from vahr.speech.audio import Audio
 
 if TYPE_CHECKING:

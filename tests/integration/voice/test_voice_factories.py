@@ -20,7 +20,7 @@ from vahr.speech.errors import SpeechError
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 
 def config_from_environment(environ: dict[str, str], **flags: object) -> AgentConfig:
@@ -28,7 +28,7 @@ def config_from_environment(environ: dict[str, str], **flags: object) -> AgentCo
 
 
 def test_the_room_voice_speaks_over_the_link_it_is_given(mosquitto: Mosquitto) -> None:
-    from vahr.local.mqtt import MqttClient, MqttEndpoint
+    from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
     from vahr.protocol import topics
 
     # Given a link to the broker (the agent's own, when robot-agent run builds the voice)

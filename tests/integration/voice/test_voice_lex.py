@@ -209,7 +209,7 @@ def test_an_unreachable_lex_is_a_voice_error(
     pki: tuple[LocalCA, ClientCredentials], credentials_server: tuple[str, Recorder]
 ) -> None:
     endpoint, _ = credentials_server
-    from vahr.local.ports import free_port
+    from vahr.plumbing.ports import free_port
 
     interpreter = make_lex(pki, endpoint, f"http://127.0.0.1:{free_port()}", "vahr-robot-lex")
     with pytest.raises(SpeechError, match="Amazon Lex could not interpret"):

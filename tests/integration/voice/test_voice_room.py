@@ -16,17 +16,17 @@ import pytest
 
 from robot_agent.config import AgentConfig, VoiceSettings
 from robot_agent.voice.factories import room
-from vahr.local.mqtt import MqttClient, MqttEndpoint
-from vahr.local.room import Exchange, offline_room_assistant
+from vahr.local.room_assistant import Exchange, offline_room_assistant
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
-from vahr.speech.room import Utterance
+from vahr.speech.room_channel import Utterance
 from vahr.speech.tts import EspeakSynthesizer
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
     from robot_agent.voice.room import RoomVoice
-    from vahr.local.broker import Mosquitto
+    from vahr.twin.broker import Mosquitto
 
 QUESTION = "Alexa, ask robot fleet what the weather is"
 WEATHER_ANSWERS = {"sunny": "The weather is sunny.", "rainy": "The weather is rainy."}
@@ -77,7 +77,7 @@ def test_the_robot_asks_and_understands_the_spoken_answer(
     room_setup: tuple[Skill, list[Exchange], str], weather: str
 ) -> None:
     skill, exchanges, url = room_setup
-    skill.weather = weather
+    skill.experiment_weather = weather
     # Given a robot's room voice on the broker
     robot = RobotInTheRoom(url, "placebot1", synthesizer="en-us+m3")
     voice = robot.voice

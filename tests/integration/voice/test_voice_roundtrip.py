@@ -88,7 +88,7 @@ def test_a_sentence_after_the_answer_does_not_hide_it(hearing: Hearing) -> None:
 
 @pytest.mark.parametrize("voice", VOICES)
 def test_the_room_assistant_hears_questions_and_ignores_other_robot_talk(voice: str) -> None:
-    from vahr.local.room import QUESTIONS
+    from vahr.local.room_assistant import QUESTIONS
     from vahr.speech.stt import GrammarRecognizer
 
     # Given the assistant's fast question recognizer (grammar, decoys, no phone loop)

@@ -21,14 +21,14 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from tests.conftest import load_event
-from vahr.local.lifetime import spawn
-from vahr.local.mqtt import MqttClient, MqttEndpoint
-from vahr.local.room import offline_room_assistant
+from vahr.local.room_assistant import offline_room_assistant
+from vahr.plumbing.lifetime import spawn
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import encode, new_command, topics
 from vahr.protocol.shadow import ExperimentState
 
 if TYPE_CHECKING:
-    from vahr.local.stack import LocalStack
+    from vahr.twin.stack import LocalStack
 
 ROOT = Path(__file__).resolve().parents[3]
 AGENT = [sys.executable, "-m", "robot_agent.cli"]

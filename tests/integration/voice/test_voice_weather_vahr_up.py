@@ -18,9 +18,9 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from tests.integration.voice.test_voice_weather_task import EventLog
-from vahr.local.lifetime import spawn
-from vahr.local.mqtt import MqttClient, MqttEndpoint
-from vahr.local.ports import free_port
+from vahr.plumbing.lifetime import spawn
+from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
+from vahr.plumbing.ports import free_port
 from vahr.protocol import topics
 from vahr.protocol.shadow import ExperimentState
 

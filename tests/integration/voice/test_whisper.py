@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from tests.support.push_to_talk import clip
-from vahr.protocol.fleet import load_fleet
+from vahr.domain.fleet import load_fleet
 from vahr.speech.errors import SpeechError
 from vahr.speech.whisper_stt import (
     MODEL_ENV,

@@ -17,7 +17,8 @@ from robot_agent.core.executor import Executor
 if TYPE_CHECKING:
     from robot_agent.backends.sim_ticker import SimTicker
     from robot_agent.voice.port import Voice
-    from vahr.protocol import Event, Fleet, Reported
+    from vahr.domain import Fleet
+    from vahr.protocol import Event, Reported
 
 
 # The longest any `async def` test may run, so that a task which never ends fails the test.

@@ -8,10 +8,11 @@ from typing import TYPE_CHECKING
 from robot_agent.backends.port import Progress
 from robot_agent.config import ExecutorSettings, SimSettings
 from tests.unit.agent.conftest import make_executor, until_moved
-from vahr.protocol import Event, Pose, new_command, utc_now
+from vahr.domain import Pose
+from vahr.protocol import Event, new_command, utc_now
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 def cmd(action: str, params: dict[str, object] | None = None, command_id: str | None = None):  # type: ignore[no-untyped-def]

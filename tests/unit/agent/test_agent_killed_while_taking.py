@@ -25,7 +25,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-    from vahr.protocol import Event, Fleet
+    from vahr.domain import Fleet
+    from vahr.protocol import Event
 
 THING = "placebot1"
 

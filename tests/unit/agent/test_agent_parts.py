@@ -17,13 +17,14 @@ from robot_agent.config import SimSettings
 from robot_agent.core.in_flight import InFlight
 from robot_agent.core.peers import PeerDeliveries
 from robot_agent.core.recent_ids import RecentIds
-from vahr.protocol import Pose, utc_now
+from vahr.domain import Pose
+from vahr.protocol import utc_now
 from vahr.protocol.link import topic_matches
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 def test_recent_ids_remember_across_instances_and_forget_the_oldest(tmp_path: Path) -> None:

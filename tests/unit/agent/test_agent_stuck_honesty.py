@@ -18,7 +18,7 @@ from vahr.protocol import new_command
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 STUCK_AFTER_S = 5.0
 

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from vahr.protocol import load_fleet
+from vahr.domain import load_fleet
 
 
 @pytest.mark.parametrize("count", ["0", "-1", "3"])

@@ -15,12 +15,12 @@ import pytest
 from robot_agent.config import ExecutorSettings
 from robot_agent.voice.port import Heard
 from tests.unit.agent.conftest import make_executor
+from vahr.domain.invocation import WEATHER_QUESTION
 from vahr.protocol import new_command
-from vahr.protocol.assistant import WEATHER_QUESTION
 from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 class ScriptedAssistant:

@@ -26,7 +26,7 @@ from vahr.announce.speech import Names
 from vahr.protocol import ProtocolError, decode_event, decode_presence
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
     from vahr.protocol.announcements import Announcement
 
 T0 = datetime(2026, 11, 22, 10, 15, 3, 120000, tzinfo=UTC)

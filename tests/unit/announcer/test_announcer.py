@@ -37,7 +37,7 @@ from vahr.protocol.announcements import decode_announcement
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 EVENTS = Path(__file__).resolve().parents[2] / "events"
 REGION = "us-east-1"

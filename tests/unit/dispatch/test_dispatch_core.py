@@ -13,9 +13,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from vahr.local.task_store import SqliteTaskStore
-from vahr.protocol import Command, Fleet, Pose
-from vahr.protocol.dispatch import (
+from vahr.dispatch.core import (
     Dispatcher,
     DispatchError,
     Order,
@@ -24,10 +22,14 @@ from vahr.protocol.dispatch import (
     rank,
     task_cost,
 )
+from vahr.domain import Fleet, Pose
+from vahr.local.task_store import SqliteTaskStore
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
+
+    from vahr.protocol import Command
 
 # A made-up floor: LOADING at the origin, zone FAR 30 m east, zone NEAR 3 m north; robots
 # spread so that distances are easy to add up by hand.

@@ -17,11 +17,11 @@ import pytest
 
 from dispatcher.errors import SearchError
 from dispatcher.fleet_search import FleetSearch, available_query
-from vahr.local.dataplane import DataPlane, DataPlaneServer
-from vahr.local.meter import Meter
-from vahr.local.shadow_service import ShadowService
-from vahr.local.shadow_store import ShadowStore
-from vahr.protocol.fleet import Pose
+from vahr.domain.fleet import Pose
+from vahr.twin.dataplane import DataPlane, DataPlaneServer
+from vahr.twin.meter import Meter
+from vahr.twin.shadow_service import ShadowService
+from vahr.twin.shadow_store import ShadowStore
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

@@ -23,12 +23,13 @@ from dispatcher.errors import ConfigError, DispatcherError
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
 from tests.support.dispatch_meter import REGION, AtomicCalls, load_event
-from vahr.local.dataplane import DataPlane, DataPlaneServer
-from vahr.local.meter import Meter
-from vahr.local.shadow_service import ShadowService
-from vahr.local.shadow_store import ShadowStore
-from vahr.protocol import load_fleet, topics
-from vahr.protocol.dispatch import Dispatcher, Task, timestamp
+from vahr.dispatch.core import Dispatcher, Task, timestamp
+from vahr.domain import load_fleet
+from vahr.protocol import topics
+from vahr.twin.dataplane import DataPlane, DataPlaneServer
+from vahr.twin.meter import Meter
+from vahr.twin.shadow_service import ShadowService
+from vahr.twin.shadow_store import ShadowStore
 
 if TYPE_CHECKING:
     from collections.abc import Iterator

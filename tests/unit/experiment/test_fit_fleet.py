@@ -8,8 +8,8 @@ import pytest
 from tests.support.fleets import SIX_ROBOTS
 from vahr.commands.demo import script_for
 from vahr.commands.fleet_flag import read_fleet
+from vahr.domain import Fleet
 from vahr.experiment.tasks import UnfitFleet, draw_plan, require_fit_fleet
-from vahr.protocol import Fleet
 
 # The paper's zones under other names, and two robots that are not placebots.
 FIT = """

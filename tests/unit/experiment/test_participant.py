@@ -31,7 +31,7 @@ from vahr.protocol import decode_command
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 SPEED = 100.0
 

@@ -27,7 +27,7 @@ from vahr.experiment.tasks import TASKS, draw_plan
 from vahr.protocol import decode_command
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 MODEL = Path(__file__).resolve().parents[3] / "skill-package/interactionModels/custom/en-US.json"
 COMPOUND = ("deliver", "weather_delivery", "sequential_delivery")

@@ -10,7 +10,7 @@ from vahr.experiment.world import World
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 TASK_III = TaskGoal("III", {"placebot1": "D", "placebot2": "D"}, ("placebot1", "placebot2"))
 

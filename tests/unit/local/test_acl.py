@@ -3,7 +3,7 @@ tests/integration/local/test_acl_enforced.py)."""
 
 from __future__ import annotations
 
-from vahr.local.acl import render_acl
+from vahr.twin.acl import render_acl
 
 
 def test_robots_get_only_their_own_topics_by_certificate_name() -> None:

@@ -4,8 +4,8 @@ fits clearly better; the margin is the one single-edit mishearings score best wi
 
 from __future__ import annotations
 
-from vahr.local.alexa.ambiguity import CANDIDATE_MARGINS, SlotAmbiguity, calibrated_margin
-from vahr.local.alexa.slot_finder import SlotTypeValues
+from vahr.assistant.ambiguity import CANDIDATE_MARGINS, SlotAmbiguity, calibrated_margin
+from vahr.assistant.slot_finder import SlotTypeValues
 
 ZONES = SlotTypeValues(
     "ZONE",

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from vahr.local.announcement_feed import AnnouncementFeed
+from vahr.plumbing.announcement_feed import AnnouncementFeed
 
 
 def test_only_announcements_made_after_the_start_are_handed_over_once() -> None:

@@ -7,9 +7,9 @@ import json
 
 import pytest
 
-from vahr.local.fleet_index import AggregationError
-from vahr.local.fleet_query import QueryError, parse
-from vahr.local.shadow_store import ShadowStore
+from vahr.twin.fleet_index import AggregationError
+from vahr.twin.fleet_query import QueryError, parse
+from vahr.twin.shadow_store import ShadowStore
 
 
 def _report(store: ShadowStore, thing: str, **reported: object) -> None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import socket
 from pathlib import Path
 
-from vahr.local.ports import LISTEN_PORTS, LOOPBACK, free_port
+from vahr.plumbing.ports import LISTEN_PORTS, LOOPBACK, free_port
 
 
 def test_a_free_port_is_below_the_ephemeral_range_and_can_be_listened_on() -> None:

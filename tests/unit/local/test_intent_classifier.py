@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from vahr.local.alexa.intent_classifier import features, fit
-from vahr.local.alexa.nlu import InteractionModel
+from vahr.assistant.intent_classifier import features, fit
+from vahr.assistant.nlu import InteractionModel
 from vahr.speech.text_classifier import TextClassifier, export
 
 

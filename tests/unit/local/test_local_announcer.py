@@ -13,7 +13,7 @@ from vahr.local.announcer import Announcer
 from vahr.protocol import encode, topics
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
     from vahr.protocol.announcements import Announcement
 
 T0 = datetime(2026, 11, 22, 10, 15, 3, tzinfo=UTC)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from vahr.local.alexa.nbest import (
+from vahr.assistant.nbest import (
     MIN_SLOT_CONFIDENCE,
     Weighing,
     agreement,
@@ -15,7 +15,7 @@ from vahr.local.alexa.nbest import (
     request_reader,
     weigh,
 )
-from vahr.local.alexa.nlu import FALLBACK, InteractionModel, Understanding
+from vahr.assistant.nlu import FALLBACK, InteractionModel, Understanding
 from vahr.speech.stt import Hypothesis
 
 

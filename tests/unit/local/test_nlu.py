@@ -8,14 +8,14 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from vahr.local.alexa import envelope
-from vahr.local.alexa.nlu import (
+from vahr.assistant import envelope
+from vahr.assistant.nlu import (
     CONFIDENCE_THRESHOLD,
     FALLBACK,
     InteractionModel,
     normalize_utterance,
 )
-from vahr.local.alexa.simulator import strip_invocation
+from vahr.assistant.simulator import strip_invocation
 
 if TYPE_CHECKING:
     from pathlib import Path

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from vahr.local.alexa.consistency import SlotConsistency
-from vahr.local.alexa.slot_finder import SlotMatch
+from vahr.assistant.consistency import SlotConsistency
+from vahr.assistant.slot_finder import SlotMatch
 
 INTENT_SLOTS = {
     "NavigateIntent": {"robot": "ROBOT", "zone": "ZONE"},

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
-from vahr.local.alexa.evaluation import DEVELOPMENT_SET, LabelledSet, Report, evaluate
-from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel, normalize_utterance
-from vahr.local.alexa.simulator import strip_invocation
+from vahr.assistant.background import built_in_phrases, out_of_domain_phrases
+from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet, Report, evaluate
+from vahr.assistant.nlu import DEFAULT_MODEL, InteractionModel, normalize_utterance
+from vahr.assistant.simulator import strip_invocation
 
 TUNING_SET = DEVELOPMENT_SET.with_name("tuning-en-US.yaml")
 

@@ -9,14 +9,14 @@ from pathlib import Path
 import msgspec
 import pytest
 
+from vahr.assistant.localized import load_model, strip_invocation
+from vahr.assistant.nlu import FALLBACK, InteractionModel
+from vahr.assistant.understanding import load_understanding
 from vahr.errors import VahrError
-from vahr.local.alexa.localized import load_model, strip_invocation
-from vahr.local.alexa.nlu import FALLBACK, InteractionModel
-from vahr.local.alexa.understanding import load_understanding
 from vahr.skill_model.templates import expand
 
 DEVSET = (
-    Path(__file__).resolve().parents[3] / "vahr" / "local" / "alexa" / "data" / "devset-de-DE.yaml"
+    Path(__file__).resolve().parents[3] / "vahr" / "assistant" / "data" / "devset-de-DE.yaml"
 )
 
 

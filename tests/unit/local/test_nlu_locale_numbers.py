@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from vahr.local.alexa.nlu import DEFAULT_MODEL, InteractionModel
-from vahr.local.alexa.slot_finder import normalize_utterance
-from vahr.local.alexa.understanding import load_understanding
+from vahr.assistant.nlu import DEFAULT_MODEL, InteractionModel
+from vahr.assistant.slot_finder import normalize_utterance
+from vahr.assistant.understanding import load_understanding
 
 GERMAN_MODEL = Path(DEFAULT_MODEL).with_name("de-DE.json")
 

@@ -18,11 +18,11 @@ from typing import Any
 import msgspec
 import pytest
 
+from vahr.assistant.nlu import FALLBACK, InteractionModel
+from vahr.assistant.understanding import load_understanding
+from vahr.domain.fleet import load_fleet
+from vahr.domain.locale import Language, read_yaml
 from vahr.errors import VahrError
-from vahr.local.alexa.nlu import FALLBACK, InteractionModel
-from vahr.local.alexa.understanding import load_understanding
-from vahr.protocol.fleet import load_fleet
-from vahr.protocol.locale import Language, read_yaml
 from vahr.skill_model.generator import build_interaction_model
 from vahr.skill_model.locale_templates import locale_intents
 

@@ -12,15 +12,15 @@ from typing import TYPE_CHECKING
 
 import pytest
 
+from vahr.assistant import roles
+from vahr.assistant.nlu import FALLBACK, InteractionModel
+from vahr.assistant.understanding import LOCALES_DIR, load_understanding
 from vahr.errors import VahrError
-from vahr.local.alexa import roles
-from vahr.local.alexa.nlu import FALLBACK, InteractionModel
-from vahr.local.alexa.understanding import LOCALES_DIR, load_understanding
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from vahr.local.alexa.nlu import Understanding
+    from vahr.assistant.nlu import Understanding
 
 
 @pytest.fixture(scope="module")

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from vahr.local.alexa.evaluation import LabelledUtterance, outcome
-from vahr.local.alexa.nlu import ROLES_CONFIDENCE_THRESHOLD, InteractionModel
+from vahr.assistant.evaluation import LabelledUtterance, outcome
+from vahr.assistant.nlu import ROLES_CONFIDENCE_THRESHOLD, InteractionModel
 
 
 @pytest.fixture(scope="module")

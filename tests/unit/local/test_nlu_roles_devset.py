@@ -9,10 +9,10 @@ from collections import Counter
 import pytest
 from test_nlu_devset import TUNING_SET, generated_patterns
 
-from vahr.local.alexa.background import built_in_phrases, out_of_domain_phrases
-from vahr.local.alexa.evaluation import DEVELOPMENT_SET, LabelledSet, Report, evaluate
-from vahr.local.alexa.nlu import InteractionModel, normalize_utterance
-from vahr.local.alexa.simulator import strip_invocation
+from vahr.assistant.background import built_in_phrases, out_of_domain_phrases
+from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet, Report, evaluate
+from vahr.assistant.nlu import InteractionModel, normalize_utterance
+from vahr.assistant.simulator import strip_invocation
 
 ROLES_SET = DEVELOPMENT_SET.with_name("roles-devset-en-US.yaml")
 

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from vahr.local.shadow_store import ShadowError, ShadowStore, delta_of
+from vahr.twin.shadow_store import ShadowError, ShadowStore, delta_of
 
 if TYPE_CHECKING:
     from pathlib import Path

@@ -12,11 +12,11 @@ from __future__ import annotations
 import json
 import threading
 
-from vahr.local.alexa.commands_seen import CommandLog
-from vahr.local.dataplane import DataPlane
-from vahr.local.meter import Meter
-from vahr.local.shadow_service import ShadowService
-from vahr.local.shadow_store import ShadowStore
+from vahr.assistant.commands_seen import CommandLog
+from vahr.twin.dataplane import DataPlane
+from vahr.twin.meter import Meter
+from vahr.twin.shadow_service import ShadowService
+from vahr.twin.shadow_store import ShadowStore
 
 
 def _command(command_id: str) -> bytes:

@@ -14,7 +14,7 @@ from vahr.protocol import Reported
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 @pytest.fixture

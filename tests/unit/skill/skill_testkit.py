@@ -21,7 +21,8 @@ from vahr.protocol import LastCommand, Reported, decode_command, topics
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.protocol import Command, Fleet
+    from vahr.domain import Fleet
+    from vahr.protocol import Command
 
 REGION = "us-east-1"
 

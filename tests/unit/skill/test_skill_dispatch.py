@@ -19,13 +19,15 @@ from skill.config import SkillConfig
 from skill.task_desk import TaskRefused
 from tests.conftest import load_event
 from tests.support.fleets import SIX_ROBOTS
+from vahr.dispatch.core import Dispatcher, DispatchError, Order, RobotState, Submission, Task
+from vahr.domain import load_fleet
 from vahr.local.task_store import SqliteTaskStore
-from vahr.protocol import Command, load_fleet
-from vahr.protocol.dispatch import Dispatcher, DispatchError, Order, RobotState, Submission, Task
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
     from pathlib import Path
+
+    from vahr.protocol import Command
 
 BAKERY = load_fleet(SIX_ROBOTS)
 

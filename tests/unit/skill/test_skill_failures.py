@@ -49,7 +49,7 @@ def test_gateway_error_inside_a_conversation_keeps_listening(aws: None) -> None:
 
 def test_unreachable_endpoint_is_spoken_as_a_gateway_error(aws: None) -> None:
     # Given the real boto3 adapter pointed at a port where nothing listens
-    from vahr.local.ports import free_port
+    from vahr.plumbing.ports import free_port
 
     config = SkillConfig(data_endpoint=f"http://127.0.0.1:{free_port()}")
     skill = make_lambda_handler(config, gateway=IotDataGateway(create_client(config)))
@@ -91,7 +91,7 @@ def test_the_endpoint_variable_reaches_the_iot_data_client(
     aws: None, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # Given AWS_ENDPOINT_URL_IOT_DATA_PLANE pointing at a port where nothing listens
-    from vahr.local.ports import free_port
+    from vahr.plumbing.ports import free_port
 
     url = f"http://127.0.0.1:{free_port()}"
     monkeypatch.setenv("AWS_ENDPOINT_URL_IOT_DATA_PLANE", url)

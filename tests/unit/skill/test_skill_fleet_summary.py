@@ -17,12 +17,12 @@ import pytest
 from skill_testkit import speech
 
 from tests.conftest import load_event
-from vahr.local.dataplane import DataPlane, DataPlaneServer
-from vahr.local.meter import Meter
 from vahr.local.robots import generated_fleet, write_fleet
-from vahr.local.shadow_service import ShadowService
-from vahr.local.shadow_store import ShadowStore
-from vahr.protocol import Reported, ShadowPose
+from vahr.protocol import Reported, ReportedPose
+from vahr.twin.dataplane import DataPlane, DataPlaneServer
+from vahr.twin.meter import Meter
+from vahr.twin.shadow_service import ShadowService
+from vahr.twin.shadow_store import ShadowStore
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
@@ -30,7 +30,7 @@ if TYPE_CHECKING:
 
     from skill_testkit import RobotDoubles
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
     from vahr.protocol.shadow import Status
 
 SIZE = 1000
@@ -58,7 +58,7 @@ def plane(big_fleet: Fleet) -> Iterator[tuple[ShadowStore, DataPlane, str]]:
             state = Reported(status="navigating", destination="B", connected=True)
         _report(store, f"rover{number}", state)
     _report(store, "rover17", Reported(status="stuck", zone="C", connected=True))
-    near_a = ShadowPose(zone_a.x - 3.0, zone_a.y + 1.0)
+    near_a = ReportedPose(zone_a.x - 3.0, zone_a.y + 1.0)
     _report(store, "rover230", Reported(status="stuck", pose=near_a, connected=True))
     store.commit()
     dataplane = DataPlane(ShadowService(store, lambda _t, _p: None), lambda *_: None, Meter())
@@ -202,8 +202,8 @@ def test_a_fleet_command_reply_names_only_the_first_few_unconfirmed() -> None:
 def test_every_mix_of_troubles_stays_within_the_word_bound(
     big_fleet: Fleet, stuck: int, failed: int, offline: int
 ) -> None:
-    from skill.fleet_index import IndexedRobot
     from skill.fleet_status import NAMED_MAX, FleetState
+    from skill.iot_fleet_index import IndexedRobot
     from skill.speech import fleet_summary, problem_report
     from skill.vocabulary import Vocabulary
 
@@ -238,8 +238,8 @@ def test_every_mix_of_troubles_stays_within_the_word_bound(
 
 
 def test_robots_are_named_in_the_order_a_person_counts_them() -> None:
-    from skill.fleet_index import IndexedRobot
     from skill.fleet_status import spoken_order
+    from skill.iot_fleet_index import IndexedRobot
 
     robots = [IndexedRobot(thing, Reported()) for thing in ("rover1000", "rover101", "rover99")]
     assert [robot.thing for robot in spoken_order(robots)] == ["rover99", "rover101", "rover1000"]

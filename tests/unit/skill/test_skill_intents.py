@@ -18,7 +18,7 @@ from vahr.protocol import decode_command
 if TYPE_CHECKING:
     from skill_testkit import RobotDoubles
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 def commands_sent(fleet: Fleet) -> list[tuple[str, dict[str, Any]]]:

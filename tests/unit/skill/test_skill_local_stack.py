@@ -18,8 +18,7 @@ from skill_testkit import speech
 from skill.app import make_lambda_handler
 from skill.config import SkillConfig
 from tests.conftest import load_event
-from vahr.local.ports import free_port
-from vahr.local.stack import LocalStack, StackConfig
+from vahr.plumbing.ports import free_port
 from vahr.protocol import (
     LastCommand,
     Reported,
@@ -27,12 +26,13 @@ from vahr.protocol import (
     experiment_state_from_payload,
     topics,
 )
+from vahr.twin.stack import LocalStack, StackConfig
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
 
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 @pytest.fixture

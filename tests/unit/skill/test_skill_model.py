@@ -19,7 +19,8 @@ from skill.config import SkillConfig
 from skill.runtime import SkillRuntime
 from skill.vocabulary import FLEET
 from tests.conftest import EVENTS_DIR, load_event
-from vahr.protocol import Fleet, ProtocolError
+from vahr.domain import Fleet
+from vahr.protocol import ProtocolError
 from vahr.skill_model import FLEET_ROBOT_ID, ModelError, build_files, build_interaction_model
 from vahr.skill_model.__main__ import main as skill_model_main
 from vahr.skill_model.generator import (
@@ -361,7 +362,7 @@ def test_example_phrases_are_sample_utterances(model: dict[str, Any]) -> None:
 
 def test_the_robots_weather_question_is_a_weather_intent_sample(model: dict[str, Any]) -> None:
     # The robots ask the assistant themselves (task II); the skill must understand them.
-    from vahr.protocol.assistant import WEATHER_QUESTION
+    from vahr.domain.invocation import WEATHER_QUESTION
 
     invocation = language_model(model)["invocationName"]
     asked = re.sub(rf"^Alexa, ask {invocation} (to )?", "", WEATHER_QUESTION).rstrip("?.").lower()

@@ -11,8 +11,8 @@ from typing import Any
 import pytest
 from ask_sdk_core.serialize import DefaultSerializer
 
+from vahr.domain import load_fleet
 from vahr.errors import VahrError
-from vahr.protocol import load_fleet
 from vahr.skill_model.generator import build_locale_model, model_path, render
 from vahr.skill_model.intents import CUSTOM_INTENTS
 from vahr.skill_model.locale_templates import locale_intents

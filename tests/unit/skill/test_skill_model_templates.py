@@ -24,7 +24,7 @@ from vahr.skill_model.phrases import RULES
 from vahr.skill_model.templates import TemplateError, draw, expand
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 ROOT = Path(__file__).resolve().parents[3]
 

@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING, Any
 import pytest
 from skill_testkit import published
 
-from vahr.local.alexa.nlu import InteractionModel, SlotValue, Understanding
-from vahr.local.alexa.simulator import CONFIRM_SLOT, SILENCE, AlexaSimulator
+from vahr.assistant.nlu import InteractionModel, SlotValue, Understanding
+from vahr.assistant.simulator import CONFIRM_SLOT, SILENCE, AlexaSimulator
 from vahr.protocol.conversation import CORRECTION_WINDOW_S
 
 if TYPE_CHECKING:

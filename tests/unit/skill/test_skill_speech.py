@@ -11,7 +11,8 @@ from skill.commands import dispatch, sequential
 from skill.robots import ShadowRead
 from skill.speech import command_report, robot_status, sequential_report, status_report
 from skill.vocabulary import FLEET, Vocabulary, zone_phrase
-from vahr.protocol import Fleet, LastCommand, Reported, RobotShadow
+from vahr.domain import Fleet
+from vahr.protocol import LastCommand, Reported, RobotShadow
 
 
 @pytest.fixture(scope="module")

@@ -22,14 +22,16 @@ import pytest
 
 from skill.task_desk import HttpTaskDesk, LambdaTaskDesk, TaskDesk, TaskRefused
 from tests.support.fleets import SIX_ROBOTS
+from vahr.dispatch.core import Dispatcher, Order, RobotState
+from vahr.domain import load_fleet
 from vahr.local.dispatcher import TasksApi
 from vahr.local.task_store import SqliteTaskStore
-from vahr.protocol import Command, load_fleet
-from vahr.protocol.dispatch import Dispatcher, Order, RobotState
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
+
+    from vahr.protocol import Command
 
 BAKERY = load_fleet(SIX_ROBOTS)
 

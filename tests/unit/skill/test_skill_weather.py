@@ -10,8 +10,8 @@ import pytest
 from skill_testkit import published, speech
 
 from skill.errors import ShadowConflict
+from skill.experiment_weather import current_weather
 from skill.iot_data import IotDataGateway
-from skill.weather import current_weather
 from tests.conftest import load_event
 from vahr.protocol import ExperimentState, experiment_state_from_payload
 

@@ -11,10 +11,10 @@ from collections import Counter
 import pytest
 
 from tests.support.skill_effects import SkillEffects
+from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet, LabelledUtterance
+from vahr.assistant.nlu import FALLBACK, InteractionModel, SlotValue, Understanding
+from vahr.assistant.simulator import strip_invocation
 from vahr.errors import VahrError
-from vahr.local.alexa.evaluation import DEVELOPMENT_SET, LabelledSet, LabelledUtterance
-from vahr.local.alexa.nlu import FALLBACK, InteractionModel, SlotValue, Understanding
-from vahr.local.alexa.simulator import strip_invocation
 
 SETS = (DEVELOPMENT_SET, DEVELOPMENT_SET.with_name("roles-devset-en-US.yaml"))
 

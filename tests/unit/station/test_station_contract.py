@@ -9,8 +9,8 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from vahr.protocol.station import DRIVE_ENDS, PageMessage
 from vahr.station import contract
+from vahr.station.page_messages import DRIVE_ENDS, PageMessage
 
 if TYPE_CHECKING:
     from pathlib import Path

@@ -11,9 +11,13 @@ import pytest
 
 from tests.conftest import load_event
 from tests.support.station import RecordingAssistant, Wire
-from vahr.protocol import Event, EventPose, Presence, encode, new_command, topics, utc_now
-from vahr.protocol.dispatch import Task
-from vahr.protocol.station import (
+from vahr.dispatch.core import Task
+from vahr.protocol import Event, Presence, ReportedPose, encode, new_command, topics, utc_now
+from vahr.station.app import StationApp
+from vahr.station.controls import Controls
+from vahr.station.desk import Desk
+from vahr.station.feed import ALERTS_LIMIT, Feed, Subscriber, fleet_view
+from vahr.station.page_messages import (
     AlertAcknowledgedMessage,
     AnnouncementMessage,
     PageMessage,
@@ -22,13 +26,9 @@ from vahr.protocol.station import (
     TasksMessage,
     TurnMessage,
 )
-from vahr.station.app import StationApp
-from vahr.station.controls import Controls
-from vahr.station.desk import Desk
-from vahr.station.feed import ALERTS_LIMIT, Feed, Subscriber, fleet_view
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 PAGE = msgspec.json.Decoder(PageMessage)
@@ -233,7 +233,7 @@ def test_a_page_that_falls_behind_gets_each_robots_latest_progress(feed: Feed) -
     page = feed.subscribe()
     messages(page)
     for step in range(5):
-        pose = EventPose(1.0 + step, 3.0)
+        pose = ReportedPose(1.0 + step, 3.0)
         feed.on_event(
             topics.robot_events("placebot1"), event("progress", progress=step / 5, pose=pose)
         )
@@ -324,7 +324,7 @@ def test_a_rejected_command_or_a_ping_answered_mid_drive_does_not_end_the_drive(
     feed: Feed,
 ) -> None:
     events = topics.robot_events("placebot1")
-    feed.on_event(events, event("progress", progress=0.4, pose=EventPose(2.0, 3.0)))
+    feed.on_event(events, event("progress", progress=0.4, pose=ReportedPose(2.0, 3.0)))
     # When the robot rejects a bad command and answers a ping while it drives
     feed.on_event(events, event("rejected", reason="params.zone: 'Q' is not a zone"))
     feed.on_event(events, event("done", action="ping"))
@@ -523,7 +523,7 @@ def test_a_fleet_commands_answers_reach_a_page_as_one_message(feed: Feed) -> Non
     # When both robots accept a command, drive, and one arrives, all before the page reads
     for thing in ("placebot1", "placebot2"):
         feed.on_event(topics.robot_events(thing), event("accepted", thing=thing))
-        pose = EventPose(2.0, 3.0)
+        pose = ReportedPose(2.0, 3.0)
         feed.on_event(
             topics.robot_events(thing), event("progress", thing=thing, progress=0.5, pose=pose)
         )

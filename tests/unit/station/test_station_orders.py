@@ -11,14 +11,14 @@ import pytest
 
 from tests.support.station import RecordingAssistant, Wire
 from vahr.protocol import decode_command, topics
-from vahr.protocol.station import Interaction, PuzzleInput, decode_station_input
+from vahr.protocol.station_topics import Interaction, PuzzleInput, decode_station_input
 from vahr.station.app import StationApp
 from vahr.station.controls import Controls
 from vahr.station.desk import Desk
 from vahr.station.feed import Feed
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
 
 
 @pytest.fixture

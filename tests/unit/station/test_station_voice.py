@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from vahr.protocol.text import spell_numbers
+from vahr.domain.text import spell_numbers
 from vahr.speech.errors import SpeechError
 from vahr.speech.pronounce import arpabet, compound_phones
 from vahr.speech.stt import NOTHING_HEARD, Hypothesis, Recognition
@@ -19,7 +19,7 @@ from vahr.station.vocabulary import load_model, sentences
 from vahr.station.voice import SORRY, PushToTalk, read_clip
 
 if TYPE_CHECKING:
-    from vahr.protocol import Fleet
+    from vahr.domain import Fleet
     from vahr.speech.audio import Audio
 
 

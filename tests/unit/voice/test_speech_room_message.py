@@ -10,7 +10,7 @@ import pytest
 from vahr.protocol import topics
 from vahr.speech.audio import Audio
 from vahr.speech.errors import SpeechError
-from vahr.speech.room import MAX_MESSAGE_BYTES, Utterance
+from vahr.speech.room_channel import MAX_MESSAGE_BYTES, Utterance
 
 
 def test_room_topics_are_built_and_parsed_in_one_place() -> None:

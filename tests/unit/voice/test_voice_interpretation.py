@@ -11,7 +11,7 @@ from robot_agent.voice.answers import WeatherAnswers
 from robot_agent.voice.evaluation import EVALUATION_SET, TUNING_SET, Phrasings
 from robot_agent.voice.interpreter import LocalInterpreter
 from robot_agent.voice.sense import SENSE_FILE, training_sentences
-from vahr.protocol.text import normalize
+from vahr.domain.text import normalize
 from vahr.speech.errors import SpeechError
 
 if TYPE_CHECKING:
@@ -171,7 +171,7 @@ def test_normalize_drops_punctuation_and_case() -> None:
         ),
         (
             "intents: {sunny: [a], rainy: [b]}\ncues: {sunny: [sun]}\nnegations: [not]",
-            "negations are vahr.protocol.weather.NEGATIONS",
+            "negations are vahr.domain.weather.NEGATIONS",
         ),
         ("intents: [unclosed", "not valid YAML"),
     ],

@@ -1,6 +1,6 @@
 // @ts-check
 // The station's page contract: the messages the page is sent and sends, and the constants
-// it shares with the station. Generated from vahr/protocol/station.py by
+// it shares with the station. Generated from vahr/station/page_messages.py by
 // `python -m vahr.station.contract`: do not edit; change the structs and run it again.
 
 /**
@@ -94,7 +94,7 @@
  * @property {string|null} [zone]
  * @property {string|null} [reason]
  * @property {number|null} [progress]
- * @property {EventPose|null} [pose]
+ * @property {ReportedPose|null} [pose]
  * @property {string|null} [text]
  * @property {string|null} [intent]
  * @property {number|null} [confidence]
@@ -115,17 +115,10 @@
  * @property {string|null} [zone]
  * @property {string|null} [reason]
  * @property {number|null} [progress]
- * @property {EventPose|null} [pose]
+ * @property {ReportedPose|null} [pose]
  * @property {string|null} [text]
  * @property {string|null} [intent]
  * @property {number|null} [confidence]
- */
-
-/**
- * @typedef {object} EventPose
- * @property {number} x
- * @property {number} y
- * @property {number} theta
  */
 
 /**
@@ -148,13 +141,24 @@
  * @property {boolean} [simulated]
  * @property {Record<string, string>} [assignments]
  * @property {"I"|"II"|"III"|null} [task]
- * @property {Record<string, TaskStatus>} [tasks]
+ * @property {Record<string, ExperimentTaskStatus>} [tasks]
  * @property {Array<string>} [allowed]
  * @property {number} [puzzle]
  * @property {boolean} [led_on]
  * @property {string|null} [started_at]
  * @property {boolean} [ended]
  * @property {string|null} [at]
+ */
+
+/**
+ * One task as the judge sees it now: not started, running (with the verdict so far), or ended
+ * with success or failure and why.
+ * @typedef {object} ExperimentTaskStatus
+ * @property {"failure"|"running"|"success"|"waiting"} state
+ * @property {string} [reason]
+ * @property {string} [title]
+ * @property {string|null} [started_at]
+ * @property {string|null} [ended_at]
  */
 
 /**
@@ -254,7 +258,17 @@
  * @property {boolean} [connected]
  * @property {string|null} [destination]
  * @property {string|null} [task]
- * @property {ShadowPose|null} [pose]
+ * @property {ReportedPose|null} [pose]
+ */
+
+/**
+ * Where a robot says it is, in the `map` frame (metres, radians): in its events, its shadow's
+ * `reported.pose` and the fleet index. Read tolerantly, as everything a robot reports is; the
+ * fleet file's poses are `vahr.domain.Pose`, read strictly.
+ * @typedef {object} ReportedPose
+ * @property {number} x
+ * @property {number} y
+ * @property {number} theta
  */
 
 /**
@@ -316,13 +330,6 @@
  */
 
 /**
- * @typedef {object} ShadowPose
- * @property {number} x
- * @property {number} y
- * @property {number} [theta]
- */
-
-/**
  * What a page starts from: the fleet, every robot, the conversation so far, the commands seen
  * with their acknowledgments, the session, the announcements nobody has acknowledged yet
  * (oldest first), the station's clock (ms since the epoch) for the page to correct its own, and
@@ -364,21 +371,10 @@
  */
 
 /**
- * One task as the judge sees it now: not started, running (with the verdict so far), or ended
- * with success or failure and why.
- * @typedef {object} TaskStatus
- * @property {"failure"|"running"|"success"|"waiting"} state
- * @property {string} [reason]
- * @property {string} [title]
- * @property {string|null} [started_at]
- * @property {string|null} [ended_at]
- */
-
-/**
  * The fleet's task queue, sent when it changed: every task the dispatcher lists (`GET
- * {api}/vahr/tasks`, `vahr.protocol.dispatch.Task`: what is to be done where, its state, the
- * robot that took it), in its order; `available` is False when the deployment has no dispatcher
- * to ask.
+ * {api}/vahr/tasks`, `vahr.dispatch.core.Task`: what is to be done where, its state, the robot
+ * that took it), in its order; `available` is False when the deployment has no dispatcher to
+ * ask.
  * @typedef {object} TasksMessage
  * @property {"tasks"} type
  * @property {Array<Task>} tasks
