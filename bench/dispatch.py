@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from bench._results import median, percentile, write_section
-from vahr.dispatch.core import Dispatcher, Order, Task, rank
+from vahr.dispatch import Dispatcher, Order, Task, rank
 from vahr.domain import Fleet, Pose, Robot, load_fleet
 from vahr.local.dispatcher import IndexCandidates
 from vahr.local.task_store import SqliteTaskStore

@@ -31,7 +31,7 @@ from constructs import Construct
 from infra.constructs.fleet_indexing import INDEX_NAME
 from infra.constructs.python_function import python_function
 from infra.constructs.topic_rule import lambda_topic_rule
-from vahr.dispatch.core import IDLE_STATUSES
+from vahr.dispatch import IDLE_STATUSES
 from vahr.protocol import topics
 
 if TYPE_CHECKING:

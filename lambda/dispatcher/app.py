@@ -35,7 +35,7 @@ from dispatcher.requests import (
 )
 from dispatcher.robot_updates import robot_freed
 from dispatcher.task_table import TaskTable
-from vahr.dispatch.core import Dispatcher, DispatchError
+from vahr.dispatch import Dispatcher, DispatchError
 from vahr.domain import load_fleet
 from vahr.protocol.errors import ProtocolError, from_validation_error
 
@@ -80,7 +80,10 @@ def handle(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, Any]:
     try:
         answer = on_request(_request(event), dispatcher)
     except BadRequest as err:
-        answer = Answer(err.status, {"code": err.status, "message": str(err)})
+        refusal: dict[str, Any] = {"code": err.status, "message": str(err)}
+        if err.error is not None:
+            refusal["error"] = err.error
+        answer = Answer(err.status, refusal)
     return msgspec.to_builtins(answer)  # type: ignore[no-any-return]
 
 
@@ -117,7 +120,7 @@ def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
         try:
             return Answer(200, dispatcher.submit(request.order))
         except DispatchError as err:
-            raise BadRequest(str(err)) from err
+            raise BadRequest(str(err), error=err.code) from err
     if isinstance(request, ListTasks):
         return Answer(200, {"tasks": dispatcher.tasks()})
     if isinstance(request, ListPending):

@@ -18,11 +18,13 @@ class ConfigError(DispatcherError):
 
 class BadRequest(DispatcherError):
     """The caller asked for something that cannot be done as asked; nothing was changed.
-    `status` is the HTTP status the local data plane answers the same request with."""
+    `status` is the HTTP status the local data plane answers the same request with, and
+    `error` the dispatcher's `DispatchError.code` when the order itself was refused."""
 
-    def __init__(self, message: str, *, status: int = 400) -> None:
+    def __init__(self, message: str, *, status: int = 400, error: str | None = None) -> None:
         super().__init__(message)
         self.status = status
+        self.error = error
 
 
 class StoreError(DispatcherError):

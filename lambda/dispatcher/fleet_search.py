@@ -1,4 +1,4 @@
-"""Candidate robots from AWS IoT fleet indexing: `vahr.dispatch.core.Candidates` on
+"""Candidate robots from AWS IoT fleet indexing: `vahr.dispatch.Candidates` on
 `SearchIndex`, never reading a shadow.
 
 Thing indexing with the classic shadow (REGISTRY_AND_SHADOW) and the custom fields
@@ -22,7 +22,7 @@ from botocore.config import Config
 from botocore.exceptions import BotoCoreError, ClientError
 
 from dispatcher.errors import SearchError
-from vahr.dispatch.core import BUSY_STATUSES, IDLE_STATUSES, RobotState
+from vahr.dispatch import BUSY_STATUSES, IDLE_STATUSES, RobotState
 
 # msgspec reads the annotations at run time: Pose is needed outside TYPE_CHECKING.
 from vahr.domain.fleet import Pose  # noqa: TC001

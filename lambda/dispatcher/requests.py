@@ -27,7 +27,7 @@ from typing import Any
 import msgspec
 
 # msgspec reads the annotations at run time: Order is needed outside TYPE_CHECKING.
-from vahr.dispatch.core import Order  # noqa: TC001
+from vahr.dispatch import Order  # noqa: TC001
 
 
 class Submit(msgspec.Struct, frozen=True, tag_field="operation", tag="submit"):

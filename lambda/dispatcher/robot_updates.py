@@ -17,7 +17,7 @@ from datetime import datetime
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from vahr.dispatch.core import Dispatcher, RobotState, Task
+    from vahr.dispatch import Dispatcher, RobotState, Task
 
 log = logging.getLogger("dispatcher")
 # Longer than a command takes to reach a connected robot and be acknowledged in its shadow

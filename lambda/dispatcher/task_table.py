@@ -1,4 +1,4 @@
-"""The task queue in DynamoDB: `vahr.dispatch.core.TaskStore` with conditional writes.
+"""The task queue in DynamoDB: `vahr.dispatch.TaskStore` with conditional writes.
 
 One table, keyed by `section` (partition) and `id` (sort):
 
@@ -30,10 +30,10 @@ from botocore.config import Config
 from botocore.exceptions import BotoCoreError, ClientError
 
 from dispatcher.errors import StoreError
-from vahr.dispatch.core import Task
+from vahr.dispatch import Task
 
 if TYPE_CHECKING:
-    from vahr.dispatch.core import Outcome
+    from vahr.dispatch import Outcome
 
 CLIENT_CONFIG = Config(
     connect_timeout=2.0, read_timeout=3.0, retries={"mode": "standard", "total_max_attempts": 3}
@@ -81,9 +81,7 @@ class TaskTable:
         task = self._open(task_id)
         if task is None or task.status != "queued":
             return None
-        taken = msgspec.structs.replace(
-            task, status="assigned", thing=thing, assigned_at=at, version=task.version + 1
-        )
+        taken = task.assigned(thing, at=at)
         try:
             self._transact(
                 self._rewrite(taken, seen=task, status="queued"),
@@ -108,9 +106,7 @@ class TaskTable:
             task = self._open(task_id)
             if task is None or task.status != "assigned" or task.thing is None:
                 return None
-            back = msgspec.structs.replace(
-                task, status="queued", thing=None, assigned_at=None, version=task.version + 1
-            )
+            back = task.released()
             try:
                 self._transact(
                     self._rewrite(back, seen=task), self._drop_claim(task.thing, task_id)
@@ -125,12 +121,7 @@ class TaskTable:
             task = self._open(task_id)
             if task is None or task.status != "assigned" or task.thing is None:
                 return None
-            ended = msgspec.structs.replace(
-                task,
-                status="done" if outcome == "done" else "cancelled",
-                outcome=outcome,
-                version=task.version + 1,
-            )
+            ended = task.finished(outcome)
             try:
                 self._close(task, ended)
             except _Conflict:
@@ -141,11 +132,9 @@ class TaskTable:
     def cancel(self, task_id: str) -> Task | None:
         for _ in range(ATTEMPTS):
             task = self._open(task_id)
-            if task is None or task.status not in ("queued", "assigned"):
+            if task is None or not task.is_open:
                 return None
-            ended = msgspec.structs.replace(
-                task, status="cancelled", outcome="cancelled", version=task.version + 1
-            )
+            ended = task.cancelled()
             try:
                 self._close(task, ended)
             except _Conflict:

@@ -27,7 +27,7 @@ from urllib.parse import quote
 import msgspec
 
 from skill.errors import GatewayError, SkillError
-from vahr.dispatch.core import Order, Submission, Task
+from vahr.dispatch import DispatchErrorCode, Order, Submission, Task
 
 if TYPE_CHECKING:
     from skill.config import SkillConfig
@@ -38,11 +38,13 @@ TASKS_PATH = "/vahr/tasks"
 
 
 class TaskRefused(SkillError):
-    """The dispatcher refused the request; `str(error)` is its one-line reason."""
+    """The dispatcher refused the request; `str(error)` is its one-line reason and `error`
+    the `DispatchError.code` of an order it refused (None for other refusals)."""
 
-    def __init__(self, status: int, message: str) -> None:
+    def __init__(self, status: int, message: str, error: DispatchErrorCode | None = None) -> None:
         super().__init__(message)
         self.status = status
+        self.error = error
 
 
 class TaskDesk(Protocol):
@@ -71,6 +73,7 @@ class _Cancelled(msgspec.Struct):
 
 class _Refusal(msgspec.Struct):
     message: str = "the dispatcher refused the request"
+    error: DispatchErrorCode | None = None
 
 
 def _read(status: int, body: bytes | Any, kind: type[Any]) -> Any:
@@ -81,7 +84,7 @@ def _read(status: int, body: bytes | Any, kind: type[Any]) -> Any:
             refusal = decode(body, type=_Refusal)
         except (msgspec.ValidationError, msgspec.DecodeError):
             refusal = _Refusal()
-        raise TaskRefused(status, refusal.message)
+        raise TaskRefused(status, refusal.message, refusal.error)
     try:
         return decode(body, type=kind)
     except (msgspec.ValidationError, msgspec.DecodeError) as err:

@@ -16,7 +16,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from skill.vocabulary import Vocabulary
-    from vahr.dispatch.core import Order, Submission, Task
+    from vahr.dispatch import Order, Submission, Task
 
 # The queue is read out to this many tasks; the rest are counted.
 QUEUE_READ_MAX = 5

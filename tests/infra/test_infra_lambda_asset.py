@@ -146,7 +146,7 @@ def test_the_dispatcher_loads_from_the_same_bundle_and_answers_in_one_line(
         "answer = dispatcher.app.lambda_handler({'operation': 'launch'}, None)\n"
         "print(json.dumps({'answer': answer, 'file': dispatcher.app.__file__,"
         " 'loaded': sorted(m for m in ('skill', 'ask_sdk_core', 'announcer', 'awscrt',"
-        " 'vahr.announce', 'vahr.dispatch.core') if m in sys.modules)}))"
+        " 'vahr.announce', 'vahr.dispatch') if m in sys.modules)}))"
     )
     result = run_in_lambda_python(bundle.out_dir, script, VAHR_TASK_TABLE="vahr-tasks")
     assert result.returncode == 0, result.stderr
@@ -161,7 +161,7 @@ def test_the_dispatcher_loads_from_the_same_bundle_and_answers_in_one_line(
             "message": "operation: 'launch' is not one of submit, tasks, pending, cancel",
         },
     }
-    assert seen["loaded"] == ["vahr.dispatch.core"]
+    assert seen["loaded"] == ["vahr.dispatch"]
 
 
 class IotDataRecorder(BaseHTTPRequestHandler):

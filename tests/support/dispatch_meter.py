@@ -27,7 +27,7 @@ from dispatcher.command_channel import CommandChannel
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
 from infra.cost_estimate import dynamodb_units
-from vahr.dispatch.core import Dispatcher
+from vahr.dispatch import Dispatcher
 from vahr.domain import load_fleet
 from vahr.twin.dataplane import DataPlane, DataPlaneServer
 from vahr.twin.meter import Meter

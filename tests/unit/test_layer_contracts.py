@@ -61,7 +61,7 @@ def test_the_packages_keep_every_contract(tree: Path) -> None:
         ("vahr/protocol/topics.py", "import vahr.domain.fleet", "The wire contract"),
         ("vahr/protocol/topics.py", "import yaml", "The wire contract"),
         ("vahr/domain/fleet.py", "import vahr.assistant.nlu", "The domain and the dispatch"),
-        ("vahr/dispatch/core.py", "import boto3", "The domain and the dispatch"),
+        ("vahr/dispatch/tasks.py", "import boto3", "The domain and the dispatch"),
         ("vahr/speech/audio.py", "import vahr.plumbing.mqtt", "Speech imports nothing"),
         ("robot_agent/agent.py", "import vahr.local.room_assistant", "robot_agent never imports"),
         ("robot_agent/agent.py", "import vahr.assistant.nlu", "robot_agent never imports"),
@@ -85,9 +85,17 @@ def test_the_packages_keep_every_contract(tree: Path) -> None:
         # The plumbing and the assistant are siblings: neither knows the other.
         ("vahr/plumbing/client.py", "import vahr.assistant.nlu", "The top layer is one-way"),
         # The station serves any deployment: nothing of the twin or the local hosts.
-        ("vahr/station/voice.py", "import vahr.twin.dataplane", "The station and the experiment know"),
+        (
+            "vahr/station/voice.py",
+            "import vahr.twin.dataplane",
+            "The station and the experiment know",
+        ),
         ("vahr/station/app.py", "import vahr.local.system", "The station and the experiment know"),
-        ("vahr/experiment/bus.py", "import vahr.twin.broker", "The station and the experiment know"),
+        (
+            "vahr/experiment/bus.py",
+            "import vahr.twin.broker",
+            "The station and the experiment know",
+        ),
         ("vahr/station/vocabulary.py", "import vahr.assistant.nlu", "The station and the"),
         ("robot_agent/link/shadow.py", "import robot_agent.voice.port", "robot_agent's adapters"),
         # Cycles no layer names: two modules of one package, two packages of robot_agent.

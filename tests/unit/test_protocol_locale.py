@@ -7,10 +7,9 @@ import logging
 
 import pytest
 
-from vahr.domain import Fleet, load_fleet
+from vahr.domain import Fleet, load_fleet, text, weather
 from vahr.domain.fleet import spoken_in
 from vahr.domain.locale import SUPPORTED_LOCALES, LocaleError, check_locale, load_language
-from vahr.domain import text, weather
 
 
 def test_the_shipped_locales_are_english_and_german() -> None:

@@ -1,4 +1,4 @@
-"""The local stack's fleet dispatcher: the core of `vahr.dispatch.core` wired to `vahr up`.
+"""The local stack's fleet dispatcher: the core of `vahr.dispatch` wired to `vahr up`.
 
 - tasks: `SqliteTaskStore` in the state directory (the queue survives a restart);
 - candidates: the local fleet index the shadow store keeps (`IndexCandidates`), the twin
@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from vahr.dispatch.core import (
+from vahr.dispatch import (
     BUSY_STATUSES,
     IDLE_STATUSES,
     Dispatcher,
@@ -139,18 +139,23 @@ class TasksApi:
         try:
             return _ok(self.dispatcher.submit(order))
         except DispatchError as err:
-            return _error(400, str(err))
+            return _error(400, str(err), error=err.code)
 
 
 def _ok(body: object) -> Answer:
     return 200, msgspec.json.encode(body), None
 
 
-def _error(status: int, message: str) -> Answer:
+def _error(status: int, message: str, *, error: str | None = None) -> Answer:
+    """A refusal in the data plane's shape; `error` is the `DispatchError.code` of a refused
+    order, which the skill decides by."""
     error_type = {400: "InvalidRequestException", 404: "ResourceNotFoundException"}.get(
         status, "MethodNotAllowedException"
     )
-    return status, msgspec.json.encode({"code": status, "message": message}), error_type
+    body: dict[str, object] = {"code": status, "message": message}
+    if error is not None:
+        body["error"] = error
+    return status, msgspec.json.encode(body), error_type
 
 
 class LocalDispatcher:

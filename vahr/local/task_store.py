@@ -1,4 +1,4 @@
-"""The local stack's fleet task queue: `vahr.dispatch.core.TaskStore` over SQLite.
+"""The local stack's fleet task queue: `vahr.dispatch.TaskStore` over SQLite.
 
 One row per task, in `tasks.sqlite3` in the state directory, so the queue and who holds
 which task survive a restart of `vahr up`. Every conditional change is one SQL statement
@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from vahr.dispatch.core import Outcome, Task
+from vahr.dispatch import Outcome, Task
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -106,9 +106,7 @@ class SqliteTaskStore:
             ).fetchone()
             if busy is not None:
                 return None
-            taken = msgspec.structs.replace(
-                task, status="assigned", thing=thing, assigned_at=at, version=task.version + 1
-            )
+            taken = task.assigned(thing, at=at)
             self._save(db, taken)
             return taken
 
@@ -117,9 +115,7 @@ class SqliteTaskStore:
             task = self._load(db, task_id)
             if task is None or task.status != "assigned":
                 return None
-            back = msgspec.structs.replace(
-                task, status="queued", thing=None, assigned_at=None, version=task.version + 1
-            )
+            back = task.released()
             self._save(db, back)
             return back
 
@@ -128,26 +124,16 @@ class SqliteTaskStore:
             task = self._load(db, task_id)
             if task is None or task.status != "assigned":
                 return None
-            ended = msgspec.structs.replace(
-                task,
-                status="done" if outcome == "done" else "cancelled",
-                outcome=outcome,
-                version=task.version + 1,
-            )
+            ended = task.finished(outcome)
             self._save(db, ended)
             return ended
 
     def cancel(self, task_id: str) -> Task | None:
         with self._transaction() as db:
             task = self._load(db, task_id)
-            if task is None or task.status not in ("queued", "assigned"):
+            if task is None or not task.is_open:
                 return None
-            self._save(
-                db,
-                msgspec.structs.replace(
-                    task, status="cancelled", outcome="cancelled", version=task.version + 1
-                ),
-            )
+            self._save(db, task.cancelled())
             return task
 
     def get(self, task_id: str) -> Task | None:

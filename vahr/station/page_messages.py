@@ -13,7 +13,7 @@ from typing import Annotated, Any, Literal
 import msgspec
 
 # The page's structs name these in annotations, which msgspec reads at run time.
-from vahr.dispatch.core import Task  # noqa: TC001
+from vahr.dispatch import Task  # noqa: TC001
 from vahr.domain.fleet import Floor, Pose  # noqa: TC001
 from vahr.protocol.announcements import Announcement
 from vahr.protocol.messages import Event, EventKind
@@ -97,7 +97,7 @@ class CommandParams(msgspec.Struct, frozen=True, omit_defaults=True):
 
 class TasksMessage(msgspec.Struct, frozen=True, kw_only=True, tag="tasks", tag_field="type"):
     """The fleet's task queue, sent when it changed: every task the dispatcher lists
-    (`GET {api}/vahr/tasks`, `vahr.dispatch.core.Task`: what is to be done where, its
+    (`GET {api}/vahr/tasks`, `vahr.dispatch.Task`: what is to be done where, its
     state, the robot that took it), in its order; `available` is False when the deployment
     has no dispatcher to ask."""
 

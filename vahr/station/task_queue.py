@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from vahr.dispatch.core import Task  # noqa: TC001 (msgspec reads it at run time)
+from vahr.dispatch import Task  # noqa: TC001 (msgspec reads it at run time)
 from vahr.station.page_messages import TasksMessage
 
 if TYPE_CHECKING:

@@ -21,7 +21,7 @@ from skill.responses import answer
 from skill.slots import read_slot
 from skill.task_desk import TaskRefused
 from skill.vocabulary import capitalise, join_choices
-from vahr.dispatch.core import Order
+from vahr.dispatch import Order
 from vahr.domain import FLEET_GROUP
 from vahr.domain.text import normalize, number_in_words
 
@@ -56,7 +56,7 @@ class _FleetHandler(AbstractRequestHandler):
         except TaskRefused as err:
             if err.status == 404:  # a stack without the dispatcher's routes
                 return answer(handler_input, prompts.NO_DISPATCHER)
-            if err.status == 400 and "free to go" in str(err):
+            if err.error == "none_free":
                 return answer(handler_input, when_none)
             return answer(handler_input, prompts.DISPATCH_REFUSED.format(reason=str(err)))
         speech = task_speech.submission_report(self.runtime.vocabulary, order, submission)

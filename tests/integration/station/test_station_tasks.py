@@ -69,7 +69,7 @@ class Dispatcher:
 
 
 def task(id: str, status: str, thing: str | None = None, zone: str = "C") -> dict[str, Any]:
-    """A task as `GET /vahr/tasks` serves it (`vahr.dispatch.core.Task`)."""
+    """A task as `GET /vahr/tasks` serves it (`vahr.dispatch.Task`)."""
     return {
         "id": id, "request": f"order-{id}", "kind": "deliver", "zone": zone,
         "pickup": "LOADING", "group": None, "robots": [], "status": status, "thing": thing,

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from vahr.dispatch.core import (
+from vahr.dispatch import (
     Dispatcher,
     DispatchError,
     Order,

@@ -23,7 +23,7 @@ from dispatcher.errors import ConfigError, DispatcherError
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
 from tests.support.dispatch_meter import REGION, AtomicCalls, load_event
-from vahr.dispatch.core import Dispatcher, Task, timestamp
+from vahr.dispatch import Dispatcher, Task, timestamp
 from vahr.domain import load_fleet
 from vahr.protocol import topics
 from vahr.twin.dataplane import DataPlane, DataPlaneServer

@@ -11,7 +11,7 @@ import pytest
 from dispatcher.errors import StoreError
 from dispatcher.task_table import TaskTable
 from tests.support.dispatch_meter import AtomicCalls
-from vahr.dispatch.core import Task
+from vahr.dispatch import Task
 
 if TYPE_CHECKING:
     from collections.abc import Callable

@@ -15,9 +15,7 @@ from vahr.assistant.understanding import load_understanding
 from vahr.errors import VahrError
 from vahr.skill_model.templates import expand
 
-DEVSET = (
-    Path(__file__).resolve().parents[3] / "vahr" / "assistant" / "data" / "devset-de-DE.yaml"
-)
+DEVSET = Path(__file__).resolve().parents[3] / "vahr" / "assistant" / "data" / "devset-de-DE.yaml"
 
 
 @pytest.fixture(scope="module")

@@ -19,7 +19,7 @@ from skill.config import SkillConfig
 from skill.task_desk import TaskRefused
 from tests.conftest import load_event
 from tests.support.fleets import SIX_ROBOTS
-from vahr.dispatch.core import Dispatcher, DispatchError, Order, RobotState, Submission, Task
+from vahr.dispatch import Dispatcher, DispatchError, Order, RobotState, Submission, Task
 from vahr.domain import load_fleet
 from vahr.local.task_store import SqliteTaskStore
 
@@ -62,7 +62,7 @@ class CoreDesk:
         try:
             return self.dispatcher.submit(order)
         except DispatchError as err:
-            raise TaskRefused(400, str(err)) from err
+            raise TaskRefused(400, str(err), err.code) from err
 
     def tasks(self) -> list[Task]:
         return self.dispatcher.tasks()
@@ -255,6 +255,21 @@ def test_the_robots_in_a_zone_go_and_none_there_is_said(
         "ZoneRobotsIntent", origin=("the pantry", "PANTRY"), zone=("the mill", "LOADING")
     )
     assert said(skill, empty) == "No free robot is in the pantry, so I sent none."
+
+
+def test_a_refusal_is_read_by_its_code_not_its_words(
+    skill: Callable[[dict[str, Any]], dict[str, Any]],
+    robots: Robots,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # Given a dispatcher whose refusal says "none free" in other words than today's
+    def refuse(order: Order) -> Submission:
+        raise TaskRefused(400, "alle Roboter sind unterwegs", "none_free")
+
+    monkeypatch.setattr(CoreDesk, "submit", lambda self, order: refuse(order))
+    event = intent("ZoneRobotsIntent", origin=("the shop", "SHOP"), zone=("the mill", "LOADING"))
+    # Then the skill says what its code means
+    assert said(skill, event) == "No free robot is in the shop, so I sent none."
 
 
 def test_every_idle_robot_goes_and_busy_ones_stay(

@@ -22,7 +22,7 @@ import pytest
 
 from skill.task_desk import HttpTaskDesk, LambdaTaskDesk, TaskDesk, TaskRefused
 from tests.support.fleets import SIX_ROBOTS
-from vahr.dispatch.core import Dispatcher, Order, RobotState
+from vahr.dispatch import Dispatcher, Order, RobotState
 from vahr.domain import load_fleet
 from vahr.local.dispatcher import TasksApi
 from vahr.local.task_store import SqliteTaskStore

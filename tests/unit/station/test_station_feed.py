@@ -11,7 +11,7 @@ import pytest
 
 from tests.conftest import load_event
 from tests.support.station import RecordingAssistant, Wire
-from vahr.dispatch.core import Task
+from vahr.dispatch import Task
 from vahr.protocol import Event, Presence, ReportedPose, encode, new_command, topics, utc_now
 from vahr.station.app import StationApp
 from vahr.station.controls import Controls

@@ -1,145 +1,44 @@
-"""Fleet dispatch: tasks without a robot's name, given to the best free robot or queued.
-
-One dispatcher, two hosts. This module is the pure core both run: the `Task` model, the
-documented cost, the ranking, and a `Dispatcher` that reaches the world only through three
-ports, so the local stack (SQLite, the local fleet index, the local broker) and AWS
-(DynamoDB, IoT fleet indexing, iot-data) run the same decisions.
-
-The cost of giving a task to a robot (docs/dispatch.md): the length of the path from the
-robot's reported pose to the task's pickup zone and from there to its drop zone, on the
-floor's geometry from fleet.yaml. VAHR's robots drive straight from anywhere to anywhere
-(the simulator does, and walls are drawn, not driven around: `fleet._check_reachable`), so
-the default path length is the straight line; a host with a planner passes its own
-`path_length`. Robots that are idle rank before robots that are busy with work the
-dispatcher did not give them (a command by name), whatever the distance; equal costs are
-broken by thing name, so the same state always picks the same robot.
+"""The dispatcher both hosts run (`vahr up`'s and the dispatcher Lambda): it gives tasks
+to robots and reaches the world only through three ports, so the local stack (SQLite, the
+local fleet index, the local broker) and AWS (DynamoDB, IoT fleet indexing, iot-data) make
+the same decisions.
 
 A person's request is an `Order`; the dispatcher turns it into one `Task` per robot it needs
 (two for "send two robots", one per member for a group), so that a task is only ever held
 by one robot and "two robots never take one task" is one conditional write in the store.
-This module imports only msgspec and the rest of `vahr.protocol`: the Lambda bundle carries it.
 """
 
 from __future__ import annotations
 
-import heapq
-import math
 import uuid
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from datetime import UTC, datetime, timedelta
-from typing import Literal, Protocol
+from typing import TYPE_CHECKING, Protocol
 
-import msgspec
-
-from vahr.domain.fleet import FLEET_GROUP, Fleet, Pose
+from vahr.dispatch.ranking import (
+    BUSY_STATUSES,
+    IDLE_STATUSES,
+    PathLength,
+    RobotState,
+    rank,
+    straight_line,
+)
+from vahr.dispatch.tasks import (
+    FINAL_RESULTS,
+    PICKUP_ZONE,
+    SOURCE,
+    DispatchError,
+    Order,
+    Outcome,
+    Submission,
+    Task,
+    timestamp,
+)
+from vahr.domain.fleet import FLEET_GROUP
 from vahr.protocol.messages import Command, new_command
 
-TaskKind = Literal["navigate", "deliver"]
-TaskStatus = Literal["queued", "assigned", "done", "cancelled"]
-# What a finished task ended as: the robot's result for its command, or why it ended early.
-Outcome = Literal["done", "failed", "cancelled", "rejected", "preempted"]
-
-# The zone every delivery picks its package up at (the arm at the conveyor, DESIGN.md).
-PICKUP_ZONE = "LOADING"
-# Statuses of a robot with nothing to do: ranked before every busy one.
-IDLE_STATUSES = frozenset({"idle", "stopped"})
-# Statuses of a robot at work on something the dispatcher did not give it: it may be given
-# a task (which preempts that work, as any new motion command does) but only after every
-# idle robot. Any other status (stuck, error) or a disconnected robot is never a candidate.
-BUSY_STATUSES = frozenset({"navigating", "loading", "unloading", "waiting"})
-# A command's result that ends the task it carried.
-FINAL_RESULTS = frozenset({"done", "failed", "cancelled", "rejected"})
-# The `source` of every command the dispatcher publishes.
-SOURCE = "dispatcher"
-
-
-class DispatchError(ValueError):
-    """An order that cannot be carried out as asked: an unknown zone or group, a count the
-    fleet cannot meet. `str(error)` is one line a person can act on; nothing was changed."""
-
-
-class Task(msgspec.Struct, frozen=True, kw_only=True):
-    """One robot's share of an order, as the store keeps it and `GET /vahr/tasks` shows it.
-
-    `id` is also the id of the command published for it (so republishing after a restart is
-    executed once, DESIGN.md). `robots` lists the only robots that may take it (a group's
-    member, a robot in a named zone); empty means any. `created_at` (RFC 3339 UTC with
-    microseconds) then `id` order the queue. `version` grows by one on every write; stores
-    use it for their conditional writes.
-    """
-
-    id: str
-    request: str
-    kind: TaskKind
-    zone: str
-    pickup: str | None = None
-    group: str | None = None
-    robots: list[str] = []
-    status: TaskStatus = "queued"
-    thing: str | None = None
-    created_at: str
-    assigned_at: str | None = None
-    outcome: Outcome | None = None
-    version: int = 1
-
-    @property
-    def order_key(self) -> tuple[str, str]:
-        """The queue's order: first come, first served; `id` breaks a tie."""
-        return (self.created_at, self.id)
-
-    def allows(self, thing: str) -> bool:
-        return not self.robots or thing in self.robots
-
-
-class Order(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
-    """What a person asked for, the body of `POST {api}/vahr/tasks` and the skill's submit.
-
-    - `count` robots of any (or of `group`'s members when `group` is given and `count` is
-      set) go to `zone`: "send two robots to zone B".
-    - `group` alone: every member of the group goes, each its own task; a busy member's
-      task waits for that member: "send the waders to the shop".
-    - `origin`: the free robots reported in that zone now go; nothing is queued: "send the
-      robots in zone A to the loading zone".
-    - `idle`: every idle robot now goes; nothing is queued: "every idle robot to zone C".
-    """
-
-    kind: TaskKind = "navigate"
-    zone: str
-    count: int | None = None
-    group: str | None = None
-    origin: str | None = None
-    idle: bool = False
-
-
-class RobotState(msgspec.Struct, frozen=True, kw_only=True):
-    """What the dispatcher needs to know of one robot, from a fleet index (or its shadow)."""
-
-    thing: str
-    status: str
-    connected: bool = True
-    zone: str | None = None
-    pose: Pose | None = None
-    last_command_id: str | None = None
-    last_result: str | None = None
-
-    @property
-    def available(self) -> bool:
-        """Connected and idle or busy; a stuck, failed or offline robot takes no task."""
-        return self.connected and (self.status in IDLE_STATUSES or self.status in BUSY_STATUSES)
-
-    @property
-    def idle(self) -> bool:
-        return self.status in IDLE_STATUSES
-
-
-class Submission(msgspec.Struct, frozen=True, kw_only=True):
-    """What became of an order: the tasks given to a robot now and those queued, with each
-    queued task's place in line (1 is next), as `POST /vahr/tasks` answers it."""
-
-    request: str
-    assigned: list[Task] = []
-    queued: list[Task] = []
-    positions: list[int] = []
+if TYPE_CHECKING:
+    from vahr.domain.fleet import Fleet
 
 
 class TaskStore(Protocol):
@@ -207,83 +106,6 @@ class Candidates(Protocol):
 # Sends a command to one robot: (thing, command). The local host publishes on the broker,
 # AWS through iot-data. It raises on failure; the dispatcher then gives the task back.
 Publish = Callable[[str, Command], None]
-# The length of the path between two poses on the floor, in metres.
-PathLength = Callable[[Pose, Pose], float]
-
-
-def straight_line(start: Pose, end: Pose) -> float:
-    """The path length on VAHR's floors: robots drive straight, walls are not obstacles."""
-    return math.hypot(end.x - start.x, end.y - start.y)
-
-
-def task_cost(
-    fleet: Fleet, pose: Pose, task: Task, path_length: PathLength = straight_line
-) -> float:
-    """Metres a robot at `pose` drives to do `task`: to the pickup (if any), then to the
-    drop zone. A robot already in the drop zone of a navigation costs nothing."""
-    drop = fleet.zone(task.zone).pose
-    if task.pickup is None:
-        return path_length(pose, drop)
-    pickup = fleet.zone(task.pickup).pose
-    return path_length(pose, pickup) + path_length(pickup, drop)
-
-
-def robot_pose(fleet: Fleet, state: RobotState) -> Pose:
-    """Where a robot is: its reported pose, else its reported zone's, else its start."""
-    if state.pose is not None:
-        return state.pose
-    if state.zone is not None and state.zone in fleet.zone_ids:
-        return fleet.zone(state.zone).pose
-    try:
-        return fleet.robot(state.thing).start
-    except KeyError:
-        return Pose(0.0, 0.0)
-
-
-def rank(
-    fleet: Fleet,
-    task: Task,
-    robots: Iterable[RobotState],
-    *,
-    limit: int | None = None,
-    path_length: PathLength = straight_line,
-) -> list[RobotState]:
-    """The robots allowed to take `task`, best first: idle before busy, then by cost, then
-    by thing name. With `limit`, only the best `limit` (a partial sort: 10,000 robots are
-    ranked without sorting them all).
-
-    The cost is `task_cost`, computed here with the pickup and drop looked up once: the
-    leg from the pickup to the drop is the same for every robot.
-    """
-    drop = fleet.zone(task.zone).pose
-    pickup = fleet.zone(task.pickup).pose if task.pickup is not None else None
-    first = pickup or drop
-    rest = path_length(pickup, drop) if pickup is not None else 0.0
-    allowed = frozenset(task.robots)
-    hypot, fx, fy = math.hypot, first.x, first.y
-    straight = path_length is straight_line
-    keyed: list[tuple[bool, float, str, RobotState]] = []
-    for robot in robots:
-        if allowed and robot.thing not in allowed:
-            continue
-        pose = robot.pose if robot.pose is not None else robot_pose(fleet, robot)
-        to_first = hypot(pose.x - fx, pose.y - fy) if straight else path_length(pose, first)
-        # False sorts before True: idle robots first.
-        keyed.append((robot.status not in IDLE_STATUSES, to_first + rest, robot.thing, robot))
-    # Tuples compare field by field and thing names are unique, so the states themselves
-    # are never compared.
-    if limit is None:
-        keyed.sort()
-    elif limit == 1:
-        keyed = [min(keyed)] if keyed else []
-    else:
-        keyed = heapq.nsmallest(limit, keyed)
-    return [entry[3] for entry in keyed]
-
-
-def timestamp(moment: datetime) -> str:
-    """RFC 3339 UTC with microseconds: sorts as text in time order."""
-    return moment.astimezone(UTC).strftime("%Y-%m-%dT%H:%M:%S.%fZ")
 
 
 class Dispatcher:
@@ -432,14 +254,16 @@ class Dispatcher:
         fleet = self.fleet
         if order.zone not in fleet.zone_ids:
             raise DispatchError(
-                f"there is no zone {order.zone!r}; zones are {', '.join(fleet.zone_ids)}"
+                "unknown_zone",
+                f"there is no zone {order.zone!r}; zones are {', '.join(fleet.zone_ids)}",
             )
         if order.origin is not None and order.origin not in fleet.zone_ids:
             raise DispatchError(
-                f"there is no zone {order.origin!r}; zones are {', '.join(fleet.zone_ids)}"
+                "unknown_zone",
+                f"there is no zone {order.origin!r}; zones are {', '.join(fleet.zone_ids)}",
             )
         if order.count is not None and order.count < 1:
-            raise DispatchError("count: at least one robot is needed")
+            raise DispatchError("bad_count", "count: at least one robot is needed")
         members: list[list[str]]
         if order.group is not None:
             group = self._group(order.group)
@@ -457,7 +281,7 @@ class Dispatcher:
             members = [[]] * count
         if not members:
             where = f" in zone {order.origin}" if order.origin else ""
-            raise DispatchError(f"no robot{where} is free to go now")
+            raise DispatchError("none_free", f"no robot{where} is free to go now")
         request = uuid.uuid4().hex
         now = self.clock()
         pickup = PICKUP_ZONE if order.kind == "deliver" else None
@@ -483,13 +307,15 @@ class Dispatcher:
             if group.id == group_id:
                 return list(group.robots)
         known = [group.id for group in self.fleet.groups] or ["none"]
-        raise DispatchError(f"there is no group {group_id!r}; groups are {', '.join(known)}")
+        raise DispatchError(
+            "unknown_group", f"there is no group {group_id!r}; groups are {', '.join(known)}"
+        )
 
     @staticmethod
     def _check_count(count: int, most: int, what: str) -> None:
         if count > most:
             robots = "robot" if most == 1 else "robots"
-            raise DispatchError(f"{what} has {most} {robots}; {count} cannot go")
+            raise DispatchError("too_many", f"{what} has {most} {robots}; {count} cannot go")
 
     def _free(self, *, zone: str | None = None, idle: bool = False) -> list[RobotState]:
         """Available robots that hold no task (in the candidates' order)."""

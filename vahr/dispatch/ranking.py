@@ -1,0 +1,127 @@
+"""The cost of a robot for a task, and the ranking of robots by it.
+
+The cost (docs/dispatch.md) is the length of the path from the robot's reported pose to
+the task's pickup zone and from there to its drop zone. VAHR's robots drive straight from
+anywhere to anywhere on the fleet file's floor (the simulator does, and walls are drawn, not
+driven around), so the default path length is the straight line; a host with a planner
+passes its own `path_length`. Robots that are idle rank before robots busy with work the
+dispatcher did not give them (a command by name), whatever the distance; equal costs are
+broken by thing name, so the same state always picks the same robot.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING
+
+import msgspec
+
+from vahr.domain.fleet import Pose
+
+if TYPE_CHECKING:
+    from vahr.dispatch.tasks import Task
+    from vahr.domain.fleet import Fleet
+
+# Statuses of a robot with nothing to do: ranked before every busy one.
+IDLE_STATUSES = frozenset({"idle", "stopped"})
+# Statuses of a robot at work on something the dispatcher did not give it: it may be given
+# a task (which preempts that work, as any new motion command does) but only after every
+# idle robot. Any other status (stuck, error) or a disconnected robot is never a candidate.
+BUSY_STATUSES = frozenset({"navigating", "loading", "unloading", "waiting"})
+
+
+class RobotState(msgspec.Struct, frozen=True, kw_only=True):
+    """What the dispatcher needs to know of one robot, from a fleet index (or its shadow)."""
+
+    thing: str
+    status: str
+    connected: bool = True
+    zone: str | None = None
+    pose: Pose | None = None
+    last_command_id: str | None = None
+    last_result: str | None = None
+
+    @property
+    def available(self) -> bool:
+        """Connected and idle or busy; a stuck, failed or offline robot takes no task."""
+        return self.connected and (self.status in IDLE_STATUSES or self.status in BUSY_STATUSES)
+
+    @property
+    def idle(self) -> bool:
+        return self.status in IDLE_STATUSES
+
+
+# The length of the path between two poses on the floor, in metres.
+PathLength = Callable[[Pose, Pose], float]
+
+
+def straight_line(start: Pose, end: Pose) -> float:
+    """The path length on VAHR's floors: robots drive straight, walls are not obstacles."""
+    return math.hypot(end.x - start.x, end.y - start.y)
+
+
+def task_cost(
+    fleet: Fleet, pose: Pose, task: Task, path_length: PathLength = straight_line
+) -> float:
+    """Metres a robot at `pose` drives to do `task`: to the pickup (if any), then to the
+    drop zone. A robot already in the drop zone of a navigation costs nothing."""
+    drop = fleet.zone(task.zone).pose
+    if task.pickup is None:
+        return path_length(pose, drop)
+    pickup = fleet.zone(task.pickup).pose
+    return path_length(pose, pickup) + path_length(pickup, drop)
+
+
+def robot_pose(fleet: Fleet, state: RobotState) -> Pose:
+    """Where a robot is: its reported pose, else its reported zone's, else its start."""
+    if state.pose is not None:
+        return state.pose
+    if state.zone is not None and state.zone in fleet.zone_ids:
+        return fleet.zone(state.zone).pose
+    try:
+        return fleet.robot(state.thing).start
+    except KeyError:
+        return Pose(0.0, 0.0)
+
+
+def rank(
+    fleet: Fleet,
+    task: Task,
+    robots: Iterable[RobotState],
+    *,
+    limit: int | None = None,
+    path_length: PathLength = straight_line,
+) -> list[RobotState]:
+    """The robots allowed to take `task`, best first: idle before busy, then by cost, then
+    by thing name. With `limit`, only the best `limit` (a partial sort: 10,000 robots are
+    ranked without sorting them all).
+
+    The cost is `task_cost`, computed here with the pickup and drop looked up once: the
+    leg from the pickup to the drop is the same for every robot.
+    """
+    drop = fleet.zone(task.zone).pose
+    pickup = fleet.zone(task.pickup).pose if task.pickup is not None else None
+    first = pickup or drop
+    rest = path_length(pickup, drop) if pickup is not None else 0.0
+    allowed = frozenset(task.robots)
+    hypot, fx, fy = math.hypot, first.x, first.y
+    straight = path_length is straight_line
+    keyed: list[tuple[bool, float, str, RobotState]] = []
+    for robot in robots:
+        if allowed and robot.thing not in allowed:
+            continue
+        pose = robot.pose if robot.pose is not None else robot_pose(fleet, robot)
+        to_first = hypot(pose.x - fx, pose.y - fy) if straight else path_length(pose, first)
+        # False sorts before True: idle robots first.
+        keyed.append((robot.status not in IDLE_STATUSES, to_first + rest, robot.thing, robot))
+    # Tuples compare field by field and thing names are unique, so the states themselves
+    # are never compared.
+    if limit is None:
+        keyed.sort()
+    elif limit == 1:
+        keyed = [min(keyed)] if keyed else []
+    else:
+        keyed = heapq.nsmallest(limit, keyed)
+    return [entry[3] for entry in keyed]
