@@ -118,7 +118,7 @@ class Probe:
 
 def swarm_fan_out(port: int, count: int, rounds: int) -> list[float]:
     """Fleet-wide ping to a swarm of `count` robots: ms until every robot's shadow acked it."""
-    from tests.support.swarm import SwarmThread
+    from tests.support.swarm_runner import SwarmThread
 
     acked: dict[str, set[str]] = {}
     done: dict[str, threading.Event] = {}
@@ -263,7 +263,7 @@ same client (two broker hops on loopback, QoS 1, sequential):
 {row("ping", pings)}
 {row("navigate (each preempts the previous)", navigates)}
 
-Swarm mode (`tests.support.swarm`, one process, one connection): one publish on
+Swarm mode (`tests.support.swarm_runner`, one process, one connection): one publish on
 `vahr/fleet/cmd` -> every robot's acknowledging shadow update received:
 
 | robots | rounds | p50 ms | p99 ms | max ms |

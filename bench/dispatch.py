@@ -1,6 +1,6 @@
 """Fleet dispatch on the local host: choosing a robot among 10,000, in-process.
 
-The dispatcher of `vahr up` (`vahr.local.dispatcher`) as it runs there: the dispatch core,
+The dispatcher of `vahr up` (`vahr.local.dispatch_host`) as it runs there: the dispatch core,
 candidates from the local fleet index (`IndexCandidates` over a `FleetIndex` holding every
 robot's reported state), tasks in the SQLite store on disk, and a publish that only counts
 (the broker is not what is measured). A fleet of N robots parked on a grid between the
@@ -33,7 +33,7 @@ import msgspec
 from bench._results import median, percentile, write_section
 from vahr.dispatch import Dispatcher, Order, Task, rank
 from vahr.domain import Fleet, Pose, Robot, load_fleet
-from vahr.local.dispatcher import IndexCandidates
+from vahr.local.dispatch_host import IndexCandidates
 from vahr.local.task_store import SqliteTaskStore
 from vahr.twin.fleet_index import FleetIndex
 

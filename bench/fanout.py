@@ -1,7 +1,7 @@
 """Fan-out: one fleet command to 10 ... 10,000 robots until every shadow acknowledged.
 
 The robots run in swarm mode (many agent cores on one event loop and one MQTT connection,
-`tests.support.swarm`) against the local stack. The command goes out as the skill sends it,
+`tests.support.swarm_runner`) against the local stack. The command goes out as the skill sends it,
 one iot-data Publish to `vahr/fleet/cmd` through the local data plane; the clock stops when
 the shadow service has accepted, for every robot, a reported `last_command.id` equal to the
 command's id (seen on `update/accepted`, which the shadow service publishes after storing).
@@ -84,7 +84,7 @@ def swarm_process(broker: str, size: int, ready: Any, stop: Any) -> None:
     """The robots, in their own process as robots are on their own machines: the swarm
     must not share the shadow service's interpreter lock."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from tests.support.swarm import SwarmThread
+    from tests.support.swarm_runner import SwarmThread
 
     with SwarmThread(broker=broker, count=size, speed_factor=50, listen_to_peers=False):
         ready.set()

@@ -15,7 +15,7 @@ run, each on a fresh stack, swarm, station and page, so the figures sit side by 
   shown, beside the recognizer's own time for the clip.
 
 Each part runs in its own process, as on a lab's machines: the local stack (broker, shadow
-service, data plane, the Alexa simulator), the robots in swarm mode (`tests.support.swarm`),
+service, data plane, the Alexa simulator), the robots in swarm mode (`tests.support.swarm_runner`),
 the station (`vahr station`, against the stack), the browser, and this script, which
 notes when each shadow update reaches the broker. Every few seconds one fleet command sends
 all robots to the other end of the floor.
@@ -51,7 +51,7 @@ from playwright.sync_api import TimeoutError as PlaywrightTimeout  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
 
 from tests.support.browser import launch  # noqa: E402
-from tests.support.swarm import swarm_fleet  # noqa: E402
+from tests.support.swarm_runner import swarm_fleet  # noqa: E402
 from vahr.local.alexa_host import serve_alexa
 from vahr.plumbing.lifetime import spawn  # noqa: E402
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint  # noqa: E402
@@ -100,7 +100,7 @@ def stack_process(state: str, ports: tuple[int, int, int], ready: Any, stop: Any
 def swarm_process(broker: str, size: int, ready: Any, stop: Any) -> None:
     """The robots, in their own process as robots are on their own machines."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from tests.support.swarm import SwarmThread
+    from tests.support.swarm_runner import SwarmThread
 
     with SwarmThread(broker=broker, count=size, speed_factor=SPEED_FACTOR):
         ready.set()

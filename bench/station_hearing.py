@@ -62,9 +62,10 @@ from vahr.assistant.nbest import (  # noqa: E402
     posteriors,
     weigh,
 )
-from vahr.assistant.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
+from vahr.assistant.nlu import InteractionModel, Understanding  # noqa: E402
 from vahr.assistant.simulator import strip_invocation  # noqa: E402
 from vahr.domain.fleet import load_fleet  # noqa: E402
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.speech.audio import Audio, concatenate  # noqa: E402
 from vahr.speech.stt import Hypothesis, Recognition  # noqa: E402
 from vahr.speech.tts import engine_of, make_synthesizer  # noqa: E402
@@ -178,7 +179,7 @@ def decide_with_second_ear(
     the values the two heard differently asked about. The station asks the second ear only
     when the best transcript reads as a request (`PushToTalk._listen_twice`)."""
     best = clip.recognition.text if clip.recognition.accepted else ""
-    if not second or not best or read(best).intent == FALLBACK:
+    if not second or not best or read(best).intent == FALLBACK_INTENT:
         return decide(clip, read, weighing)
     both = agreement(read.model, second, best, read)
     if both is not None:
@@ -205,7 +206,7 @@ def decide(clip: Clip, read: Reader, weighing: Weighing) -> Understanding:
     """What the station acts on (as `weigh_recognition`, with each reading read once)."""
     recognition = clip.recognition
     if not recognition.accepted or recognition.confidence < weighing.min_word_posterior:
-        return Understanding(FALLBACK, confidence=1.0)
+        return Understanding(FALLBACK_INTENT, confidence=1.0)
     hypotheses = recognition.hypotheses or (Hypothesis(recognition.text, 0.0),)
     return weigh(hypotheses, read, weighing).understanding
 
@@ -225,7 +226,7 @@ def tally(
         else:
             got = decide_with_second_ear(clip, seconds[n], read, weighing)
         result = outcome(read.model, clip.item, got)
-        if clip.item.intent == FALLBACK:
+        if clip.item.intent == FALLBACK_INTENT:
             counts["ood"] += 1
             counts["ood acted"] += result == "wrong"
             continue
@@ -239,7 +240,7 @@ def log_loss(clips: list[Clip], read: Reader, sharpness: float) -> float:
     losses = []
     for clip in clips:
         hypotheses = clip.recognition.hypotheses
-        if clip.item.intent == FALLBACK or not hypotheses:
+        if clip.item.intent == FALLBACK_INTENT or not hypotheses:
             continue
         weights = posteriors(hypotheses, sharpness)
         readings = [read(h.text) for h in hypotheses]
@@ -289,8 +290,10 @@ def bad_input(recognizer: object, read: Reader, weighing: Weighing) -> list[tupl
     found = []
     for name, audio in clips.items():
         recognition = recognizer.recognize(audio)  # type: ignore[attr-defined]
-        got = decide(Clip(LabelledUtterance("", FALLBACK), "", recognition, 0, 0), read, weighing)
-        moved = got.intent not in (FALLBACK,) and not got.intent.startswith("AMAZON.")
+        got = decide(
+            Clip(LabelledUtterance("", FALLBACK_INTENT), "", recognition, 0, 0), read, weighing
+        )
+        moved = got.intent not in (FALLBACK_INTENT,) and not got.intent.startswith("AMAZON.")
         found.append((name, f"heard {recognition.text!r}: {'MOVES' if moved else 'nothing moves'}"))
     return found
 
@@ -302,7 +305,7 @@ def main() -> int:
     tuning_set = LabelledSet.load(TUNING_SET)
     tuning_items = [
         *tuning_set.utterances[::TUNING_EVERY],
-        *(LabelledUtterance(t, FALLBACK) for t in tuning_set.out_of_domain[::TUNING_EVERY]),
+        *(LabelledUtterance(t, FALLBACK_INTENT) for t in tuning_set.out_of_domain[::TUNING_EVERY]),
     ]
     tuning = hear(
         recognizer,

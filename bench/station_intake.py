@@ -34,7 +34,7 @@ from _results import median, percentile
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from tests.support.swarm import swarm_fleet  # noqa: E402
+from tests.support.swarm_runner import swarm_fleet  # noqa: E402
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint  # noqa: E402
 from vahr.plumbing.ports import free_port  # noqa: E402
 from vahr.protocol import Event, ReportedPose, encode, topics, utc_now  # noqa: E402

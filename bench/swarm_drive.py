@@ -37,7 +37,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from robot_agent.config import ExecutorSettings, SimSettings  # noqa: E402
 from robot_agent.swarm import Swarm  # noqa: E402
-from tests.support.swarm import swarm_fleet  # noqa: E402
+from tests.support.swarm_runner import swarm_fleet  # noqa: E402
 from vahr.local.robots import swarm_agent_config  # noqa: E402
 from vahr.plumbing.ports import free_port  # noqa: E402
 from vahr.protocol import encode, new_command, topics  # noqa: E402

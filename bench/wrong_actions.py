@@ -41,8 +41,9 @@ from station_hearing import (  # noqa: E402
 from tests.support.skill_effects import VERDICTS, SkillEffects  # noqa: E402
 from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet, LabelledUtterance  # noqa: E402
 from vahr.assistant.nbest import Weighing  # noqa: E402
-from vahr.assistant.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
+from vahr.assistant.nlu import InteractionModel, Understanding  # noqa: E402
 from vahr.domain.fleet import load_fleet  # noqa: E402
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.speech.tts import engine_of  # noqa: E402
 from vahr.speech.whisper_stt import WhisperTranscriber  # noqa: E402
 from vahr.station.vocabulary import command_recognizer, whisper_prompt  # noqa: E402
@@ -67,7 +68,7 @@ class EffectTally:
         self, effects: SkillEffects, item: LabelledUtterance, got: Understanding, voice: str = ""
     ) -> None:
         verdict = effects.verdict(item, got)
-        (self.requests if item.intent != FALLBACK else self.out_of_domain)[verdict] += 1
+        (self.requests if item.intent != FALLBACK_INTENT else self.out_of_domain)[verdict] += 1
         if verdict in ("moved wrongly", "stopped wrongly"):
             sent = "; ".join(f"{topic.split('/')[-2]} {action} {params}"
                              for topic, action, params in effects.of(got))  # fmt: skip

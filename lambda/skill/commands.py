@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 SOURCE = "alexa"
 
 
-class Dispatch(msgspec.Struct, frozen=True):
+class Publication(msgspec.Struct, frozen=True):
     """One publish: the topic, the command, and the robots expected to acknowledge it."""
 
     topic: str
@@ -33,25 +33,25 @@ class Dispatch(msgspec.Struct, frozen=True):
         return self.target == FLEET
 
 
-def dispatch(
+def publication(
     fleet: Fleet, action: str, target: str, params: dict[str, object] | None = None
-) -> Dispatch:
+) -> Publication:
     """A fresh command for one robot or (target `all`) for the whole fleet."""
     command = new_command(action, params, source=SOURCE)
     check_against_fleet(command, fleet)
     if target == FLEET:
-        return Dispatch(topics.FLEET_CMD, command, fleet.robot_things, FLEET)
+        return Publication(topics.FLEET_CMD, command, fleet.robot_things, FLEET)
     fleet.robot(target)  # KeyError for a robot the fleet does not have
-    return Dispatch(topics.robot_cmd(target), command, (target,), target)
+    return Publication(topics.robot_cmd(target), command, (target,), target)
 
 
 def sequential(
     fleet: Fleet, first: str, first_zone: str, second: str, second_zone: str
-) -> tuple[Dispatch, Dispatch]:
+) -> tuple[Publication, Publication]:
     """Task III: `first` delivers at once; `second` delivers once `first` has delivered."""
     if first == second or FLEET in (first, second):
         raise ValueError("a sequential delivery needs two different robots")
     return (
-        dispatch(fleet, "sequential_delivery", first, {"zone": first_zone, "after": None}),
-        dispatch(fleet, "sequential_delivery", second, {"zone": second_zone, "after": first}),
+        publication(fleet, "sequential_delivery", first, {"zone": first_zone, "after": None}),
+        publication(fleet, "sequential_delivery", second, {"zone": second_zone, "after": first}),
     )

@@ -29,7 +29,7 @@ HELP_REPROMPT = "What would you like the robots to do?"
 NEXT = "What else would you like the robots to do?"
 GOODBYE = "Goodbye."
 GOODBYE_ROBOTS_KEEP_GOING = "Goodbye. The robots carry on; to halt them, say emergency stop."
-FALLBACK = (
+FALLBACK_SPEECH = (
     f"Sorry, {SKILL_NAME} can't help with that. I sent nothing to the robots. "
     "You can say: send {robot} to {zone}, or: where are the robots?"
 )

@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
 
     from skill.acknowledgment import RobotAnswer
-    from skill.commands import Dispatch
+    from skill.commands import Publication
     from skill.fleet_acknowledgment import FleetAcknowledgments
     from skill.gateway import RobotGateway
     from vahr.protocol import RobotShadow
@@ -60,10 +60,10 @@ class Robots:
         self._clock = clock
         self._many = many
 
-    def send(self, dispatches: Sequence[Dispatch]) -> dict[str, RobotAnswer]:
+    def send(self, publications: Sequence[Publication]) -> dict[str, RobotAnswer]:
         """Publish every dispatch, then wait for every recipient; one answer per robot."""
         started = self._clock()
-        for item in dispatches:
+        for item in publications:
             self.gateway.publish(item.topic, encode(item.command))
             log_event(
                 "published",
@@ -72,7 +72,7 @@ class Robots:
                 action=item.command.action,
                 recipients=list(item.recipients),
             )
-        expected = {thing: item.command.id for item in dispatches for thing in item.recipients}
+        expected = {thing: item.command.id for item in publications for thing in item.recipients}
         # With no time left the robots are still read once: an answer may already be there.
         left = self.reply_budget_s - (self._clock() - started)
         budget = max(0.0, min(self.ack_timeout_s, left))

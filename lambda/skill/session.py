@@ -18,13 +18,13 @@ from vahr.protocol.conversation import LAST_COMMAND_ATTRIBUTE
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
 
-    from skill.commands import Dispatch
+    from skill.commands import Publication
 
 # The actions a correction can redirect or an undo can stop.
 CORRECTABLE = ("navigate", "deliver", "weather_delivery")
 
 
-class LastCommand(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+class SentCommand(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     """What the skill sent last: to which robot (a thing, or the fleet), what, and where."""
 
     robot: str
@@ -43,13 +43,13 @@ def _attributes(handler_input: HandlerInput) -> dict[str, object] | None:
     return attributes
 
 
-def remember(handler_input: HandlerInput, item: Dispatch) -> None:
+def remember(handler_input: HandlerInput, item: Publication) -> None:
     """Keep `item` as the command a correction or undo refers to (motion commands only)."""
     attributes = _attributes(handler_input)
     if attributes is None or item.command.action not in CORRECTABLE:
         return
     zone = getattr(item.command.params, "zone", None)
-    last = LastCommand(
+    last = SentCommand(
         robot=item.target,
         action=item.command.action,
         id=item.command.id,
@@ -58,14 +58,14 @@ def remember(handler_input: HandlerInput, item: Dispatch) -> None:
     attributes[LAST_COMMAND_ATTRIBUTE] = msgspec.to_builtins(last)
 
 
-def recall(handler_input: HandlerInput) -> LastCommand | None:
+def recall(handler_input: HandlerInput) -> SentCommand | None:
     """The last command, or None when there is none (or what is stored is not one)."""
     attributes = _attributes(handler_input) or {}
     stored = attributes.get(LAST_COMMAND_ATTRIBUTE)
     if stored is None:
         return None
     try:
-        return msgspec.convert(stored, LastCommand)
+        return msgspec.convert(stored, SentCommand)
     except msgspec.ValidationError:
         # Attributes come back from the device: a damaged one is no command to act on.
         return None

@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
 
     from skill.acknowledgment import RobotAnswer
-    from skill.commands import Dispatch
+    from skill.commands import Publication
     from skill.fleet_status import FleetState
     from skill.iot_fleet_index import IndexedRobot
     from skill.robots import ShadowRead
@@ -28,13 +28,13 @@ def _reason(answer: RobotAnswer) -> str:
     return (answer.reason or prompts.NO_REASON).rstrip(". ")
 
 
-def _zone_of(item: Dispatch) -> str | None:
+def _zone_of(item: Publication) -> str | None:
     zone = getattr(item.command.params, "zone", None)
     return zone if isinstance(zone, str) else None
 
 
 def command_report(
-    vocabulary: Vocabulary, item: Dispatch, answers: Mapping[str, RobotAnswer]
+    vocabulary: Vocabulary, item: Publication, answers: Mapping[str, RobotAnswer]
 ) -> str:
     """What happened to one dispatch: acknowledged, rejected, or not confirmed."""
     mine = [answers[thing] for thing in item.recipients]
@@ -75,7 +75,7 @@ def command_report(
 
 
 def sequential_report(
-    vocabulary: Vocabulary, items: Sequence[Dispatch], answers: Mapping[str, RobotAnswer]
+    vocabulary: Vocabulary, items: Sequence[Publication], answers: Mapping[str, RobotAnswer]
 ) -> str:
     """Task III: both robots confirmed, or what went wrong with each."""
     first, second = items

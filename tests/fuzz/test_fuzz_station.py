@@ -26,7 +26,7 @@ from hypothesis import strategies as st
 
 from tests.fuzz.strategies import THINGS, ZONES, encode, json_values, text
 from tests.fuzz.tally import TALLY, budget
-from tests.support.station import RecordingAssistant, Wire
+from tests.support.station_stand_ins import RecordingAssistant, Wire
 from vahr.plumbing.ports import free_port
 from vahr.protocol import decode_command
 from vahr.speech.stt import NOTHING_HEARD

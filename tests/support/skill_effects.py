@@ -23,13 +23,15 @@ from unittest import mock
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "lambda"))
 
 from vahr.assistant.evaluation import LabelledUtterance, labelled_understanding  # noqa: E402
-from vahr.assistant.nlu import FALLBACK, InteractionModel, Understanding  # noqa: E402
 from vahr.assistant.simulator import AlexaSimulator  # noqa: E402
 from vahr.domain import load_fleet
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.protocol import MOTION_ACTIONS, ExperimentState, Reported, topics
 
 if TYPE_CHECKING:
     from types import TracebackType
+
+    from vahr.assistant.nlu import InteractionModel, Understanding
 
 REGION = "us-east-1"
 # The skill waits this long for robots to acknowledge; nobody answers here, and what it
@@ -95,7 +97,7 @@ class SkillEffects:
 
     def of(self, understanding: Understanding) -> Effect:
         """The commands the skill sends when `understanding` is what was heard."""
-        if understanding.intent == FALLBACK:
+        if understanding.intent == FALLBACK_INTENT:
             return ()  # the station says "Sorry" and sends the skill nothing
         key = repr((understanding.intent, sorted(understanding.slots.items())))
         key += repr(understanding.needs_confirmation)
@@ -111,7 +113,11 @@ class SkillEffects:
         `less or nothing sent` (some or none of the label's commands: the skill asked
         which robot or zone, asked to confirm, refused, or the words were not caught)."""
         done = self.of(heard)
-        meant = () if item.intent == FALLBACK else self.of(labelled_understanding(self.model, item))
+        meant = (
+            ()
+            if item.intent == FALLBACK_INTENT
+            else self.of(labelled_understanding(self.model, item))
+        )
         if set(done) == set(meant):
             return "as labelled"
         extra = set(done) - set(meant)

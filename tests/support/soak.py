@@ -40,9 +40,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from robot_agent.config import ExecutorSettings
-from tests.faults import TcpProxy, alive, kill_hard, processes_of, wait_until
+from tests.support.fault_injection_steps import TcpProxy, alive, kill_hard, processes_of, wait_until
 from tests.support.soak_ledger import Ledger, Record, Sent, Verdict, read_agent_log
-from tests.support.swarm import SwarmThread
+from tests.support.swarm_runner import SwarmThread
 from tests.support.vahr_up import start_up, stop_up
 from vahr.errors import VahrError
 from vahr.pki import LocalCA

@@ -23,8 +23,9 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
-from vahr.assistant.nlu import FALLBACK, Understanding
+from vahr.assistant.nlu import Understanding
 from vahr.assistant.simulator import strip_invocation
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.speech.scoring import OutcomeTally, read_labelled_set
 
 if TYPE_CHECKING:
@@ -50,7 +51,10 @@ class LabelledSet(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
         return read_labelled_set(path, cls)
 
     def items(self) -> list[LabelledUtterance]:
-        return [*self.utterances, *(LabelledUtterance(t, FALLBACK) for t in self.out_of_domain)]
+        return [
+            *self.utterances,
+            *(LabelledUtterance(t, FALLBACK_INTENT) for t in self.out_of_domain),
+        ]
 
 
 @dataclass(frozen=True)
@@ -62,7 +66,7 @@ class Scored:
     @property
     def as_labelled(self) -> bool:
         """Right for a request; the fallback for an out-of-domain sentence."""
-        return self.outcome == ("fallback" if self.item.intent == FALLBACK else "right")
+        return self.outcome == ("fallback" if self.item.intent == FALLBACK_INTENT else "right")
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -109,11 +113,11 @@ class Report:
 
 
 def outcome(model: InteractionModel, item: LabelledUtterance, got: Understanding) -> str:
-    if got.intent == FALLBACK:
+    if got.intent == FALLBACK_INTENT:
         return "fallback"
     if got.needs_confirmation:
         return "asks"
-    if item.intent == FALLBACK:
+    if item.intent == FALLBACK_INTENT:
         return "asks" if got.intent.startswith("AMAZON.") else "wrong"
     if got.intent != item.intent:
         return "wrong"
@@ -144,7 +148,7 @@ def evaluate(model: InteractionModel, labelled: LabelledSet) -> Report:
         understood = model.understand(strip_invocation(model.invocation_name, item.text))
         result = outcome(model, item, understood)
         scored.append(Scored(item, result, understood))
-        if item.intent == FALLBACK:
+        if item.intent == FALLBACK_INTENT:
             out_of_domain.counts[result] += 1
             continue
         per_intent.setdefault(item.intent, OutcomeTally(OUTCOMES)).counts[result] += 1

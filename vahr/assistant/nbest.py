@@ -33,7 +33,8 @@ from collections import defaultdict
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
-from vahr.assistant.nlu import FALLBACK, SlotValue, Understanding
+from vahr.assistant.nlu import SlotValue, Understanding
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.skill_model.intents import ROBOT_TYPE, ZONE_TYPE
 from vahr.speech.stt import Hypothesis
 
@@ -117,19 +118,19 @@ def weigh(
 ) -> Weighed:
     """The understanding push-to-talk acts on, from the N best (best first)."""
     if not hypotheses:
-        return Weighed(Understanding(FALLBACK, confidence=1.0), 1.0, {}, 0)
+        return Weighed(Understanding(FALLBACK_INTENT, confidence=1.0), 1.0, {}, 0)
     weights = posteriors(hypotheses, weighing.sharpness)
     readings = [understand(h.text) for h in hypotheses]
     mass: dict[str, float] = defaultdict(float)
     for weight, reading in zip(weights, readings, strict=True):
-        share = reading.confidence if reading.intent != FALLBACK else 1.0
+        share = reading.confidence if reading.intent != FALLBACK_INTENT else 1.0
         mass[reading.intent] += weight * share
-        mass[FALLBACK] += weight * (1.0 - share)
-    intent = max(mass, key=lambda name: (mass[name], name != FALLBACK))
+        mass[FALLBACK_INTENT] += weight * (1.0 - share)
+    intent = max(mass, key=lambda name: (mass[name], name != FALLBACK_INTENT))
     intent_confidence = mass[intent]
-    if intent == FALLBACK or intent_confidence < weighing.min_intent_confidence:
-        guess = intent if intent != FALLBACK else None
-        fallback = Understanding(FALLBACK, confidence=intent_confidence, best_guess=guess)
+    if intent == FALLBACK_INTENT or intent_confidence < weighing.min_intent_confidence:
+        guess = intent if intent != FALLBACK_INTENT else None
+        fallback = Understanding(FALLBACK_INTENT, confidence=intent_confidence, best_guess=guess)
         return Weighed(fallback, intent_confidence, {}, len(readings))
     agreeing = [
         (weight * reading.confidence, reading)
@@ -164,7 +165,7 @@ def weigh_recognition(
     read by `reading` (the simulator's, in the dialog under way), else by `model` as the
     simulator reads a request (the invocation taken off)."""
     if not recognition.accepted or recognition.confidence < weighing.min_word_posterior:
-        nothing = Understanding(FALLBACK, confidence=1.0)
+        nothing = Understanding(FALLBACK_INTENT, confidence=1.0)
         return Weighed(nothing, 0.0, {}, 0)
     hypotheses = recognition.hypotheses or (Hypothesis(recognition.text, 0.0),)
     return weigh(hypotheses, reading or request_reader(model), weighing)
@@ -185,7 +186,7 @@ def agreement(
     said (docs/voice.md)."""
     read = reading or request_reader(model)
     first, second = read(heard), read(confirming)
-    if first.intent == FALLBACK or _moving(model, first) != _moving(model, second):
+    if first.intent == FALLBACK_INTENT or _moving(model, first) != _moving(model, second):
         return None
     confidence = {name: 1.0 for name, _ in _moving(model, first)[1]}
     return Weighed(first, 1.0, confidence, 2, agreed=True)
@@ -199,7 +200,7 @@ def disputed(
     the two ("Zone B or zone D?"): two recognizers that disagree on a value are sure of
     neither. Nothing is asked when the second hearing is of another intent, since then it
     is the one more likely to have misheard the whole."""
-    if decided.intent == FALLBACK or second.intent != decided.intent:
+    if decided.intent == FALLBACK_INTENT or second.intent != decided.intent:
         return decided
     types = model.intent_slots.get(decided.intent, {})
     slots = dict(decided.slots)

@@ -49,6 +49,7 @@ from vahr.assistant.intent_classifier import MARKERS, load_or_train
 from vahr.assistant.slot_finder import SlotFinder, SlotMatch, SlotTypeValues, normalize_utterance
 from vahr.assistant.understanding import LanguageUnderstanding, load_understanding
 from vahr.domain import FLEET_GROUP
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.errors import VahrError
 from vahr.skill_model.intents import ROBOT_TYPE
 from vahr.speech.text_classifier import TextClassifier, default_cache_dir
@@ -57,7 +58,7 @@ __all__ = [
     "CONFIDENCE_THRESHOLD",
     "ROLES_CONFIDENCE_THRESHOLD",
     "DEFAULT_MODEL",
-    "FALLBACK",
+    "FALLBACK_INTENT",
     "InteractionModel",
     "SlotValue",
     "Understanding",
@@ -68,7 +69,7 @@ __all__ = [
 DEFAULT_MODEL = (
     Path(__file__).with_name("skill-package") / "interactionModels" / "custom" / "en-US.json"
 )
-FALLBACK = "AMAZON.FallbackIntent"
+
 # The classifier's label for a bare answer to "which robot?" ("robot one", "to zone b"),
 # learnt from the slots' elicitation samples; it is never an intent of its own.
 SLOT_ANSWER = "vahr.SlotAnswer"
@@ -128,7 +129,7 @@ class Understanding:
     def needs_confirmation(self) -> bool:
         """Whether the reading is too unsure to act on: the person is asked to confirm it
         first (the simulator's Dialog.ConfirmIntent), and a "no" sends nothing."""
-        return self.intent != FALLBACK and self.roles_confidence < ROLES_CONFIDENCE_THRESHOLD
+        return self.intent != FALLBACK_INTENT and self.roles_confidence < ROLES_CONFIDENCE_THRESHOLD
 
 
 class InteractionModel:
@@ -261,10 +262,10 @@ class InteractionModel:
         for name, answer in answers:
             texts.append(self._abstract_sample(name, answer))
             labels.append(SLOT_ANSWER)
-        if FALLBACK in self.intent_slots:
+        if FALLBACK_INTENT in self.intent_slots:
             background = out_of_domain_phrases(understanding=self._understanding)
             texts += background
-            labels += [FALLBACK] * len(background)
+            labels += [FALLBACK_INTENT] * len(background)
         return texts, labels
 
     @classmethod
@@ -328,23 +329,23 @@ class InteractionModel:
         classifier = self.wait_ready()
         words, matches = self.find_slots(utterance)
         if not words:
-            return Understanding(FALLBACK, confidence=1.0)
+            return Understanding(FALLBACK_INTENT, confidence=1.0)
         abstracted = self._listed_as_one(_abstract(words, matches))
         # Outside a dialog there is no question to answer: the answer reading is set aside.
         intent, confidence = classifier.scores(abstracted).without(SLOT_ANSWER).best
         declared = self.intent_slots.get(intent, {})
         assigned: dict[str, SlotMatch] | None = {}
         reading = None
-        if intent != FALLBACK and confidence >= CONFIDENCE_THRESHOLD:
+        if intent != FALLBACK_INTENT and confidence >= CONFIDENCE_THRESHOLD:
             assigned, reading = self._assign(intent, matches, words)
         if (
-            intent == FALLBACK
+            intent == FALLBACK_INTENT
             or confidence < CONFIDENCE_THRESHOLD
             or not self.consistency.agrees(intent, matches)
             or assigned is None
         ):
-            guess = None if intent == FALLBACK else intent
-            return Understanding(FALLBACK, confidence=confidence, best_guess=guess)
+            guess = None if intent == FALLBACK_INTENT else intent
+            return Understanding(FALLBACK_INTENT, confidence=confidence, best_guess=guess)
         slots = {name: _slot_value(name, declared[name], m) for name, m in assigned.items()}
         slots = self._with_alternatives(slots, assigned, words, matches)
         return Understanding(
@@ -408,7 +409,7 @@ class InteractionModel:
         if not values:
             return None
         best, confidence = classifier.scores(self._listed_as_one(_abstract(words, matches))).best
-        request = best not in (SLOT_ANSWER, FALLBACK, intent)
+        request = best not in (SLOT_ANSWER, FALLBACK_INTENT, intent)
         if request and confidence >= CONFIDENCE_THRESHOLD:
             return None
         # Several values are read as the intent's tagger reads them in a request: "robot one

@@ -30,8 +30,9 @@ from typing import TYPE_CHECKING
 
 from vahr.assistant import roles
 from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet, outcome
-from vahr.assistant.nlu import FALLBACK, InteractionModel
+from vahr.assistant.nlu import InteractionModel
 from vahr.assistant.simulator import strip_invocation
+from vahr.domain.invocation import FALLBACK_INTENT
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -60,7 +61,9 @@ class Reading:
     @property
     def has_roles(self) -> bool:
         """The intent is the expected one and the tagger read the roles of its values."""
-        return self.understood.intent == self.item.intent and self.understood.intent != FALLBACK
+        return (
+            self.understood.intent == self.item.intent and self.understood.intent != FALLBACK_INTENT
+        )
 
     @property
     def right(self) -> bool:
@@ -69,7 +72,7 @@ class Reading:
     def outcome_at(self, threshold: float) -> str:
         """The outcome with readings below `threshold` asked about instead of acted on."""
         unsure = self.understood.roles_confidence < threshold
-        if self.understood.intent != FALLBACK and unsure:
+        if self.understood.intent != FALLBACK_INTENT and unsure:
             return "asks"
         return self.acted
 
@@ -155,7 +158,7 @@ def sweep(readings: Sequence[Reading], grid: Sequence[float] = GRID) -> str:
         for reading in readings:
             result = reading.outcome_at(threshold)
             # An out-of-domain sentence is right when it falls back (`evaluation`).
-            if reading.item.intent == FALLBACK and result == "fallback":
+            if reading.item.intent == FALLBACK_INTENT and result == "fallback":
                 result = "right"
             counts[result if result in counts else "asks"] += 1
         score = counts["right"] - 3 * counts["wrong"]

@@ -45,7 +45,8 @@ import yaml
 
 from vahr.assistant import envelope
 from vahr.assistant.localized import invocation_patterns
-from vahr.assistant.nlu import FALLBACK, Understanding, normalize_utterance
+from vahr.assistant.nlu import Understanding, normalize_utterance
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.protocol.conversation import CORRECTION_WINDOW_S, LAST_COMMAND_ATTRIBUTE, speaker
 
 if TYPE_CHECKING:
@@ -416,7 +417,7 @@ class AlexaSimulator:
                 slots = {**pending.understanding.slots, **given.slots}
                 understanding = replace(given, slots=slots)
         elif len(text.split()) > self._longest_words:
-            understanding = Understanding(FALLBACK, confidence=1.0)
+            understanding = Understanding(FALLBACK_INTENT, confidence=1.0)
         elif pending is not None and pending.slot is not None:
             understanding = self._answer(text, pending.understanding, pending.slot)
         else:

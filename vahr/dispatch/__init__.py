@@ -1,5 +1,5 @@
 """Fleet task assignment: tasks without a robot's name, given to the best free robot or
-queued. One dispatcher, two hosts: `vahr up` (vahr.local.dispatcher) and the dispatcher
+queued. One dispatcher, two hosts: `vahr up` (vahr.local.dispatch_host) and the dispatcher
 Lambda (lambda/dispatcher) run the same core.
 
 - `tasks`: `Order`, `Task` and the four changes of its state, `Submission`, `DispatchError`

@@ -27,8 +27,8 @@ from vahr.assistant import SimulatorAssistant
 from vahr.domain.fleet import SPOKEN_LOCALE
 from vahr.errors import VahrError
 from vahr.local.alexa_host import serve_alexa
-from vahr.local.announcer import LocalAnnouncer
-from vahr.local.dispatcher import TASKS_PATH, LocalDispatcher
+from vahr.local.announce_host import LocalAnnouncer
+from vahr.local.dispatch_host import TASKS_PATH, LocalDispatcher
 from vahr.local.robots import (
     ProgressRate,
     RobotProcesses,

@@ -15,6 +15,7 @@ import random
 from dataclasses import dataclass
 from functools import cached_property
 
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.skill_model.phrases import RULES
 from vahr.skill_model.templates import draw
 
@@ -634,5 +635,5 @@ BUILT_IN_INTENTS: tuple[str, ...] = (
     "AMAZON.CancelIntent",
     "AMAZON.StopIntent",
     "AMAZON.NavigateHomeIntent",
-    "AMAZON.FallbackIntent",
+    FALLBACK_INTENT,
 )

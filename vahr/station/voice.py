@@ -39,6 +39,7 @@ from vahr.assistant import (
     request_reader,
     weigh_recognition,
 )
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.errors import VahrError
 from vahr.speech.audio import SAMPLE_RATE, SAMPLE_WIDTH, Audio
 from vahr.speech.errors import SpeechError
@@ -64,7 +65,6 @@ SORRY = "Sorry, I didn't catch that. I sent nothing to the robots."
 # A clip may be up to 20 s long: the page's recorder stops there.
 MAX_CLIP_S = 20.0
 ORIGIN = "station-voice"
-FALLBACK = "AMAZON.FallbackIntent"
 
 
 def read_clip(data: bytes) -> Audio:
@@ -190,7 +190,7 @@ class PushToTalk:
         second = self.second_ear()
         if second is None or not recognition.accepted or not recognition.text:
             return recognition, None
-        if self._reader()(recognition.text).intent == FALLBACK:
+        if self._reader()(recognition.text).intent == FALLBACK_INTENT:
             return recognition, None
         try:
             return recognition, second.transcribe(audio)
@@ -266,12 +266,12 @@ class PushToTalk:
         weighed = self.weigh(recognition, second)
         heard["weighed"] = weighed.to_json()
         understanding = weighed.understanding
-        if understanding.intent == FALLBACK:
+        if understanding.intent == FALLBACK_INTENT:
             return self._not_caught(result)
         heard["accepted"] = True
         turn = self._ask(recognition.text, heard, weighed)
         result["turn"] = turn
-        if turn.get("intent") not in (None, FALLBACK):
+        if turn.get("intent") not in (None, FALLBACK_INTENT):
             result.update(understood=True, speech=turn.get("speech") or "")
         return result
 

@@ -11,6 +11,7 @@ from ask_sdk_core.utils import is_intent_name, is_request_type
 from skill import prompts
 from skill.logs import log_event
 from skill.responses import ask, end, start_conversation
+from vahr.domain.invocation import FALLBACK_INTENT
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
@@ -86,10 +87,10 @@ class FallbackIntentHandler(AbstractRequestHandler):
         self.runtime = runtime
 
     def can_handle(self, handler_input: HandlerInput) -> bool:
-        return bool(is_intent_name("AMAZON.FallbackIntent")(handler_input))
+        return bool(is_intent_name(FALLBACK_INTENT)(handler_input))
 
     def handle(self, handler_input: HandlerInput) -> Response:
-        speech = prompts.FALLBACK.format(**self.runtime.vocabulary.examples())
+        speech = prompts.FALLBACK_SPEECH.format(**self.runtime.vocabulary.examples())
         return ask(handler_input, speech, prompts.FALLBACK_REPROMPT)
 
 

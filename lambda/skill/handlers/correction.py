@@ -16,7 +16,7 @@ from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_intent_name
 
 from skill import dialog, prompts, session, speech
-from skill.commands import dispatch
+from skill.commands import publication
 from skill.responses import answer, confirm_slot
 from skill.vocabulary import FLEET, capitalise
 
@@ -24,9 +24,9 @@ if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
     from ask_sdk_model import Intent, IntentRequest, Response
 
-    from skill.commands import Dispatch
+    from skill.commands import Publication
     from skill.runtime import SkillRuntime
-    from skill.session import LastCommand
+    from skill.session import SentCommand
     from skill.slots import SlotReading
 
 CONFIRMED, DENIED = "CONFIRMED", "DENIED"
@@ -74,7 +74,7 @@ class CorrectionIntentHandler(AbstractRequestHandler):
         return self._redirect(handler_input, last, target or last.robot, zone.id or last.zone)
 
     def _other_robot(
-        self, handler_input: HandlerInput, last: LastCommand, robot: SlotReading
+        self, handler_input: HandlerInput, last: SentCommand, robot: SlotReading
     ) -> Response:
         others = [thing for thing in self.runtime.fleet.robot_things if thing != last.robot]
         if last.robot != FLEET and len(others) == 1:
@@ -84,14 +84,14 @@ class CorrectionIntentHandler(AbstractRequestHandler):
         return self._ask_which_robot(handler_input, last, robot)
 
     def _ask_which_robot(
-        self, handler_input: HandlerInput, last: LastCommand, robot: SlotReading
+        self, handler_input: HandlerInput, last: SentCommand, robot: SlotReading
     ) -> Response:
         return dialog.ask_robot(
             handler_input, self.runtime, robot, prompts.ASK_CORRECT_ROBOT, include_fleet=False
         )
 
     def _redirect(
-        self, handler_input: HandlerInput, last: LastCommand, target: str, zone: str | None
+        self, handler_input: HandlerInput, last: SentCommand, target: str, zone: str | None
     ) -> Response:
         vocabulary = self.runtime.vocabulary
         if zone != last.zone and last.zone is None:
@@ -101,14 +101,14 @@ class CorrectionIntentHandler(AbstractRequestHandler):
             text = prompts.ALREADY_SO.format(robot=vocabulary.robot(target))
             return answer(handler_input, capitalise(text))
         params: dict[str, object] | None = {"zone": zone} if zone is not None else None
-        items: list[Dispatch] = []
+        items: list[Publication] = []
         if target != last.robot:
             old = vocabulary.robot(last.robot)
             # The robot first sent stops: only it, since the person meant another one.
-            items.append(dispatch(self.runtime.fleet, "stop", last.robot))
+            items.append(publication(self.runtime.fleet, "stop", last.robot))
         else:
             old = vocabulary.zone(last.zone) if last.zone else vocabulary.robot(last.robot)
-        new = dispatch(self.runtime.fleet, last.action, target, params)
+        new = publication(self.runtime.fleet, last.action, target, params)
         items.append(new)
         answers = self.runtime.robots.send(items)
         session.remember(handler_input, new)
@@ -129,7 +129,7 @@ class UndoIntentHandler(AbstractRequestHandler):
         last = session.recall(handler_input)
         if last is None:
             return answer(handler_input, prompts.NOTHING_TO_UNDO)
-        item = dispatch(self.runtime.fleet, "stop", last.robot)
+        item = publication(self.runtime.fleet, "stop", last.robot)
         answers = self.runtime.robots.send([item])
         session.forget(handler_input)
         report = speech.command_report(self.runtime.vocabulary, item, answers)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from skill import session, speech
-from skill.commands import dispatch
+from skill.commands import publication
 from skill.responses import answer
 
 if TYPE_CHECKING:
@@ -23,7 +23,7 @@ def send_and_report(
     params: dict[str, object] | None = None,
 ) -> Response:
     """Publish `action` to one robot (or the fleet) and say what the robots answered."""
-    item = dispatch(runtime.fleet, action, target, params)
+    item = publication(runtime.fleet, action, target, params)
     answers = runtime.robots.send([item])
     session.remember(handler_input, item)
     return answer(handler_input, speech.command_report(runtime.vocabulary, item, answers))

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from tests.integration.agent.harness import command
-from tests.support.swarm import SwarmThread, swarm_fleet
+from tests.support.swarm_runner import SwarmThread, swarm_fleet
 from vahr.errors import VahrError
 
 if TYPE_CHECKING:

@@ -9,8 +9,8 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from tests.faults import crash_and_restart_broker, wait_until
 from tests.integration.agent.harness import command
+from tests.support.fault_injection_steps import crash_and_restart_broker, wait_until
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
@@ -70,8 +70,8 @@ def test_the_agent_recovers_from_broker_crashes_and_runs_each_command_once(
 def test_the_agent_recovers_from_dropped_connections_and_runs_each_command_once(
     mosquitto: Mosquitto, start_agent: Callable[..., AgentProcess]
 ) -> None:
-    from tests.faults import TcpProxy
     from tests.integration.agent.harness import WireTap
+    from tests.support.fault_injection_steps import TcpProxy
 
     # Given an agent whose connection to the broker goes through a relay that can cut it
     proxy = TcpProxy(mosquitto.config.plain_port or 0)

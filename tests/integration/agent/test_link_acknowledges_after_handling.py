@@ -14,7 +14,7 @@ from awscrt import mqtt5
 
 from robot_agent.config import MqttSettings
 from robot_agent.link.mqtt5 import LinkSettings, Mqtt5Link
-from tests.faults import wait_until
+from tests.support.fault_injection_steps import wait_until
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 
 if TYPE_CHECKING:

@@ -1,7 +1,7 @@
 """One fault, one announcement, under a 100-robot swarm with faults injected.
 
-A real mosquitto carries a swarm of 100 simulated robots (tests/support/swarm.py) and the
-local announcer (`vahr.local.announcer.LocalAnnouncer`, as `vahr up` runs it). Ten robots
+A real mosquitto carries a swarm of 100 simulated robots (tests/support/swarm_runner.py) and the
+local announcer (`vahr.local.announce_host.LocalAnnouncer`, as `vahr up` runs it). Ten robots
 get stuck, ten fail their task and ten go offline; each fault also reaches the announcer
 more than once before it clears (a stuck task ends as failed, a QoS 1 redelivery, a last
 will published twice). Each fault is told exactly once, on the announcements topic too;
@@ -21,9 +21,9 @@ import pytest
 from robot_agent.backends.sim import SimBackend
 from robot_agent.config import ExecutorSettings
 from tests.integration.agent.harness import ShadowResponder, WireTap, command
-from tests.support.swarm import SwarmThread, swarm_fleet
+from tests.support.swarm_runner import SwarmThread, swarm_fleet
 from vahr.announce import settings_from
-from vahr.local.announcer import LocalAnnouncer
+from vahr.local.announce_host import LocalAnnouncer
 from vahr.plumbing.mqtt import MqttEndpoint
 from vahr.protocol import topics
 from vahr.protocol.announcements import decode_announcement

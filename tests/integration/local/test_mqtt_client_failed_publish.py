@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from tests.faults import wait_until
+from tests.support.fault_injection_steps import wait_until
 from vahr.errors import VahrError
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 

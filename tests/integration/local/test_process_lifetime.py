@@ -18,7 +18,13 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from tests.faults import alive, kill_hard, processes_of, wait_all_gone, wait_until
+from tests.support.fault_injection_steps import (
+    alive,
+    kill_hard,
+    processes_of,
+    wait_all_gone,
+    wait_until,
+)
 from vahr.errors import VahrError
 from vahr.plumbing.lifetime import STARTED_FOR, spawn
 from vahr.plumbing.ports import free_port

@@ -333,7 +333,7 @@ def _reported_zone(stack: LocalStack) -> str | None:
 
 
 def _wait(condition: Any, timeout_s: float = 10.0) -> bool:
-    from tests.faults import wait_until
+    from tests.support.fault_injection_steps import wait_until
 
     wait_until(condition, timeout_s)
     return True

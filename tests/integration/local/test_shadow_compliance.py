@@ -12,8 +12,8 @@ import boto3
 import pytest
 from moto import mock_aws
 
-from tests.faults import wait_until
 from tests.integration.local.shadow_clients import Boto3Shadows, MqttShadows, Shadows, unique_thing
+from tests.support.fault_injection_steps import wait_until
 from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import topics
 

@@ -11,7 +11,7 @@ import json
 import time
 from typing import TYPE_CHECKING
 
-from tests.faults import crash_and_restart_broker, wait_until
+from tests.support.fault_injection_steps import crash_and_restart_broker, wait_until
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
 from vahr.twin.shadow_store import ShadowError

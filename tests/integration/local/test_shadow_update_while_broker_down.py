@@ -12,7 +12,7 @@ import json
 import time
 from typing import TYPE_CHECKING
 
-from tests.faults import wait_until
+from tests.support.fault_injection_steps import wait_until
 from vahr.plumbing.client import call
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics

@@ -24,7 +24,7 @@ import pytest
 from playwright.sync_api import sync_playwright
 
 from tests.support.browser import Watch, launch
-from tests.support.swarm import SwarmThread, swarm_fleet
+from tests.support.swarm_runner import SwarmThread, swarm_fleet
 from tests.support.vahr_up import ROOT
 from vahr.plumbing.lifetime import spawn
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint

@@ -20,7 +20,7 @@ import pytest
 from playwright.sync_api import sync_playwright
 
 from tests.support.browser import Watch, launch
-from tests.support.station import RecordingAssistant
+from tests.support.station_stand_ins import RecordingAssistant
 from tests.support.vahr_up import ROOT
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.plumbing.ports import LOOPBACK, free_port

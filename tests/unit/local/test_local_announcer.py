@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from tests.conftest import load_event
 from vahr.announce import settings_from
-from vahr.local.announcer import Announcer
+from vahr.local.announce_host import Announcer
 from vahr.protocol import encode, topics
 
 if TYPE_CHECKING:

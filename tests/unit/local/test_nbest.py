@@ -15,7 +15,8 @@ from vahr.assistant.nbest import (
     request_reader,
     weigh,
 )
-from vahr.assistant.nlu import FALLBACK, InteractionModel, Understanding
+from vahr.assistant.nlu import InteractionModel, Understanding
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.speech.stt import Hypothesis
 
 
@@ -107,11 +108,11 @@ def test_a_zone_only_some_readings_hear_is_asked_for(understand: object) -> None
 def test_speech_about_something_else_moves_nothing(understand: object, readings: list[str]) -> None:
     hypotheses = [Hypothesis(text, -50.0 * n) for n, text in enumerate(readings)]
     weighed = weigh(hypotheses, understand)  # type: ignore[arg-type]
-    assert weighed.understanding.intent == FALLBACK
+    assert weighed.understanding.intent == FALLBACK_INTENT
 
 
 def test_no_reading_at_all_is_the_fallback(understand: object) -> None:
-    assert weigh([], understand).understanding.intent == FALLBACK  # type: ignore[arg-type]
+    assert weigh([], understand).understanding.intent == FALLBACK_INTENT  # type: ignore[arg-type]
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ import pytest
 from vahr.assistant import envelope
 from vahr.assistant.nlu import (
     CONFIDENCE_THRESHOLD,
-    FALLBACK,
+    FALLBACK_INTENT,
     InteractionModel,
     normalize_utterance,
 )
@@ -220,7 +220,7 @@ def test_names_that_overlap_and_disagree_are_asked_about(model: InteractionModel
 def test_an_intent_the_values_named_do_not_fit_falls_back(model: InteractionModel) -> None:
     # The classifier reads the weather question; the words name a robot
     understood = model.understand("robot one what is the weather")
-    assert (understood.intent, understood.slots) == (FALLBACK, {})
+    assert (understood.intent, understood.slots) == (FALLBACK_INTENT, {})
     assert understood.best_guess is not None
 
 
@@ -328,14 +328,14 @@ def test_the_weather_rule_pairs_each_zone_with_its_weather(
 )
 def test_out_of_domain_falls_back_without_slots(model: InteractionModel, utterance: str) -> None:
     understood = model.understand(utterance)
-    assert understood.intent == FALLBACK
+    assert understood.intent == FALLBACK_INTENT
     assert understood.slots == {}
 
 
 def test_a_bare_robot_name_outside_a_dialog_is_no_command(model: InteractionModel) -> None:
     # The answer reading ("robot two" to "which robot?") needs a question first; alone, a
     # name moves nothing (at most it reads as a question about that robot).
-    assert model.understand("robot two").intent in (FALLBACK, "StatusIntent")
+    assert model.understand("robot two").intent in (FALLBACK_INTENT, "StatusIntent")
     answer = model.answer("robot two", "NavigateIntent", "robot")
     assert answer is not None and answer.id == "placebot2"
     both = model.answer("both of them", "NavigateIntent", "robot")

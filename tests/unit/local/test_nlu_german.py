@@ -5,15 +5,19 @@ and the German development set stays apart from what the NLU is built from."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import msgspec
 import pytest
 
 from vahr.assistant.localized import load_model, strip_invocation
-from vahr.assistant.nlu import FALLBACK, InteractionModel
 from vahr.assistant.understanding import load_understanding
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.errors import VahrError
 from vahr.skill_model.templates import expand
+
+if TYPE_CHECKING:
+    from vahr.assistant.nlu import InteractionModel
 
 DEVSET = Path(__file__).resolve().parents[3] / "vahr" / "assistant" / "data" / "devset-de-DE.yaml"
 
@@ -46,7 +50,7 @@ def test_german_requests_are_understood(
 
 @pytest.mark.parametrize("said", ["spiel musik von nena", "wie spät ist es in tokio"])
 def test_everyday_german_falls_back(model: InteractionModel, said: str) -> None:
-    assert model.understand(said).intent == FALLBACK
+    assert model.understand(said).intent == FALLBACK_INTENT
 
 
 def test_the_german_development_set_is_no_sample_or_training_phrase(

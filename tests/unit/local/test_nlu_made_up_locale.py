@@ -18,9 +18,10 @@ from typing import Any
 import msgspec
 import pytest
 
-from vahr.assistant.nlu import FALLBACK, InteractionModel
+from vahr.assistant.nlu import InteractionModel
 from vahr.assistant.understanding import load_understanding
 from vahr.domain.fleet import load_fleet
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.domain.locale import Language, read_yaml
 from vahr.errors import VahrError
 from vahr.skill_model.generator import build_interaction_model
@@ -90,7 +91,7 @@ def test_a_made_up_locale_is_understood_from_its_data(
 @pytest.mark.parametrize("utterance", ["sona la radio", "dona me kafe e pan", "kom vas tu"])
 def test_its_out_of_domain_sentences_fall_back(model: InteractionModel, utterance: str) -> None:
     # Not the out-of-domain phrases it trains on, but their kind
-    assert model.understand(utterance).intent == FALLBACK
+    assert model.understand(utterance).intent == FALLBACK_INTENT
 
 
 def test_its_built_in_phrases_train_the_built_in_intents(model: InteractionModel) -> None:

@@ -13,8 +13,9 @@ from typing import TYPE_CHECKING
 import pytest
 
 from vahr.assistant import roles
-from vahr.assistant.nlu import FALLBACK, InteractionModel
+from vahr.assistant.nlu import InteractionModel
 from vahr.assistant.understanding import LOCALES_DIR, load_understanding
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.errors import VahrError
 
 if TYPE_CHECKING:
@@ -102,7 +103,7 @@ def test_the_tagger_is_cached_by_its_data(tmp_path: Path) -> None:
 
 
 def test_nothing_understood_is_nothing_assigned(model: InteractionModel) -> None:
-    assert model.understand("play some jazz").intent == FALLBACK
+    assert model.understand("play some jazz").intent == FALLBACK_INTENT
 
 
 def test_the_weather_words_are_the_locales() -> None:

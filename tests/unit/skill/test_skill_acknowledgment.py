@@ -165,7 +165,7 @@ def test_a_slow_publish_shortens_the_wait_so_alexa_still_gets_an_answer(
     iot_data: Any, robots: RobotDoubles, fleet: Any
 ) -> None:
     # Given a publish that takes 0.4 s, a 2.5 s acknowledgment budget, 0.6 s for the whole reply
-    from skill.commands import dispatch
+    from skill.commands import publication
     from skill.robots import Robots
 
     class SlowPublish(IotDataGateway):
@@ -177,7 +177,7 @@ def test_a_slow_publish_shortens_the_wait_so_alexa_still_gets_an_answer(
     sender = Robots(SlowPublish(iot_data), ack_timeout_s=2.5, reply_budget_s=0.6)
     # When a command is sent to a robot that never answers
     started = time.monotonic()
-    answers = sender.send([dispatch(fleet, "navigate", "placebot1", {"zone": "A"})])
+    answers = sender.send([publication(fleet, "navigate", "placebot1", {"zone": "A"})])
     # Then the wait only used what was left of the reply budget
     assert time.monotonic() - started < 1.0
     assert answers["placebot1"].outcome == "unconfirmed"

@@ -171,7 +171,7 @@ def test_a_fleet_command_reply_names_only_the_first_few_unconfirmed() -> None:
     from datetime import UTC, datetime
 
     from skill.acknowledgment import RobotAnswer
-    from skill.commands import Dispatch
+    from skill.commands import Publication
     from skill.speech import command_report
     from skill.vocabulary import FLEET, Vocabulary
     from vahr.protocol import Navigate, ZoneParams
@@ -181,7 +181,9 @@ def test_a_fleet_command_reply_names_only_the_first_few_unconfirmed() -> None:
         id="c1", issued_at=datetime.now(UTC), source="alexa", params=ZoneParams(zone="B")
     )
     things = list(fleet.robot_things)
-    item = Dispatch(topic="vahr/fleet/cmd", command=command, recipients=tuple(things), target=FLEET)
+    item = Publication(
+        topic="vahr/fleet/cmd", command=command, recipients=tuple(things), target=FLEET
+    )
     answers = {
         thing: RobotAnswer(
             thing=thing, command_id="c1", outcome="acknowledged" if i >= 7 else "unconfirmed"

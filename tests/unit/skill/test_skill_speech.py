@@ -7,7 +7,7 @@ from typing import Any
 import pytest
 
 from skill.acknowledgment import RobotAnswer, classify
-from skill.commands import dispatch, sequential
+from skill.commands import publication, sequential
 from skill.robots import ShadowRead
 from skill.speech import command_report, robot_status, sequential_report, status_report
 from skill.vocabulary import FLEET, Vocabulary, zone_phrase
@@ -143,7 +143,7 @@ def test_fleet_of_three_speaks_all_robots(words: Vocabulary) -> None:
         + "  - {id: A, spoken: [zone a], pose: {x: 5, y: 0}}\n"
     )
     vocabulary = Vocabulary(three)
-    item = dispatch(three, "navigate", FLEET, {"zone": "A"})
+    item = publication(three, "navigate", FLEET, {"zone": "A"})
     answers = {thing: answer(thing, item.command.id, "accepted") for thing in three.robot_things}
     assert command_report(vocabulary, item, answers) == "All 3 robots are on their way to zone A."
     answers["r3"] = answer("r3", item.command.id, None, connected=False)

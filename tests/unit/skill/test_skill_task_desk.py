@@ -1,7 +1,7 @@
 """The skill's two TaskDesk adapters against the real other side.
 
 - `HttpTaskDesk` over real HTTP on 127.0.0.1 to the local host's `/vahr/tasks` routes
-  (`vahr.local.dispatcher.TasksApi`, the object the data plane serves);
+  (`vahr.local.dispatch_host.TasksApi`, the object the data plane serves);
 - `LambdaTaskDesk` against the dispatcher function's own handler (`dispatcher.app.handle`),
   called in-process by a client with boto3's `invoke` shape, since no Lambda runtime runs
   here: the request and answer shapes are the function's.
@@ -24,7 +24,7 @@ from skill.task_desk import HttpTaskDesk, LambdaTaskDesk, TaskDesk, TaskRefused
 from tests.support.fleets import SIX_ROBOTS
 from vahr.dispatch import Dispatcher, Order, RobotState
 from vahr.domain import load_fleet
-from vahr.local.dispatcher import TasksApi
+from vahr.local.dispatch_host import TasksApi
 from vahr.local.task_store import SqliteTaskStore
 
 if TYPE_CHECKING:

@@ -12,8 +12,9 @@ import pytest
 
 from tests.support.skill_effects import SkillEffects
 from vahr.assistant.evaluation import DEVELOPMENT_SET, LabelledSet, LabelledUtterance
-from vahr.assistant.nlu import FALLBACK, InteractionModel, SlotValue, Understanding
+from vahr.assistant.nlu import InteractionModel, SlotValue, Understanding
 from vahr.assistant.simulator import strip_invocation
+from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.errors import VahrError
 
 SETS = (DEVELOPMENT_SET, DEVELOPMENT_SET.with_name("roles-devset-en-US.yaml"))
@@ -34,7 +35,7 @@ def test_the_development_sets_move_no_robot_where_nobody_asked_but_one(
         for item in (item for file in SETS for item in LabelledSet.load(file).items()):
             heard = model.understand(strip_invocation(model.invocation_name, item.text))
             verdict = effects.verdict(item, heard)
-            (requests if item.intent != FALLBACK else out_of_domain)[verdict] += 1
+            (requests if item.intent != FALLBACK_INTENT else out_of_domain)[verdict] += 1
             if verdict in ("moved wrongly", "stopped wrongly"):
                 wrong.append((item.text, effects.of(heard)))
     # Measured: 1 of 321 requests moved robots wrongly (0.3%), a sequential delivery sent
@@ -60,7 +61,10 @@ def test_a_misheard_zone_is_a_wrong_move_and_an_unsure_robot_sends_nothing(
         assert effects.of(said) == (("vahr/robots/placebot1/cmd", "navigate", '{"zone": "D"}'),)
         assert effects.verdict(item, said) == "moved wrongly"
         assert effects.verdict(item, asked) == "less or nothing sent"
-        assert effects.verdict(LabelledUtterance("what's up", FALLBACK), said) == "moved wrongly"
+        assert (
+            effects.verdict(LabelledUtterance("what's up", FALLBACK_INTENT), said)
+            == "moved wrongly"
+        )
         stop_all = Understanding("EmergencyStopIntent", {}, ("robot",))
         stop_one = LabelledUtterance("stop placebot one", "EmergencyStopIntent",
                                      {"robot": "placebot1"})  # fmt: skip

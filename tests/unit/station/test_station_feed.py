@@ -10,7 +10,7 @@ import msgspec
 import pytest
 
 from tests.conftest import load_event
-from tests.support.station import RecordingAssistant, Wire
+from tests.support.station_stand_ins import RecordingAssistant, Wire
 from vahr.dispatch import Task
 from vahr.protocol import Event, Presence, ReportedPose, encode, new_command, topics, utc_now
 from vahr.station.app import StationApp

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from tests.support.station import RecordingAssistant, Wire
+from tests.support.station_stand_ins import RecordingAssistant, Wire
 from vahr.protocol import decode_command, topics
 from vahr.protocol.station_topics import Interaction, PuzzleInput, decode_station_input
 from vahr.station.app import StationApp
