@@ -201,8 +201,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _experiment(system: Any, log_dir: Path, args: argparse.Namespace) -> list[str]:
     """The paper's tasks I-III, performed by the simulated participant with both methods."""
-    from vahr.experiment.demo_session import rehearse
     from vahr.experiment.eventlog import read_log
+    from vahr.experiment.live_session import run_simulated_session
     from vahr.experiment.metrics import fan_out, rad
     from vahr.experiment.results import row_from_log
     from vahr.plumbing.client import HttpAssistant
@@ -212,7 +212,7 @@ def _experiment(system: Any, log_dir: Path, args: argparse.Namespace) -> list[st
     failures: list[str] = []
     methods = ("vahr", "keyboard") if system.voice_enabled else ("keyboard",)
     for method in methods:
-        verdict, log_path = rehearse(
+        verdict, log_path = run_simulated_session(
             fleet=system.fleet,
             method=method,
             log_dir=log_dir,

@@ -157,7 +157,7 @@ def _show_plan(name: str, plan: dict[str, Any], resumed: bool, method: str) -> N
 
 
 def _run_session(args: argparse.Namespace, fleet: Any, session: Any) -> Any:
-    from vahr.experiment.demo_session import run_live, simulated_performer
+    from vahr.experiment.live_session import run_live, simulated_performer
 
     performer_for: Any
     if args.simulate:

@@ -25,8 +25,8 @@ import random
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from vahr.experiment.demo_session import rehearse
 from vahr.experiment.eventlog import Kind, read_log, session_file
+from vahr.experiment.live_session import run_simulated_session
 from vahr.experiment.paper import compare, render_comparison
 from vahr.experiment.report import write_report
 from vahr.experiment.results import row_from_log, rows_from_logs
@@ -94,7 +94,7 @@ def run_study(
                 if _finished(path):
                     announce(f"{participant} {method} trial {trial}: already finished, kept")
                     continue
-                verdict, path = rehearse(
+                verdict, path = run_simulated_session(
                     fleet=fleet,
                     method=method,
                     log_dir=spec.log_dir,

@@ -1,9 +1,10 @@
-"""Run a session against a live system: the entry points for `vahr experiment` and `vahr demo`.
+"""Run a session against a live system: the entry points for `vahr experiment`, `vahr demo`
+and each trial of `vahr rehearse`.
 
 `run_live` connects the recorder to the broker and lets a performer (the simulated
-participant or the observer's console) run the tasks. `rehearse` is the one call a demo
-needs: open (or resume) a simulated session, publish its plan to the experiment shadow, run
-it, and return the judge's verdict with the log's path.
+participant or the observer's console) run the tasks. `run_simulated_session` is the one
+call a demo and each trial of a study need: open (or resume) a simulated session, publish
+its plan to the experiment shadow, run it, and return the judge's verdict with the log's path.
 """
 
 from __future__ import annotations
@@ -99,7 +100,7 @@ def simulated_performer(
     return build
 
 
-def rehearse(
+def run_simulated_session(
     *,
     fleet: Fleet,
     method: str,
