@@ -139,6 +139,10 @@ class CrtClient(Receiver):
     name = "awscrt's `mqtt5.Client`, public API"
 
     subscribed = False
+    # Every client made, kept until the end, so none is freed mid-run: awscrt 0.36 once
+    # crashed the process (a segmentation fault) after a client had taken 40,000 messages
+    # and the next one was made.
+    made: list[mqtt5.Client] = []
 
     def start(self) -> None:
         # A new client each time, resuming the same session.
@@ -167,6 +171,7 @@ class CrtClient(Receiver):
                 disable_metrics=True,
             )
         )
+        self.made.append(self._client)
         self._client.start()
         if not connected.wait(60):
             raise RuntimeError("awscrt did not connect")

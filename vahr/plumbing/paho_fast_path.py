@@ -5,18 +5,18 @@ plain PUBLISH packets (MQTT 5, QoS 0 or 1, no properties) handed from the read b
 `deliver` callable, and a window of QoS 1 publishes awaiting PUBACK. Everything else is
 paho's own behaviour. `vahr.plumbing.mqtt.MqttClient` is its only user.
 
-Why it exists (`bench/mqtt_intake.py`, figures in docs/benchmarks.md): taking a burst of QoS 1
-messages, paho's public API spends hundreds of microseconds of CPU a message (a `select`,
-several `recv` calls and a wake-up write per packet), this path about 15. The AWS CRT's
-MQTT 5 client (`awscrt.mqtt5`, public API, its I/O in C) was measured in its place: 25-50
-µs a message for a short burst, and more the longer the burst (600 µs a message at 40,000
-queued messages), because awscrt 0.36 inserts each PUBACK into its operation queue by
-walking every PUBACK already queued there. So the fast path stays, held to paho's own
-behaviour by `tests/integration/local/test_paho_fast_path.py`, which feeds one byte stream
-(cut at random places) to this client and to paho's stock client and asserts the same
-messages and the same bytes back (acknowledgements included). The overridden methods are
-private, which is why paho is pinned exactly in requirements.txt: a new paho release is
-taken only when that test passes against it.
+Why it exists (`bench/mqtt_intake.py`; docs/local.md, "The lab client's fast path"): taking
+a burst of QoS 1 messages, paho through its public API spends 120-250 µs of CPU a message (a
+`select`, several `recv` calls and a wake-up write per packet), this path 15-30 µs. The AWS
+CRT's MQTT 5 client (`awscrt.mqtt5`, public API, its I/O in C) was measured in its place:
+about 40 µs a message in a burst of 2,000 and about 1,000 µs in a burst of 40,000, because
+awscrt 0.36 inserts each PUBACK into its operation queue by walking every PUBACK already
+queued there. So the fast path stays, held to paho's own behaviour by
+`tests/integration/local/test_paho_fast_path.py`, which feeds one byte stream (cut at random
+places) to this client and to paho's stock client and asserts the same messages and the same
+bytes back (acknowledgements included). The overridden methods are private, which is why
+paho is pinned exactly in requirements.txt: a new paho release is taken only when that test
+passes against it.
 """
 
 from __future__ import annotations
