@@ -79,6 +79,7 @@ class Ros1Backend:
     """Drives a ROS 1 robot through its `move_base` action server."""
 
     name = "ros1"
+    observed_pose = True
 
     def __init__(self, settings: Ros1Settings, *, start: Pose) -> None:
         self.settings = settings

@@ -55,6 +55,7 @@ from vahr.protocol.messages import (
     utc_now,
 )
 from vahr.protocol.shadow import (
+    Battery,
     ExperimentState,
     LastCommand,
     Reported,
@@ -75,6 +76,7 @@ __all__ = [
     "FLEET_GROUP_NAMES",
     "MAX_PAYLOAD_BYTES",
     "MOTION_ACTIONS",
+    "Battery",
     "Command",
     "Conveyor",
     "Deliver",
