@@ -23,9 +23,14 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+import pytest
 
 from vahr.local.lifetime import spawn
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
 
 ROOT = Path(__file__).resolve().parents[2]
 ROS2_VENV = ROOT / ".venv-ros2"
@@ -146,7 +151,9 @@ class Nav2StandIn:
 
     def battery(self, percentage: float, status: int) -> None:
         path = self.control / "battery.json"
-        path.with_suffix(".tmp").write_text(json.dumps({"percentage": percentage, "status": status}))
+        path.with_suffix(".tmp").write_text(
+            json.dumps({"percentage": percentage, "status": status})
+        )
         path.with_suffix(".tmp").replace(path)
 
     # -- what it saw --------------------------------------------------------------------
@@ -174,3 +181,15 @@ class Nav2StandIn:
         with contextlib.suppress(OSError):
             return (self.control / "stand-in.log").read_text()
         return ""
+
+
+@pytest.fixture(scope="module")
+def nav2_stand_in(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Nav2StandIn]:
+    """One stand-in bt_navigator per test module, in a ROS domain of its own."""
+    if not HAS_ROS2:
+        pytest.skip(WITHOUT_ROS2)
+    home = tmp_path_factory.mktemp("ros2")
+    isolate_ros2(home)
+    stand_in = Nav2StandIn(home / "stand-in", domain_id=next_domain_id()).start()
+    yield stand_in
+    stand_in.stop()
