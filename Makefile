@@ -24,6 +24,9 @@ ROS_SITE := $(VENV)/ros-site
 # ros2/nav2_msgs (docs/robot-agent.md, "ROS 2").
 VENV_ROS2 := .venv-ros2
 BIN_ROS2 := $(VENV_ROS2)/bin
+# Where the tests marked ros2 are (.venv-ros2 holds the project and pytest, not every test's
+# libraries, so it collects only these).
+ROS2_TESTS := tests/integration/agent
 export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
 export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 
@@ -103,12 +106,12 @@ pytest: setup
 # The tests marked ros2 (the nav2 backend against real rclpy and Fast DDS) in .venv-ros2, in a
 # private network namespace where one can be made (root, as CI is): no DDS packet leaves it
 # and no other process's DDS meets these. Inside, each test's ROS graph has a domain of its
-# own and discovery stays on localhost (tests/integration/ros2/conftest.py).
+# own and discovery stays on localhost (tests/support/nav2.py).
 pytest-ros2: setup
 	if [ "$$(id -u)" = 0 ] && unshare -n true 2>/dev/null; then \
-		unshare -n sh -c 'ip link set lo up && exec $(BIN_ROS2)/pytest -q -m ros2 tests'; \
+		unshare -n sh -c 'ip link set lo up && exec $(BIN_ROS2)/pytest -q -m ros2 $(ROS2_TESTS)'; \
 	else \
-		$(BIN_ROS2)/pytest -q -m ros2 tests; \
+		$(BIN_ROS2)/pytest -q -m ros2 $(ROS2_TESTS); \
 	fi
 
 # The 90 s soak (docs/reliability.md): every fault under load. Not part of `make test`.

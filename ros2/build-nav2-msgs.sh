@@ -13,16 +13,21 @@ python=$venv/bin/python
 # Python and numpy include directories. Point them at this venv's before CMake reads them.
 py_include=$("$python" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')
 np_include=$("$python" -c 'import numpy; print(numpy.get_include())')
-grep -rlZ --include='*.cmake' '/opt/python/cp311-cp311/' "$venv/share" | xargs -0 -r sed -i \
+{ grep -rlZ --include='*.cmake' '/opt/python/cp311-cp311/' "$venv/share" || true; } | xargs -0 -r sed -i \
 	-e "s#/opt/python/cp311-cp311/include/python3.11#$py_include#g" \
 	-e "s#/opt/python/cp311-cp311/lib/python3.11/site-packages/numpy/_core/include#$np_include#g"
 
 export PATH="$venv/bin:$PATH"
-cmake -S "$source_dir" -B "$build" -G Ninja -Wno-dev --log-level=WARNING \
+mkdir -p "$build"
+# Quiet unless something fails: then the whole log.
+log=$build/build.log
+{
+cmake -S "$source_dir" -B "$build" -G Ninja -Wno-author --log-level=WARNING \
 	-DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING=OFF \
 	-DCMAKE_PREFIX_PATH="$venv" -DCMAKE_INSTALL_PREFIX="$venv" \
 	-DPython3_EXECUTABLE="$python"
 cmake --build "$build"
-cmake --install "$build" >/dev/null
+cmake --install "$build"
+} >"$log" 2>&1 || { cat "$log"; exit 1; }
 # The check that it is usable: the action's Jazzy fields, imported as a node would.
 "$python" -c 'from nav2_msgs.action import NavigateToPose as A; assert "error_msg" in A.Result.get_fields_and_field_types()'

@@ -52,6 +52,8 @@ log = logging.getLogger(__name__)
 
 # How often a goal checks that its server is still there and still talking.
 WATCH_PERIOD_S = 0.25
+# How long a goal request waits for its answer before it is sent again (see `_send`).
+RESEND_S = 1.0
 # How long the spinning thread blocks at most, so that closing never waits on it for long.
 SPIN_PERIOD_S = 0.1
 
@@ -128,19 +130,7 @@ class Nav2Backend:
             )
             loop.call_soon_threadsafe(self._progressed, progress, on_progress)
 
-        goal = self._goal(target)
-        sending = await self._call(
-            lambda: self._client.send_goal_async(goal, feedback_callback=on_feedback)
-        )
-        try:
-            handle = await self._answer(
-                _awaitable(loop, sending), f"accept or reject the goal to {zone.id}"
-            )
-        except (NavigationFailed, asyncio.CancelledError):
-            # Unanswered, or no longer wanted: should the server accept it later, it is
-            # cancelled then.
-            sending.add_done_callback(_cancel_if_accepted)
-            raise
+        handle = await self._send(self._goal(target), on_feedback, zone)
         if not handle.accepted:
             raise GoalRejected(f"Nav2's {action!r} server rejected the goal to {zone.id}")
         self._active = handle
@@ -152,6 +142,7 @@ class Nav2Backend:
                 if outcome.done():
                     break
                 if not await self._answer(self._call(self._client.server_is_ready), "answer"):
+                    self._active = None  # no one is left to cancel it
                     raise NavigationFailed(
                         f"Nav2's {action!r} server went away during the goal to {zone.id}"
                     )
@@ -163,9 +154,8 @@ class Nav2Backend:
                     )
             response = outcome.result()
         except NavigationFailed:
-            # The server may still be there, only mute: ask it to drop the goal, unawaited.
-            self._call(handle.cancel_goal_async)
-            self._active = None
+            # A mute server may still drive the robot: the goal stays active, and the halt
+            # that follows a failure cancels it (bounded by answer_timeout_s).
             raise
         except asyncio.CancelledError:
             # Preempted or stopped: the cancel goes out now, and halt() waits for its answer.
@@ -177,6 +167,38 @@ class Nav2Backend:
             # Succeeded without a word on the way: the robot is where the goal was.
             self._pose = target
         on_progress(Progress(1.0, self._pose))
+
+    async def _send(self, goal: Any, on_feedback: Callable[[Any], None], zone: Zone) -> Any:
+        """Send `goal` until the server accepts or rejects it, for `answer_timeout_s`.
+
+        A request is sent again after `RESEND_S` without an answer: DDS drops a request
+        sent to a server that the graph already lists but whose endpoints are not matched
+        yet (a bt_navigator just restarted while its dead predecessor's are still listed).
+        Every request left unanswered is cancelled should the server accept it later.
+        """
+        loop = asyncio.get_running_loop()
+        deadline = time.monotonic() + self.settings.answer_timeout_s
+        unanswered: list[Any] = []
+        try:
+            while True:
+                sending = await self._call(
+                    lambda: self._client.send_goal_async(goal, feedback_callback=on_feedback)
+                )
+                unanswered.append(sending)
+                answer = _awaitable(loop, sending)
+                left = deadline - time.monotonic()
+                await asyncio.wait({answer}, timeout=max(min(RESEND_S, left), 0))
+                if answer.done():
+                    unanswered.remove(sending)
+                    return answer.result()
+                if time.monotonic() >= deadline:
+                    raise NavigationFailed(
+                        f"Nav2's {self.settings.action!r} server did not accept or reject the "
+                        f"goal to {zone.id} within {self.settings.answer_timeout_s:g} s"
+                    )
+        finally:
+            for pending in unanswered:
+                pending.add_done_callback(_cancel_if_accepted)
 
     def _ended(self, status: int, result: Any, zone: Zone) -> None:
         """Raise what a goal's end means for the command; return when it succeeded."""
