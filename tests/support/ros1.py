@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from collections.abc import Iterator
 
 STEPS = 8
-STEP_S = 0.03
+STEP_S = 0.05
 
 
 @pytest.fixture(scope="session")
