@@ -120,14 +120,19 @@ class Nav2Backend:
             nonlocal heard, total, fed
             heard, fed = time.monotonic(), True
             feedback = message.feedback
-            remaining = float(feedback.distance_remaining)
-            total = max(total, remaining)
             pose = _pose_of(feedback.current_pose.pose)
+            remaining = float(feedback.distance_remaining)
+            # Nav2 gives the path's length left; without it (0 before a path is planned),
+            # the straight line to the goal is what is known.
+            left = remaining if remaining > 0 else pose.distance_to(target)
+            total = max(total, left)
+            eta = _seconds(feedback.estimated_time_remaining)
+            # Short of the goal, Nav2's zeros mean "not known yet", not "there".
             progress = Progress(
-                fraction=min(max(1.0 - remaining / total, 0.0), 1.0),
+                fraction=min(max(1.0 - left / total, 0.0), 1.0),
                 pose=pose,
-                eta_s=_seconds(feedback.estimated_time_remaining),
-                distance_remaining_m=remaining,
+                eta_s=eta if eta > 0 else None,
+                distance_remaining_m=remaining if remaining > 0 else None,
             )
             loop.call_soon_threadsafe(self._progressed, progress, on_progress)
 
@@ -270,7 +275,9 @@ class Nav2Backend:
     async def close(self) -> None:
         await self.halt()
         self._stopping.set()
-        self._executor.wake()
+        # A task ends the spinning thread's wait (Executor.wake() does not: with nothing
+        # ready, spin_once waits out its timeout).
+        self._executor.create_task(lambda: None)
         await asyncio.to_thread(self._spinner.join, SPIN_PERIOD_S + 5)
         self._executor.shutdown()
         self._node.destroy_node()

@@ -41,9 +41,17 @@ WITHOUT_ROS2 = (
     "make test runs these tests there)"
 )
 
-# Domains 1-100, in an order of this process's own: two test processes that share a network
-# namespace are unlikely to pick the same domain at the same time.
-_domains = itertools.cycle(random.sample(range(1, 101), 100))
+
+def _domains_of_this_process() -> list[int]:
+    """Domains 1-100, shared out among pytest-xdist's workers (which share one network
+    namespace), in an order of this process's own."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw")
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    mine = list(range(1 + int(worker) % workers, 101, workers))
+    return random.sample(mine, len(mine))
+
+
+_domains = itertools.cycle(_domains_of_this_process())
 
 
 def next_domain_id() -> int:

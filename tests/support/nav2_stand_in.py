@@ -147,10 +147,11 @@ class StandIn:
             feedback.current_pose.pose.position.x = self.position[0]
             feedback.current_pose.pose.position.y = self.position[1]
             feedback.current_pose.pose.orientation = goal_handle.request.pose.pose.orientation
-            feedback.distance_remaining = float(total * (1 - fraction))
-            remaining_s = (steps - step) * step_s
-            feedback.estimated_time_remaining.sec = int(remaining_s)
-            feedback.estimated_time_remaining.nanosec = int((remaining_s % 1) * 1e9)
+            if not mode.get("pose_only"):  # else only current_pose, as a plain server may
+                feedback.distance_remaining = float(total * (1 - fraction))
+                remaining_s = (steps - step) * step_s
+                feedback.estimated_time_remaining.sec = int(remaining_s)
+                feedback.estimated_time_remaining.nanosec = int((remaining_s % 1) * 1e9)
             elapsed = time.monotonic() - began
             feedback.navigation_time.sec = int(elapsed)
             feedback.navigation_time.nanosec = int((elapsed % 1) * 1e9)

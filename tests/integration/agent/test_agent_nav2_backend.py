@@ -97,6 +97,26 @@ async def test_feedback_becomes_progress_with_eta_and_distance_and_moves_the_sha
     assert rec.states[-1].pose is not None and rec.states[-1].pose.x == 9.0
 
 
+async def test_feedback_with_only_a_pose_still_reports_the_way(
+    fleet: Fleet, own_stand_in: Nav2StandIn
+) -> None:
+    # Given a server whose feedback carries current_pose and no distance or time left
+    await asyncio.to_thread(own_stand_in.start)
+    own_stand_in.plan({"mode": "succeed", "pose_only": True})
+    executor, rec = nav2_robot(fleet, own_stand_in.domain_id)
+    try:
+        executor.execute(cmd("navigate", {"zone": "B"}, "g3"))
+        await executor.wait_idle()
+    finally:
+        await executor.close()
+    # Then the way is reported from the poses, and no estimate is made up
+    progress = [e for e in rec.events if e.event == "progress"]
+    fractions = [e.progress for e in progress]
+    assert len(progress) >= 5 and fractions == sorted(fractions)
+    assert {(e.eta_s, e.distance_remaining_m) for e in progress} == {(None, None)}
+    assert rec.kinds("g3")[-2:] == ["arrived", "done"]
+
+
 async def test_goals_go_to_the_configured_action_in_the_configured_frame_and_tree(
     fleet: Fleet, own_stand_in: Nav2StandIn
 ) -> None:
