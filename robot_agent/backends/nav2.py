@@ -3,7 +3,8 @@
 Goals are `nav2_msgs/action/NavigateToPose` goals to the configured action (bt_navigator's
 `navigate_to_pose`) at the zone's pose from `fleet.yaml`, in the configured frame (`map`).
 Feedback becomes progress: `current_pose` is where the robot is, `distance_remaining` and
-`estimated_time_remaining` go into the progress report as they are. The goal's end maps onto
+`estimated_time_remaining` go into the progress report (where Nav2 knows them). The goal's
+end maps onto
 the command's: succeeded is done, aborted fails with Nav2's `error_code` and `error_msg`,
 canceled by the server ends cancelled, a rejected goal is rejected.
 
@@ -154,15 +155,13 @@ class Nav2Backend:
                     )
                 silent = time.monotonic() - heard
                 if silent > self.settings.feedback_timeout_s:
+                    # A mute server may still drive the robot: the goal stays active, and
+                    # the halt that follows a failure cancels it (within answer_timeout_s).
                     raise NavigationFailed(
                         f"Nav2's {action!r} server said nothing about the goal to {zone.id} "
                         f"for {self.settings.feedback_timeout_s:g} s"
                     )
             response = outcome.result()
-        except NavigationFailed:
-            # A mute server may still drive the robot: the goal stays active, and the halt
-            # that follows a failure cancels it (bounded by answer_timeout_s).
-            raise
         except asyncio.CancelledError:
             # Preempted or stopped: the cancel goes out now, and halt() waits for its answer.
             outcome.cancel()
