@@ -4,9 +4,8 @@ Goals are `nav2_msgs/action/NavigateToPose` goals to the configured action (bt_n
 `navigate_to_pose`) at the zone's pose from `fleet.yaml`, in the configured frame (`map`).
 Feedback becomes progress: `current_pose` is where the robot is, `distance_remaining` and
 `estimated_time_remaining` go into the progress report (where Nav2 knows them). The goal's
-end maps onto
-the command's: succeeded is done, aborted fails with Nav2's `error_code` and `error_msg`,
-canceled by the server ends cancelled, a rejected goal is rejected.
+end maps onto the command's: succeeded is done, aborted fails with Nav2's `error_code` and
+`error_msg`, canceled by the server ends cancelled, a rejected goal is rejected.
 
 Nothing waits without a bound: a server that is not there, does not answer a goal or a
 cancel, or goes silent (dies) while it navigates fails the goal with a reason after
