@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 
 import rclpy
 from action_msgs.msg import GoalStatus
+from action_msgs.srv import CancelGoal
 from nav2_msgs.action import NavigateToPose
 from rclpy.action import ActionClient
 from rclpy.context import Context
@@ -266,9 +267,19 @@ class Nav2Backend:
         loop = asyncio.get_running_loop()
         try:
             cancelling = await self._call(handle.cancel_goal_async)
-            await self._answer(_awaitable(loop, cancelling), "confirm the cancel")
+            answer = await self._answer(_awaitable(loop, cancelling), "confirm the cancel")
         except NavigationFailed as err:
             log.warning("%s; the robot may still be driving", err)
+            return
+        # rclcpp's servers say ERROR_REJECTED; rclpy's leave ERROR_NONE with no goal.
+        refused = answer.return_code == CancelGoal.Response.ERROR_REJECTED or (
+            answer.return_code == CancelGoal.Response.ERROR_NONE and not answer.goals_canceling
+        )
+        if refused:
+            log.warning(
+                "Nav2's %r server refused to cancel the goal; the robot may still be driving",
+                self.settings.action,
+            )
 
     async def close(self) -> None:
         await self.halt()

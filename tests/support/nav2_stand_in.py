@@ -5,7 +5,7 @@ publishing NavigateToPose feedback on the way (`current_pose`, `distance_remaini
 `estimated_time_remaining`, `navigation_time`), and ends the goal as the test asks: succeed,
 abort with an error code and message, reject, stall (accept and never say a word), die part
 way (the process exits), or see its goal cancelled by another client. It honours cancel
-requests, and publishes a `sensor_msgs/BatteryState` while it runs.
+requests (or refuses them, when asked to), and publishes a `sensor_msgs/BatteryState`.
 
 Run it as its own process, in a ROS 2 venv (tests start it through `tests.support.nav2`):
 
@@ -105,6 +105,9 @@ class StandIn:
 
     def on_cancel(self, goal_handle: Any) -> CancelResponse:
         self.log("cancel_requested")
+        if self._pending.get("refuse_cancel"):
+            self.log("cancel_refused")
+            return CancelResponse.REJECT
         return CancelResponse.ACCEPT
 
     def execute(self, goal_handle: Any) -> Any:
@@ -160,7 +163,7 @@ class StandIn:
             time.sleep(step_s)
         if kind == "stall":
             # Still stalled after its steps: it never answers unless cancelled.
-            while not goal_handle.is_cancel_requested:
+            while not goal_handle.is_cancel_requested and rclpy.ok():
                 time.sleep(0.01)
             goal_handle.canceled()
             self.log("canceled")

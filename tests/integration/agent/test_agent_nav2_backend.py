@@ -197,6 +197,29 @@ async def test_a_goal_that_never_answers_fails_after_the_feedback_timeout(
     nav2_stand_in.wait_for("cancel_requested", seen + 1, timeout_s=0)
 
 
+async def test_a_cancel_nav2_refuses_is_logged_as_such(
+    fleet: Fleet, own_stand_in: Nav2StandIn, caplog: pytest.LogCaptureFixture
+) -> None:
+    await asyncio.to_thread(own_stand_in.start)
+    own_stand_in.plan({"mode": "stall", "refuse_cancel": True})
+    executor, rec = nav2_robot(fleet, own_stand_in.domain_id, feedback_timeout_s=30)
+    try:
+        executor.execute(cmd("navigate", {"zone": "A"}, "z1"))
+        await asyncio.to_thread(own_stand_in.wait_for, "accepted")
+        # When a stop comes and Nav2 refuses to cancel the goal
+        executor.execute(cmd("stop", None, "z2"))
+        await executor.wait_idle()
+    finally:
+        await executor.close()
+    own_stand_in.wait_for("cancel_refused", timeout_s=0)
+    # Then the stop ends as a stop does, and the log says the robot may still be driving
+    assert rec.kinds("z2") == ["accepted", "stopped", "done"]
+    assert (
+        "Nav2's 'navigate_to_pose' server refused to cancel the goal; the robot may still be "
+        "driving"
+    ) in caplog.messages
+
+
 async def test_without_a_server_a_goal_fails_in_bounded_time_and_works_once_it_is_there(
     fleet: Fleet, own_stand_in: Nav2StandIn
 ) -> None:
