@@ -33,7 +33,6 @@ if TYPE_CHECKING:
     from collections.abc import Iterator
 
 ROOT = Path(__file__).resolve().parents[2]
-ROS2_VENV = ROOT / ".venv-ros2"
 # Whether this interpreter has ROS 2 (rclpy) and the NavigateToPose it was built with.
 HAS_ROS2 = all(importlib.util.find_spec(name) for name in ("rclpy", "nav2_msgs"))
 WITHOUT_ROS2 = (
@@ -131,13 +130,6 @@ class Nav2StandIn:
         try:
             process.wait(timeout=5)
         except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=5)
-
-    def kill(self) -> None:
-        """Die at once, as a crashed bt_navigator does: no goodbye on the graph."""
-        process, self.process = self.process, None
-        if process is not None and process.poll() is None:
             process.kill()
             process.wait(timeout=5)
 
