@@ -66,15 +66,17 @@ $(ROS_SITE)/.linked: $(VENV)/.installed
 	echo "$(CURDIR)/$(ROS_SITE)" > $$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))')/vahr-ros.pth
 	touch $@
 
-# ROS 2 Jazzy's wheels (pinned), nav2_msgs built into the venv, then the project itself at the
-# main venv's versions of its dependencies.
-$(VENV_ROS2)/.installed: requirements-ros2.txt requirements.txt pyproject.toml \
-		ros2/build-nav2-msgs.sh ros2/nav2_msgs/package.xml ros2/nav2_msgs/CMakeLists.txt \
-		ros2/nav2_msgs/action/NavigateToPose.action
+# ROS 2 Jazzy's wheels (pinned) and nav2_msgs built into the venv; then the project itself at
+# the main venv's versions of its dependencies (a change there does not rebuild nav2_msgs).
+$(VENV_ROS2)/.ros2: requirements-ros2.txt ros2/build-nav2-msgs.sh ros2/nav2_msgs/package.xml \
+		ros2/nav2_msgs/CMakeLists.txt ros2/nav2_msgs/action/NavigateToPose.action
 	test -x $(BIN_ROS2)/python || $(PYTHON) -m venv $(VENV_ROS2)
 	$(BIN_ROS2)/pip install -q --upgrade pip
 	$(BIN_ROS2)/pip install -q -r requirements-ros2.txt
 	ros2/build-nav2-msgs.sh $(VENV_ROS2) .build/ros2-nav2-msgs
+	touch $@
+
+$(VENV_ROS2)/.installed: $(VENV_ROS2)/.ros2 requirements.txt pyproject.toml
 	$(BIN_ROS2)/pip install -q -c requirements.txt --no-build-isolation -e .
 	touch $@
 
