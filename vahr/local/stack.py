@@ -44,6 +44,8 @@ class StackConfig:
     mqtts_port: int
     mqtt_port: int | None
     api_port: int
+    # Names the data plane answers to besides the loopback ones (`vahr up --api-host`).
+    api_hosts: frozenset[str] = frozenset()
 
 
 class LocalStack:
@@ -146,7 +148,9 @@ class LocalStack:
                 client.publish(topic, payload, qos=qos, retain=retain, wait=qos > 0)
 
             self.dataplane = DataPlane(self.shadows, publish, self.meter)
-            self._server = DataPlaneServer(self.dataplane, cfg.api_port).start()
+            self._server = DataPlaneServer(
+                self.dataplane, cfg.api_port, hosts=cfg.api_hosts
+            ).start()
         except BaseException:
             self.stop()
             raise
@@ -164,6 +168,7 @@ class LocalStack:
         """Serve the Alexa simulator (and the skill, in-process) at `POST /vahr/say`, in
         `locale`: its understanding data, and the locale of every request it sends."""
         from vahr.local.alexa.commands_seen import CommandLog
+        from vahr.local.alexa.envelope import Identity
         from vahr.local.alexa.nlu import InteractionModel
         from vahr.local.alexa.simulator import AlexaSimulator
         from vahr.local.alexa.skill import load_skill_handler
@@ -177,9 +182,13 @@ class LocalStack:
         # the first utterance waits for it.
         understanding = load_understanding(locale)
         model = InteractionModel.load(model_file, background=True, understanding=understanding)
+        # The skill serves one skill id, as on Lambda, and the simulated Echo's envelopes
+        # carry it: the handler's check runs here too (skill.skill_gate).
+        identity = Identity()
         handler = load_skill_handler(
             self.api_url,
             ack_timeout_s=ack_timeout_s,
+            skill_id=identity.skill_id,
             fleet_file=str(fleet_file) if fleet_file else None,
             log_level=log_level,
         )
@@ -192,7 +201,12 @@ class LocalStack:
                 service.publish(topics.ASSISTANT_TURNS, payload, qos=1, wait=False)
 
         simulator = AlexaSimulator(
-            model, handler, command_log=log.take, on_turn=publish_turn, locale=locale
+            model,
+            handler,
+            identity=identity,
+            command_log=log.take,
+            on_turn=publish_turn,
+            locale=locale,
         )
         self.alexa = simulator
 

@@ -275,7 +275,12 @@ class LocalSystem:
         if self.config.locale != SPOKEN_LOCALE:
             # Robots ask in English whatever the people speak: the room's Echo is English.
             model = InteractionModel(build_interaction_model(self.fleet), background=True)
-        room_echo = AlexaSimulator(model, self.alexa.handler)
+        from vahr.local.alexa.envelope import Identity
+
+        # Another Echo (its own user and device) of the same skill.
+        room_echo = AlexaSimulator(
+            model, self.alexa.handler, identity=Identity(self.alexa.identity.skill_id)
+        )
 
         def ask(request: str) -> str | None:
             turn = room_echo.say(f"alexa {request}")

@@ -136,6 +136,7 @@ def _simulator_for(
 ) -> Assistant:
     """The Alexa simulator and the real skill in this process, for AWS's iot-data endpoint."""
     from vahr.local.alexa import AlexaSimulator, CommandLog, InteractionModel, load_skill_handler
+    from vahr.local.alexa.envelope import Identity
 
     commands = CommandLog()
     # The skill publishes through iot-data; its commands are seen coming back from the broker.
@@ -149,9 +150,18 @@ def _simulator_for(
     else:
         model = InteractionModel.load(model_file)
     fleet_file = str(deployment.fleet_file) if deployment.fleet_file else None
+    # The skill in this process serves its simulated Echo's skill id, as on Lambda.
+    identity = Identity()
+    handler = load_skill_handler(
+        api,
+        ack_timeout_s=deployment.ack_timeout_s,
+        fleet_file=fleet_file,
+        skill_id=identity.skill_id,
+    )
     simulator = AlexaSimulator(
         model,
-        load_skill_handler(api, ack_timeout_s=deployment.ack_timeout_s, fleet_file=fleet_file),
+        handler,
+        identity=identity,
         command_log=commands.take,
         on_turn=lambda turn: feed.add_turn(turn.to_message()),
     )
