@@ -189,12 +189,14 @@ class LocalCA:
             _write_cert(self._cert, ca_file)
         return ClientCredentials(cert_file=cert_file, key_file=key_file, ca_file=ca_file)
 
-    def service_credentials(self) -> ClientCredentials:
-        """The local services' identity (CN `vahr-service`), issued once and reused."""
+    def service_credentials(self, name: str = SERVICE_COMMON_NAME) -> ClientCredentials:
+        """A local service's identity (CN `name`, by default `vahr-service`), issued once
+        and reused. The broker makes the common name the client id, so each service that
+        holds a connection of its own has a name of its own."""
         out = self.directory / "service"
         existing = ClientCredentials(
-            out / f"{SERVICE_COMMON_NAME}.cert.pem",
-            out / f"{SERVICE_COMMON_NAME}.private.key",
+            out / f"{name}.cert.pem",
+            out / f"{name}.private.key",
             out / "ca.crt",
         )
         if all(
@@ -202,4 +204,4 @@ class LocalCA:
             for p in (existing.cert_file, existing.key_file, existing.ca_file)
         ):
             return existing
-        return self.issue_client(SERVICE_COMMON_NAME, out)
+        return self.issue_client(name, out)

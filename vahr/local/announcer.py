@@ -23,6 +23,7 @@ from vahr.announce import (
     signals_from_presence,
 )
 from vahr.announce.speech import Names
+from vahr.local import identities
 from vahr.local.mqtt import MqttClient
 from vahr.protocol import ProtocolError, decode_event, decode_presence, encode, topics, utc_now
 from vahr.protocol.announcements import announcement_json
@@ -154,7 +155,7 @@ class LocalAnnouncer:
         *,
         tick_s: float = TICK_S,
     ) -> None:
-        self._client = MqttClient(endpoint, client_id="vahr-announcer-local")
+        self._client = MqttClient(endpoint, client_id=identities.ANNOUNCER)
         self.announcer = Announcer(fleet, settings, publish=self._publish)
         self._tick_s = tick_s
         self._stopping = threading.Event()

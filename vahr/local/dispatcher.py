@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
+from vahr.local import identities
 from vahr.local.mqtt import MqttClient
 from vahr.local.task_store import SqliteTaskStore
 from vahr.protocol import Pose, encode, topics
@@ -160,7 +161,7 @@ class LocalDispatcher:
     ) -> None:
         self.tasks = SqliteTaskStore.in_state_dir(state_dir)
         self.candidates = IndexCandidates(index, fleet)
-        self._client = MqttClient(endpoint, client_id="vahr-dispatcher-local")
+        self._client = MqttClient(endpoint, client_id=identities.DISPATCHER)
         self.dispatcher = Dispatcher(
             fleet=fleet, store=self.tasks, candidates=self.candidates, publish=self._publish
         )

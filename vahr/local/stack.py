@@ -1,9 +1,9 @@
 """The local stack without robots: broker, shadow service and data plane, started in order.
 
 `LocalStack` is what `vahr up`, `vahr demo`, the tests and the benchmarks share: it makes
-(or reuses) the local CA, writes the ACL, starts mosquitto with an mTLS listener (and an
-optional plaintext one), connects the shadow service and the data plane to it with the
-service identity, and serves the data-plane HTTP API. `stop()` undoes all of it.
+(or reuses) the local CA, writes the ACL, starts mosquitto with an mTLS listener (and, when
+asked for, a plaintext one), connects the shadow service and the data plane to it with
+their own identity, and serves the data-plane HTTP API. `stop()` undoes all of it.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from vahr.local import identities
 from vahr.local.acl import write_acl
 from vahr.local.broker import BrokerConfig, Mosquitto, TlsListener
 from vahr.local.dataplane import DataPlane, DataPlaneServer
@@ -79,10 +80,16 @@ class LocalStack:
         port = self.config.mqtt_port
         return f"mqtt://{LOOPBACK}:{port}" if port is not None else None
 
-    def service_endpoint(self) -> MqttEndpoint:
-        """How a local service connects: the mTLS listener with the service identity."""
+    def service_endpoint(self, identity: str = identities.TOOL) -> MqttEndpoint:
+        """How a local service connects: the mTLS listener as `identity`, one of
+        `vahr.local.identities.SERVICES` (each client its own: the broker makes the
+        identity the client id)."""
         assert self.ca is not None, "start() first"
-        return MqttEndpoint(port=self.config.mqtts_port, credentials=self.ca.service_credentials())
+        if identity not in identities.SERVICES:
+            raise ValueError(f"identity: {identity!r} is not one of the stack's services")
+        return MqttEndpoint(
+            port=self.config.mqtts_port, credentials=self.ca.service_credentials(identity)
+        )
 
     @property
     def database(self) -> Path:
@@ -105,9 +112,7 @@ class LocalStack:
             raise
         try:
             self.ca = LocalCA.load_or_create(cfg.state_dir)
-            acl = write_acl(
-                cfg.state_dir / "broker" / "acl", open_anonymous=cfg.mqtt_port is not None
-            )
+            acl = write_acl(cfg.state_dir / "broker" / "acl")
             self.broker = Mosquitto(
                 BrokerConfig(
                     state_dir=cfg.state_dir / "broker",
@@ -127,8 +132,8 @@ class LocalStack:
             # back, as AWS's shadow service never misses one. With a clean session they
             # were dropped, and a robot that then stayed idle left its shadow stale.
             self._service_client = MqttClient(
-                self.service_endpoint(),
-                client_id="vahr-shadow-service",
+                self.service_endpoint(identities.SHADOWS),
+                client_id=identities.SHADOWS,
                 session_expiry_s=SHADOW_SESSION_EXPIRY_S,
             )
             client = self._service_client

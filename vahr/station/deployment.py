@@ -135,8 +135,13 @@ def _simulator_for(
     api: str, model_file: Path | None, deployment: Deployment, feed: Feed, link: MqttClient
 ) -> Assistant:
     """The Alexa simulator and the real skill in this process, for AWS's iot-data endpoint."""
-    from vahr.local.alexa import AlexaSimulator, CommandLog, InteractionModel, load_skill_handler
-    from vahr.local.alexa.envelope import Identity
+    from vahr.local.alexa import (
+        AlexaSimulator,
+        CommandLog,
+        Identity,
+        InteractionModel,
+        load_skill_handler,
+    )
 
     commands = CommandLog()
     # The skill publishes through iot-data; its commands are seen coming back from the broker.
