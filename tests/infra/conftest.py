@@ -9,14 +9,14 @@ from typing import TYPE_CHECKING, Any
 import aws_cdk as cdk
 import pytest
 from aws_cdk.assertions import Template
-from template_tools import cdk_context
+from template_tools import SKILL_ID, cdk_context
 
 from infra.app import build_app
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-SKILL_ID = "amzn1.ask.skill.0d5c1d3e-52b4-4a53-9f0e-6f1a2b3c4d5e"
+__all__ = ["SKILL_ID", "Synthesized", "synth_app"]
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ def synth_app(outdir: Path, **context: Any) -> Synthesized:
 
 @pytest.fixture(scope="session")
 def lean_app(tmp_path_factory: pytest.TempPathFactory) -> Synthesized:
-    """The default deployment: no optional parts."""
+    """The default deployment for a skill whose id is known: no optional parts."""
     return synth_app(tmp_path_factory.mktemp("lean"))
 
 
