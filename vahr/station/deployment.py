@@ -32,6 +32,7 @@ from vahr.local.client import HttpAssistant, SimulatorAssistant
 from vahr.local.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
 from vahr.protocol.broker import parse_broker_url
+from vahr.protocol.identities import STATION_CLIENT_PREFIX
 from vahr.station.feed import Feed
 from vahr.station.station import Station, StationConfig
 
@@ -45,7 +46,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-CLIENT_ID_PREFIX = "vahr-station-"
+CLIENT_ID_PREFIX = STATION_CLIENT_PREFIX
 HEALTH_TIMEOUT_S = 3.0
 
 
