@@ -323,8 +323,10 @@ class StationServer:
         # and port): its requests' Origin is this one.
         self.public_origin = public_origin.rstrip("/") if public_origin else None
         self.idle_timeout_s = idle_timeout_s
-        # Off the loopback interface the station is reachable by others: a token guards it.
-        self.token = token or (None if is_loopback(host) else secrets.token_urlsafe(18))
+        # Off the loopback interface, or behind a proxy, the station is reachable by others:
+        # a token guards it.
+        reachable = not is_loopback(host) or self.public_origin is not None
+        self.token = token or (secrets.token_urlsafe(18) if reachable else None)
         pages = [*STATIC.iterdir(), *LOCALES.iterdir()]
         self._files = {p.name: p for p in pages if p.suffix in CONTENT_TYPES}
         self._streams = 0

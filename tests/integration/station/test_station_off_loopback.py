@@ -142,6 +142,9 @@ def test_behind_a_reverse_proxy_its_https_origin_is_the_pages_own(fleet: Fleet) 
         assert post("null") == 403
         # And the cookie is Secure: the people's side of the proxy is HTTPS
         assert "; Secure" in running.cookie()
+    # Behind a proxy on loopback, the station is reachable by others too: a token guards it
+    with StationServer(make_app(fleet), port=free_port(), public_origin=public) as proxied:
+        assert proxied.token is not None
 
 
 def test_an_idle_connection_is_closed_and_frees_its_thread(fleet: Fleet) -> None:
