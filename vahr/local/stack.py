@@ -112,6 +112,10 @@ class LocalStack:
             raise
         try:
             self.ca = LocalCA.load_or_create(cfg.state_dir)
+            # Every identity the ACL names, issued once (a tool beside the stack, such as
+            # `vahr station`, finds its certificate in STATE/pki/service/).
+            for identity in identities.SERVICES:
+                self.ca.service_credentials(identity)
             acl = write_acl(cfg.state_dir / "broker" / "acl")
             self.broker = Mosquitto(
                 BrokerConfig(
