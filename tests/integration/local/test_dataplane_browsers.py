@@ -304,3 +304,19 @@ def test_a_page_open_in_chromium_moves_no_robot(
         server.server_close()
     assert commands.after_marker(iot_data) == [(topics.FLEET_CMD, MARKER)]
     assert _shadow_version(local_stack, "placebot1") == before
+
+
+def test_a_configured_host_name_is_served(local_stack: LocalStack) -> None:
+    # Given the data plane told of a proxy's or a tunnel's name (vahr up --api-host)
+    from vahr.local.dataplane import DataPlaneServer
+
+    assert local_stack.dataplane is not None
+    port = free_port()
+    with DataPlaneServer(local_stack.dataplane, port, hosts=frozenset({"robots.lab"})):
+        for host, expected in ((f"robots.lab:{port}", 200), (f"other.lab:{port}", 421)):
+            connection = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+            try:
+                connection.request("GET", "/vahr/health", headers={"Host": host})
+                assert connection.getresponse().status == expected, host
+            finally:
+                connection.close()
