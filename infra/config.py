@@ -101,6 +101,12 @@ class InfraConfig:
     def from_context(cls, get: Callable[[str], Any]) -> InfraConfig:
         """Read every known key through `get` (e.g. `app.node.try_get_context`)."""
         defaults = cls()
+        if get("operatorPolicyName") is not None:
+            # One policy for the station and the recorder became one each.
+            raise VahrError(
+                "operatorPolicyName: the station and the recorder now have a policy each; "
+                "give stationPolicyName and recorderPolicyName"
+            )
         skill_id = _text(get, "skillId") or ask_states_skill_id(
             _path(get, "askStatesFile", REPO_ROOT / ".ask" / "ask-states.json"),
             _text(get, "askProfile") or "default",

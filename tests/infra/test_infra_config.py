@@ -59,6 +59,7 @@ def test_relative_paths_are_from_the_repository_root() -> None:
         ({"allowAnySkill": "perhaps"}, "allowAnySkill: 'perhaps' is not true or false"),
         ({"deviceDefenderAudit": "2"}, "deviceDefenderAudit: '2' is not true or false"),
         ({"alarmEmail": "ops"}, "alarmEmail: 'ops' is not an email address"),
+        ({"operatorPolicyName": "x"}, "operatorPolicyName: the station and the recorder now"),
     ],
 )
 def test_bad_values_are_refused_with_the_key_and_the_reason(
