@@ -117,8 +117,9 @@ class _Handler(QuietHandler):
     server: _Server
 
     def setup(self) -> None:
-        self.timeout = self.server.station.idle_timeout_s
         super().setup()
+        # Every read and write of the connection waits at most this long.
+        self.connection.settimeout(self.server.station.idle_timeout_s)
 
     # -- plumbing -------------------------------------------------------------------------
 
