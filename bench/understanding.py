@@ -90,7 +90,7 @@ def up_seconds(checkout: Path, cache_home: Path) -> tuple[float, float]:
             "--api-port",
             str(api),
             "--mqtt-port",
-            str(free_port()),
+            "0",
             "--mqtts-port",
             str(free_port()),
         ]

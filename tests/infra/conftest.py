@@ -8,7 +8,7 @@ from synthesis import SKILL_ID, Synthesized, synth_app
 
 @pytest.fixture(scope="session")
 def lean_app(tmp_path_factory: pytest.TempPathFactory) -> Synthesized:
-    """The default deployment: no optional parts."""
+    """The default deployment for a skill whose id is known: no optional parts."""
     return synth_app(tmp_path_factory.mktemp("lean"))
 
 

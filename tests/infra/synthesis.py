@@ -19,8 +19,6 @@ from infra.app import build_app
 if TYPE_CHECKING:
     from pathlib import Path
 
-SKILL_ID = "amzn1.ask.skill.0d5c1d3e-52b4-4a53-9f0e-6f1a2b3c4d5e"
-
 
 @dataclass(frozen=True)
 class Synthesized:
