@@ -104,8 +104,8 @@ def main() -> int:
     samples: list[dict[str, float]] = []
     with tempfile.TemporaryDirectory(prefix="vahr-announcement-bench-") as folder:
         up = start_up(
-            Path(folder), "--mqtt-port", str(free_port()), "--station-port", str(free_port()),
-            "--sim-speed-factor", f"{args.speed:g}",
+            Path(folder), "--station-port", str(free_port()),
+            "--sim-speed-factor", f"{args.speed:g}", plaintext=True,
         )  # fmt: skip
         try:
             address = parse_broker_url(up.endpoints["mqtt"])

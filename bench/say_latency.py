@@ -28,6 +28,7 @@ from vahr.plumbing.client import say  # noqa: E402
 from vahr.plumbing.mqtt import MqttClient  # noqa: E402
 from vahr.plumbing.ports import free_port  # noqa: E402
 from vahr.protocol import topics  # noqa: E402
+from vahr.twin import identities  # noqa: E402
 
 ZONES = ("zone b", "zone c", "zone d", "zone a")
 
@@ -42,8 +43,10 @@ def mqtt_round_trips(system: LocalSystem, samples: int) -> list[float]:
         received.set()
 
     timings: list[float] = []
-    endpoint = system.stack.service_endpoint()
-    with MqttClient(endpoint) as sender, MqttClient(endpoint) as receiver:
+    # Two identities: the broker makes each the client id, and one would take the other over.
+    sender_at = system.stack.service_endpoint(identities.TOOL)
+    receiver_at = system.stack.service_endpoint(identities.SECOND_TOOL)
+    with MqttClient(sender_at) as sender, MqttClient(receiver_at) as receiver:
         receiver.subscribe("bench/latency", on_message)
         for _ in range(samples):
             received.clear()

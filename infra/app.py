@@ -4,7 +4,8 @@ Context flags (cdk.json or `-c key=value`): `skill=true` adds the Alexa skill, `
 the Lex bot and the robots' role alias, `announcer=true` the announcer, `dispatcher=true`
 the fleet dispatcher with fleet indexing (`taskTableDeletionProtection`); `skillId`,
 `vendorId`, `lwaSecretName`, `architecture`, `fleetFile`, `logRetentionDays`, `ackTimeoutS`,
-`logLevel`, `stackName`, `robotPolicyName`, `operatorPolicyName`, `roleAliasName`,
+`logLevel`, `stackName`, `robotPolicyName`, `stationPolicyName`, `recorderPolicyName`,
+`roleAliasName`, `allowAnySkill`, `alarmEmail`, `iotLogging`, `deviceDefenderAudit`,
 `weatherAnswersFile` (docs/deploy.md lists them all).
 cdk-nag's AwsSolutions checks run on the whole app; synth fails on any finding that the
 stack has not acknowledged with a reason.

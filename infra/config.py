@@ -30,6 +30,7 @@ LOG_RETENTION_NAMES = {
 }  # fmt: skip
 _SKILL_ID = re.compile(r"^amzn1\.ask\.skill\.[0-9a-f-]{36}$")
 _NAME = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
+_EMAIL = re.compile(r"^[^@\s]+@[^@\s]+\.[^@\s]+$")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -45,13 +46,18 @@ class InfraConfig:
     ack_timeout_s: float = 2.5
     log_level: str = "INFO"
     robot_policy_name: str = "vahr-robot-policy"
-    operator_policy_name: str = "vahr-operator-policy"
+    # The operator station's and the experiment recorder's certificates, each its own.
+    station_policy_name: str = "vahr-station-policy"
+    recorder_policy_name: str = "vahr-recorder-policy"
     thing_group_name: str = "vahr-robots"
     presence_rule_name: str = "vahr_presence_to_shadow"
     # Known only after the skill exists (`ask deploy` prints it and keeps it in
     # .ask/ask-states.json, read when no skillId is given); when set, only that skill may
     # invoke the function and the handler checks the applicationId.
     skill_id: str | None = None
+    # With no skill id and no skill in the stack, synth stops unless this says that any
+    # Alexa skill may invoke the function (and the handler then serves any skill).
+    allow_any_skill: bool = False
     skill: bool = False
     skill_package_dir: Path = REPO_ROOT / "skill-package"
     lwa_secret_name: str = "vahr/lwa"
@@ -77,11 +83,30 @@ class InfraConfig:
     dispatcher_rule_name: str = "vahr_dispatcher_robot_freed"
     # On: the table survives `cdk destroy` and cannot be deleted by accident.
     task_table_deletion_protection: bool = False
+    # What lets AWS see trouble (infra/constructs/iot_logging.py, device_audit.py,
+    # alarms.py). Logging and the audit are the account's one configuration in the
+    # region: off where another stack already owns it.
+    iot_logging: bool = True
+    device_audit: bool = True
+    # Where the alarms are mailed (an SNS subscription to confirm); none: subscribe later.
+    alarm_email: str | None = None
+
+    def skill_invocation(self) -> SkillInvocation:
+        """Which Alexa skill may invoke the skill function: the one whose id is given, the
+        one the stack creates, or (said by name) any; a VahrError naming the flags when
+        none of them is."""
+        return _skill_invocation(self)
 
     @classmethod
     def from_context(cls, get: Callable[[str], Any]) -> InfraConfig:
         """Read every known key through `get` (e.g. `app.node.try_get_context`)."""
         defaults = cls()
+        if get("operatorPolicyName") is not None:
+            # One policy for the station and the recorder became one each.
+            raise VahrError(
+                "operatorPolicyName: the station and the recorder now have a policy each; "
+                "give stationPolicyName and recorderPolicyName"
+            )
         skill_id = _text(get, "skillId") or ask_states_skill_id(
             _path(get, "askStatesFile", REPO_ROOT / ".ask" / "ask-states.json"),
             _text(get, "askProfile") or "default",
@@ -113,10 +138,12 @@ class InfraConfig:
             ack_timeout_s=ack_timeout,
             log_level=(_text(get, "logLevel") or defaults.log_level).upper(),
             robot_policy_name=_text(get, "robotPolicyName") or defaults.robot_policy_name,
-            operator_policy_name=(
-                _text(get, "operatorPolicyName") or defaults.operator_policy_name
+            station_policy_name=(_text(get, "stationPolicyName") or defaults.station_policy_name),
+            recorder_policy_name=(
+                _text(get, "recorderPolicyName") or defaults.recorder_policy_name
             ),
             skill_id=skill_id,
+            allow_any_skill=_flag(get, "allowAnySkill"),
             skill=_flag(get, "skill"),
             skill_package_dir=_path(get, "skillPackageDir", defaults.skill_package_dir),
             lwa_secret_name=_text(get, "lwaSecretName") or defaults.lwa_secret_name,
@@ -133,7 +160,13 @@ class InfraConfig:
             announce_settings=_announce_settings(get("announce")),
             dispatcher=_flag(get, "dispatcher"),
             task_table_deletion_protection=_flag(get, "taskTableDeletionProtection"),
+            iot_logging=_flag(get, "iotLogging", default=True),
+            device_audit=_flag(get, "deviceDefenderAudit", default=True),
+            alarm_email=_text(get, "alarmEmail"),
         )
+        config.skill_invocation()
+        if config.alarm_email is not None and not _EMAIL.match(config.alarm_email):
+            raise VahrError(f"alarmEmail: {config.alarm_email!r} is not an email address")
         if config.alexa_region not in ("NA", "EU", "FE"):
             raise VahrError(f"alexaRegion: {config.alexa_region!r} must be NA, EU or FE")
         if config.announcer_stage not in ("development", "live"):
@@ -142,7 +175,8 @@ class InfraConfig:
             )
         for key, value in (
             ("robotPolicyName", config.robot_policy_name),
-            ("operatorPolicyName", config.operator_policy_name),
+            ("stationPolicyName", config.station_policy_name),
+            ("recorderPolicyName", config.recorder_policy_name),
             ("roleAliasName", config.role_alias_name),
         ):
             if not _NAME.match(value):
@@ -150,6 +184,23 @@ class InfraConfig:
         if config.log_level not in ("DEBUG", "INFO", "WARNING", "ERROR"):
             raise VahrError(f"logLevel: {config.log_level!r} must be DEBUG, INFO, WARNING or ERROR")
         return config
+
+
+SkillInvocation = Literal["skill_id", "stack_skill", "any_skill"]
+
+
+def _skill_invocation(config: InfraConfig) -> SkillInvocation:
+    if config.skill_id is not None:
+        return "skill_id"
+    if config.skill:
+        return "stack_skill"
+    if config.allow_any_skill:
+        return "any_skill"
+    raise VahrError(
+        "skillId: none is known, so any Alexa skill could invoke the skill function; give "
+        "-c skillId=amzn1.ask.skill... (ask deploy prints it), create the skill with the "
+        "stack (-c skill=true), or accept that risk with -c allowAnySkill=true"
+    )
 
 
 def _announce_settings(value: Any) -> str:
@@ -189,10 +240,12 @@ def _text(get: Callable[[str], Any], key: str) -> str | None:
     return str(value)
 
 
-def _flag(get: Callable[[str], Any], key: str) -> bool:
+def _flag(get: Callable[[str], Any], key: str, *, default: bool = False) -> bool:
     value = get(key)
-    if value is None or isinstance(value, bool):
-        return bool(value)
+    if value is None:
+        return default
+    if isinstance(value, bool):
+        return value
     text = str(value).strip().lower()
     if text in ("true", "1", "yes", "on"):
         return True

@@ -1,7 +1,7 @@
 """Build the parts of one robot from its configuration: clock, backend, voice, link, agent.
 
-Adapters are imported only when chosen, so the simulator never loads rospy and the
-plaintext link never reads certificates.
+Adapters are imported only when chosen, so the simulator never loads rospy or rclpy and
+the plaintext link never reads certificates.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from robot_agent.agent import RobotAgent
+from robot_agent.backends.port import BatteryGauge
 from robot_agent.backends.sim import SimBackend
 from robot_agent.core.in_flight import InFlight
 from robot_agent.core.recent_ids import RecentIds
@@ -44,6 +45,15 @@ def build_backend(config: AgentConfig, fleet: Fleet, clock: ScaledClock) -> Navi
                 "install ros-core and python3-move-base-msgs, then run make setup"
             ) from err
         return Ros1Backend(config.ros, start=fleet.robot(thing).start)
+    if config.backend == "nav2":
+        try:
+            from robot_agent.backends.nav2 import Nav2Backend
+        except ImportError as err:
+            raise VahrError(
+                f"--backend nav2 needs ROS 2's rclpy and nav2_msgs ({err}); run robot-agent "
+                "from .venv-ros2 (make setup makes it), or next to the robot's own ROS 2"
+            ) from err
+        return Nav2Backend(config.nav2, start=fleet.robot(thing).start)
     return SimBackend(start=fleet.robot(thing).start, clock=clock, settings=config.sim)
 
 
@@ -138,14 +148,18 @@ def build_agent(
 ) -> RobotAgent:
     thing = str(config.thing)
     state_dir = Path(config.state_dir) / "robots" / thing
-    return RobotAgent(
+    backend = build_backend(config, fleet, clock)
+    agent = RobotAgent(
         thing=thing,
         fleet=fleet,
         link=link,
-        backend=build_backend(config, fleet, clock),
+        backend=backend,
         clock=clock,
         recent_ids=RecentIds(state_dir / "recent-ids.json"),
         voice=voice,
         settings=config.executor,
         in_flight=InFlight(state_dir / "in-flight.json"),
     )
+    if isinstance(backend, BatteryGauge):
+        backend.watch_battery(agent.executor.report_battery)
+    return agent

@@ -2,9 +2,9 @@
 flags, parsed and validated at start-up into `AgentConfig`.
 
 Each adapter's settings struct is its section of the config, with its limits: `sim`
-(`SimBackend`), `ros` (`Ros1Backend`), `executor` (the core), `mqtt` (the awscrt link) and
-`voice` (which voice, its synthesizer, devices and interpreter). The adapters take these
-very structs; nothing copies them field by field.
+(`SimBackend`), `ros` (`Ros1Backend`), `nav2` (`Nav2Backend`), `executor` (the core), `mqtt`
+(the awscrt link) and `voice` (which voice, its synthesizer, devices and interpreter). The
+adapters take these very structs; nothing copies them field by field.
 
 Environment variables map onto the config in one place, `ENVIRONMENT` below:
 `VAHR_AGENT_<FIELD>` for the top-level fields (e.g. `VAHR_AGENT_THING`,
@@ -95,6 +95,30 @@ class Ros1Settings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, fro
     shutdown_node_on_close: bool = True
 
 
+class Nav2Settings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
+    """The ROS 2 Nav2 backend (`robot_agent.backends.nav2`)."""
+
+    # bt_navigator's NavigateToPose action, and the frame the zones' poses are in.
+    action: str = "navigate_to_pose"
+    frame: str = "map"
+    # The robot's sensor_msgs/BatteryState topic (empty: the shadow reports no battery).
+    battery_topic: str = "battery_state"
+    # The goal's behavior_tree (empty: bt_navigator's default tree).
+    behavior_tree: str = ""
+    node_name: str = "vahr_robot_agent"
+    # None: ROS_DOMAIN_ID from the environment, as every ROS 2 node does.
+    domain_id: Annotated[int, msgspec.Meta(ge=0, le=232)] | None = None
+    # How long a goal waits for the action server to be there, for it to accept or reject
+    # the goal, and for it to confirm a cancel; and how long an accepted goal may go without
+    # a word from the server (bt_navigator sends feedback on every tick while it navigates).
+    server_timeout_s: Positive = 5.0
+    answer_timeout_s: Positive = 5.0
+    feedback_timeout_s: Positive = 5.0
+    # Nav2 has no arm: the loading and unloading arms are timed like the simulator's.
+    loader_delay_s: NonNegative = 3.0
+    unloader_delay_s: NonNegative = 3.0
+
+
 class MqttSettings(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, frozen=True):
     """The awscrt link's session (`robot_agent.link.mqtt5`)."""
 
@@ -156,7 +180,7 @@ class AgentConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, froz
     ca: str | None = None
     broker: str | None = None
     client_id: str | None = None
-    backend: Literal["sim", "ros1"] = "sim"
+    backend: Literal["sim", "ros1", "nav2"] = "sim"
     fleet_file: str | None = None
     state_dir: str = ".state"
     log_level: Literal["DEBUG", "INFO", "WARNING", "ERROR"] = "INFO"
@@ -164,6 +188,7 @@ class AgentConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, froz
     sim: SimSettings = SimSettings()
     executor: ExecutorSettings = ExecutorSettings()
     ros: Ros1Settings = Ros1Settings()
+    nav2: Nav2Settings = Nav2Settings()
     mqtt: MqttSettings = MqttSettings()
     voice: VoiceSettings = VoiceSettings()
 
@@ -191,7 +216,7 @@ class AgentConfig(msgspec.Struct, kw_only=True, forbid_unknown_fields=True, froz
                     raise VahrError(f"--{name} {value}: no such file")
         if not 0 < self.sim_speed_factor < math.inf:
             raise VahrError("--sim-speed-factor must be greater than 0")
-        if self.backend == "ros1" and self.sim_speed_factor != 1.0:
+        if self.backend in ("ros1", "nav2") and self.sim_speed_factor != 1.0:
             raise VahrError(
                 "--sim-speed-factor applies to the sim backend only; ROS runs in real time"
             )

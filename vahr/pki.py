@@ -65,6 +65,14 @@ def _name(common_name: str) -> x509.Name:
     )
 
 
+def _subject_name(name: str) -> x509.GeneralName:
+    """A SAN entry: an IP address as one, anything else as a DNS name."""
+    try:
+        return x509.IPAddress(ipaddress.ip_address(name))
+    except ValueError:
+        return x509.DNSName(name)
+
+
 class LocalCA:
     """A CA kept in `state_dir/pki/`; `load_or_create` makes it on first use."""
 
@@ -142,7 +150,26 @@ class LocalCA:
         _write_cert(cert, directory / "ca.crt")
         return cls(directory, key, cert)
 
-    def _issue(self, common_name: str, cert_file: Path, key_file: Path, *, server: bool) -> None:
+    def issue_server(self, names: list[str], out_dir: Path) -> tuple[Path, Path]:
+        """A server certificate for `names` (host names or IP addresses; the first is its
+        common name) written to `out_dir` as `server.crt` and `server.key`: the operator
+        station's HTTPS, for browsers that trust this CA."""
+        if not names:
+            raise VahrError("a server certificate needs at least one name")
+        out_dir = Path(out_dir)
+        cert_file, key_file = out_dir / "server.crt", out_dir / "server.key"
+        self._issue(names[0], cert_file, key_file, server=True, names=names)
+        return cert_file, key_file
+
+    def _issue(
+        self,
+        common_name: str,
+        cert_file: Path,
+        key_file: Path,
+        *,
+        server: bool,
+        names: list[str] | None = None,
+    ) -> None:
         key = _new_key()
         now = dt.datetime.now(dt.UTC)
         builder = (
@@ -161,7 +188,7 @@ class LocalCA:
         if server:
             builder = builder.add_extension(
                 x509.SubjectAlternativeName(
-                    [x509.DNSName("localhost"), x509.IPAddress(ipaddress.ip_address("127.0.0.1"))]
+                    [_subject_name(name) for name in names or ["localhost", "127.0.0.1"]]
                 ),
                 critical=False,
             ).add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH]), False)
@@ -189,12 +216,14 @@ class LocalCA:
             _write_cert(self._cert, ca_file)
         return ClientCredentials(cert_file=cert_file, key_file=key_file, ca_file=ca_file)
 
-    def service_credentials(self) -> ClientCredentials:
-        """The local services' identity (CN `vahr-service`), issued once and reused."""
+    def service_credentials(self, name: str = SERVICE_COMMON_NAME) -> ClientCredentials:
+        """A local service's identity (CN `name`, by default `vahr-service`), issued once
+        and reused. The broker makes the common name the client id, so each service that
+        holds a connection of its own has a name of its own."""
         out = self.directory / "service"
         existing = ClientCredentials(
-            out / f"{SERVICE_COMMON_NAME}.cert.pem",
-            out / f"{SERVICE_COMMON_NAME}.private.key",
+            out / f"{name}.cert.pem",
+            out / f"{name}.private.key",
             out / "ca.crt",
         )
         if all(
@@ -202,4 +231,4 @@ class LocalCA:
             for p in (existing.cert_file, existing.key_file, existing.ca_file)
         ):
             return existing
-        return self.issue_client(SERVICE_COMMON_NAME, out)
+        return self.issue_client(name, out)

@@ -5,6 +5,14 @@ Login-with-Amazon client and refresh token; they are read from Secrets Manager a
 time (never stored in the template). The package is uploaded as an S3 asset that only the
 Alexa service role can read, and the endpoint is overridden with the function's ARN, so the
 `skill.json` in the repository needs no account-specific value.
+
+Given `skill_id_parameter` (the skill's id was not known at synth), it also locks the
+function to this skill in the one deployment: Alexa checks at creation that it may invoke
+the endpoint, before the skill's id exists, so an invocation grant without a skill id
+(`AllowSkillCreation`, statement `CREATION_STATEMENT`) is added just before the skill is
+created; then the permission carrying the new skill's id as `EventSourceToken`, the id
+written to the SSM parameter the handler reads, and finally the creation grant removed
+(`CloseSkillCreation`). From then on only this skill may invoke the function.
 """
 
 from __future__ import annotations
@@ -14,7 +22,10 @@ from typing import TYPE_CHECKING
 import aws_cdk as cdk
 from aws_cdk import alexa_ask
 from aws_cdk import aws_iam as iam
+from aws_cdk import aws_lambda as lambda_
 from aws_cdk import aws_s3_assets as s3_assets
+from aws_cdk import aws_ssm as ssm
+from aws_cdk import custom_resources as cr
 from constructs import Construct
 
 from vahr.errors import VahrError
@@ -22,10 +33,13 @@ from vahr.errors import VahrError
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from aws_cdk import aws_lambda as lambda_
+    from aws_cdk import aws_logs as logs
 
 # The keys of the JSON secret (see docs/deploy.md, "Login with Amazon").
 SECRET_KEYS = ("clientId", "clientSecret", "refreshToken", "vendorId")
+ALEXA = "alexa-appkit.amazon.com"
+# The statement of the grant Alexa's creation check needs, removed once the skill exists.
+CREATION_STATEMENT = "VahrAlexaSkillCreation"
 
 
 class AlexaSkill(Construct):
@@ -40,6 +54,8 @@ class AlexaSkill(Construct):
         function: lambda_.IFunction,
         lwa_secret_name: str,
         vendor_id: str | None,
+        skill_id_parameter: str | None = None,
+        provider_logs: logs.ILogGroup | None = None,
     ) -> None:
         super().__init__(scope, construct_id)
         if not (package_dir / "skill.json").is_file():
@@ -85,3 +101,72 @@ class AlexaSkill(Construct):
         # Alexa checks at creation that it may invoke the endpoint.
         self.skill.node.add_dependency(function)
         self.skill_id: str = self.skill.ref
+        self.skill_only: lambda_.CfnPermission | None = None
+        self.skill_id_parameter: ssm.StringParameter | None = None
+        if skill_id_parameter is not None:
+            self._lock_to_this_skill(function, skill_id_parameter, provider_logs)
+
+    def _lock_to_this_skill(
+        self, function: lambda_.IFunction, parameter: str, provider_logs: logs.ILogGroup | None
+    ) -> None:
+        grant = {
+            "FunctionName": function.function_arn,
+            "StatementId": CREATION_STATEMENT,
+            "Action": "lambda:InvokeFunction",
+            "Principal": ALEXA,
+        }
+        remove = cr.AwsSdkCall(
+            service="Lambda",
+            action="removePermission",
+            parameters={"FunctionName": function.function_arn, "StatementId": CREATION_STATEMENT},
+            physical_resource_id=cr.PhysicalResourceId.of(CREATION_STATEMENT),
+            ignore_error_codes_matching="ResourceNotFoundException",
+        )
+        policy = cr.AwsCustomResourcePolicy.from_statements(
+            [
+                iam.PolicyStatement(
+                    actions=["lambda:AddPermission", "lambda:RemovePermission"],
+                    resources=[function.function_arn],
+                )
+            ]
+        )
+        opened = cr.AwsCustomResource(
+            self,
+            "AllowSkillCreation",
+            on_create=cr.AwsSdkCall(
+                service="Lambda",
+                action="addPermission",
+                parameters=grant,
+                physical_resource_id=cr.PhysicalResourceId.of(CREATION_STATEMENT),
+            ),
+            on_delete=remove,
+            policy=policy,
+            install_latest_aws_sdk=False,
+            log_group=provider_logs,
+        )
+        self.skill.node.add_dependency(opened)
+        self.skill_only = lambda_.CfnPermission(
+            self,
+            "InvokeByThisSkillOnly",
+            action="lambda:InvokeFunction",
+            function_name=function.function_arn,
+            principal=ALEXA,
+            event_source_token=self.skill.ref,
+        )
+        self.skill_id_parameter = ssm.StringParameter(
+            self,
+            "SkillId",
+            parameter_name=parameter,
+            string_value=self.skill.ref,
+            description="The VAHR skill's id: the one skill its function serves",
+        )
+        closed = cr.AwsCustomResource(
+            self,
+            "CloseSkillCreation",
+            on_create=remove,
+            on_update=remove,
+            policy=policy,
+            install_latest_aws_sdk=False,
+            log_group=provider_logs,
+        )
+        closed.node.add_dependency(self.skill_only, self.skill_id_parameter)

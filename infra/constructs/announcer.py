@@ -34,7 +34,7 @@ from aws_cdk import aws_sqs as sqs
 from constructs import Construct
 
 from infra.constructs.python_function import python_function
-from infra.constructs.topic_rule import lambda_topic_rule
+from infra.constructs.topic_rule import lambda_topic_rule, rule_role
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
@@ -157,16 +157,20 @@ class Announcer(Construct):
                 "VAHR_LOG_LEVEL": config.log_level,
             },
         )
-        self.rule_role = iam.Role(
+        names = {
+            "Events": f"{config.announcer_rule_prefix}_events",
+            "Presence": f"{config.announcer_rule_prefix}_presence",
+        }
+        self.rule_role = rule_role(
             self,
             "RuleRole",
-            assumed_by=iam.ServicePrincipal("iot.amazonaws.com"),
+            rule_names=list(names.values()),
             description="Lets the VAHR announcer rules dead-letter what they cannot deliver",
         )
         self.dead_letters.grant_send_messages(self.rule_role)
         self.rules = [
-            self._rule("Events", f"{config.announcer_rule_prefix}_events", events_sql()),
-            self._rule("Presence", f"{config.announcer_rule_prefix}_presence", presence_sql()),
+            self._rule("Events", names["Events"], events_sql()),
+            self._rule("Presence", names["Presence"], presence_sql()),
         ]
         # A tick EventBridge cannot deliver is not retried: the next one, a minute later,
         # does the same work (and the held announcements stay in the state meanwhile).

@@ -30,7 +30,7 @@ from constructs import Construct
 
 from infra.constructs.fleet_indexing import INDEX_NAME
 from infra.constructs.python_function import python_function
-from infra.constructs.topic_rule import lambda_topic_rule
+from infra.constructs.topic_rule import lambda_topic_rule, rule_role
 from vahr.dispatch import IDLE_STATUSES
 from vahr.protocol import topics
 
@@ -151,10 +151,10 @@ class Dispatcher(Construct):
                 "VAHR_LOG_LEVEL": config.log_level,
             },
         )
-        self.rule_role = iam.Role(
+        self.rule_role = rule_role(
             self,
             "RuleRole",
-            assumed_by=iam.ServicePrincipal("iot.amazonaws.com"),
+            rule_names=[config.dispatcher_rule_name],
             description="Lets the VAHR dispatcher rule dead-letter what it cannot deliver",
         )
         self.dead_letters.grant_send_messages(self.rule_role)

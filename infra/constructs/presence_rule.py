@@ -15,6 +15,7 @@ from aws_cdk import aws_iam as iam
 from aws_cdk import aws_iot as iot
 from constructs import Construct
 
+from infra.constructs.topic_rule import rule_role
 from vahr.protocol import topics
 
 if TYPE_CHECKING:
@@ -51,10 +52,10 @@ class PresenceRule(Construct):
     ) -> None:
         super().__init__(scope, construct_id)
         stack = cdk.Stack.of(self)
-        self.role = iam.Role(
+        self.role = rule_role(
             self,
             "Role",
-            assumed_by=iam.ServicePrincipal("iot.amazonaws.com"),
+            rule_names=[rule_name],
             description="Lets the VAHR presence rule update the fleet's shadows",
         )
         # One statement, one ARN per robot: a presence message for any other thing name is

@@ -2,8 +2,18 @@
 
 The function may publish only to the robots' command topics and the fleet topic, read only
 the fleet's shadows, and read and update only the experiment thing's shadow. It logs to its
-own log group with a retention period, and Alexa may invoke it (only the configured skill,
-once its id is known).
+own log group with a retention period.
+
+Which Alexa skill may invoke it, and which the handler serves (skill.skill_gate), is one
+of three, decided at synth (infra.config refuses a stack that says none of them):
+
+- a skill id given (`-c skillId=`, or `.ask/ask-states.json` after `ask deploy`): the
+  permission carries it as `EventSourceToken` and the handler gets it as `VAHR_SKILL_ID`;
+- the skill created by the stack (`-c skill=true`): its id exists only once the skill
+  does, so `AlexaSkill` grants the permission and writes the id into an SSM parameter,
+  which the handler reads (`VAHR_SKILL_ID_PARAMETER`);
+- `-c allowAnySkill=true`: any skill may invoke it and the handler serves any
+  (`VAHR_ALLOW_ANY_SKILL`), a risk the user took by name.
 """
 
 from __future__ import annotations
@@ -103,8 +113,30 @@ class SkillFunction(Construct):
             "VAHR_ACK_TIMEOUT_S": f"{config.ack_timeout_s:g}",
             "VAHR_LOG_LEVEL": config.log_level,
         }
+        invocation = config.skill_invocation()
+        # The parameter a stack-made skill's id is written to (None: the id is known here).
+        self.skill_id_parameter = (
+            skill_id_parameter_name(stack.stack_name) if invocation == "stack_skill" else None
+        )
         if config.skill_id:
             environment["VAHR_SKILL_ID"] = config.skill_id
+        elif self.skill_id_parameter is not None:
+            environment["VAHR_SKILL_ID_PARAMETER"] = self.skill_id_parameter
+            self.role.add_to_policy(
+                iam.PolicyStatement(
+                    sid="ReadTheSkillId",
+                    actions=["ssm:GetParameter"],
+                    resources=[
+                        stack.format_arn(
+                            service="ssm",
+                            resource="parameter",
+                            resource_name=self.skill_id_parameter.lstrip("/"),
+                        )
+                    ],
+                )
+            )
+        elif config.allow_any_skill:
+            environment["VAHR_ALLOW_ANY_SKILL"] = "true"
         self.function, self.log_group = python_function(
             self,
             config=config,
@@ -116,15 +148,14 @@ class SkillFunction(Construct):
             timeout=TIMEOUT,
             environment=environment,
         )
-        # Without a skill id (the skill does not exist before its endpoint does) any skill
-        # could call the function; the handler then checks nothing, so set skillId once
-        # `ask deploy` has printed it and deploy again.
+        if self.skill_id_parameter is not None:
+            return  # AlexaSkill grants Alexa's invocation, once the skill's id exists
         if not config.skill_id:
             cdk.Annotations.of(self.function).add_warning_v2(
-                "vahr:skill-id-unknown",
-                "No skill id yet: any Alexa skill may invoke this function. After `ask deploy` "
-                "(or with -c skill=true), deploy again; the id is read from "
-                ".ask/ask-states.json or given with -c skillId=...",
+                "vahr:any-skill-allowed",
+                "allowAnySkill=true: any Alexa skill may invoke this function and the handler "
+                "serves it. Deploy again with the skill's id (-c skillId=..., or after `ask "
+                "deploy`, from .ask/ask-states.json) to close it.",
             )
         self.function.add_permission(
             "AlexaInvoke",
@@ -132,6 +163,11 @@ class SkillFunction(Construct):
             action="lambda:InvokeFunction",
             event_source_token=config.skill_id,
         )
+
+
+def skill_id_parameter_name(stack_name: str) -> str:
+    """The SSM parameter a stack-made skill's id is kept in."""
+    return f"/vahr/{stack_name}/skill-id"
 
 
 def skill_statements(stack: cdk.Stack, fleet: Fleet) -> list[iam.PolicyStatement]:

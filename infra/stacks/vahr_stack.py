@@ -8,12 +8,15 @@ import aws_cdk as cdk
 from aws_cdk import aws_logs as logs
 
 from announcer.config import events_url
+from infra.constructs.alarms import Alarms
 from infra.constructs.alexa_skill import AlexaSkill
 from infra.constructs.announcer import Announcer
+from infra.constructs.device_audit import DeviceAudit
 from infra.constructs.dispatcher import Dispatcher
 from infra.constructs.fleet_indexing import FleetIndexing
 from infra.constructs.iot_endpoint import IotEndpoint
 from infra.constructs.iot_fleet import IotFleet
+from infra.constructs.iot_logging import IotLogging
 from infra.constructs.operator_policy import OperatorPolicy
 from infra.constructs.presence_rule import PresenceRule
 from infra.constructs.robot_policy import RobotPolicy
@@ -31,8 +34,9 @@ if TYPE_CHECKING:
 
 
 class VahrStack(cdk.Stack):
-    """IoT fleet, robot and operator policies, presence rule, skill function; optionally the
-    Alexa skill, the Lex bot, the announcer and the fleet dispatcher."""
+    """IoT fleet, robot, station and recorder policies, presence rule, skill function, IoT
+    logging, the Device Defender audit and the alarms; optionally the Alexa skill, the Lex
+    bot, the announcer and the fleet dispatcher."""
 
     def __init__(
         self,
@@ -77,10 +81,18 @@ class VahrStack(cdk.Stack):
             policy_name=config.robot_policy_name,
             role_alias_arn=self.weather_bot.role_alias_arn if self.weather_bot else None,
         )
-        self.operator_policy = OperatorPolicy(
+        self.station_policy = OperatorPolicy(
             self,
-            "OperatorPolicy",
-            policy_name=config.operator_policy_name,
+            "StationPolicy",
+            operator="station",
+            policy_name=config.station_policy_name,
+            things=fleet.robot_things,
+        )
+        self.recorder_policy = OperatorPolicy(
+            self,
+            "RecorderPolicy",
+            operator="recorder",
+            policy_name=config.recorder_policy_name,
             things=fleet.robot_things,
         )
         self.presence = PresenceRule(
@@ -148,8 +160,32 @@ class VahrStack(cdk.Stack):
                 function=self.skill_function.function,
                 lwa_secret_name=config.lwa_secret_name,
                 vendor_id=config.vendor_id,
+                skill_id_parameter=self.skill_function.skill_id_parameter,
+                provider_logs=provider_logs,
             )
             if config.skill
+            else None
+        )
+        self.iot_logging = (
+            IotLogging(self, "IotLogging", config=config) if config.iot_logging else None
+        )
+        self.alarms = Alarms(self, "Alarms", email=config.alarm_email)
+        self.alarms.watch_function("Skill", self.skill_function.function)
+        if self.announcer is not None:
+            self.alarms.watch_function("Announcer", self.announcer.function)
+            self.alarms.watch_queue("Announcer", self.announcer.dead_letters)
+        if self.dispatcher is not None:
+            self.alarms.watch_function("Dispatcher", self.dispatcher.function)
+            self.alarms.watch_queue("Dispatcher", self.dispatcher.dead_letters)
+        self.device_audit = (
+            DeviceAudit(
+                self,
+                "DeviceAudit",
+                audit_name=f"{config.stack_name.lower()}-daily-audit",
+                findings=self.alarms.topic,
+                findings_key=self.alarms.key,
+            )
+            if config.device_audit
             else None
         )
         self._outputs(config)
@@ -220,6 +256,15 @@ class VahrStack(cdk.Stack):
                 "configuration is the account's), so its only valid resource is '*'; the "
                 "statement allows that one action.",
             )
+        if self.device_audit is not None:
+            acknowledge(
+                self.device_audit.role,
+                "IAM4[Policy::arn:<AWS::Partition>:iam::aws:policy/service-role/"
+                "AWSIoTDeviceDefenderAudit]",
+                "AWS's own policy for Device Defender's audit role: read-only describe and "
+                "list rights over the IoT configuration the checks read, kept by AWS as checks "
+                "change; only iot.amazonaws.com may assume the role, for this account.",
+            )
         acknowledge(
             self.skill_function,
             "L1",
@@ -246,10 +291,16 @@ class VahrStack(cdk.Stack):
         output("ExperimentThing", self.fleet.experiment_thing_name, "The experiment's thing")
         output("RobotPolicyName", config.robot_policy_name, "IoT policy for robot certificates")
         output(
-            "OperatorPolicyName",
-            config.operator_policy_name,
-            "IoT policy for the experiment recorder's and console's certificates",
+            "StationPolicyName",
+            config.station_policy_name,
+            "IoT policy for the operator station's certificate (client ids vahr-station-*)",
         )
+        output(
+            "RecorderPolicyName",
+            config.recorder_policy_name,
+            "IoT policy for the experiment recorder's certificate (client ids vahr-experiment-*)",
+        )
+        output("AlarmTopicArn", self.alarms.topic.topic_arn, "Subscribe here to hear of trouble")
         if self.weather_bot is not None and self.credentials_endpoint is not None:
             output(
                 "CredentialsEndpoint",

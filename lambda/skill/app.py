@@ -5,6 +5,8 @@ is created; warm invocations reuse them. That happens when `lambda_handler` is f
 up (Lambda's runtime does so while initialising), not on import, so tools that import this
 module without AWS settings (the local stack, the tests) do not fail or pay for it.
 `make_lambda_handler` builds the same handler around another configuration or gateway.
+Before any handler runs, `skill.skill_gate` decides whether the request's skill is the one
+served; a refused request is answered, logged, and sends nothing.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from ask_sdk_core.exceptions import SerializationException
 from ask_sdk_core.skill_builder import SkillBuilder
 
 from skill import logs, prompts
+from skill.catalog import use_locale
 from skill.config import SkillConfig
 from skill.handlers.built_in import (
     CancelIntentHandler,
@@ -52,8 +55,10 @@ from skill.interceptors import (
     ResponseLogInterceptor,
 )
 from skill.iot_data import IotDataGateway
-from skill.logs import log_event
+from skill.logs import correlation_id, log_event
 from skill.runtime import SkillRuntime
+from skill.skill_gate import SkillGate, application_ids
+from skill.skill_id_source import SkillIdSource
 from skill.task_desk import task_desk
 
 if TYPE_CHECKING:
@@ -101,9 +106,9 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
 
 
 def build_skill_builder(runtime: SkillRuntime) -> SkillBuilder:
+    # The skill id is checked by `skill.skill_gate` before the SDK sees the request (the
+    # SDK's own check would fail the invocation instead of answering).
     builder = SkillBuilder()
-    if runtime.config.skill_id:
-        builder.skill_id = runtime.config.skill_id  # type: ignore[assignment]
     for handler in request_handlers(runtime):
         builder.add_request_handler(handler)
     # The correlation id is set before anything is logged.
@@ -126,7 +131,44 @@ def make_lambda_handler(
     runtime = SkillRuntime.create(config, gateway or IotDataGateway.from_config(config))
     handler: Callable[[dict[str, Any], Any], dict[str, Any]]
     handler = build_skill_builder(runtime).lambda_handler()  # type: ignore[assignment]
-    return _answering_malformed(handler)
+    if config.on_lambda and config.skill_id is None and config.skill_id_parameter is None:
+        log_event(
+            "any_skill_allowed" if config.allow_any_skill else "no_skill_id",
+            logging.WARNING,
+            detail="any Alexa skill may call this function"
+            if config.allow_any_skill
+            else "every request is refused until VAHR_SKILL_ID is set",
+        )
+    source = SkillIdSource(config.skill_id, config.skill_id_parameter)
+    return _answering_malformed(_gated(handler, config, source))
+
+
+def _gated(
+    handler: Callable[[dict[str, Any], Any], dict[str, Any]],
+    config: SkillConfig,
+    skill_id: Callable[[], str | None],
+) -> Callable[[dict[str, Any], Any], dict[str, Any]]:
+    """`handler` behind the skill-id check: a refused request is logged and answered with a
+    sentence saying nothing was sent, before any handler (or the robots) sees it."""
+
+    def gated(event: dict[str, Any], context: Any) -> dict[str, Any]:
+        gate = SkillGate(skill_id(), config.allow_any_skill, config.on_lambda)
+        reason = gate.refusal(event)
+        if reason is None:
+            return handler(event, context)
+        request = event.get("request") if isinstance(event, dict) else None
+        request = request if isinstance(request, dict) else {}
+        correlation_id.set(str(request.get("requestId") or "-"))
+        use_locale(request.get("locale") if isinstance(request.get("locale"), str) else None)
+        log_event(
+            "request_refused",
+            logging.WARNING,
+            reason=reason,
+            application_id=next(iter(application_ids(event)), None),
+        )
+        return _spoken(prompts.NOT_THIS_SKILL)
+
+    return gated
 
 
 def _answering_malformed(
@@ -136,8 +178,8 @@ def _answering_malformed(
 
     The SDK reads the envelope before any exception handler exists, so a malformed one
     (a request `type` it does not know, a field of the wrong type) would fail the Lambda
-    invocation, and Alexa would speak its own vague error. A failed skill-id check is not
-    caught: a request meant for another skill must stay refused.
+    invocation, and Alexa would speak its own vague error. A request for another skill
+    never reaches the SDK: `_gated` answers it.
     """
 
     def lambda_handler(event: dict[str, Any], context: Any) -> dict[str, Any]:
@@ -155,10 +197,15 @@ def _answering_malformed(
 
 
 def _safe_answer() -> dict[str, Any]:
+    return _spoken(prompts.GENERIC_ERROR)
+
+
+def _spoken(sentence: str) -> dict[str, Any]:
+    """A whole Alexa response that says `sentence` and ends the session."""
     return {
         "version": "1.0",
         "response": {
-            "outputSpeech": {"type": "SSML", "ssml": f"<speak>{prompts.GENERIC_ERROR}</speak>"},
+            "outputSpeech": {"type": "SSML", "ssml": f"<speak>{sentence}</speak>"},
             "shouldEndSession": True,
         },
     }

@@ -7,7 +7,10 @@ Every setting has a default, so the handler runs with only a region configured:
 | `AWS_ENDPOINT_URL_IOT_DATA_PLANE` | unset | iot-data endpoint URL (boto3's own variable) |
 | `VAHR_IOT_DATA_ENDPOINT` | unset | iot-data endpoint set by the CDK stack (URL or host name) |
 | `AWS_ENDPOINT_URL_IOT` | unset | IoT control plane for fleet indexing (see `index_endpoint`) |
-| `VAHR_SKILL_ID` | unset | when set, requests for any other skill id are refused |
+| `VAHR_SKILL_ID` | unset | the skill whose requests are served; any other is refused |
+| `VAHR_SKILL_ID_PARAMETER` | unset | an SSM parameter holding it (a stack making the skill) |
+| `VAHR_ALLOW_ANY_SKILL` | false | on Lambda with no skill id, serve any skill instead of none |
+| `AWS_LAMBDA_FUNCTION_NAME` | unset | set by Lambda: there, no skill id means none is served |
 | `VAHR_ACK_TIMEOUT_S` | 2.5 | how long to wait for robots to acknowledge a command (0-6 s) |
 | `VAHR_FLEET_FILE` | bundled fleet.yaml | the fleet definition |
 | `VAHR_LOG_LEVEL` | INFO | DEBUG, INFO, WARNING or ERROR |
@@ -37,7 +40,11 @@ class SkillConfig(msgspec.Struct, frozen=True):
     """Validated settings; build it with `from_env` (or directly in tests and the simulator)."""
 
     data_endpoint: str | None = None
+    # The one skill served (skill.skill_gate): given, or read from an SSM parameter.
     skill_id: str | None = None
+    skill_id_parameter: str | None = None
+    allow_any_skill: bool = False
+    on_lambda: bool = False
     ack_timeout_s: float = DEFAULT_ACK_TIMEOUT_S
     fleet_file: str | None = None
     log_level: str = DEFAULT_LOG_LEVEL
@@ -67,6 +74,9 @@ class SkillConfig(msgspec.Struct, frozen=True):
         return cls(
             data_endpoint=_as_url(endpoint) if endpoint else None,
             skill_id=_blank_to_none(env.get("VAHR_SKILL_ID")),
+            skill_id_parameter=_blank_to_none(env.get("VAHR_SKILL_ID_PARAMETER")),
+            allow_any_skill=_flag(env.get("VAHR_ALLOW_ANY_SKILL"), "VAHR_ALLOW_ANY_SKILL"),
+            on_lambda=_blank_to_none(env.get("AWS_LAMBDA_FUNCTION_NAME")) is not None,
             ack_timeout_s=_ack_timeout(env.get("VAHR_ACK_TIMEOUT_S")),
             fleet_file=_blank_to_none(env.get("VAHR_FLEET_FILE")),
             log_level=_log_level(env.get("VAHR_LOG_LEVEL")),
@@ -77,6 +87,15 @@ class SkillConfig(msgspec.Struct, frozen=True):
 
 def _blank_to_none(value: str | None) -> str | None:
     return value.strip() if value and value.strip() else None
+
+
+def _flag(raw: str | None, name: str) -> bool:
+    text = (raw or "").strip().lower()
+    if text in ("", "false", "0", "no"):
+        return False
+    if text in ("true", "1", "yes"):
+        return True
+    raise ConfigError(f"{name}: {raw!r} is not true or false")
 
 
 def _as_url(endpoint: str) -> str:

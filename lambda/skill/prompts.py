@@ -163,6 +163,10 @@ WEATHER = {weather: f"The weather is {weather}." for weather in WEATHERS}
 # Errors, spoken by the catch-all exception handler.
 GATEWAY_ERROR = "Sorry, I could not reach the robots just now. Please try again in a moment."
 GENERIC_ERROR = "Sorry, something went wrong on my side. Please try again."
+# A request from a skill this function does not serve (skill.skill_gate).
+NOT_THIS_SKILL = (
+    "Sorry, this skill is not set up to take requests here, so I sent nothing to the robots."
+)
 ERROR_REPROMPT = "What would you like the robots to do?"
 
 # Corrections and undo of the last command ("no, zone b", "I meant placebot two", "cancel

@@ -79,6 +79,7 @@ class Ros1Backend:
     """Drives a ROS 1 robot through its `move_base` action server."""
 
     name = "ros1"
+    observed_pose = True
 
     def __init__(self, settings: Ros1Settings, *, start: Pose) -> None:
         self.settings = settings
@@ -150,7 +151,10 @@ class Ros1Backend:
 
     async def halt(self) -> None:
         if self._server_ready:
-            self._client.cancel_all_goals()
+            # Every goal up to now, never a later one: a cancel-all would also cancel the
+            # next command's goal should move_base take that goal before this cancel (goal
+            # and cancel travel on two topics, in no order between them).
+            self._client.cancel_goals_at_and_before_time(rospy.Time.now())
 
     async def close(self) -> None:
         await self.halt()

@@ -37,6 +37,7 @@ class SimBackend:
     """A robot that moves at `speed_mps` and turns at `turn_rate_rps` in simulated time."""
 
     name = "sim"
+    observed_pose = False
 
     def __init__(
         self,

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 from robot_agent.provisioning.files import Bundle, prepare_out_dir, write_config, write_private
 from vahr.errors import VahrError
-from vahr.protocol import topics
+from vahr.protocol import identities
 
 if TYPE_CHECKING:
     import argparse
@@ -33,13 +33,18 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--port", type=int, default=8883, help="MQTT port to write in the config (default 8883)"
     )
-    parser.add_argument("--force", action="store_true", help="replace credentials already in --out")
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="replace credentials already in --out (with --aws, the replaced certificate is "
+        "detached from the thing and deactivated)",
+    )
     parser.add_argument("--json", action="store_true", help="print what was written as JSON")
 
 
 def run(args: argparse.Namespace) -> int:
     try:
-        topics.check_thing(args.thing)
+        identities.check_robot_thing(args.thing)
     except ValueError as err:
         raise VahrError(str(err)) from err
     if not 0 < args.port < 65536:
@@ -55,20 +60,38 @@ def run(args: argparse.Namespace) -> int:
             value = getattr(bundle, label)
             print(f"{label + ':':8}{value if value is not None else '(none)'}")
         print(f"{'endpoint:':8}{bundle.endpoint}:{bundle.port}")
+        if bundle.replaced:
+            print(f"replaced: certificate {bundle.replaced} (detached and deactivated)")
         if bundle.note:
             print(f"note:   {bundle.note}")
     return 0
 
 
 def _provision_aws(args: argparse.Namespace, out_dir: Path) -> Bundle:
-    from robot_agent.provisioning.aws import AMAZON_ROOT_CA_URL, amazon_root_ca, provision_thing
+    from robot_agent.provisioning.aws import (
+        AMAZON_ROOT_CA_URL,
+        amazon_root_ca,
+        provision_thing,
+        retire_certificate,
+    )
 
     # Read before registering: a bad path must not leave an active certificate behind.
     ca_pem = _read_ca_file(args.ca_file) if args.ca_file else None
+    # The certificate --force replaces: deactivated once the new one is written.
+    old_cert = out_dir / "cert.pem"
+    replaced_pem = old_cert.read_text() if args.force and old_cert.is_file() else None
     credentials = provision_thing(args.thing, policy=args.policy, region=args.region)
     cert = write_private(out_dir / "cert.pem", credentials.certificate_pem)
     key = write_private(out_dir / "private.key", credentials.private_key)
     note = None
+    retired = None
+    if replaced_pem is not None:
+        retired = retire_certificate(args.thing, replaced_pem, region=args.region)
+        if retired is None:
+            note = (
+                f"the certificate this replaced was not attached to {args.thing}; "
+                "nothing was deactivated"
+            )
     if ca_pem is not None:
         ca: Path | None = write_private(out_dir / "ca.pem", ca_pem)
     else:
@@ -84,7 +107,7 @@ def _provision_aws(args: argparse.Namespace, out_dir: Path) -> Bundle:
         key=key,
         ca=ca,
     )
-    return Bundle(args.thing, cert, key, ca, config, credentials.endpoint, args.port, note)
+    return Bundle(args.thing, cert, key, ca, config, credentials.endpoint, args.port, note, retired)
 
 
 def _read_ca_file(path: str) -> bytes:

@@ -33,7 +33,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     link.add_argument("--broker", help="plaintext mqtt://127.0.0.1:PORT (development only)")
     link.add_argument("--client-id", help="MQTT client id (default: the thing name)")
     parser.add_argument(
-        "--backend", choices=["sim", "ros1"], help="navigation backend (default sim)"
+        "--backend",
+        choices=["sim", "ros1", "nav2"],
+        help="navigation backend (default sim; nav2 runs from .venv-ros2)",
     )
     parser.add_argument(
         "--sim-speed-factor", type=float, help="run simulated time this many times faster"

@@ -43,7 +43,7 @@ if TYPE_CHECKING:
     from robot_agent.clock import Clock
     from robot_agent.voice.port import Voice
     from vahr.domain import Fleet, Pose, Zone
-    from vahr.protocol import Command, Result, Status
+    from vahr.protocol import Battery, Command, Result, Status
 
 log = logging.getLogger(__name__)
 
@@ -66,12 +66,15 @@ async def _bounded(step: Awaitable[T], timeout_s: float, what: str) -> T:
 
 
 class TaskFailed(Exception):
-    """A task ended without doing its job; `status` is what the robot reports afterwards."""
+    """A task ended without doing its job; `status` is what the robot reports afterwards,
+    `result` how the command ends (`rejected` or `cancelled` when the robot's navigation
+    server refused or cancelled the goal)."""
 
-    def __init__(self, reason: str, status: Status = "idle") -> None:
+    def __init__(self, reason: str, status: Status = "idle", result: Result = "failed") -> None:
         super().__init__(reason)
         self.reason = reason
         self.status = status
+        self.result = result
 
 
 class Executor:
@@ -184,6 +187,10 @@ class Executor:
         if event.event == "delivered" and event.thing != self.thing:
             self.peers.record(event.thing, event.at)
 
+    def report_battery(self, battery: Battery) -> None:
+        """Record the battery as the backend read it; the shadow hears of it when it changes."""
+        self._update(battery=battery)
+
     def set_connected(self, connected: bool) -> None:
         """Record the link state; the link publishes the full state itself on connect."""
         self.state = msgspec.structs.replace(self.state, connected=connected)
@@ -254,7 +261,7 @@ class Executor:
             raise
         except TaskFailed as failure:
             await self.backend.halt()
-            self._close(command, "failed", failure.reason, status=failure.status)
+            self._close(command, failure.result, failure.reason, status=failure.status)
             return
         except Exception as err:  # a bug or a backend crash must not kill the agent
             log.exception("%s: task %s crashed", self.thing, command.id)
@@ -341,12 +348,18 @@ class Executor:
                 and fraction - last_fraction >= step - 1e-9
             ):
                 last_report, last_fraction = now, fraction
+                if self.backend.observed_pose:
+                    # Where a real robot is comes from the robot: the shadow follows it at
+                    # the rate of the progress reports (the state before its event).
+                    self._update(pose=_pose(progress.pose))
                 self._emit(
                     "progress",
                     command,
                     zone=zone.id,
                     progress=round(fraction, 3),
                     pose=progress.pose,
+                    eta_s=_rounded(progress.eta_s),
+                    distance_remaining_m=_rounded(progress.distance_remaining_m),
                 )
 
         # One future wakes this task: the drive ending, the backend stalling, or (without
@@ -393,7 +406,7 @@ class Executor:
             try:
                 drive.result()
             except NavigationFailed as err:
-                raise TaskFailed(str(err), status="error") from err
+                raise TaskFailed(str(err), status=err.status, result=err.result) from err
         finally:
             active = False
             if not drive.done():
@@ -492,7 +505,7 @@ class Executor:
         self, command: Command, result: Result, reason: str | None, *, status: Status
     ) -> None:
         self._update(status=status, **self._closing(command, result, reason))
-        self._emit("done" if result == "done" else "failed", command, reason=reason)
+        self._emit(result, command, reason=reason)
         if self._current is command:
             self._current = None
 
@@ -531,6 +544,10 @@ def _destination(command: Command) -> str | None:
     params = command.params
     zone = getattr(params, "zone", None)
     return zone if isinstance(zone, str) else None
+
+
+def _rounded(value: float | None) -> float | None:
+    return None if value is None else round(value, 2)
 
 
 def _pose(pose: Pose) -> ReportedPose:

@@ -1,9 +1,13 @@
 """Provision a robot in AWS IoT Core with boto3 (imported only here).
 
-Creates the thing if it is missing, a key pair and an active certificate, attaches the
-fleet policy (made by the CDK stack) and the thing to the certificate, and looks up the
-account's ATS data endpoint. A failure after the certificate exists deactivates and
-deletes it again, so a failed run leaves no usable orphan credentials behind.
+Creates the thing if it is missing; makes the key pair here, on the robot, and has AWS IoT
+sign a certificate for it from a certificate signing request (the private key never leaves
+the machine); attaches the fleet policy (made by the CDK stack), and the thing to the
+certificate exclusively (`EXCLUSIVE_THING`: that certificate can never be attached to
+another thing), and looks up the account's ATS data endpoint. A failure after the
+certificate exists deactivates and deletes it again, so a failed run leaves no usable
+orphan credentials behind. `retire_certificate` deactivates the certificate a new one
+replaces (`robot-agent provision --force`).
 """
 
 from __future__ import annotations
@@ -15,6 +19,10 @@ from typing import Any
 
 import boto3
 from botocore.exceptions import BotoCoreError, ClientError, NoCredentialsError, NoRegionError
+from cryptography import x509
+from cryptography.hazmat.primitives import hashes, serialization
+from cryptography.hazmat.primitives.asymmetric import ec
+from cryptography.x509.oid import NameOID
 
 from vahr.errors import VahrError
 
@@ -36,20 +44,25 @@ class AwsCredentials:
 
 def provision_thing(thing: str, *, policy: str, region: str | None = None) -> AwsCredentials:
     """Register `thing` and give it a certificate bound to `policy`; see the module docstring."""
+    private_key, request = signing_request(thing)
     try:
         iot = boto3.client("iot", region_name=region)
         created = _ensure_thing(iot, thing)
-        keys = iot.create_keys_and_certificate(setAsActive=True)
+        issued = iot.create_certificate_from_csr(
+            certificateSigningRequest=request, setAsActive=True
+        )
     except NoCredentialsError as err:
         raise VahrError("no AWS credentials found; configure a profile or AWS_* variables") from err
     except NoRegionError as err:
         raise VahrError("no AWS region set; pass --region or set AWS_REGION") from err
     except (ClientError, BotoCoreError) as err:
         raise VahrError(f"AWS IoT refused the request: {err}") from err
-    arn, cert_id = keys["certificateArn"], keys["certificateId"]
+    arn, cert_id = issued["certificateArn"], issued["certificateId"]
     try:
         iot.attach_policy(policyName=policy, target=arn)
-        iot.attach_thing_principal(thingName=thing, principal=arn)
+        iot.attach_thing_principal(
+            thingName=thing, principal=arn, thingPrincipalType="EXCLUSIVE_THING"
+        )
         endpoint = iot.describe_endpoint(endpointType="iot:Data-ATS")["endpointAddress"]
     except (ClientError, BotoCoreError) as err:
         _discard_certificate(iot, thing, policy, arn, cert_id)
@@ -63,11 +76,60 @@ def provision_thing(thing: str, *, policy: str, region: str | None = None) -> Aw
         thing=thing,
         certificate_arn=arn,
         certificate_id=cert_id,
-        certificate_pem=keys["certificatePem"],
-        private_key=keys["keyPair"]["PrivateKey"],
+        certificate_pem=issued["certificatePem"],
+        private_key=private_key,
         endpoint=endpoint,
         thing_created=created,
     )
+
+
+def signing_request(thing: str) -> tuple[str, str]:
+    """A new EC P-256 private key (PKCS8 PEM) and a CSR for it naming `thing`."""
+    key = ec.generate_private_key(ec.SECP256R1())
+    request = (
+        x509.CertificateSigningRequestBuilder()
+        .subject_name(x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, thing)]))
+        .sign(key, hashes.SHA256())
+    )
+    private = key.private_bytes(
+        serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8, serialization.NoEncryption()
+    )
+    return private.decode(), request.public_bytes(serialization.Encoding.PEM).decode()
+
+
+def retire_certificate(
+    thing: str, certificate_pem: str, *, region: str | None = None
+) -> str | None:
+    """Detach from `thing` and deactivate the certificate whose PEM is `certificate_pem` (the
+    one a new certificate replaces); its id, or None when `thing` holds no such certificate."""
+    wanted = _normalised(certificate_pem)
+    try:
+        iot = boto3.client("iot", region_name=region)
+        for principal in _thing_principals(iot, thing):
+            certificate_id = principal.rsplit("/", 1)[-1]
+            if ":cert/" not in principal:
+                continue
+            description = iot.describe_certificate(certificateId=certificate_id)
+            if _normalised(description["certificateDescription"]["certificatePem"]) != wanted:
+                continue
+            iot.detach_thing_principal(thingName=thing, principal=principal)
+            iot.update_certificate(certificateId=certificate_id, newStatus="INACTIVE")
+            return certificate_id
+    except (ClientError, BotoCoreError) as err:
+        raise VahrError(f"AWS IoT refused to retire the replaced certificate: {err}") from err
+    return None
+
+
+def _thing_principals(iot: Any, thing: str) -> list[str]:
+    principals: list[str] = []
+    pages = iot.get_paginator("list_thing_principals").paginate(thingName=thing)
+    for page in pages:
+        principals += page.get("principals", [])
+    return principals
+
+
+def _normalised(pem: str) -> str:
+    return "".join(pem.split())
 
 
 def _ensure_thing(iot: Any, thing: str) -> bool:

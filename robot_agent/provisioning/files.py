@@ -26,6 +26,8 @@ class Bundle:
     endpoint: str
     port: int
     note: str | None = None
+    # The id of the certificate this one replaced and deactivated (`--aws --force`).
+    replaced: str | None = None
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -37,6 +39,7 @@ class Bundle:
             "endpoint": self.endpoint,
             "port": self.port,
             "note": self.note,
+            "replaced": self.replaced,
         }
 
 
@@ -46,7 +49,7 @@ def prepare_out_dir(out_dir: Path, names: tuple[str, ...], *, force: bool) -> No
     if existing and not force:
         raise VahrError(
             f"{out_dir} already holds {', '.join(existing)}; pass --force to replace them "
-            "(the old certificate stays registered until you revoke it)"
+            "(with --aws, the old certificate is then deactivated)"
         )
     try:
         out_dir.mkdir(parents=True, exist_ok=True)

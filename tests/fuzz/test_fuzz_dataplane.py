@@ -102,12 +102,15 @@ LENGTHS = st.sampled_from(["exact", "exact", "missing", "shorter", "spaced", "ab
 
 
 def _request(port: int, method: str, target: str, headers: list[tuple[str, str]],
-             body: bytes, length: str) -> http.client.HTTPResponse:  # fmt: skip
+             body: bytes, length: str, *, signed: bool = False) -> http.client.HTTPResponse:  # fmt: skip
     declared = {
         "exact": str(len(body)), "missing": None, "shorter": str(len(body) // 2),
         "spaced": f" {len(body)} ",
     }.get(length, length)  # fmt: skip
     lines = [f"{method} {target} HTTP/1.1", "Host: 127.0.0.1", "Connection: close"]
+    if signed:
+        # As boto3 signs (the data plane serves writes only to signed or JSON requests).
+        lines.append("Authorization: AWS4-HMAC-SHA256 Credential=fuzz/20260101/us-east-1/iotdata")
     lines += [f"{name}: {value}" for name, value in headers if name.lower() != "content-length"]
     if declared is not None:
         lines.append(f"Content-Length: {declared}")
@@ -152,6 +155,7 @@ def _shadows(stack: LocalStack) -> list[Any]:
     headers=st.lists(st.tuples(HEADER_NAMES, HEADER_VALUES), max_size=4),
     body=BODIES,
     length=LENGTHS,
+    signed=st.booleans(),
 )
 @settings(max_examples=budget(150))
 def test_every_request_gets_a_clear_answer_and_rejections_change_nothing(
@@ -161,10 +165,11 @@ def test_every_request_gets_a_clear_answer_and_rejections_change_nothing(
     headers: list[tuple[str, str]],
     body: bytes,
     length: str,
+    signed: bool,
 ) -> None:
     stack, published = api
     before, sent = _shadows(stack), len(published)
-    response = _request(stack.config.api_port, method, target, headers, body, length)
+    response = _request(stack.config.api_port, method, target, headers, body, length, signed=signed)
     answer = response.read() if method != "HEAD" else b""
     assert response.status < 500, (response.status, answer[:300])
     if response.status >= 400:

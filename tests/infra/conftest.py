@@ -2,44 +2,14 @@
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
-
-import aws_cdk as cdk
 import pytest
-from aws_cdk.assertions import Template
-from template_tools import cdk_context
-
-from infra.app import build_app
-
-if TYPE_CHECKING:
-    from pathlib import Path
-
-SKILL_ID = "amzn1.ask.skill.0d5c1d3e-52b4-4a53-9f0e-6f1a2b3c4d5e"
-
-
-@dataclass(frozen=True)
-class Synthesized:
-    """A whole app's template, as a document and as a file (for cfn-lint)."""
-
-    template: dict[str, Any]
-    file: Path
-
-
-def synth_app(outdir: Path, **context: Any) -> Synthesized:
-    # cdk-nag runs on the app: from_stack raises on any unacknowledged finding.
-    app = cdk.App(context=cdk_context(**context), outdir=str(outdir / "cdk.out"))
-    stack = build_app(app)
-    template = Template.from_stack(stack).to_json()
-    file = outdir / f"{stack.stack_name}.template.json"
-    file.write_text(json.dumps(template, indent=1))
-    return Synthesized(template, file)
+from synthesis import Synthesized, synth_app
+from template_tools import SKILL_ID
 
 
 @pytest.fixture(scope="session")
 def lean_app(tmp_path_factory: pytest.TempPathFactory) -> Synthesized:
-    """The default deployment: no optional parts."""
+    """The default deployment for a skill whose id is known: no optional parts."""
     return synth_app(tmp_path_factory.mktemp("lean"))
 
 

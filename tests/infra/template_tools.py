@@ -15,13 +15,18 @@ PSEUDO = {"AWS::Partition": PARTITION, "AWS::Region": REGION, "AWS::AccountId": 
 
 # A developer's own `ask deploy` state must not change what the tests synthesize.
 NO_ASK_STATES = str(REPO_ROOT / ".ask" / "absent-in-tests.json")
+# The skill whose id the tests' apps know, as after `ask deploy` (synth refuses an app
+# that knows none); a test that is about the skill id overrides `skillId`.
+SKILL_ID = "amzn1.ask.skill.0d5c1d3e-52b4-4a53-9f0e-6f1a2b3c4d5e"
 
 
 def cdk_context(**overrides: Any) -> dict[str, Any]:
-    """cdk.json's context (pytest's `cdk.App()` does not read it), bundling skipped."""
+    """cdk.json's context (pytest's `cdk.App()` does not read it), bundling skipped, and
+    the skill id `SKILL_ID`."""
     context: dict[str, Any] = json.loads((REPO_ROOT / "cdk.json").read_text())["context"]
     return {
-        **context, "aws:cdk:bundling-stacks": [], "askStatesFile": NO_ASK_STATES, **overrides,
+        **context, "aws:cdk:bundling-stacks": [], "askStatesFile": NO_ASK_STATES,
+        "skillId": SKILL_ID, **overrides,
     }  # fmt: skip
 
 

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 from aws_cdk import aws_lambda as lambda_
 from aws_cdk.assertions import Template
-from conftest import synth_app
+from synthesis import synth_app
 from template_tools import bare_stack, only, resources, role_grants
 
 from infra.config import InfraConfig

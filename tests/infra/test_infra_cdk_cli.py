@@ -44,8 +44,18 @@ def test_cdk_synth_works_offline_without_credentials_with_and_without_options(
 ) -> None:
     assert CDK_CLI.is_file(), "run `make setup` (npm ci) to install the pinned CDK CLI"
     outdir = tmp_path / "cdk.out"
-    # Given no credentials, When the default app is synthesized
-    lean = cdk_synth(outdir)
+    # Given no credentials and no skill id yet, When the default app is synthesized
+    refused = cdk_synth(outdir)
+    # Then it is refused in one line that names the flag accepting the risk
+    assert refused.returncode != 0
+    [line] = [line for line in refused.stderr.splitlines() if line.startswith("error: ")]
+    assert line == (
+        "error: skillId: none is known, so any Alexa skill could invoke the skill function; "
+        "give -c skillId=amzn1.ask.skill... (ask deploy prints it), create the skill with the "
+        "stack (-c skill=true), or accept that risk with -c allowAnySkill=true"
+    )
+    # When the user accepts it by name
+    lean = cdk_synth(outdir, "allowAnySkill=true")
     assert lean.returncode == 0, lean.stderr[-3000:]
     lean_template = json.loads((outdir / "Vahr.template.json").read_text())
     # Then the skill's code was bundled locally from the one build script
@@ -63,7 +73,7 @@ def test_cdk_synth_works_offline_without_credentials_with_and_without_options(
     [nag] = [r for r in reports if r["pluginName"] == "AwsSolutions"]
     assert (nag["conclusion"], nag["violations"]) == ("success", [])
     # And the user is told, as a warning, that any skill may call the function for now
-    assert "No skill id yet: any Alexa skill may invoke this function" in lean.stderr
+    assert "allowAnySkill=true: any Alexa skill may invoke this function" in lean.stderr
 
     # When the optional parts are switched on from the command line
     full = cdk_synth(outdir, "skill=true", "lex=true")

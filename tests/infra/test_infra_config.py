@@ -8,19 +8,28 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from template_tools import NO_ASK_STATES
+from template_tools import NO_ASK_STATES, SKILL_ID
 
 from infra.config import REPO_ROOT, InfraConfig
 from vahr.errors import VahrError
 
 
 def config(**context: Any) -> InfraConfig:
-    return InfraConfig.from_context({"askStatesFile": NO_ASK_STATES, **context}.get)
+    """The flags `context` (with any skill allowed, unless said otherwise: synth refuses
+    an app that knows no skill id, tested apart)."""
+    return InfraConfig.from_context(
+        {"askStatesFile": NO_ASK_STATES, "allowAnySkill": "true", **context}.get
+    )
 
 
 def test_defaults_are_the_lean_deployment() -> None:
     defaults = config()
     assert (defaults.skill, defaults.lex, defaults.skill_id) == (False, False, None)
+    assert (defaults.iot_logging, defaults.device_audit, defaults.alarm_email) == (True, True, None)
+    assert (defaults.station_policy_name, defaults.recorder_policy_name) == (
+        "vahr-station-policy",
+        "vahr-recorder-policy",
+    )
     assert defaults.fleet_file == REPO_ROOT / "fleet.yaml"
     assert defaults.robot_policy_name == "vahr-robot-policy"
     assert defaults.architecture == "x86_64"
@@ -46,6 +55,11 @@ def test_relative_paths_are_from_the_repository_root() -> None:
         ({"ackTimeoutS": "soon"}, "ackTimeoutS: 'soon' is not a number"),
         ({"logLevel": "chatty"}, "logLevel: 'CHATTY' must be DEBUG, INFO, WARNING or ERROR"),
         ({"robotPolicyName": "a/b"}, "robotPolicyName: 'a/b' must be 1-64 letters"),
+        ({"stationPolicyName": "a b"}, "stationPolicyName: 'a b' must be 1-64 letters"),
+        ({"allowAnySkill": "perhaps"}, "allowAnySkill: 'perhaps' is not true or false"),
+        ({"deviceDefenderAudit": "2"}, "deviceDefenderAudit: '2' is not true or false"),
+        ({"alarmEmail": "ops"}, "alarmEmail: 'ops' is not an email address"),
+        ({"operatorPolicyName": "x"}, "operatorPolicyName: the station and the recorder now"),
     ],
 )
 def test_bad_values_are_refused_with_the_key_and_the_reason(
@@ -61,9 +75,6 @@ def test_lambda_python_must_exist(tmp_path: Path) -> None:
     with pytest.raises(VahrError, match=r"^lambdaPython: '.*missing' is not a file$"):
         config(lambdaPython=str(tmp_path / "missing"))
     assert config(lambdaPython=sys.executable).lambda_python == Path(sys.executable)
-
-
-SKILL_ID = "amzn1.ask.skill.0d5c1d3e-52b4-4a53-9f0e-6f1a2b3c4d5e"
 
 
 def ask_states(tmp_path: Path, profiles: object) -> str:
@@ -91,3 +102,26 @@ def test_a_broken_ask_state_file_is_reported_in_one_line(tmp_path: Path) -> None
     bad_id = ask_states(tmp_path, {"default": {"skillId": "nope"}})
     with pytest.raises(VahrError, match=r"^skillId: 'nope' is not an Alexa skill id"):
         config(askStatesFile=bad_id)
+
+
+def test_a_stack_that_knows_no_skill_id_is_refused_in_one_line_naming_the_flag() -> None:
+    # Given no skill id (none given, no `ask deploy` state), no skill in the stack, and
+    # nothing said about the risk
+    with pytest.raises(VahrError) as raised:
+        config(allowAnySkill=None)
+    # Then synth stops, naming the flag that would accept the risk
+    assert str(raised.value) == (
+        "skillId: none is known, so any Alexa skill could invoke the skill function; give "
+        "-c skillId=amzn1.ask.skill... (ask deploy prints it), create the skill with the "
+        "stack (-c skill=true), or accept that risk with -c allowAnySkill=true"
+    )
+    # And each of the three ways out is accepted
+    assert config(allowAnySkill=None, skillId=SKILL_ID).skill_invocation() == "skill_id"
+    assert config(allowAnySkill=None, skill="true").skill_invocation() == "stack_skill"
+    assert config(allowAnySkill="true").skill_invocation() == "any_skill"
+
+
+def test_what_lets_aws_see_trouble_can_be_left_to_another_stack() -> None:
+    chosen = config(iotLogging="false", deviceDefenderAudit="false", alarmEmail="ops@lab.example")
+    assert (chosen.iot_logging, chosen.device_audit) == (False, False)
+    assert chosen.alarm_email == "ops@lab.example"

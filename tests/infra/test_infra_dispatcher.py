@@ -14,7 +14,7 @@ import pytest
 from aws_cdk import aws_iam as iam
 from aws_cdk import aws_lambda as lambda_
 from aws_cdk.assertions import Template
-from conftest import synth_app
+from synthesis import synth_app
 from template_tools import bare_stack, only, resources, role_grants
 
 from infra.config import InfraConfig
@@ -24,7 +24,7 @@ from infra.constructs.task_table import TaskTable
 from vahr.domain import load_fleet
 
 if TYPE_CHECKING:
-    from conftest import Synthesized
+    from synthesis import Synthesized
 
 DATA = "a1b2c3d4e5f6g7-ats.iot.us-east-1.amazonaws.com"
 IOT = "arn:aws:iot:us-east-1:123456789012"

@@ -15,7 +15,7 @@ import pytest
 from aws_cdk.assertions import Template
 from iot_policy_eval import Connection, IotPolicy
 from moto import mock_aws
-from template_tools import ACCOUNT, REGION, REPO_ROOT, bare_stack, only, resources
+from template_tools import ACCOUNT, REGION, REPO_ROOT, SKILL_ID, bare_stack, only, resources
 
 from infra.config import InfraConfig
 from infra.constructs.skill_function import SkillFunction
@@ -44,7 +44,13 @@ ACTIONS = {
 @pytest.fixture(scope="module")
 def role_policy(tmp_path_factory: pytest.TempPathFactory, fleet: Fleet) -> IotPolicy:
     stack = bare_stack(tmp_path_factory.mktemp("skill-contract"))
-    SkillFunction(stack, "Skill", config=InfraConfig(), fleet=fleet, data_endpoint="example")
+    SkillFunction(
+        stack,
+        "Skill",
+        config=InfraConfig(skill_id=SKILL_ID),
+        fleet=fleet,
+        data_endpoint="example",
+    )
     template = Template.from_stack(stack).to_json()
     role_id = only(template, "AWS::Lambda::Function")["Role"].strip("<>").split(".")[0]
     statements = [

@@ -8,16 +8,16 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 from aws_cdk.assertions import Annotations, Match, Template
-from template_tools import bare_stack, only, resources, role_grants
+from template_tools import SKILL_ID, bare_stack, only, resources, role_grants
 
 from infra.config import InfraConfig
 from infra.constructs.skill_function import SkillFunction
+from vahr.errors import VahrError
 
 if TYPE_CHECKING:
     from vahr.domain import Fleet
 
 PREFIX = "arn:aws:iot:us-east-1:123456789012"
-SKILL_ID = "amzn1.ask.skill.0d5c1d3e-52b4-4a53-9f0e-6f1a2b3c4d5e"
 DATA_HOST = "a1b2c3d4e5f6g7-ats.iot.us-east-1.amazonaws.com"
 
 
@@ -29,7 +29,9 @@ def synth(outdir: Path, fleet: Fleet, config: InfraConfig) -> dict[str, Any]:
 
 @pytest.fixture(scope="module")
 def template(tmp_path_factory: pytest.TempPathFactory, fleet: Fleet) -> dict[str, Any]:
-    return synth(tmp_path_factory.mktemp("skill"), fleet, InfraConfig())
+    # Any skill allowed (by name): the permission and environment of the other ways are
+    # tested below.
+    return synth(tmp_path_factory.mktemp("skill"), fleet, InfraConfig(allow_any_skill=True))
 
 
 def test_the_function_runs_the_skill_handler_on_python_3_12(template: dict[str, Any]) -> None:
@@ -49,6 +51,7 @@ def test_the_function_is_configured_through_the_agreed_environment(
         "VAHR_IOT_DATA_ENDPOINT": f"https://{DATA_HOST}",
         "VAHR_ACK_TIMEOUT_S": "2.5",
         "VAHR_LOG_LEVEL": "INFO",
+        "VAHR_ALLOW_ANY_SKILL": "true",
     }
 
 
@@ -79,7 +82,7 @@ def test_the_role_has_exactly_the_skill_rights(template: dict[str, Any]) -> None
     }
 
 
-def test_alexa_may_invoke_it_and_without_a_skill_id_any_skill_can(
+def test_alexa_may_invoke_it_and_with_any_skill_allowed_any_skill_can(
     template: dict[str, Any],
 ) -> None:
     permission = only(template, "AWS::Lambda::Permission")
@@ -104,9 +107,15 @@ def test_with_a_skill_id_only_that_skill_may_invoke_and_the_handler_checks_it(
 
 def test_a_precompiling_build_is_a_different_asset(tmp_path: Path, fleet: Fleet) -> None:
     # Given the same sources, with and without -c lambdaPython
-    plain = only(synth(tmp_path / "plain", fleet, InfraConfig()), "AWS::Lambda::Function")
+    plain = only(
+        synth(tmp_path / "plain", fleet, InfraConfig(skill_id=SKILL_ID)), "AWS::Lambda::Function"
+    )
     compiled = only(
-        synth(tmp_path / "compiled", fleet, InfraConfig(lambda_python=Path(sys.executable))),
+        synth(
+            tmp_path / "compiled",
+            fleet,
+            InfraConfig(skill_id=SKILL_ID, lambda_python=Path(sys.executable)),
+        ),
         "AWS::Lambda::Function",
     )
     # Then CDK sees two different code assets, so switching it redeploys the code
@@ -120,6 +129,34 @@ def test_synth_warns_while_the_function_is_open_to_any_skill(tmp_path: Path, fle
         found = Annotations.from_stack(stack).find_warning("*", Match.any_value())
         return [str(entry.entry.data) for entry in found]
 
-    assert any("any Alexa skill may invoke" in w for w in warnings(InfraConfig(), tmp_path / "a"))
+    opened = warnings(InfraConfig(allow_any_skill=True), tmp_path / "a")
+    assert any("any Alexa skill may invoke" in w for w in opened)
     locked = warnings(InfraConfig(skill_id=SKILL_ID), tmp_path / "b")
     assert not any("any Alexa skill" in w for w in locked)
+
+
+def test_a_function_no_skill_may_be_named_for_is_refused(tmp_path: Path, fleet: Fleet) -> None:
+    # (infra.config refuses such a context; the construct refuses such a configuration too)
+    with pytest.raises(VahrError, match=r"^skillId: none is known, .* -c allowAnySkill=true$"):
+        synth(tmp_path, fleet, InfraConfig())
+
+
+def test_a_skill_the_stack_creates_is_read_from_its_parameter(tmp_path: Path, fleet: Fleet) -> None:
+    # Given the skill is created by the stack, its id unknown at synth
+    template = synth(tmp_path, fleet, InfraConfig(skill=True))
+    # Then the handler is told where to read it, and may read that one parameter
+    function = only(template, "AWS::Lambda::Function")
+    variables = function["Environment"]["Variables"]
+    assert variables["VAHR_SKILL_ID_PARAMETER"] == "/vahr/Bare/skill-id"
+    assert "VAHR_SKILL_ID" not in variables and "VAHR_ALLOW_ANY_SKILL" not in variables
+    role_id = function["Role"].strip("<>").split(".")[0]
+    ssm = {grant for grant in role_grants(template, role_id) if grant[1].startswith("ssm:")}
+    assert ssm == {
+        (
+            "Allow",
+            "ssm:GetParameter",
+            "arn:aws:ssm:us-east-1:123456789012:parameter/vahr/Bare/skill-id",
+        )
+    }
+    # And this construct grants Alexa nothing: the skill's own construct does, by its id
+    assert resources(template, "AWS::Lambda::Permission") == {}

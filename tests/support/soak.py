@@ -50,6 +50,7 @@ from vahr.plumbing.client import call, say
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint, PublishUnconfirmed
 from vahr.plumbing.ports import free_port
 from vahr.protocol import encode, new_command, topics
+from vahr.twin import identities
 
 if TYPE_CHECKING:
     from tests.support.vahr_up import Up
@@ -199,7 +200,8 @@ class Soak:
         self.up = start_up(
             self.state,
             "--robots", str(len(AGENTS)),
-            "--mqtt-port", str(self.mqtt_port),
+            # The console publishes on the plaintext development listener.
+            "--dev-plaintext", "--mqtt-port", str(self.mqtt_port),
             "--station-port", "0",
             "--sim-speed-factor", f"{cfg.sim_speed_factor:g}",
             # Robot-agents log each event at INFO only when `vahr up` runs at DEBUG: their
@@ -215,7 +217,7 @@ class Soak:
             # anonymous session after a crash without the identity its ACL needs, and then
             # drops what is queued for it (docs/reliability.md); a robot always has one.
             broker=f"mqtts://127.0.0.1:{self.relay.port}",
-            tls=LocalCA.load_or_create(self.state).service_credentials(),
+            tls=LocalCA.load_or_create(self.state).service_credentials(identities.SWARM),
             count=cfg.swarm_size,
             speed_factor=cfg.sim_speed_factor,
             # Generous stuck detection: a starved simulator on a shared machine is not stuck.

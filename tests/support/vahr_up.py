@@ -56,14 +56,16 @@ class Up:
                 return event
 
 
-def start_up(state: Path, *extra: str) -> Up:
+def start_up(state: Path, *extra: str, plaintext: bool = False) -> Up:
     """`vahr up --json --no-voice` with every port free and `extra` flags (which may give a
     port of their own, or 0 for none: the last flag wins). Never a default port: another
-    `vahr up` on this machine (a developer's, another test's) may hold it."""
+    `vahr up` on this machine (a developer's, another test's) may hold it. `plaintext`
+    opens the plaintext development listener too (`--dev-plaintext`), on a free port."""
+    listener = ["--dev-plaintext", "--mqtt-port", str(free_port())] if plaintext else []
     process = spawn(
         [*VAHR, "up", "--json", "--no-voice", "--state-dir", str(state),
          "--api-port", str(free_port()), "--mqtts-port", str(free_port()),
-         "--mqtt-port", str(free_port()), "--station-port", str(free_port()), *extra],
+         *listener, "--station-port", str(free_port()), *extra],
         started_for=state, cwd=ROOT, env=clean_env(), stdout=subprocess.PIPE,
         stderr=(state / "up.err").open("w"),
         text=True,

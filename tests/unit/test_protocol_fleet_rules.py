@@ -80,6 +80,12 @@ def test_a_missing_fleet_file_says_it_cannot_be_read() -> None:
             "robots.0.start: (1, 1) is outside the floor (x 1.5 to 6.5, y 0 to 5), so the "
             "robot cannot start there",
         ),
+        (
+            # The system's own identities (vahr.protocol.identities): never a robot's name.
+            "robots: [{thing: vahr-station-lab, spoken: [r], start: {x: 1, y: 1}}]\n" + ZONES,
+            "robots.0.thing: 'vahr-station-lab' is reserved: names starting with 'vahr-' are "
+            "the system's own identities (services, stations, recorders), never a robot's",
+        ),
     ],
 )
 def test_fleet_rules_name_the_entry(text: str, message: str) -> None:

@@ -10,7 +10,8 @@ experiment out of them (pyproject.toml, docs/architecture.md):
 - `InteractionModel` (the NLU built from an interaction model; `DEFAULT_MODEL`, the one
   that ships with the package), `load_skill_handler` (the skill's Lambda handler
   in-process) and `CommandLog` (the commands the skill published during a turn): what a
-  simulator is built from;
+  simulator is built from, with the `Identity` (skill, user, device) its envelopes carry,
+  whose skill id the handler is given to serve;
 - `built_in_phrases` (what the simulator knows Alexa's built-in intents by),
   `confirmation_phrases` (the yes and no it takes) and `RULE_SLOTS` (the weather rule's
   slots): what a vocabulary of the model is made from;
@@ -23,6 +24,7 @@ experiment out of them (pyproject.toml, docs/architecture.md):
 
 from vahr.assistant.background import built_in_phrases
 from vahr.assistant.commands_seen import CommandLog
+from vahr.assistant.envelope import Identity
 from vahr.assistant.nbest import (
     Weighed,
     Weighing,
@@ -49,6 +51,7 @@ __all__ = [
     "RULE_SLOTS",
     "AlexaSimulator",
     "CommandLog",
+    "Identity",
     "InteractionModel",
     "SimulatorAssistant",
     "Turn",

@@ -21,6 +21,8 @@ if TYPE_CHECKING:
 DEFAULT_API_PORT = 8180
 DEFAULT_STATION_PORT = 8181
 DEFAULT_STATE_DIR = Path(".state")
+# The plaintext development listener's usual port, when --dev-plaintext opens it.
+PLAINTEXT_PORT = 1883
 # The banner names at most this many robots; a swarm's are given as a range.
 BANNER_ROBOTS = 12
 # Robots a swarm builds and brings online per second, at least (measured: docs/local.md).
@@ -46,9 +48,25 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--api-port", type=int, default=DEFAULT_API_PORT, help="data-plane API port (default 8180)"
     )
     parser.add_argument(
-        "--mqtt-port", type=int, default=1883, help="plaintext loopback MQTT port, 0 for none"
+        "--dev-plaintext",
+        action="store_true",
+        help="also open the plaintext MQTT listener on 127.0.0.1 (development only: any "
+        "program on this machine can then command every robot)",
+    )
+    parser.add_argument(
+        "--mqtt-port",
+        type=int,
+        help=f"the plaintext listener's port with --dev-plaintext (default {PLAINTEXT_PORT})",
     )
     parser.add_argument("--mqtts-port", type=int, default=8883, help="mTLS MQTT port (8883)")
+    parser.add_argument(
+        "--api-host",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="a host name the data plane answers to besides 127.0.0.1 and localhost (a "
+        "proxy's or a tunnel's); repeat for several",
+    )
     parser.add_argument(
         "--station-port",
         type=int,
@@ -91,9 +109,10 @@ def run(args: argparse.Namespace) -> int:
             "English only, so push-to-talk and the robots' spoken weather exchange stay English",
             file=sys.stderr,
         )
-    for flag in ("api_port", "mqtts_port", "mqtt_port", "station_port"):
+    mqtt_port = _plaintext_port(args)
+    for flag in ("api_port", "mqtts_port", "station_port"):
         value = getattr(args, flag)
-        if not 0 <= value <= 65535 or (value == 0 and flag not in ("mqtt_port", "station_port")):
+        if not 0 <= value <= 65535 or (value == 0 and flag != "station_port"):
             raise VahrError(f"--{flag.replace('_', '-')} {value}: not a usable port")
     if args.sim_speed_factor <= 0:
         raise VahrError("--sim-speed-factor must be more than 0")
@@ -108,8 +127,9 @@ def run(args: argparse.Namespace) -> int:
     config = SystemConfig(
         state_dir=args.state_dir.resolve(),
         mqtts_port=args.mqtts_port,
-        mqtt_port=args.mqtt_port or None,
+        mqtt_port=mqtt_port,
         api_port=args.api_port,
+        api_hosts=frozenset(args.api_host),
         fleet=read_fleet(args.fleet),
         robots=args.robots,
         swarm=args.swarm,
@@ -152,6 +172,24 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _plaintext_port(args: argparse.Namespace) -> int | None:
+    """The plaintext listener's port, or None: it is opened only with --dev-plaintext."""
+    from vahr.errors import VahrError
+
+    if not args.dev_plaintext:
+        if args.mqtt_port:
+            raise VahrError(
+                f"--mqtt-port {args.mqtt_port}: the plaintext listener is off; add "
+                "--dev-plaintext to open it (any program on this machine can then command "
+                "the robots), or connect to --mqtts-port with a certificate"
+            )
+        return None
+    port = PLAINTEXT_PORT if args.mqtt_port is None else args.mqtt_port
+    if not 0 < port <= 65535:
+        raise VahrError(f"--mqtt-port {port}: not a usable port")
+    return int(port)
+
+
 def _emit(line: str) -> None:
     print(line, flush=True)
 
@@ -172,7 +210,9 @@ def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
         f"  mqtts       {endpoints['mqtts']}   (CA {endpoints['ca']})",
     ]
     if endpoints["mqtt"]:
-        lines.append(f"  mqtt        {endpoints['mqtt']}   (plaintext, loopback only)")
+        lines.append(
+            f"  mqtt        {endpoints['mqtt']}   (plaintext: any program here may use it)"
+        )
     lines += [
         f"  station     {endpoints['station'] or '(off)'}   (the operator station page)",
         f"  robots      {named} (sim backend{', room voice' if voice else ''})",

@@ -18,6 +18,7 @@ import msgspec
 
 from vahr.domain.text import normalize
 from vahr.protocol.errors import ProtocolError, from_validation_error
+from vahr.protocol.identities import check_robot_thing
 from vahr.protocol.topics import check_thing
 
 # The bundled fleet definition, next to this module: in a checkout a link to the repository's
@@ -162,13 +163,14 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
         """Check the rules that span fields; return self. `from_yaml` calls this.
 
         Each error names the entry (`robots.2.thing`, `zones.1.spoken.0`) and the reason:
-        thing names valid; things, zone ids, group ids, a group's members and every spoken
+        thing names valid (a robot's not one of the system's own, `vahr.protocol.identities`);
+        things, zone ids, group ids, a group's members and every spoken
         name used once; a zone LOADING; a group's members robots of the fleet; every pose
         reachable (`_check_reachable`); the floor's arms at zones with an arm.
         """
         for index, robot in enumerate(self.robots):
             try:
-                check_thing(robot.thing)
+                check_robot_thing(robot.thing)
             except ValueError as err:
                 raise ProtocolError(f"robots.{index}.thing", str(err).split(": ", 1)[1]) from err
         try:

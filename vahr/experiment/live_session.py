@@ -24,6 +24,7 @@ from vahr.experiment.session import (
 from vahr.experiment.station_link import WILL, StatusBroadcast
 from vahr.experiment.tasks import default_seed
 from vahr.experiment.timing import Person
+from vahr.protocol.identities import RECORDER_CLIENT_PREFIX
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -51,7 +52,7 @@ def run_live(
     bus = Bus(
         broker_url,
         recorder.on_message,
-        client_id=f"vahr-experiment-{session.spec.name}",
+        client_id=f"{RECORDER_CLIENT_PREFIX}{session.spec.name}",
         tls=tls,
         will=WILL,
     )

@@ -33,6 +33,7 @@ def serve_alexa(
     `locale`: its understanding data, and the locale of every request it sends."""
     # The NLU's libraries load here, not when `vahr.local` is imported.
     from vahr.assistant.commands_seen import CommandLog
+    from vahr.assistant.envelope import Identity
     from vahr.assistant.nlu import InteractionModel
     from vahr.assistant.simulator import AlexaSimulator
     from vahr.assistant.skill import load_skill_handler
@@ -47,9 +48,13 @@ def serve_alexa(
     # the first utterance waits for it.
     understanding = load_understanding(locale)
     model = InteractionModel.load(model_file, background=True, understanding=understanding)
+    # The skill serves one skill id, as on Lambda, and the simulated Echo's envelopes carry
+    # it: the handler's check runs here too (skill.skill_gate).
+    identity = Identity()
     handler = load_skill_handler(
         stack.api_url,
         ack_timeout_s=ack_timeout_s,
+        skill_id=identity.skill_id,
         fleet_file=str(fleet_file) if fleet_file else None,
         log_level=log_level,
     )
@@ -60,7 +65,12 @@ def serve_alexa(
         stack.publish_service(topics.ASSISTANT_TURNS, payload)
 
     simulator = AlexaSimulator(
-        model, handler, command_log=log.take, on_turn=publish_turn, locale=locale
+        model,
+        handler,
+        identity=identity,
+        command_log=log.take,
+        on_turn=publish_turn,
+        locale=locale,
     )
 
     def say(request: dict[str, Any]) -> tuple[int, dict[str, Any]]:

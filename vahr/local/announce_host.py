@@ -26,6 +26,7 @@ from vahr.announce.speech import Names
 from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import ProtocolError, decode_event, decode_presence, encode, topics, utc_now
 from vahr.protocol.announcements import announcement_json
+from vahr.twin import identities
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable
@@ -154,7 +155,7 @@ class LocalAnnouncer:
         *,
         tick_s: float = TICK_S,
     ) -> None:
-        self._client = MqttClient(endpoint, client_id="vahr-announcer-local")
+        self._client = MqttClient(endpoint, client_id=identities.ANNOUNCER)
         self.announcer = Announcer(fleet, settings, publish=self._publish)
         self._tick_s = tick_s
         self._stopping = threading.Event()

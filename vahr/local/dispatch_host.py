@@ -35,6 +35,7 @@ from vahr.local.task_store import SqliteTaskStore
 from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import encode, topics
 from vahr.protocol.errors import from_validation_error
+from vahr.twin import identities
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -167,7 +168,7 @@ class LocalDispatcher:
     ) -> None:
         self.tasks = SqliteTaskStore.in_state_dir(state_dir)
         self.candidates = IndexCandidates(index, fleet)
-        self._client = MqttClient(endpoint, client_id="vahr-dispatcher-local")
+        self._client = MqttClient(endpoint, client_id=identities.DISPATCHER)
         self.dispatcher = Dispatcher(
             fleet=fleet, store=self.tasks, candidates=self.candidates, publish=self._publish
         )

@@ -41,6 +41,7 @@ from vahr.plumbing.mqtt import MqttClient
 from vahr.plumbing.ports import ensure_free
 from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
 from vahr.skill_model.generator import build_interaction_model, build_locale_model, render
+from vahr.twin import identities
 from vahr.twin.shadow_store import ShadowError
 from vahr.twin.stack import LocalStack, StackConfig
 
@@ -66,6 +67,8 @@ class SystemConfig:
     mqtts_port: int
     mqtt_port: int | None
     api_port: int
+    # Names the data plane answers to besides the loopback ones (`vahr up --api-host`).
+    api_hosts: frozenset[str] = frozenset()
     # The fleet to run (`vahr up --fleet FILE`); None is the bundled fleet.yaml. `robots`
     # then keeps its first N robots, or adds more.
     fleet: Fleet | None = None
@@ -139,6 +142,7 @@ class LocalSystem:
                 mqtts_port=config.mqtts_port,
                 mqtt_port=config.mqtt_port,
                 api_port=config.api_port,
+                api_hosts=config.api_hosts,
             )
         )
         self.robots: RobotProcesses | SwarmProcess | None = None
@@ -202,7 +206,9 @@ class LocalSystem:
             assert self.stack.dataplane is not None and self.stack.ca is not None
             self.stack.dataplane.local_routes[("GET", "/vahr/status")] = self._status
             self.stack.dataplane.local_routes[("GET", "/vahr/fleet")] = self._fleet_route
-            self._watcher = MqttClient(self.stack.service_endpoint()).connect()
+            self._watcher = MqttClient(
+                self.stack.service_endpoint(identities.WATCHER), client_id=identities.WATCHER
+            ).connect()
             self._watcher.subscribe(topics.ALL_EVENTS, self._on_event)
             self._watcher.subscribe(topics.ALL_PRESENCE, self._on_presence)
             self._start_announcer()
@@ -215,7 +221,7 @@ class LocalSystem:
                 self.robots = SwarmProcess(
                     fleet_file=fleet_file,
                     count=cfg.swarm,
-                    credentials=self.stack.ca.service_credentials(),
+                    credentials=self.stack.ca.service_credentials(identities.SWARM),
                     mqtts_port=cfg.mqtts_port,
                     state_dir=cfg.state_dir / "swarm",
                     sim_speed_factor=cfg.sim_speed_factor,
@@ -245,7 +251,9 @@ class LocalSystem:
 
         dataplane = self.stack.dataplane
         assert dataplane is not None and self._watcher is not None
-        self.announcer = LocalAnnouncer(self.stack.service_endpoint(), self.fleet).start()
+        self.announcer = LocalAnnouncer(
+            self.stack.service_endpoint(identities.ANNOUNCER), self.fleet
+        ).start()
         dataplane.local_routes[("GET", "/vahr/announcements")] = self.announcer.announcer.route
         dataplane.local_routes[("POST", "/vahr/fault")] = FaultInjector(
             self._watcher, self.fleet
@@ -261,7 +269,7 @@ class LocalSystem:
         self.dispatcher = LocalDispatcher(
             fleet=self.fleet,
             index=store.index,
-            endpoint=self.stack.service_endpoint(),
+            endpoint=self.stack.service_endpoint(identities.DISPATCHER),
             state_dir=self.config.state_dir,
         ).start()
         dataplane.typed_routes[TASKS_PATH] = self.dispatcher.api.respond
@@ -277,7 +285,12 @@ class LocalSystem:
         if self.config.locale != SPOKEN_LOCALE:
             # Robots ask in English whatever the people speak: the room's Echo is English.
             model = InteractionModel(build_interaction_model(self.fleet), background=True)
-        room_echo = AlexaSimulator(model, self.alexa.handler)
+        from vahr.assistant.envelope import Identity
+
+        # Another Echo (its own user and device) of the same skill.
+        room_echo = AlexaSimulator(
+            model, self.alexa.handler, identity=Identity(self.alexa.identity.skill_id)
+        )
 
         def ask(request: str) -> str | None:
             turn = room_echo.say(f"alexa {request}")
@@ -285,7 +298,9 @@ class LocalSystem:
             room_echo.end_session()
             return turn.speech or None
 
-        self._room_client = MqttClient(self.stack.service_endpoint()).connect()
+        self._room_client = MqttClient(
+            self.stack.service_endpoint(identities.ROOM), client_id=identities.ROOM
+        ).connect()
         self._room = offline_room_assistant(self._room_client, ask).start()
 
     def _start_station(self, port: int) -> None:
@@ -294,7 +309,7 @@ class LocalSystem:
         assert self.start_station is not None
         assert self.alexa is not None and self.stack.dataplane is not None
         self._station_client = MqttClient(
-            self.stack.service_endpoint(), client_id="vahr-station-local"
+            self.stack.service_endpoint(identities.STATION), client_id=identities.STATION
         ).connect()
         self.station = self.start_station(
             port=port,

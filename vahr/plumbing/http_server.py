@@ -6,6 +6,7 @@ every request, however mangled, in their own error shape; served on a background
 from __future__ import annotations
 
 import logging
+import ssl
 import sys
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -77,8 +78,12 @@ class QuietServer(ThreadingHTTPServer):
     request_queue_size = 128
 
     def handle_error(self, request: object, client_address: object) -> None:
-        # A client closing its kept-alive connection is routine, not a server error.
-        if isinstance(sys.exc_info()[1], ConnectionError):
+        # A client closing its kept-alive connection, going quiet, or failing a TLS
+        # handshake (a plain-HTTP request to an HTTPS server) is routine, not a server error.
+        if isinstance(sys.exc_info()[1], (ConnectionError, TimeoutError, ssl.SSLError)):
+            log.debug(
+                "%s connection from %s ended: %s", self.what, client_address, sys.exc_info()[1]
+            )
             return
         log.exception("%s connection from %s failed", self.what, client_address)
 

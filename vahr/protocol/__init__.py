@@ -42,6 +42,7 @@ from vahr.protocol.messages import (
     utc_now,
 )
 from vahr.protocol.shadow import (
+    Battery,
     ExperimentState,
     LastCommand,
     Reported,
@@ -57,6 +58,7 @@ __all__ = [
     "ACTIONS",
     "MAX_PAYLOAD_BYTES",
     "MOTION_ACTIONS",
+    "Battery",
     "Command",
     "Deliver",
     "Event",

@@ -233,8 +233,9 @@ class Event(msgspec.Struct, frozen=True, kw_only=True, omit_defaults=True):
     """What a robot did, published on `vahr/robots/{thing}/events`.
 
     Only the fields that apply are sent: `zone` for arrived/loaded/delivered, `reason`
-    for rejected/failed/stuck/cancelled, `progress` (0..1) for progress, `text` for what
-    was said or heard, `intent` and `confidence` for interpreted.
+    for rejected/failed/stuck/cancelled, `progress` (0..1) for progress (with `eta_s` and
+    `distance_remaining_m` from a backend that estimates them, such as Nav2), `text` for
+    what was said or heard, `intent` and `confidence` for interpreted.
     """
 
     event: EventKind
@@ -245,6 +246,8 @@ class Event(msgspec.Struct, frozen=True, kw_only=True, omit_defaults=True):
     zone: str | None = None
     reason: str | None = None
     progress: float | None = None
+    eta_s: float | None = None
+    distance_remaining_m: float | None = None
     pose: ReportedPose | None = None
     text: str | None = None
     intent: str | None = None

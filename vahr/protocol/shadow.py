@@ -7,7 +7,7 @@ the body of a shadow `update`; `from_payload` reads the body of `get/accepted`,
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import msgspec
 
@@ -20,6 +20,13 @@ Status = Literal[
 Result = Literal["accepted", "rejected", "done", "failed", "cancelled"]
 # The experiment's weather (the paper's task II); its words and zones are `vahr.domain.weather`.
 Weather = Literal["sunny", "rainy"]
+
+
+class Battery(msgspec.Struct, frozen=True):
+    """A robot's battery as its backend reads it: charge in percent and whether it charges."""
+
+    percent: Annotated[int, msgspec.Meta(ge=0, le=100)]
+    charging: bool = False
 
 
 class LastCommand(msgspec.Struct, frozen=True, omit_defaults=True):
@@ -43,6 +50,8 @@ class Reported(msgspec.Struct, frozen=True):
     destination: str | None = None
     task: str | None = None
     pose: ReportedPose | None = None
+    # Reported by a backend that reads the robot's battery (nav2: sensor_msgs/BatteryState).
+    battery: Battery | None = None
 
     def to_payload(self, client_token: str | None = None) -> bytes:
         """The body of a shadow update reporting this whole state."""
@@ -148,6 +157,7 @@ def experiment_state_from_payload(payload: bytes | bytearray | memoryview) -> Ex
 
 
 __all__ = [
+    "Battery",
     "ExperimentState",
     "LastCommand",
     "ProtocolError",

@@ -23,7 +23,7 @@ from vahr.station.app import StationApp
 from vahr.station.controls import Controls
 from vahr.station.desk import Desk
 from vahr.station.feed import Feed
-from vahr.station.server import StationServer
+from vahr.station.server import ServerTls, StationServer
 from vahr.station.task_queue import TaskPoller
 
 if TYPE_CHECKING:
@@ -52,6 +52,9 @@ class StationConfig:
     model_file: Path | None = None
     # The dispatcher's task queue (`GET {api}/vahr/tasks`), relayed to the pages; None: not shown.
     tasks_url: str | None = None
+    # HTTPS served here, or the HTTPS address of a reverse proxy in front (server.py).
+    tls: ServerTls | None = None
+    public_origin: str | None = None
 
 
 class Station:
@@ -86,7 +89,12 @@ class Station:
             synthesize=_espeak() if shutil.which("espeak-ng") else None,
         )
         self.server = StationServer(
-            self.app, host=config.host, port=config.port, token=config.token
+            self.app,
+            host=config.host,
+            port=config.port,
+            token=config.token,
+            tls=config.tls,
+            public_origin=config.public_origin,
         )
         self.tasks = TaskPoller(config.tasks_url, self.feed) if config.tasks_url else None
 

@@ -33,6 +33,7 @@ from vahr.plumbing.client import HttpAssistant
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.protocol import topics
 from vahr.protocol.broker import parse_broker_url
+from vahr.protocol.identities import STATION_CLIENT_PREFIX
 from vahr.station.assembly import Station, StationConfig
 from vahr.station.feed import Feed
 
@@ -46,7 +47,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-CLIENT_ID_PREFIX = "vahr-station-"
+CLIENT_ID_PREFIX = STATION_CLIENT_PREFIX
 HEALTH_TIMEOUT_S = 3.0
 
 
@@ -136,7 +137,13 @@ def _simulator_for(
     api: str, model_file: Path | None, deployment: Deployment, feed: Feed, link: MqttClient
 ) -> Assistant:
     """The Alexa simulator and the real skill in this process, for AWS's iot-data endpoint."""
-    from vahr.assistant import AlexaSimulator, CommandLog, InteractionModel, load_skill_handler
+    from vahr.assistant import (
+        AlexaSimulator,
+        CommandLog,
+        Identity,
+        InteractionModel,
+        load_skill_handler,
+    )
 
     commands = CommandLog()
     # The skill publishes through iot-data; its commands are seen coming back from the broker.
@@ -150,9 +157,18 @@ def _simulator_for(
     else:
         model = InteractionModel.load(model_file)
     fleet_file = str(deployment.fleet_file) if deployment.fleet_file else None
+    # The skill in this process serves its simulated Echo's skill id, as on Lambda.
+    identity = Identity()
+    handler = load_skill_handler(
+        api,
+        ack_timeout_s=deployment.ack_timeout_s,
+        fleet_file=fleet_file,
+        skill_id=identity.skill_id,
+    )
     simulator = AlexaSimulator(
         model,
-        load_skill_handler(api, ack_timeout_s=deployment.ack_timeout_s, fleet_file=fleet_file),
+        handler,
+        identity=identity,
         command_log=commands.take,
         on_turn=lambda turn: feed.add_turn(turn.to_message()),
     )

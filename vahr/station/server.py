@@ -2,14 +2,23 @@
 
 It binds 127.0.0.1 unless told otherwise. Bound elsewhere (a tablet on the lab network), it
 requires a token, printed at start-up in the station's URL: the first page load carries it
-as `?token=`, which sets a cookie for the page's later requests. Every request is checked:
+as `?token=`, which sets a cookie for the page's later requests (HttpOnly, SameSite=Strict,
+`Secure` when the page is HTTPS, expiring after `COOKIE_HOURS`) and is redirected to the
+same page without it, so the token stays in neither the address bar nor the history. Off
+loopback the page should be HTTPS (browsers give a plain-HTTP page elsewhere no
+microphone, and the token would cross the network in the clear): the station serves TLS
+itself (`ServerTls`: a certificate from the local CA, or one the user gives), or stands
+behind a reverse proxy whose address it is told (`public_origin`), so that the proxy's
+HTTPS origin is its own. Every request is checked:
 
 - the `Host` header must name this server (a page elsewhere cannot rebind its own name to
-  this address and read the station), and a POST with an `Origin` must come from it;
+  this address and read the station), and a POST with an `Origin` must come from it (its
+  own origin, or the public origin);
 - a POST must say what it carries (`application/json`, or `audio/wav` for push-to-talk),
   which a form on another site cannot send without asking first, and must be small:
   `MAX_JSON_BYTES`, or `MAX_AUDIO_BYTES` for a clip (whose length `voice` checks again);
-- at most `MAX_STREAMS` pages are streamed to at once.
+- at most `MAX_STREAMS` pages are streamed to at once, and a connection that sends nothing
+  for `IDLE_TIMEOUT_S` is closed, so idle sockets do not hold the server's threads.
 
 The event stream (`GET /api/stream`) is server-sent events: each event is a JSON array of
 the feed messages that were waiting (one, or many when robots report faster than the page
@@ -23,13 +32,15 @@ from __future__ import annotations
 import hmac
 import logging
 import secrets
+import ssl
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from http.cookies import CookieError, SimpleCookie
 from pathlib import Path
 from typing import TYPE_CHECKING
-from urllib.parse import parse_qs, urlsplit
+from urllib.parse import parse_qs, urlencode, urlsplit
 
 from vahr.plumbing.http_server import QuietHandler, QuietServer, ServerThread
 from vahr.plumbing.ports import LOOPBACK
@@ -56,6 +67,12 @@ KEEPALIVE_S = 15.0
 # after a quiet spell goes at once; under load changes are batched a frame at a time.
 FRAME_S = 1 / 60
 COOKIE = "vahr_station"
+# How long the token's cookie opens the station before the URL must be opened again: a day
+# of lab work, and not forever on a tablet that leaves the lab.
+COOKIE_HOURS = 12
+# A connection idle this long (a request never finished, a dead client) is closed; the event
+# stream writes a keepalive every KEEPALIVE_S, well inside it.
+IDLE_TIMEOUT_S = 30.0
 CONTENT_TYPES = {
     ".html": "text/html; charset=utf-8",
     ".css": "text/css; charset=utf-8",
@@ -82,8 +99,27 @@ def is_loopback(host: str) -> bool:
     return host in ("127.0.0.1", "localhost", "::1")
 
 
+@dataclass(frozen=True)
+class ServerTls:
+    """The certificate (chain) and key the station serves HTTPS with."""
+
+    cert_file: Path
+    key_file: Path
+
+    def context(self) -> ssl.SSLContext:
+        context = ssl.create_default_context(ssl.Purpose.CLIENT_AUTH)
+        context.minimum_version = ssl.TLSVersion.TLSv1_2
+        context.load_cert_chain(str(self.cert_file), str(self.key_file))
+        return context
+
+
 class _Handler(QuietHandler):
     server: _Server
+
+    def setup(self) -> None:
+        super().setup()
+        # Every read and write of the connection waits at most this long.
+        self.connection.settimeout(self.server.station.idle_timeout_s)
 
     # -- plumbing -------------------------------------------------------------------------
 
@@ -115,7 +151,11 @@ class _Handler(QuietHandler):
             self.refuse(401, "this station needs its token: open the URL it printed")
             return None
         origin = self.headers.get("Origin")
-        if self.command == "POST" and origin is not None and origin != f"http://{host}":
+        if (
+            self.command == "POST"
+            and origin is not None
+            and not station.origin_allowed(origin, host)
+        ):
             self.refuse(403, f"requests from {origin} are not accepted")
             return None
         return url.path, query
@@ -175,11 +215,16 @@ class _Handler(QuietHandler):
 
     def _page(self, path: str, query: dict[str, str]) -> None:
         station = self.server.station
-        extra: dict[str, str] = {}
         if station.token is not None and query.get("token"):
-            # The page's own later requests (the stream, the API) carry the cookie.
-            extra["Set-Cookie"] = f"{COOKIE}={station.token}; Path=/; HttpOnly; SameSite=Strict"
-        self._send(station.file("index.html"), extra)
+            # The page's own later requests (the stream, the API) carry the cookie, and the
+            # page is opened again without the token in its address.
+            rest = urlencode({k: v for k, v in query.items() if k != "token"})
+            self._send(
+                Reply(303, b"", "text/plain; charset=utf-8"),
+                {"Set-Cookie": station.cookie(), "Location": path + (f"?{rest}" if rest else "")},
+            )
+            return
+        self._send(station.file("index.html"))
 
     def _favicon(self, path: str, query: dict[str, str]) -> None:
         self._send(self.server.station.file("favicon.svg"))
@@ -262,12 +307,27 @@ class StationServer:
     """Serve a `StationApp` on host:port in a background thread; `stop()` joins it."""
 
     def __init__(
-        self, app: StationApp, *, host: str = LOOPBACK, port: int, token: str | None = None
+        self,
+        app: StationApp,
+        *,
+        host: str = LOOPBACK,
+        port: int,
+        token: str | None = None,
+        tls: ServerTls | None = None,
+        public_origin: str | None = None,
+        idle_timeout_s: float = IDLE_TIMEOUT_S,
     ) -> None:
         self.app = app
         self.host = host
-        # Off the loopback interface the station is reachable by others: a token guards it.
-        self.token = token or (None if is_loopback(host) else secrets.token_urlsafe(18))
+        self.tls = tls
+        # Where people open the page when a reverse proxy stands in front (its scheme, name
+        # and port): its requests' Origin is this one.
+        self.public_origin = public_origin.rstrip("/") if public_origin else None
+        self.idle_timeout_s = idle_timeout_s
+        # Off the loopback interface, or behind a proxy, the station is reachable by others:
+        # a token guards it.
+        reachable = not is_loopback(host) or self.public_origin is not None
+        self.token = token or (secrets.token_urlsafe(18) if reachable else None)
         pages = [*STATIC.iterdir(), *LOCALES.iterdir()]
         self._files = {p.name: p for p in pages if p.suffix in CONTENT_TYPES}
         self._streams = 0
@@ -287,19 +347,53 @@ class StationServer:
         }
         self._serving = ServerThread(_Server, _Handler, host, port)
         self._serving.server.station = self  # type: ignore[attr-defined]
+        if tls is not None:
+            # The handshake is made on the connection's own thread, on its first read, so
+            # a client slow to shake hands holds no other client back.
+            server = self._serving.server
+            server.socket = tls.context().wrap_socket(
+                server.socket, server_side=True, do_handshake_on_connect=False
+            )
 
     @property
     def port(self) -> int:
         return self._serving.port
 
     @property
+    def scheme(self) -> str:
+        return "https" if self.tls is not None else "http"
+
+    @property
+    def secure(self) -> bool:
+        """Whether people open the page over HTTPS (here, or at the proxy)."""
+        return self.tls is not None or (self.public_origin or "").startswith("https://")
+
+    @property
     def url(self) -> str:
         """The page's address, with the token when one is needed."""
-        shown = LOOPBACK if self.host in ("0.0.0.0", "") else self.host  # noqa: S104
-        if ":" in shown:
-            shown = f"[{shown}]"
-        base = f"http://{shown}:{self.port}/"
+        if self.public_origin is not None:
+            base = f"{self.public_origin}/"
+        else:
+            shown = LOOPBACK if self.host in ("0.0.0.0", "") else self.host  # noqa: S104
+            if ":" in shown:
+                shown = f"[{shown}]"
+            base = f"{self.scheme}://{shown}:{self.port}/"
         return f"{base}?token={self.token}" if self.token else base
+
+    def origin_allowed(self, origin: str, host: str) -> bool:
+        """Whether a request with this `Origin` (and `Host`) comes from the station's page."""
+        return origin == f"{self.scheme}://{host}" or (
+            self.public_origin is not None and origin == self.public_origin
+        )
+
+    def cookie(self) -> str:
+        """The token's cookie: the page's later requests carry it, and only they."""
+        assert self.token is not None
+        secure = "; Secure" if self.secure else ""
+        return (
+            f"{COOKIE}={self.token}; Path=/; Max-Age={COOKIE_HOURS * 3600}; HttpOnly; "
+            f"SameSite=Strict{secure}"
+        )
 
     def route(self, method: str, path: str) -> Answer | None:
         """What answers `method` on `path`, or None (nothing is there)."""

@@ -4,7 +4,10 @@ Point boto3 at it with `AWS_ENDPOINT_URL_IOT_DATA_PLANE=http://127.0.0.1:PORT`. 
 Publish (to the local broker, QoS and retain honoured), Get/Update/DeleteThingShadow
 (classic and named) and ListNamedShadowsForThing with AWS's status codes, error shapes and
 `x-amzn-ErrorType` names (so boto3 raises `ResourceNotFoundException`, `ConflictException`,
-...). SigV4 headers are accepted and not checked: it listens on 127.0.0.1 only.
+...). It listens on 127.0.0.1 only and checks no signature, so what a web page could make
+the operator's browser send is refused before anything runs (`vahr.twin.browser_guard`):
+a foreign `Host` (DNS rebinding), a foreign `Origin` or `Sec-Fetch-Site`, and a write that
+is neither JSON nor signed with SigV4 (boto3 and the AWS CLI sign every request).
 
 It also answers the IoT control plane's fleet-indexing calls under `/indices`
 (`vahr.twin.fleet_index_api`), so boto3's `iot` client pointed here can search the fleet.
@@ -25,6 +28,7 @@ from vahr.errors import VahrError
 from vahr.plumbing.http_server import QuietHandler, QuietServer, ServerThread
 from vahr.plumbing.ports import LOOPBACK, ensure_free
 from vahr.protocol import topics
+from vahr.twin.browser_guard import BrowserGuard
 from vahr.twin.fleet_index_api import FleetIndexApi
 from vahr.twin.shadow_store import MAX_REQUEST_BYTES, ShadowError
 
@@ -242,6 +246,14 @@ class _Handler(QuietHandler):
     MAX_BODY_BYTES = MAX_PUBLISH_BYTES + 1024
 
     def _serve(self) -> None:
+        refusal = self.server.guard.refusal(self.command, self.headers)
+        if refusal is not None:
+            # Refused before the body is read, so the connection cannot be used again.
+            self.close_connection = True
+            log.warning(
+                "data plane refused %s %s: %s", self.command, self.path[:200], refusal.message
+            )
+            return self._answer(*_error(refusal.status, refusal.message))
         declared = self.headers.get("Content-Length")
         if declared is not None and not declared.strip().isdigit():
             # The body's end is unknown, so the connection cannot be used again.
@@ -291,15 +303,21 @@ class _Handler(QuietHandler):
 class _Server(QuietServer):
     what = "data-plane API"
     dataplane: DataPlane
+    guard: BrowserGuard
 
 
 class DataPlaneServer:
-    """Serve a `DataPlane` on 127.0.0.1:port in a background thread; `stop()` joins it."""
+    """Serve a `DataPlane` on 127.0.0.1:port in a background thread; `stop()` joins it.
 
-    def __init__(self, dataplane: DataPlane, port: int) -> None:
+    `hosts` are names it answers to besides the loopback ones (a proxy's or a tunnel's)."""
+
+    def __init__(
+        self, dataplane: DataPlane, port: int, *, hosts: frozenset[str] = frozenset()
+    ) -> None:
         ensure_free(port, "data-plane API")
         self._serving = ServerThread(_Server, _Handler, LOOPBACK, port)
         self._serving.server.dataplane = dataplane  # type: ignore[attr-defined]
+        self._serving.server.guard = BrowserGuard(hosts)  # type: ignore[attr-defined]
 
     @property
     def port(self) -> int:

@@ -1,9 +1,9 @@
 """The local stack without robots: broker, shadow service and data plane, started in order.
 
 `LocalStack` is what `vahr up`, `vahr demo`, the tests and the benchmarks share: it makes
-(or reuses) the local CA, writes the ACL, starts mosquitto with an mTLS listener (and an
-optional plaintext one), connects the shadow service and the data plane to it with the
-service identity, and serves the data-plane HTTP API. `stop()` undoes all of it.
+(or reuses) the local CA, writes the ACL, starts mosquitto with an mTLS listener (and, when
+asked for, a plaintext one), connects the shadow service and the data plane to it with
+their own identity, and serves the data-plane HTTP API. `stop()` undoes all of it.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 from vahr.pki import LocalCA
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint
 from vahr.plumbing.ports import LOOPBACK, ensure_free
+from vahr.twin import identities
 from vahr.twin.acl import write_acl
 from vahr.twin.broker import BrokerConfig, Mosquitto, TlsListener
 from vahr.twin.dataplane import DataPlane, DataPlaneServer
@@ -39,6 +40,8 @@ class StackConfig:
     mqtts_port: int
     mqtt_port: int | None
     api_port: int
+    # Names the data plane answers to besides the loopback ones (`vahr up --api-host`).
+    api_hosts: frozenset[str] = frozenset()
 
 
 class LocalStack:
@@ -71,10 +74,16 @@ class LocalStack:
         port = self.config.mqtt_port
         return f"mqtt://{LOOPBACK}:{port}" if port is not None else None
 
-    def service_endpoint(self) -> MqttEndpoint:
-        """How a local service connects: the mTLS listener with the service identity."""
+    def service_endpoint(self, identity: str = identities.TOOL) -> MqttEndpoint:
+        """How a local service connects: the mTLS listener as `identity`, one of
+        `vahr.twin.identities.SERVICES` (each client its own: the broker makes the
+        identity the client id)."""
         assert self.ca is not None, "start() first"
-        return MqttEndpoint(port=self.config.mqtts_port, credentials=self.ca.service_credentials())
+        if identity not in identities.SERVICES:
+            raise ValueError(f"identity: {identity!r} is not one of the stack's services")
+        return MqttEndpoint(
+            port=self.config.mqtts_port, credentials=self.ca.service_credentials(identity)
+        )
 
     @property
     def database(self) -> Path:
@@ -97,9 +106,11 @@ class LocalStack:
             raise
         try:
             self.ca = LocalCA.load_or_create(cfg.state_dir)
-            acl = write_acl(
-                cfg.state_dir / "broker" / "acl", open_anonymous=cfg.mqtt_port is not None
-            )
+            # Every identity the ACL names, issued once (a tool beside the stack, such as
+            # `vahr station`, finds its certificate in STATE/pki/service/).
+            for identity in identities.SERVICES:
+                self.ca.service_credentials(identity)
+            acl = write_acl(cfg.state_dir / "broker" / "acl")
             self.broker = Mosquitto(
                 BrokerConfig(
                     state_dir=cfg.state_dir / "broker",
@@ -119,8 +130,8 @@ class LocalStack:
             # back, as AWS's shadow service never misses one. With a clean session they
             # were dropped, and a robot that then stayed idle left its shadow stale.
             self._service_client = MqttClient(
-                self.service_endpoint(),
-                client_id="vahr-shadow-service",
+                self.service_endpoint(identities.SHADOWS),
+                client_id=identities.SHADOWS,
                 session_expiry_s=SHADOW_SESSION_EXPIRY_S,
             )
             client = self._service_client
@@ -140,7 +151,9 @@ class LocalStack:
                 client.publish(topic, payload, qos=qos, retain=retain, wait=qos > 0)
 
             self.dataplane = DataPlane(self.shadows, publish, self.meter)
-            self._server = DataPlaneServer(self.dataplane, cfg.api_port).start()
+            self._server = DataPlaneServer(
+                self.dataplane, cfg.api_port, hosts=cfg.api_hosts
+            ).start()
         except BaseException:
             self.stop()
             raise

@@ -1,5 +1,7 @@
 """Fixtures for the agent's integration tests: a tap on the broker, a shadow responder,
-and a factory of real `robot-agent run` processes that are always stopped."""
+a factory of real `robot-agent run` processes that are always stopped, ROS 1's master and
+fake move_base (tests/support/ros1.py) and ROS 2's stand-in bt_navigator
+(tests/support/nav2.py)."""
 
 from __future__ import annotations
 
@@ -8,6 +10,8 @@ from typing import TYPE_CHECKING
 import pytest
 
 from tests.integration.agent.harness import AgentProcess, ShadowResponder, WireTap
+from tests.support.nav2 import nav2_stand_in  # noqa: F401 - a module's stand-in
+from tests.support.ros1 import move_base, ros_master  # noqa: F401 - session fixtures
 from tests.unit.agent.conftest import pytest_pyfunc_call  # noqa: F401 - runs async tests
 
 if TYPE_CHECKING:

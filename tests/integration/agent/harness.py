@@ -14,6 +14,7 @@ import os
 import signal
 import socket
 import subprocess
+import sys
 import threading
 import time
 from dataclasses import dataclass
@@ -29,7 +30,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
 ROOT = Path(__file__).resolve().parents[3]
-AGENT = ROOT / ".venv" / "bin" / "robot-agent"
+# The robot-agent of the venv running the tests (.venv, or .venv-ros2 for the nav2 backend).
+AGENT = Path(sys.executable).with_name("robot-agent")
 
 
 @dataclass(frozen=True)

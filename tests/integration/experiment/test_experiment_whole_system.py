@@ -44,6 +44,8 @@ def system(tmp_path: Path) -> Iterator[dict[str, Any]]:
                 str(tmp_path / "state"),
                 "--api-port",
                 str(free_port()),
+                # `vahr experiment` records from the plaintext development listener.
+                "--dev-plaintext",
                 "--mqtt-port",
                 str(free_port()),
                 "--mqtts-port",

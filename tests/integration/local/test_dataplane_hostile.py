@@ -23,7 +23,7 @@ def _raw(stack: LocalStack, request: bytes) -> tuple[int, dict[str, str], bytes]
 def test_a_content_length_that_is_not_a_number_is_a_400(local_stack: LocalStack) -> None:
     status, headers, body = _raw(
         local_stack,
-        b"POST /things/placebot1/shadow HTTP/1.1\r\nHost: x\r\nContent-Length: abc\r\n\r\n{}",
+        b"POST /things/placebot1/shadow HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\nContent-Length: abc\r\n\r\n{}",
     )
     assert status == 400
     assert json.loads(body) == {
@@ -37,7 +37,7 @@ def test_a_body_larger_than_aws_allows_is_refused_before_it_is_read(
 ) -> None:
     status, _, body = _raw(
         local_stack,
-        b"POST /topics/t?qos=1 HTTP/1.1\r\nHost: x\r\nContent-Length: 999999999\r\n\r\n",
+        b"POST /topics/t?qos=1 HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\nContent-Length: 999999999\r\n\r\n",
     )
     assert status == 413
     assert json.loads(body)["message"] == "The payload exceeds the maximum size allowed"
@@ -45,7 +45,8 @@ def test_a_body_larger_than_aws_allows_is_refused_before_it_is_read(
 
 def test_a_method_the_api_does_not_know_is_a_405_in_aws_shape(local_stack: LocalStack) -> None:
     status, headers, body = _raw(
-        local_stack, b"BREW /things/placebot1/shadow HTTP/1.1\r\nHost: x\r\n\r\n"
+        local_stack,
+        b"BREW /things/placebot1/shadow HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n\r\n",
     )
     assert status == 405
     assert json.loads(body) == {"code": 405, "message": "BREW is not allowed on a shadow"}
@@ -55,7 +56,10 @@ def test_a_method_the_api_does_not_know_is_a_405_in_aws_shape(local_stack: Local
 def test_a_request_line_broken_by_a_line_feed_gets_an_http_11_answer(
     local_stack: LocalStack,
 ) -> None:
-    status, _, body = _raw(local_stack, b"GET /vahr/health?a=\n HTTP/1.1\r\nHost: x\r\n\r\n")
+    status, _, body = _raw(
+        local_stack,
+        b"GET /vahr/health?a=\n HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n\r\n",
+    )
     assert status == 400
     assert json.loads(body)["message"] == "Bad request line: HTTP/1.1 is required"
 
@@ -67,7 +71,7 @@ def test_a_shadow_nested_deeper_than_the_parser_goes_is_a_400_not_a_500(
     document = b'{"state":{"reported":{"a":' + deep + b"}}}"
     status, _, body = _raw(
         local_stack,
-        b"POST /things/placebot1/shadow HTTP/1.1\r\nHost: x\r\nContent-Length: %d\r\n\r\n"
+        b"POST /things/placebot1/shadow HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\nContent-Length: %d\r\n\r\n"
         % len(document)
         + document,
     )

@@ -23,6 +23,8 @@ from cryptography.hazmat.primitives import hashes, serialization
 from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 from paho.mqtt.enums import CallbackAPIVersion, MQTTProtocolVersion
+from paho.mqtt.packettypes import PacketTypes
+from paho.mqtt.properties import Properties
 
 from vahr.pki import LocalCA
 from vahr.plumbing.mqtt import MqttClient
@@ -41,7 +43,14 @@ NOT_AUTHORIZED = 0x87
 class Probe:
     """A paho MQTT 5 client over mTLS that records what it receives and its PUBACKs."""
 
-    def __init__(self, port: int, credentials: ClientCredentials, client_id: str) -> None:
+    def __init__(
+        self,
+        port: int,
+        credentials: ClientCredentials,
+        client_id: str,
+        *,
+        session_expiry_s: int = 0,
+    ) -> None:
         self.client = paho.Client(
             CallbackAPIVersion.VERSION2, client_id=client_id, protocol=MQTTProtocolVersion.MQTTv5
         )
@@ -56,7 +65,15 @@ class Probe:
         self.client.on_publish = self._on_publish
         self.client.on_subscribe = lambda *a: self._notify()
         self.client.on_disconnect = lambda c, u, f, rc, p: self._disconnected(str(rc))
-        self.client.connect("127.0.0.1", port, keepalive=30)
+        properties = Properties(PacketTypes.CONNECT)
+        properties.SessionExpiryInterval = session_expiry_s
+        self.client.connect(
+            "127.0.0.1",
+            port,
+            keepalive=30,
+            clean_start=session_expiry_s == 0,
+            properties=properties,
+        )
         self.client.loop_start()
         assert connected.wait(10), "probe could not connect"
 
@@ -269,25 +286,46 @@ def test_expired_foreign_and_missing_certificates_are_refused_at_the_handshake(
     assert _handshake(port, no_certificate) is not None
 
 
-def test_a_client_id_that_is_not_the_thing_name_gets_nothing_of_that_thing(
-    local_stack: LocalStack, intruder: Probe, tmp_path: Path
+def test_a_certificate_claiming_another_robots_client_id_cannot_take_its_session(
+    local_stack: LocalStack, tmp_path: Path
 ) -> None:
-    # AWS refuses the CONNECT (its policy binds iot:Connect to client/<thing name>);
-    # mosquitto 2.0.11 cannot bind a client id to a certificate and accepts it. What must
-    # hold anyway: the impostor receives nothing meant for that thing.
+    # AWS refuses such a CONNECT (its policy binds iot:Connect to client/<thing name>).
+    # mosquitto 2.0.11 makes the certificate's name the client id whatever id is claimed
+    # (use_username_as_clientid): the impostor is connected as itself, and the robot it
+    # claims to be keeps its session, its connection and its queued commands.
     assert local_stack.ca is not None
-    credentials = local_stack.ca.issue_client("placebot2", tmp_path / "impostor")
-    impostor = Probe(local_stack.config.mqtts_port, credentials, "placebot1")
+    port = local_stack.config.mqtts_port
+    own = local_stack.ca.issue_client("placebot2", tmp_path / "placebot2")
+    stolen = local_stack.ca.issue_client("placebot1", tmp_path / "placebot1")
+    # Given placebot2 with a persistent session, away while a command is queued for it
+    robot = Probe(port, own, "placebot2", session_expiry_s=600)
+    robot.subscribe(topics.robot_cmd("placebot2"))
+    robot.close()
+    with MqttClient(local_stack.service_endpoint()) as service:
+        service.publish(topics.robot_cmd("placebot2"), b'{"queued":1}')
+    # When placebot1's certificate connects claiming placebot2's client id and session
+    impostor = Probe(port, stolen, "placebot2", session_expiry_s=600)
     try:
-        impostor.subscribe(topics.robot_cmd("placebot1"))
+        impostor.subscribe(topics.robot_cmd("placebot2"))
         impostor.subscribe(topics.robot_events("placebot1"))
-        with MqttClient(local_stack.service_endpoint()) as service:
-            service.publish(topics.robot_cmd("placebot1"), b'{"secret":1}')
-            service.publish(topics.robot_events("placebot1"), b'{"event":"marker-2"}')
-        received = impostor.received_until(b'{"event":"marker-2"}')
-        assert set(received) == {topics.robot_events("placebot1")}
-        # And its publishes are judged by its certificate, not by the id it claimed
-        assert impostor.publish(topics.robot_events("placebot1")) == NOT_AUTHORIZED
+        # Then placebot2 comes back to its own session: the queued command is delivered
+        robot = Probe(port, own, "placebot2", session_expiry_s=600)
+        try:
+            robot.received_until(b'{"queued":1}')
+            # And the impostor's connection does not push placebot2 off, nor the other way
+            # round: they are two clients, placebot1 and placebot2
+            with MqttClient(local_stack.service_endpoint()) as service:
+                service.publish(topics.robot_cmd("placebot2"), b'{"live":2}')
+                service.publish(topics.robot_events("placebot1"), b'{"event":"marker-2"}')
+            assert robot.received_until(b'{"live":2}')
+            received = impostor.received_until(b'{"event":"marker-2"}')
+            assert set(received) == {topics.robot_events("placebot1")}
+            assert robot.disconnects == []
+            assert impostor.disconnects == []
+            # Its publishes are judged by its certificate, not by the id it claimed
+            assert impostor.publish(topics.robot_events("placebot2")) == NOT_AUTHORIZED
+        finally:
+            robot.close()
     finally:
         impostor.close()
 

@@ -7,6 +7,7 @@ import json
 import signal
 import socket
 import subprocess
+import sys
 import urllib.request
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -24,9 +25,7 @@ if TYPE_CHECKING:
 @pytest.fixture(scope="module")
 def up(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Up]:
     state = tmp_path_factory.mktemp("up")
-    running = start_up(
-        state, "--mqtt-port", "0", "--station-port", str(free_port()), "--sim-speed-factor", "20"
-    )
+    running = start_up(state, "--station-port", str(free_port()), "--sim-speed-factor", "20")
     try:
         yield running
     finally:
@@ -42,7 +41,8 @@ def test_the_first_line_names_every_endpoint(up: Up) -> None:
     assert up.endpoints["station"].startswith(f"http://{LOOPBACK}:")
     assert up.endpoints["dashboard"] == up.endpoints["station"]
     assert up.endpoints["api"].startswith(f"http://{LOOPBACK}:")
-    assert up.endpoints["mqtt"] is None  # --mqtt-port 0: no plaintext listener
+    # No plaintext listener unless asked for (--dev-plaintext)
+    assert up.endpoints["mqtt"] is None
     assert Path(up.endpoints["ca"]).read_text().startswith("-----BEGIN CERTIFICATE-----")
 
 
@@ -62,6 +62,35 @@ def test_a_spoken_command_moves_the_robot_and_the_reply_reflects_it(up: Up) -> N
     status = say(up, "Alexa, ask robot fleet where is robot one")
     assert "zone B" in status["speech"]
     assert status["commands"] == []
+
+
+def test_boto3_with_dummy_credentials_commands_a_robot(up: Up) -> None:
+    # Given boto3 as a user's script would run it: the endpoint and dummy keys in its
+    # environment, nothing else (a subprocess, so no state of this test leaks in)
+    script = (
+        "import boto3, json\n"
+        "client = boto3.client('iot-data')\n"
+        "command = {'id': 'boto3-1', 'action': 'navigate', 'params': {'zone': 'C'},\n"
+        "           'issued_at': '2026-01-01T00:00:00Z', 'source': 'console'}\n"
+        "client.publish(topic='vahr/robots/placebot2/cmd', qos=1,\n"
+        "               payload=json.dumps(command).encode())\n"
+        "print(client.get_thing_shadow(thingName='placebot2')['payload'].read().decode())\n"
+    )
+    env = {
+        **clean_env(),
+        "AWS_ACCESS_KEY_ID": "x",
+        "AWS_SECRET_ACCESS_KEY": "x",
+        "AWS_DEFAULT_REGION": "us-east-1",
+        "AWS_ENDPOINT_URL_IOT_DATA_PLANE": up.endpoints["api"],
+    }
+    done = subprocess.run(
+        [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["state"]["reported"]["connected"] is True
+    # Then the robot drives there
+    arrived = up.wait_event("boto3-1", "arrived")
+    assert (arrived["event"], arrived["zone"]) == ("arrived", "C")
 
 
 def test_the_old_dashboard_leads_to_the_station_and_status_shows_the_robots(up: Up) -> None:
@@ -117,6 +146,22 @@ def test_a_taken_port_is_one_clear_line(tmp_path: Path) -> None:
         f"vahr up: error: port {port} for the data-plane API is already in use on "
         f"{LOOPBACK}; stop what uses it or pick another port"
     )
+
+
+def test_a_plaintext_port_without_asking_for_the_listener_is_one_clear_line(
+    tmp_path: Path,
+) -> None:
+    result = subprocess.run(
+        [*VAHR, "up", "--state-dir", str(tmp_path / "state"), "--mqtt-port", "1999"],
+        cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=30,
+    )  # fmt: skip
+    assert result.returncode == 2
+    assert result.stderr == (
+        "vahr up: error: --mqtt-port 1999: the plaintext listener is off; add --dev-plaintext "
+        "to open it (any program on this machine can then command the robots), or connect "
+        "to --mqtts-port with a certificate\n"
+    )
+    assert not (tmp_path / "state").exists()
 
 
 def test_say_without_a_running_system_is_one_clear_line() -> None:

@@ -129,7 +129,7 @@ def test_a_broken_fleet_file_starts_nothing(name: str, tmp_path: Path) -> None:
     result = subprocess.run(
         [*VAHR, "up", "--fleet", str(path), "--state-dir", str(state), "--no-voice",
          "--api-port", str(free_port()), "--mqtts-port", str(free_port()),
-         "--mqtt-port", str(free_port()), "--station-port", str(free_port())],
+         "--station-port", str(free_port())],
         cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     # Then it says in one line which entry is wrong and why, and exits 2

@@ -42,9 +42,10 @@ WAIT_S = 30.0
 def up(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Up]:
     running = start_up(
         tmp_path_factory.mktemp("station-alerts-up"),
-        "--mqtt-port", str(free_port()),
         "--station-port", str(free_port()),
         "--sim-speed-factor", "10",
+        # `vahr station` is started on its plaintext listener too.
+        plaintext=True,
     )  # fmt: skip
     try:
         yield running

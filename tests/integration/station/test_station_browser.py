@@ -50,9 +50,10 @@ def up(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Up]:
     state = tmp_path_factory.mktemp("station-up")
     running = start_up(
         state,
-        "--mqtt-port", str(free_port()),
         "--station-port", str(free_port()),
         "--sim-speed-factor", "10",
+        # `vahr station` is started on its plaintext listener too.
+        plaintext=True,
     )  # fmt: skip
     try:
         yield running

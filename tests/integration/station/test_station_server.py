@@ -195,9 +195,11 @@ def test_the_token_opens_the_page_and_its_cookie_the_rest(guarded: StationServer
     status, _, answer = request(guarded, "GET", "/")
     assert status == 401 and "token" in error(answer)
     status, headers, _ = request(guarded, "GET", f"/?token={TOKEN}")
-    assert status == 200
+    # The token sets the cookie, and the page is opened again without it in the address
+    assert (status, headers["Location"]) == (303, "/")
     cookie = headers["Set-Cookie"].split(";")[0]
     assert "HttpOnly" in headers["Set-Cookie"] and "SameSite=Strict" in headers["Set-Cookie"]
+    assert request(guarded, "GET", "/", headers={"Cookie": cookie})[0] == 200
     assert request(guarded, "GET", "/api/snapshot", headers={"Cookie": cookie})[0] == 200
     bearer = {"Authorization": f"Bearer {TOKEN}"}
     assert request(guarded, "GET", "/api/health", headers=bearer)[0] == 200

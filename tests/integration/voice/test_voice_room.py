@@ -77,7 +77,7 @@ def test_the_robot_asks_and_understands_the_spoken_answer(
     room_setup: tuple[Skill, list[Exchange], str], weather: str
 ) -> None:
     skill, exchanges, url = room_setup
-    skill.experiment_weather = weather
+    skill.weather = weather
     # Given a robot's room voice on the broker
     robot = RobotInTheRoom(url, "placebot1", synthesizer="en-us+m3")
     voice = robot.voice

@@ -45,7 +45,7 @@ def system(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Any]]
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     process = spawn(
         [sys.executable, "-m", "vahr.cli", "up", "--state-dir", str(state),
-         "--api-port", str(free_port()), "--mqtt-port", str(free_port()),
+         "--api-port", str(free_port()), "--dev-plaintext", "--mqtt-port", str(free_port()),
          "--mqtts-port", str(free_port()), "--station-port", "0",
          "--sim-speed-factor", "20", "--json"],
         started_for=state, cwd=ROOT, env=env, stdout=subprocess.PIPE,

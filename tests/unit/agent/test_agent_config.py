@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import json
 from typing import TYPE_CHECKING
 
@@ -195,6 +196,19 @@ def test_a_bad_environment_value_is_named(
             "--sim-speed-factor applies to the sim backend only; ROS runs in real time",
         ),
         (
+            (
+                "--thing",
+                "placebot1",
+                "--broker",
+                "mqtt://127.0.0.1:1",
+                "--backend",
+                "nav2",
+                "--sim-speed-factor",
+                "5",
+            ),
+            "--sim-speed-factor applies to the sim backend only; ROS runs in real time",
+        ),
+        (
             ("--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--voice", "nonsense"),
             "--voice 'nonsense': expected none or package.module:factory",
         ),
@@ -228,3 +242,23 @@ def test_a_certificate_that_is_not_pem_is_a_one_line_error(
         "--key", str(key),
     )  # fmt: skip
     assert error.startswith("robot-agent run: error: cannot load the certificate, key or CA: ")
+
+
+@pytest.mark.skipif(
+    importlib.util.find_spec("rclpy") is not None, reason="this venv has ROS 2 (.venv-ros2)"
+)
+def test_the_nav2_backend_outside_a_ros2_venv_is_a_one_line_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Given the main venv, which has ROS 1 and not ROS 2
+    # When the agent is started with the nav2 backend
+    error = error_of(
+        capsys, "--thing", "placebot1", "--broker", "mqtt://127.0.0.1:1", "--backend", "nav2",
+        "--state-dir", str(tmp_path),
+    )  # fmt: skip
+    # Then it stops before connecting, saying where ROS 2 is
+    assert error == (
+        "robot-agent run: error: --backend nav2 needs ROS 2's rclpy and nav2_msgs (No module "
+        "named 'rclpy'); run robot-agent from .venv-ros2 (make setup makes it), or next to the "
+        "robot's own ROS 2"
+    )

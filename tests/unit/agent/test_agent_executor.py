@@ -321,6 +321,7 @@ class ThreadedFeedbackBackend:
     """A backend whose feedback arrives from another thread, as rospy's does."""
 
     name = "threaded"
+    observed_pose = True
 
     def __init__(self, start: Pose) -> None:
         self.pose = start

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import json
 import stat
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import boto3
 import pytest
 import yaml
+from cryptography import x509
+from cryptography.hazmat.primitives import serialization
+from cryptography.x509.oid import NameOID
 from moto import mock_aws
 
 from robot_agent.cli import main
@@ -211,3 +214,120 @@ def test_a_port_out_of_range_is_one_line_and_registers_nothing(
     )
     client = boto3.client("iot", region_name=REGION)
     assert client.list_certificates()["certificates"] == []
+
+
+# -- one identity per robot ----------------------------------------------------------------
+
+
+def test_the_private_key_is_made_on_the_robot_and_aws_signs_its_csr(
+    iot: object, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Given the AWS calls as botocore sends them (moto keeps no record of some parameters)
+    calls = _recorded_calls(monkeypatch)
+    out = tmp_path / "placebot1"
+    # When the robot is provisioned
+    assert main(["provision", "--thing", "placebot1", "--aws", "--out", str(out)]) == 0
+    # Then the certificate came from a signing request, never from AWS-made keys
+    operations = [name for name, _ in calls]
+    assert "CreateCertificateFromCsr" in operations
+    assert "CreateKeysAndCertificate" not in operations
+    request = next(params for name, params in calls if name == "CreateCertificateFromCsr")
+    csr = x509.load_pem_x509_csr(request["certificateSigningRequest"].encode())
+    assert csr.subject.get_attributes_for_oid(NameOID.COMMON_NAME)[0].value == "placebot1"
+    # And the key on disk is the one whose public half was sent to be signed; nothing sent
+    # held it. (moto signs a key of its own instead of the request's, a moto gap, so the
+    # certificate's key is not compared; its subject is the request's.)
+    key = serialization.load_pem_private_key((out / "private.key").read_bytes(), None)
+    assert _public(key.public_key()) == _public(csr.public_key())
+    cert = x509.load_pem_x509_certificate((out / "cert.pem").read_bytes())
+    assert cert.subject.get_attributes_for_oid(NameOID.COMMON_NAME)[0].value == "placebot1"
+    sent = json.dumps([params for _, params in calls], default=str)
+    assert "PRIVATE KEY" not in sent
+
+
+def test_the_certificate_is_attached_to_its_thing_exclusively(
+    iot: object, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls = _recorded_calls(monkeypatch)
+    assert main(["provision", "--thing", "placebot1", "--aws", "--out", str(tmp_path / "p")]) == 0
+    attach = [params for name, params in calls if name == "AttachThingPrincipal"]
+    # moto 5.2.5 accepts thingPrincipalType but does not keep it (list_thing_principals_v2
+    # gives no type back), so the request as sent is what is asserted, and moto's binding
+    assert [(a["thingName"], a["thingPrincipalType"]) for a in attach] == [
+        ("placebot1", "EXCLUSIVE_THING")
+    ]
+    client = boto3.client("iot", region_name=REGION)
+    assert client.list_thing_principals(thingName="placebot1")["principals"] == [
+        attach[0]["principal"]
+    ]
+
+
+def test_force_deactivates_and_detaches_the_certificate_it_replaces(
+    iot: object, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "p1"
+    client = boto3.client("iot", region_name=REGION)
+    assert main(["provision", "--thing", "placebot1", "--aws", "--out", str(out)]) == 0
+    (old_arn,) = client.list_thing_principals(thingName="placebot1")["principals"]
+    old_id = old_arn.rsplit("/", 1)[-1]
+    capsys.readouterr()
+    # When the robot is provisioned again over its files
+    code = main(["provision", "--thing", "placebot1", "--aws", "--out", str(out), "--force"])
+    # Then the old certificate is inactive and no longer the thing's; the new one is
+    assert code == 0
+    assert f"replaced: certificate {old_id} (detached and deactivated)" in capsys.readouterr().out
+    old = client.describe_certificate(certificateId=old_id)["certificateDescription"]
+    assert old["status"] == "INACTIVE"
+    (new_arn,) = client.list_thing_principals(thingName="placebot1")["principals"]
+    assert new_arn != old_arn
+    new_id = new_arn.rsplit("/", 1)[-1]
+    new = client.describe_certificate(certificateId=new_id)["certificateDescription"]
+    assert new["status"] == "ACTIVE"
+    assert new["certificatePem"] == (out / "cert.pem").read_text()
+
+
+@pytest.mark.parametrize("thing", ["vahr-station-lab", "vahr-service", "VAHR-recorder"])
+def test_a_reserved_name_is_refused_as_a_thing_and_registers_nothing(
+    iot: object, tmp_path: Path, capsys: pytest.CaptureFixture[str], thing: str
+) -> None:
+    code = main(["provision", "--thing", thing, "--aws", "--out", str(tmp_path / "x")])
+    assert code == 2
+    assert capsys.readouterr().err == (
+        f"robot-agent provision: error: thing: {thing!r} is reserved: names starting with "
+        "'vahr-' are the system's own identities (services, stations, recorders), never a "
+        "robot's\n"
+    )
+    client = boto3.client("iot", region_name=REGION)
+    assert client.list_things()["things"] == []
+    assert client.list_certificates()["certificates"] == []
+
+
+def test_a_reserved_name_is_refused_for_the_local_stack_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main(
+        ["provision", "--thing", "vahr-shadow-service", "--local", "--state-dir", str(tmp_path)]
+    )
+    assert code == 2
+    assert "is reserved" in capsys.readouterr().err
+    assert not (tmp_path / "pki").exists()
+
+
+def _recorded_calls(monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, dict[str, Any]]]:
+    """Every IoT call's parameters as botocore is about to send them."""
+    calls: list[tuple[str, dict[str, Any]]] = []
+    session = boto3.session.Session()
+    session.events.register(
+        "provide-client-params.iot.*",
+        lambda params, model, **_: calls.append((model.name, dict(params))),
+    )
+    monkeypatch.setattr(boto3, "DEFAULT_SESSION", session)
+    return calls
+
+
+def _public(key: Any) -> bytes:
+    return bytes(
+        key.public_bytes(
+            serialization.Encoding.DER, serialization.PublicFormat.SubjectPublicKeyInfo
+        )
+    )

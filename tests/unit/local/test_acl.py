@@ -3,7 +3,9 @@ tests/integration/local/test_acl_enforced.py)."""
 
 from __future__ import annotations
 
+from vahr.protocol.identities import RESERVED_PREFIX
 from vahr.twin.acl import render_acl
+from vahr.twin.identities import SERVICES
 
 
 def test_robots_get_only_their_own_topics_by_certificate_name() -> None:
@@ -27,15 +29,18 @@ def test_robots_get_only_their_own_topics_by_certificate_name() -> None:
     ]
 
 
-def test_the_service_identity_may_use_every_topic_including_aws_reserved_ones() -> None:
+def test_each_service_identity_may_use_every_topic_including_aws_reserved_ones() -> None:
     lines = render_acl().splitlines()
-    user = lines.index("user vahr-service")
-    assert lines[user + 1 : user + 3] == ["topic readwrite #", "topic readwrite $aws/#"]
+    for service in SERVICES:
+        user = lines.index(f"user {service}")
+        assert lines[user + 1 : user + 3] == ["topic readwrite #", "topic readwrite $aws/#"]
+    # Every service is named in full: a robot's name is never one of them
+    assert {line.split()[1] for line in lines if line.startswith("user ")} == set(SERVICES)
+    assert all(service.startswith(RESERVED_PREFIX) for service in SERVICES)
 
 
-def test_anonymous_access_only_exists_when_the_plaintext_listener_is_on() -> None:
-    closed = render_acl().splitlines()
-    opened = render_acl(open_anonymous=True).splitlines()
-    first_user = closed.index("user vahr-service")
-    assert not any(line.startswith("topic") for line in closed[:first_user])
-    assert opened[1:3] == ["topic readwrite #", "topic readwrite $aws/#"]
+def test_no_anonymous_client_gets_anything() -> None:
+    # Lines before the first `user` would apply to anonymous clients.
+    lines = render_acl().splitlines()
+    first_user = next(i for i, line in enumerate(lines) if line.startswith("user "))
+    assert not any(line.startswith(("topic", "pattern")) for line in lines[:first_user])

@@ -6,9 +6,9 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-from ask_sdk_runtime.exceptions import AskSdkException
 from skill_testkit import published, speech
 
+from skill import prompts
 from skill.config import SkillConfig
 from skill.errors import ConfigError
 from skill.iot_data import create_client
@@ -29,11 +29,17 @@ def test_every_variable_is_read() -> None:
             "VAHR_ACK_TIMEOUT_S": "1.25",
             "VAHR_FLEET_FILE": "/opt/fleet.yaml",
             "VAHR_LOG_LEVEL": "debug",
+            "VAHR_SKILL_ID_PARAMETER": "/vahr/Vahr/skill-id",
+            "VAHR_ALLOW_ANY_SKILL": "true",
+            "AWS_LAMBDA_FUNCTION_NAME": "Vahr-Skill",
         }
     )
     assert config == SkillConfig(
         data_endpoint="https://abc123-ats.iot.eu-west-1.amazonaws.com",
         skill_id="amzn1.ask.skill.1234",
+        skill_id_parameter="/vahr/Vahr/skill-id",
+        allow_any_skill=True,
+        on_lambda=True,
         ack_timeout_s=1.25,
         fleet_file="/opt/fleet.yaml",
         log_level="DEBUG",
@@ -57,6 +63,7 @@ def test_boto3s_own_endpoint_variable_wins_over_the_stacks() -> None:
         ("VAHR_ACK_TIMEOUT_S", "9", "VAHR_ACK_TIMEOUT_S: 9 is out of range"),
         ("VAHR_ACK_TIMEOUT_S", "0", "VAHR_ACK_TIMEOUT_S: 0 is out of range"),
         ("VAHR_LOG_LEVEL", "chatty", "VAHR_LOG_LEVEL: 'chatty' is not one of DEBUG"),
+        ("VAHR_ALLOW_ANY_SKILL", "maybe", "VAHR_ALLOW_ANY_SKILL: 'maybe' is not true or false"),
     ],
 )
 def test_bad_values_name_the_variable(variable: str, value: str, message: str) -> None:
@@ -85,10 +92,10 @@ def test_skill_id_is_enforced_when_configured(make_skill: Any, robots: Any) -> N
     # Given the skill configured for another skill's id
     skill = make_skill(skill_id="amzn1.ask.skill.00000000-0000-0000-0000-000000000000")
     # When a request for this skill arrives
-    # Then it is refused before any handler runs (Lambda reports the error) and nothing
-    # is published
-    with pytest.raises(AskSdkException, match="Skill ID Verification failed"):
-        skill(load_event("alexa_navigate"), None)
+    response = skill(load_event("alexa_navigate"), None)
+    # Then it is answered with a sentence saying so, before any handler runs, and nothing
+    # is published (tests/unit/skill/test_skill_gate.py has every case)
+    assert speech(response) == prompts.NOT_THIS_SKILL
     assert published() == []
 
 

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-import pytest
-from ask_sdk_core.exceptions import AskSdkException
 from skill_testkit import speech
 
 from skill import prompts
@@ -33,5 +31,7 @@ def test_an_envelope_for_another_skill_is_still_refused(
 ) -> None:
     event = load_event("alexa_navigate")
     event["context"]["System"]["application"]["applicationId"] = "amzn1.ask.skill.other"
-    with pytest.raises(AskSdkException):
-        make_skill(skill_id="amzn1.ask.skill.8b5f1c1e-3f0a-4c55-9a57-2f3d6f1e9a10")(event, None)
+    response = make_skill(skill_id="amzn1.ask.skill.8b5f1c1e-3f0a-4c55-9a57-2f3d6f1e9a10")(
+        event, None
+    )
+    assert speech(response) == prompts.NOT_THIS_SKILL

@@ -49,6 +49,13 @@
  */
 
 /**
+ * A robot's battery as its backend reads it: charge in percent and whether it charges.
+ * @typedef {object} Battery
+ * @property {number} percent
+ * @property {boolean} [charging]
+ */
+
+/**
  * A command seen on a command topic (from the assistant, the console, a robot), to `target` (a
  * thing, or "fleet" for every robot in `robots`); `acks` grows as robots answer. `seen` is when
  * the station saw it (ms since the epoch).
@@ -83,8 +90,9 @@
  * What a robot did, published on `vahr/robots/{thing}/events`.
  *
  * Only the fields that apply are sent: `zone` for arrived/loaded/delivered, `reason` for
- * rejected/failed/stuck/cancelled, `progress` (0..1) for progress, `text` for what was said or
- * heard, `intent` and `confidence` for interpreted.
+ * rejected/failed/stuck/cancelled, `progress` (0..1) for progress (with `eta_s` and
+ * `distance_remaining_m` from a backend that estimates them, such as Nav2), `text` for what was
+ * said or heard, `intent` and `confidence` for interpreted.
  * @typedef {object} Event
  * @property {"accepted"|"arrived"|"cancelled"|"delivered"|"done"|"failed"|"heard"|"interpreted"|"loaded"|"progress"|"rejected"|"said"|"stopped"|"stuck"|"waiting"} event
  * @property {string} thing
@@ -94,6 +102,8 @@
  * @property {string|null} [zone]
  * @property {string|null} [reason]
  * @property {number|null} [progress]
+ * @property {number|null} [eta_s]
+ * @property {number|null} [distance_remaining_m]
  * @property {ReportedPose|null} [pose]
  * @property {string|null} [text]
  * @property {string|null} [intent]
@@ -115,6 +125,8 @@
  * @property {string|null} [zone]
  * @property {string|null} [reason]
  * @property {number|null} [progress]
+ * @property {number|null} [eta_s]
+ * @property {number|null} [distance_remaining_m]
  * @property {ReportedPose|null} [pose]
  * @property {string|null} [text]
  * @property {string|null} [intent]
@@ -259,6 +271,7 @@
  * @property {string|null} [destination]
  * @property {string|null} [task]
  * @property {ReportedPose|null} [pose]
+ * @property {Battery|null} [battery]
  */
 
 /**
@@ -372,9 +385,8 @@
 
 /**
  * The fleet's task queue, sent when it changed: every task the dispatcher lists (`GET
- * {api}/vahr/tasks`, `vahr.dispatch.core.Task`: what is to be done where, its state, the robot
- * that took it), in its order; `available` is False when the deployment has no dispatcher to
- * ask.
+ * {api}/vahr/tasks`, `vahr.dispatch.Task`: what is to be done where, its state, the robot that
+ * took it), in its order; `available` is False when the deployment has no dispatcher to ask.
  * @typedef {object} TasksMessage
  * @property {"tasks"} type
  * @property {Array<Task>} tasks
