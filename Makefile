@@ -14,8 +14,9 @@ WORKERS ?= 3
 DEB_PACKAGES := mosquitto espeak-ng sox chromium iproute2 ros-core python3-rospy python3-actionlib \
 	python3-move-base-msgs python3-geometry-msgs python3-actionlib-msgs \
 	sphinxtrain pocketsphinx sphinxbase-utils flite festival festvox-us-slt-hts
-# The pure-Python ROS packages the venv sees through a .pth file (see FIELD-NOTES: pointing
-# the venv at all of dist-packages would leak Debian's older packages into pip's view).
+# The pure-Python ROS packages the venv sees through a .pth file (pointing the venv at all of
+# Debian's dist-packages would leak its older packages, six, dateutil and a broken pynacl
+# among them, into pip's view).
 ROS_PYTHON_PACKAGES := actionlib actionlib_msgs catkin genmsg genpy geometry_msgs \
 	move_base_msgs roscpp rosgraph rosgraph_msgs roslib rospy std_msgs
 ROS_SITE := $(VENV)/ros-site

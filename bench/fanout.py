@@ -7,6 +7,9 @@ the shadow service has accepted, for every robot, a reported `last_command.id` e
 command's id (seen on `update/accepted`, which the shadow service publishes after storing).
 Before each size is timed, the swarm's start-up reports (presence, a shadow update and a
 get per robot) are left to settle until the shadow service has been quiet for a second.
+Beside the time, each command's CPU: this process's (the local stack and the watcher) and the
+swarm's. On 2 cores shared with other work the time follows the machine's load (written
+beside the figures); the CPU says whether the code itself got slower.
 Run: `.venv/bin/python bench/fanout.py [--sizes 10 100 1000 10000] [--runs 3]`.
 """
 
@@ -40,6 +43,22 @@ TARGET_ROBOTS, TARGET_S = 10_000, 5.0
 # Measured with this script before the shadow service batched its work (main at 123960d,
 # 2026-11-22): robots -> median ms.
 BEFORE_MS = {10: 21, 100: 150, 1000: 1233}
+CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
+HEADER = (
+    "| robots | runs | median (ms) | best (ms) | worst (ms) | acks/s (median) "
+    "| CPU: stack / swarm (s) | before: median (ms) |\n"
+    "| --- | --- | --- | --- | --- | --- | --- | --- |"
+)
+
+
+def own_cpu_s() -> float:
+    usage = os.times()
+    return usage.user + usage.system
+
+
+def process_cpu_s(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / CLOCK_TICKS  # utime + stime
 
 
 class Acknowledgments:
@@ -106,11 +125,12 @@ def settle(acks: Acknowledgments, at_least: int = 0) -> None:
     print(f"settled after {time.monotonic() - started:.1f} s", file=sys.stderr)
 
 
-def run_size(stack: LocalStack, size: int, runs: int) -> list[float]:
+def run_size(stack: LocalStack, size: int, runs: int) -> list[tuple[float, float, float]]:
+    """Each run's (milliseconds, this process's CPU s, the swarm's CPU s)."""
     assert stack.mqtt_url is not None
     acks = Acknowledgments(size)
     data = boto3.client("iot-data", endpoint_url=stack.api_url, region_name="us-east-1")
-    timings: list[float] = []
+    timings: list[tuple[float, float, float]] = []
     with MqttClient(stack.service_endpoint()) as watcher:
         watcher.subscribe(topics.ALL_SHADOW_UPDATES_ACCEPTED, acks.on_accepted)
         context = multiprocessing.get_context("spawn")
@@ -124,11 +144,19 @@ def run_size(stack: LocalStack, size: int, runs: int) -> list[float]:
             for run in range(runs):
                 command = new_command("stop" if run % 2 else "ping", source="console")
                 acks.expect(command.id)
+                assert robots.pid is not None
+                own, swarm = own_cpu_s(), process_cpu_s(robots.pid)
                 started = time.perf_counter()
                 data.publish(topic=topics.FLEET_CMD, qos=1, payload=encode(command))
                 if not acks.done.wait(ACK_TIMEOUT_S):
                     raise RuntimeError(f"{size} robots: only {len(acks.acked)} acknowledged")
-                timings.append((acks.last_at - started) * 1000)
+                timings.append(
+                    (
+                        (acks.last_at - started) * 1000,
+                        own_cpu_s() - own,
+                        process_cpu_s(robots.pid) - swarm,
+                    )
+                )
                 print(
                     f"{size}: first acknowledgment after {(acks.first_at - started) * 1000:.0f} ms",
                     file=sys.stderr,
@@ -150,7 +178,8 @@ def main() -> int:
     args = parser.parse_args()
     os.environ.setdefault("AWS_ACCESS_KEY_ID", "bench")
     os.environ.setdefault("AWS_SECRET_ACCESS_KEY", "bench")
-    rows = []
+    rows: list[tuple[int, list[tuple[float, float, float]]]] = []
+    load_before = os.getloadavg()
     with tempfile.TemporaryDirectory(prefix="vahr-fanout-") as state:
         config = StackConfig(
             state_dir=Path(state), mqtts_port=free_port(), mqtt_port=free_port(),
@@ -160,13 +189,19 @@ def main() -> int:
             for size in args.sizes:
                 timings = run_size(stack, size, args.runs)
                 rows.append((size, timings))
-                print(f"{size} robots: {[round(t) for t in timings]} ms", file=sys.stderr)
-    table = "\n".join(
-        f"| {size:,} | {len(t)} | {median(t):.0f} | {min(t):.0f} | {max(t):.0f} | "
-        f"{size / (median(t) / 1000):,.0f} | {BEFORE_MS.get(size, 'never tried')} |"
-        for size, t in rows
-    )
-    target = dict(rows).get(TARGET_ROBOTS)
+                print(f"{size} robots: {[round(t[0]) for t in timings]} ms", file=sys.stderr)
+    load_after = os.getloadavg()
+    lines = []
+    for size, runs in rows:
+        t = [run[0] for run in runs]
+        own, swarm = median([run[1] for run in runs]), median([run[2] for run in runs])
+        lines.append(
+            f"| {size:,} | {len(t)} | {median(t):.0f} | {min(t):.0f} | {max(t):.0f} | "
+            f"{size / (median(t) / 1000):,.0f} | {own:.2f} / {swarm:.2f} | "
+            f"{BEFORE_MS.get(size, 'never tried')} |"
+        )
+    table = "\n".join(lines)
+    target = {size: [run[0] for run in runs] for size, runs in rows}.get(TARGET_ROBOTS)
     verdict = (
         f"Target ({TARGET_ROBOTS:,} robots, median at most {TARGET_S:g} s): "
         f"{'met' if median(target) <= TARGET_S * 1000 else 'NOT met'}"
@@ -179,10 +214,12 @@ One fleet command (an iot-data Publish to `vahr/fleet/cmd` through the local dat
 until every robot's stored shadow reports that command as its `last_command` (swarm mode in its own
 process: all agent cores on one event loop and one MQTT connection; the shadow service, the broker
 and the swarm share the machine's 2 cores). Runs alternate `ping` (one shadow update per robot)
-and `stop` (two: accepted, then stopped).
+and `stop` (two: accepted, then stopped). CPU per command (median, seconds): this process's
+(the local stack: broker client, shadow service, data plane; and the watcher's client) and the
+swarm's; mosquitto's is not counted. Load average (1, 5, 15 min) before
+{"/".join(f"{v:.2f}" for v in load_before)}, after {"/".join(f"{v:.2f}" for v in load_after)}.
 
-| robots | runs | median (ms) | best (ms) | worst (ms) | acks/s (median) | before: median (ms) |
-| --- | --- | --- | --- | --- | --- | --- |
+{HEADER}
 {table}
 
 {verdict} Before: the shadow service applied, committed and answered each request on the MQTT

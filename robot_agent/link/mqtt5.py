@@ -399,12 +399,14 @@ class Mqtt5Link:
 def disable_nagle(port: int) -> int:
     """Set TCP_NODELAY on this process's TCP connections to `port`; returns how many.
 
-    awscrt exposes no TCP_NODELAY option, and without it the agent's PUBACK for a command
-    followed at once by its shadow update stalls about 40 ms on Nagle's algorithm plus the
-    broker's delayed ACK (FIELD-NOTES). The connections are found through /proc (Linux):
-    the socket inodes whose remote port is `port`, then this process's descriptors of
-    those inodes. A duplicate descriptor shares the socket, so the option set on it holds
-    for awscrt's descriptor; the file status flags (blocking mode) are restored after.
+    awscrt's Python API has no TCP_NODELAY option (aws-c-io has one it does not expose
+    yet), and without it the agent's writes after a command stall up to 40 ms on Nagle's
+    algorithm waiting for the broker's delayed ACK, even with mosquitto's own
+    `set_tcp_nodelay` (measured: docs/robot-agent.md). The connections are found through
+    /proc (Linux): the socket inodes whose remote port is `port`, then this process's
+    descriptors of those inodes. A duplicate descriptor shares the socket, so the option set
+    on it holds for awscrt's descriptor; the file status flags (blocking mode) are restored
+    after.
     """
     inodes = _connection_inodes(port)
     if not inodes:

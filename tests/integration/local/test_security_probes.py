@@ -4,7 +4,7 @@ the broker and the data plane still serve everyone else. What mosquitto does dif
 from AWS is stated in docs/reliability.md, and asserted here as it is.
 
 Negative TLS probes use `ssl` and paho rather than the AWS SDK, whose failed handshakes
-surface only after 10-18 s (FIELD-NOTES).
+surface only after 10-18 s (as measured against mosquitto 2.0.11 on loopback).
 """
 
 from __future__ import annotations

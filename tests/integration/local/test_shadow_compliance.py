@@ -47,7 +47,7 @@ def thing(shadows: Shadows) -> str:
 
 
 def moto_gap(request: pytest.FixtureRequest, shadows: Shadows, reason: str) -> None:
-    """Mark a case where moto is known to differ from AWS (see FIELD-NOTES)."""
+    """Mark a case where moto is known to differ from AWS (docs/local.md lists the gaps)."""
     if shadows.kind == "moto":
         request.applymarker(pytest.mark.xfail(strict=True, reason=f"moto gap: {reason}"))
 

@@ -8,7 +8,7 @@ import pytest
 
 from vahr.twin.browser_guard import BrowserGuard, Refusal, host_name, is_json
 
-# What boto3's iot-data client sends with a Publish (FIELD-NOTES: SigV4, no Content-Type).
+# What boto3's iot-data client sends with a Publish (SigV4 signed, no Content-Type header).
 BOTO3_PUBLISH = {
     "Host": "127.0.0.1:8180",
     "Authorization": "AWS4-HMAC-SHA256 Credential=x/20260101/us-east-1/iotdata/aws4_request, "
