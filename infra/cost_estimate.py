@@ -3,7 +3,7 @@
     python -m infra.cost_estimate [--lex] [--skill]
     python -m infra.cost_estimate --fleet
 
-Every count comes from what the code does on the wire (DESIGN.md's loop, the robot's
+Every count comes from what the code does on the wire (docs/protocol.md's loop, the robot's
 events and shadow updates, the skill's publish-then-poll), multiplied out for the usage
 below; every price is a us-east-1 list price. docs/deploy.md shows this script's output,
 and a test keeps the two in step.
@@ -65,7 +65,7 @@ class LabUsage:
     voice_sessions: int = 60
     keyboard_sessions: int = 40
     session_minutes: float = 15.0
-    # Per session: task I two deliveries, task II one, task III two (DESIGN.md, docs/experiment.md).
+    # Per session: task I two deliveries, task II one, task III two (docs/experiment.md).
     deliveries_per_session: int = 5
     # Voice: four commands, the robot's weather question, three status questions, and one
     # in four utterances repeated (misheard, or asked again).

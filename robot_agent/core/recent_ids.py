@@ -1,5 +1,5 @@
 """The ids of recently executed commands, kept on disk so a QoS 1 redelivery after a
-restart still runs once (DESIGN.md: the same `id` twice is executed once)."""
+restart still runs once (docs/protocol.md: the same `id` twice is executed once)."""
 
 from __future__ import annotations
 

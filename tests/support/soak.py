@@ -272,7 +272,7 @@ class Soak:
                 {"zone": rng.choice(ZONES[:4])} if action in ("navigate", "deliver") else None
             )
             command = new_command(action, params, source="console")
-            # One in ten is written as the robot's desired state instead (DESIGN.md: for a
+            # One in ten is written as the robot's desired state instead (docs/protocol.md: for a
             # robot that may be offline); the robot applies it from the shadow's delta.
             path = "shadow" if rng.random() < 0.1 else "console"
             error, unconfirmed = None, False

@@ -110,7 +110,7 @@ def _model(args: argparse.Namespace) -> InteractionModel:
 
 def describe(understood: Understanding) -> dict[str, Any]:
     """The JSON of `vahr nlu --json`: `intent` and `slots` {NAME: {value, id}} (a contract in
-    DESIGN.md), plus each slot's resolution, the confidence, the nearest sample and how sure
+    docs/protocol.md), plus each slot's resolution, the confidence, the nearest sample and how sure
     the reading of which value fills which slot is (`roles_confidence`; below the threshold
     the simulator confirms the reading before acting: `needs_confirmation`)."""
     slots: dict[str, dict[str, Any]] = {}

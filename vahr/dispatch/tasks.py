@@ -14,7 +14,7 @@ TaskStatus = Literal["queued", "assigned", "done", "cancelled"]
 # What a finished task ended as: the robot's result for its command, or why it ended early.
 Outcome = Literal["done", "failed", "cancelled", "rejected", "preempted"]
 
-# The zone every delivery picks its package up at (the arm at the conveyor, DESIGN.md).
+# The zone every delivery picks its package up at (the arm at the conveyor, docs/protocol.md).
 PICKUP_ZONE = "LOADING"
 # A command's result that ends the task it carried.
 FINAL_RESULTS = frozenset({"done", "failed", "cancelled", "rejected"})
@@ -40,7 +40,7 @@ class Task(msgspec.Struct, frozen=True, kw_only=True):
     """One robot's share of an order, as the store keeps it and `GET /vahr/tasks` shows it.
 
     `id` is also the id of the command published for it (so republishing after a restart is
-    executed once, DESIGN.md). `robots` lists the only robots that may take it (a group's
+    executed once, docs/protocol.md). `robots` lists the only robots that may take it (a group's
     member, a robot in a named zone); empty means any. `created_at` (RFC 3339 UTC with
     microseconds) then `id` order the queue. `version` grows by one on every write; stores
     use it for their conditional writes.

@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from vahr.protocol.shadow import Weather
 
 WEATHERS: tuple[Weather, ...] = ("sunny", "rainy")
-# Deliver to A when it is sunny, to C when it is rainy (DESIGN.md, weather_delivery).
+# Deliver to A when it is sunny, to C when it is rainy (docs/protocol.md, Command).
 WEATHER_ZONES: dict[Weather, str] = {"sunny": "A", "rainy": "C"}
 
 if TYPE_CHECKING:

@@ -3,7 +3,7 @@
 One home for the rules that the simulated participant follows, that the judge checks, that
 the observer's console enforces, and that the station's keyboard-and-mouse panel will offer
 (see docs/experiment.md, "Procedures"). The facts are the paper's
-(`PAPER-EXPERIMENT.md`):
+(docs/experiment.md):
 
 - Task I. Voice: per robot, "navigate to the loading zone"; once it is loaded, "navigate
   to" its zone. Keyboard and mouse: the same two navigation orders per robot, clicked on the

@@ -1,7 +1,7 @@
 """The paper's tables from the results rows, with the analysis a within-subjects study needs.
 
 `build_report(rows)` returns the report.json document. For each metric under `objective`
-and each questionnaire item under `subjective` (the contract of DESIGN.md):
+and each questionnaire item under `subjective` (the contract in docs/protocol.md, The command line):
 
     {"means": {METHOD: value}, "p_value": p, "sd": {...}, "n": {...},
      "ci95": {METHOD: [low, high]}, "within_subjects": {...}}

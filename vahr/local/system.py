@@ -163,7 +163,7 @@ class LocalSystem:
         return self.config.voice and shutil.which("espeak-ng") is not None
 
     def endpoints(self) -> dict[str, str | None]:
-        """What `vahr up --json` prints first (DESIGN.md, Command-line surface)."""
+        """What `vahr up --json` prints first (docs/local.md)."""
         assert self.stack.ca is not None
         station = self.station.url if self.station is not None else None
         return {

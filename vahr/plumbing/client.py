@@ -11,7 +11,7 @@ reached or gives no turn:
 - `vahr.assistant.SimulatorAssistant` calls an `AlexaSimulator` in this process (`vahr up`'s
   own, or one the station builds around the skill for a deployment on AWS IoT Core);
 - `SayCommandAssistant` runs `vahr say UTTERANCE --json`, the command-line contract
-  (DESIGN.md), for a system reachable only that way.
+  (docs/protocol.md, The command line), for a system reachable only that way.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Command, event and presence messages (DESIGN.md, Command message: a contract).
+"""Command, event and presence messages (docs/protocol.md, Command: a contract).
 
 Commands are a tagged union on `action`, so each action carries exactly its own params.
 `decode_command` is the one place a command payload is validated: it raises only

@@ -1,6 +1,6 @@
 """Device shadow documents: a robot's reported state and the experiment's state.
 
-The reported state is a contract (DESIGN.md, Reported shadow state). `to_payload` builds
+The reported state is a contract (docs/protocol.md, Reported shadow state). `to_payload` builds
 the body of a shadow `update`; `from_payload` reads the body of `get/accepted`,
 `update/accepted` or `GetThingShadow`.
 """

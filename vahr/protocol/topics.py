@@ -1,4 +1,4 @@
-"""Every MQTT topic string VAHR uses, built here and nowhere else (DESIGN.md, Topics)."""
+"""Every MQTT topic string VAHR uses, built here and nowhere else (docs/protocol.md, Topics)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Bad payloads are rejected with a reason, on the wire and in the shadow, and the agent
-keeps serving (DESIGN.md: unknown actions, missing or bad params, oversize, non-JSON)."""
+keeps serving (docs/protocol.md: unknown actions, missing or bad params, oversize, non-JSON)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The executor on its own: every action of DESIGN.md on a fast simulated robot."""
+"""The executor on its own: every action of docs/protocol.md on a fast simulated robot."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""`vahr nlu`: the utterance profiler's JSON (a contract in DESIGN.md), its errors, and
+"""`vahr nlu`: the utterance profiler's JSON (a contract in docs/protocol.md, The command line), its errors, and
 `vahr nlu --eval` on a labelled set."""
 
 from __future__ import annotations
