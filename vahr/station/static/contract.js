@@ -363,10 +363,10 @@
  * One robot's share of an order, as the store keeps it and `GET /vahr/tasks` shows it.
  *
  * `id` is also the id of the command published for it (so republishing after a restart is
- * executed once, docs/protocol.md). `robots` lists the only robots that may take it (a group's member,
- * a robot in a named zone); empty means any. `created_at` (RFC 3339 UTC with microseconds) then
- * `id` order the queue. `version` grows by one on every write; stores use it for their
- * conditional writes.
+ * executed once, docs/protocol.md). `robots` lists the only robots that may take it (a group's
+ * member, a robot in a named zone); empty means any. `created_at` (RFC 3339 UTC with
+ * microseconds) then `id` order the queue. `version` grows by one on every write; stores use it
+ * for their conditional writes.
  * @typedef {object} Task
  * @property {string} id
  * @property {string} request
