@@ -96,7 +96,7 @@ def say(api: str, utterance: str) -> dict[str, Any]:
     """`vahr say --json` against `api`: the turn it prints."""
     result = subprocess.run(
         [*VAHR, "say", "--json", "--api", api, utterance],
-        cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=30, check=True,
+        cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=60, check=True,
     )  # fmt: skip
     turn: dict[str, Any] = json.loads(result.stdout)
     return turn

@@ -297,6 +297,12 @@ class InteractionModel:
                     return SlotValue(slot, slot_type.name, canonical, found_id, canonical)
         raise VahrError(f"{intent} has no slot {slot} with a value {value_id!r}")
 
+    @property
+    def ready(self) -> bool:
+        """Whether understanding can start without waiting: the classifier and the roles
+        taggers are built (or building them failed, which `understand` then reports)."""
+        return self._ready.is_set()
+
     def wait_ready(self, timeout_s: float = BUILD_TIMEOUT_S) -> TextClassifier:
         """The classifier, once built; raises VahrError if building failed or timed out."""
         if not self._ready.wait(timeout_s):

@@ -78,7 +78,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
     from vahr.local.robots import SWARM_MAX
-    from vahr.local.system import LocalSystem, SystemConfig
+    from vahr.local.system import READY_TIMEOUT_S, LocalSystem, SystemConfig
     from vahr.station.deployment import on_local_system
 
     setup_logging(args.log_level)
@@ -132,8 +132,11 @@ def run(args: argparse.Namespace) -> int:
         system.start()
         if system.stack.recovered:
             print(f"vahr up: recovered: {system.stack.recovered}", file=sys.stderr, flush=True)
-        # A swarm's robots come online together once it has built them all.
-        system.wait_online(30.0 + (args.swarm or 0) / SWARM_BUILD_PER_S)
+        # The endpoints are printed only once the system can take a command: every robot
+        # online (a swarm's together, once it has built them all) and the assistant able to
+        # answer. A first start learns the fleet's names and the robots' hearing (cached
+        # for the next), which on a busy machine takes minutes rather than seconds.
+        system.wait_ready(READY_TIMEOUT_S + (args.swarm or 0) / SWARM_BUILD_PER_S, on_wait=_waiting)
         endpoints = system.endpoints()
         if args.json:
             _emit(json.dumps(endpoints))
@@ -150,6 +153,10 @@ def run(args: argparse.Namespace) -> int:
     if not args.json:
         print("vahr up: stopped", file=sys.stderr)
     return 0
+
+
+def _waiting(awaiting: list[str]) -> None:
+    print(f"vahr up: starting; waiting for {'; '.join(awaiting)}", file=sys.stderr, flush=True)
 
 
 def _emit(line: str) -> None:

@@ -29,6 +29,7 @@ from vahr.errors import VahrError
 from vahr.local.alexa_host import serve_alexa
 from vahr.local.announce_host import LocalAnnouncer
 from vahr.local.dispatch_host import TASKS_PATH, LocalDispatcher
+from vahr.local.readiness import Readiness
 from vahr.local.robots import (
     ProgressRate,
     RobotProcesses,
@@ -48,6 +49,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
+    from vahr.assistant.nlu import InteractionModel
     from vahr.assistant.simulator import AlexaSimulator
     from vahr.domain import Fleet
     from vahr.plumbing.client import Assistant
@@ -55,6 +57,13 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 ROOM_VOICE = "robot_agent.voice.factories:room"
+# How long a start waits for the robots and the assistant before it gives up: a first
+# start on a busy 2-core machine (every model learnt, nothing cached yet) took minutes.
+READY_TIMEOUT_S = 300.0
+# While waiting to be ready, what is awaited is told this often (seconds).
+WAIT_NOTICE_S = 10.0
+# Robots named in what the system waits for; the rest are counted.
+AWAITED_NAMED = 6
 # A part that dies more often than this is not restarted again: `vahr up` stops and says why.
 RESTART_LIMIT = 5
 RESTART_WINDOW_S = 60.0
@@ -133,13 +142,15 @@ class LocalSystem:
             self.fleet: Fleet = generated_fleet(config.swarm, config.fleet)
         else:
             self.fleet = fleet_of(config.robots, config.fleet)
+        self.readiness = Readiness(self._awaiting)
         self.stack = LocalStack(
             StackConfig(
                 state_dir=config.state_dir,
                 mqtts_port=config.mqtts_port,
                 mqtt_port=config.mqtt_port,
                 api_port=config.api_port,
-            )
+            ),
+            awaiting=self.readiness.awaiting,
         )
         self.robots: RobotProcesses | SwarmProcess | None = None
         self.alexa: AlexaSimulator | None = None
@@ -153,6 +164,7 @@ class LocalSystem:
         self._online: dict[str, bool] = {}
         self._changed = threading.Condition()
         self._restarts: dict[str, deque[float]] = {}
+        self._room_model: InteractionModel | None = None
 
     @property
     def voice_enabled(self) -> bool:
@@ -198,6 +210,7 @@ class LocalSystem:
                 fleet_file=fleet_file,
                 log_level=cfg.log_level,
                 locale=cfg.locale,
+                readiness=self.readiness,
             )
             assert self.stack.dataplane is not None and self.stack.ca is not None
             self.stack.dataplane.local_routes[("GET", "/vahr/status")] = self._status
@@ -277,6 +290,7 @@ class LocalSystem:
         if self.config.locale != SPOKEN_LOCALE:
             # Robots ask in English whatever the people speak: the room's Echo is English.
             model = InteractionModel(build_interaction_model(self.fleet), background=True)
+            self._room_model = model
         room_echo = AlexaSimulator(model, self.alexa.handler)
 
         def ask(request: str) -> str | None:
@@ -321,14 +335,7 @@ class LocalSystem:
                 missing = [t for t in self.fleet.robot_things if not self._online.get(t)]
                 if not missing:
                     return
-                exited = self.robots.exited() if self.robots else {}
-                # A robot's own process, or the swarm's, which runs every robot.
-                for thing in [*missing, SwarmProcess.SWARM]:
-                    if thing in exited and self.robots is not None:
-                        raise VahrError(
-                            f"robot {thing} exited with code {exited[thing]}: "
-                            f"{self.robots.last_log_line(thing)}"
-                        )
+                self._check_exits(missing)
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     raise VahrError(
@@ -336,6 +343,66 @@ class LocalSystem:
                         f"(logs in {self.config.state_dir / 'robots'})"
                     )
                 self._changed.wait(min(remaining, 0.5))
+
+    def wait_ready(
+        self,
+        timeout_s: float = READY_TIMEOUT_S,
+        *,
+        on_wait: Callable[[list[str]], None] | None = None,
+    ) -> None:
+        """Block until the system can take a command (every robot online, the assistant
+        able to answer), or raise VahrError naming what it still waited for. `on_wait` is
+        told what is awaited every `WAIT_NOTICE_S` seconds while waiting."""
+        deadline = time.monotonic() + timeout_s
+        notice = time.monotonic() + WAIT_NOTICE_S
+        while True:
+            if self.readiness.wait(min(max(0.0, deadline - time.monotonic()), 0.5)):
+                return
+            # A robot that exits, or a model that failed, is said at once.
+            with self._changed:
+                self._check_exits([t for t in self.fleet.robot_things if not self._online.get(t)])
+            self._check_models()
+            if time.monotonic() >= deadline:
+                raise VahrError(
+                    f"not ready within {timeout_s:.0f} s: still waiting for "
+                    f"{'; '.join(self.readiness.awaiting())} (logs in {self.config.state_dir})"
+                )
+            if on_wait is not None and time.monotonic() >= notice:
+                on_wait(self.readiness.awaiting())
+                notice = time.monotonic() + WAIT_NOTICE_S
+
+    def _check_exits(self, missing: list[str]) -> None:
+        """Raise VahrError naming a robot of `missing` whose process exited (or the swarm's,
+        which runs every robot), with its last log line."""
+        exited = self.robots.exited() if self.robots else {}
+        for thing in [*missing, SwarmProcess.SWARM]:
+            if thing in exited and self.robots is not None:
+                raise VahrError(
+                    f"robot {thing} exited with code {exited[thing]}: "
+                    f"{self.robots.last_log_line(thing)}"
+                )
+
+    def _awaiting(self) -> list[str]:
+        """What the system still waits for before it can take a command, in words."""
+        awaiting = []
+        with self._changed:
+            offline = [t for t in self.fleet.robot_things if not self._online.get(t)]
+        if offline:
+            named = ", ".join(offline[:AWAITED_NAMED])
+            more = len(offline) - AWAITED_NAMED
+            awaiting.append(
+                f"robots to come online: {named}" + (f" and {more:,} more" if more > 0 else "")
+            )
+        models = [self.alexa.model if self.alexa is not None else None, self._room_model]
+        if self.alexa is None or any(m is not None and not m.ready for m in models):
+            awaiting.append("the assistant to learn the fleet's names")
+        return awaiting
+
+    def _check_models(self) -> None:
+        """Raise VahrError when a language model failed to build (it will never be ready)."""
+        for model in (self.alexa.model if self.alexa else None, self._room_model):
+            if model is not None and model.ready:
+                model.wait_ready(0)
 
     def supervise(self) -> list[str]:
         """Restart the broker or a robot whose process died; one line for each restart.

@@ -59,7 +59,7 @@ def wait_for(condition: Callable[[], Any], timeout_s: float = 20.0) -> Any:
 
 def test_health_tells_the_robots_speed_factor(up: Up) -> None:
     assert call(up.endpoints["api"], "GET", "/vahr/health") == {
-        "ok": True, "sim_speed_factor": SPEED,
+        "ok": True, "ready": True, "sim_speed_factor": SPEED,
     }  # fmt: skip
 
 
