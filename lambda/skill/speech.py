@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 DELIVERY_TASKS = ("deliver", "weather_delivery", "sequential_delivery")
 
 
-def _reason(answer: RobotAnswer) -> str:
+def _reason(vocabulary: Vocabulary, answer: RobotAnswer) -> str:
     return (answer.reason or prompts.NO_REASON).rstrip(". ")
 
 
@@ -51,7 +51,7 @@ def command_report(
                 robot=robot, zone=zone_name, after=vocabulary.robot(after) if after else ""
             )
             return capitalise(sentence)
-        return capitalise(_problem(robot, answer, _SINGLE_PROBLEMS))
+        return capitalise(_problem(vocabulary, robot, answer, _SINGLE_PROBLEMS))
     confirmed = [answer for answer in mine if answer.confirmed]
     if len(confirmed) == len(mine):
         robots = (
@@ -63,7 +63,7 @@ def command_report(
     unconfirmed = [answer for answer in mine if not answer.confirmed]
     # A fleet of a thousand cannot hear every missing robot: the first few by name.
     named = [
-        _problem(vocabulary.robot(answer.thing), answer, _FLEET_PROBLEMS)
+        _problem(vocabulary, vocabulary.robot(answer.thing), answer, _FLEET_PROBLEMS)
         for answer in unconfirmed[:FLEET_PROBLEMS_NAMED]
     ]
     if len(unconfirmed) > FLEET_PROBLEMS_NAMED:
@@ -93,29 +93,33 @@ def sequential_report(
 
 
 # A single robot's problem is a sentence of its own; in a fleet answer it is one clause of
-# a list, so the same outcomes are worded shorter.
+# a list, so the same outcomes are worded shorter. By the message's name: each is read when
+# spoken, in the request's language.
 _SINGLE_PROBLEMS = {
-    "rejected": prompts.REJECTED,
-    "failed": prompts.FAILED,
-    "cancelled": prompts.CANCELLED,
-    "offline": prompts.OFFLINE,
-    "silent": prompts.NOT_CONFIRMED,
+    "rejected": "REJECTED",
+    "failed": "FAILED",
+    "cancelled": "CANCELLED",
+    "offline": "OFFLINE",
+    "silent": "NOT_CONFIRMED",
 }
 _FLEET_PROBLEMS = {
-    "rejected": prompts.PROBLEM_REJECTED,
-    "failed": prompts.PROBLEM_FAILED,
-    "cancelled": prompts.PROBLEM_CANCELLED,
-    "offline": prompts.PROBLEM_OFFLINE,
-    "silent": prompts.PROBLEM_SILENT,
+    "rejected": "PROBLEM_REJECTED",
+    "failed": "PROBLEM_FAILED",
+    "cancelled": "PROBLEM_CANCELLED",
+    "offline": "PROBLEM_OFFLINE",
+    "silent": "PROBLEM_SILENT",
 }
 
 
-def _problem(robot: str, answer: RobotAnswer, wording: Mapping[str, str]) -> str:
+def _problem(
+    vocabulary: Vocabulary, robot: str, answer: RobotAnswer, wording: Mapping[str, str]
+) -> str:
     """Why `answer` is not a confirmation, in `wording`'s sentence for that case."""
     case: str = answer.outcome
     if case not in ("rejected", "failed", "cancelled"):
         case = "offline" if answer.offline else "silent"
-    return wording[case].format(robot=robot, reason=_reason(answer))
+    sentence: str = getattr(prompts, wording[case])
+    return sentence.format(robot=robot, reason=_reason(vocabulary, answer))
 
 
 def status_report(vocabulary: Vocabulary, reads: Sequence[ShadowRead]) -> str:
