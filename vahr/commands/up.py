@@ -141,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
         if args.json:
             _emit(json.dumps(endpoints))
         else:
-            _emit(_banner(endpoints, system.fleet, system.voice_enabled))
+            _emit(_banner(endpoints, system.fleet, system.voice_enabled, args.locale))
         printer.release()
         while not stopping.wait(0.5):
             for line in system.supervise():
@@ -163,16 +163,27 @@ def _emit(line: str) -> None:
     print(line, flush=True)
 
 
-def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
+def example_command(fleet: Fleet, locale: str) -> str:
+    """`vahr say` of a first command in the fleet's own words and the locale's language:
+    its first robot to its first zone but LOADING, as `vahr say` must be given it."""
+    from vahr.domain.fleet import SPOKEN_LOCALE, spoken_in
+    from vahr.domain.locale import load_language
+
+    zone = next((z for z in fleet.zones if z.id != "LOADING"), fleet.zones[0])
+    sentence = load_language(locale).example_command.format(
+        robot=spoken_in(fleet.robots[0], locale)[0], zone=spoken_in(zone, locale)[0]
+    )
+    flag = "" if locale == SPOKEN_LOCALE else f" --locale {locale}"
+    return f'vahr say{flag} "{sentence}"'
+
+
+def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool, locale: str) -> str:
     things = fleet.robot_things
     named = (
         ", ".join(things)
         if len(things) <= BANNER_ROBOTS
         else (f"{things[0]} .. {things[-1]} ({len(things):,} robots)")
     )
-    # An example in the fleet's own words: its first robot to its first zone but LOADING.
-    zone = next((z for z in fleet.zones if z.id != "LOADING"), fleet.zones[0])
-    example = f"send {fleet.robots[0].spoken[0]} to {zone.spoken[0]}"
     lines = [
         "VAHR is up on this machine.",
         f"  data plane  {endpoints['api']}   (AWS_ENDPOINT_URL_IOT_DATA_PLANE)",
@@ -183,7 +194,7 @@ def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
     lines += [
         f"  station     {endpoints['station'] or '(off)'}   (the operator station page)",
         f"  robots      {named} (sim backend{', room voice' if voice else ''})",
-        f'  talk to it: vahr say "{example}"   (Ctrl-C stops everything)',
+        f"  talk to it: {example_command(fleet, locale)}   (Ctrl-C stops everything)",
     ]
     return "\n".join(lines)
 

@@ -87,6 +87,9 @@ class Language(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     weather: WeatherWords
     speech: Speech
     invocation: Invocation
+    # A first command in this language, with the fleet's names filled in (`vahr up`'s
+    # banner suggests it): "send {robot} to {zone}".
+    example_command: str = "send {robot} to {zone}"
 
     def weather_words(self) -> dict[str, tuple[str, ...]]:
         """Every word that names each weather: the sampled words, then the heard ones."""
