@@ -15,7 +15,13 @@ from typing import TYPE_CHECKING
 from skill import prompts
 from skill.catalog import current_locale
 from vahr.domain import FLEET_GROUP, FLEET_GROUP_NAMES
-from vahr.domain.fleet import SPOKEN_LOCALE, names_by_locale, spoken_in, zone_phrase
+from vahr.domain.fleet import (
+    SPOKEN_LOCALE,
+    names_by_locale,
+    reason_said,
+    spoken_in,
+    zone_phrase,
+)
 from vahr.domain.text import normalize
 
 if TYPE_CHECKING:
@@ -110,6 +116,11 @@ class Vocabulary:
             zone = next(zone for zone in self.fleet.zones if zone.id == zone_id)
             return _named_in_locale(spoken_in(zone, locale))
         return self._zone_names.get(zone_id, f"zone {zone_id}")
+
+    def reason(self, reason: str, zone_id: str | None) -> str:
+        """A robot's reason as said: the zone it names by id (`zone_id`, the zone the
+        command was for) by its spoken name, in the request's language."""
+        return reason_said(reason, zone_id, self.zone(zone_id)) if zone_id else reason
 
     def spelled(self, zone_id: str) -> str | None:
         """The spelling-alphabet word a zone named by a letter answers to ("bravo" for

@@ -115,8 +115,9 @@ def signals_from_event(event: Event) -> list[Signal]:
         reason = event.reason or ""
         if reason.startswith(STUCK_PREFIX):
             # The executor ends a stuck task as failed; that is the same fault.
-            return [Opened(thing, "stuck", at, reason=reason[len(STUCK_PREFIX) :].strip())]
-        return [Opened(thing, "failed", at, reason=event.reason)]
+            stuck = reason[len(STUCK_PREFIX) :].strip()
+            return [Opened(thing, "stuck", at, reason=stuck, zone=event.zone)]
+        return [Opened(thing, "failed", at, reason=event.reason, zone=event.zone)]
     signals: list[Signal] = []
     if event.event in _CLEARS_TASK_FAULTS:
         signals.append(Cleared(thing, _TASK_FAULTS, at))

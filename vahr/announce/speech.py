@@ -6,6 +6,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from vahr.domain.fleet import reason_said, zone_phrase
+
 if TYPE_CHECKING:
     from vahr.domain import Fleet
     from vahr.protocol.announcements import AnnouncementKind
@@ -31,7 +33,7 @@ class Names:
     def of(cls, fleet: Fleet) -> Names:
         return cls(
             robots={robot.thing: robot.spoken[0] for robot in fleet.robots},
-            zones={zone.id: zone.spoken[0] for zone in fleet.zones},
+            zones={zone.id: zone_phrase(zone) for zone in fleet.zones},
         )
 
     def robot(self, thing: str | None) -> str:
@@ -56,10 +58,12 @@ def sentence(
         where = (
             f" on its way to {names.zone(zone)}" if kind == "stuck" else f" at {names.zone(zone)}"
         )
+    # The zone a reason names by id is said by its name.
+    said = reason_said(reason, zone, names.zone(zone)) if reason and zone else reason
     text = PROMPTS[kind].format(
         robot=names.robot(thing),
         where=where,
-        reason=(reason or NO_REASON).rstrip("."),
+        reason=(said or NO_REASON).rstrip("."),
         for_robot=f" for {names.robot(thing)}" if thing else "",
         waited=_duration(waited_s),
     )

@@ -78,7 +78,7 @@ def test_a_robot_made_stuck_is_announced_once_naming_it_and_its_goal(up: Up) -> 
     time.sleep(1.0)
     told = [a for a in announcements(up) if a["thing"] == "placebot1"]
     assert [(a["kind"], a["speech"]) for a in told] == [
-        ("stuck", "Placebot one is stuck on its way to zone b and needs your help.")
+        ("stuck", "Placebot one is stuck on its way to zone B and needs your help.")
     ]
     assert set(told[0]) >= {"id", "time", "thing", "kind", "speech", "reason", "opened_at"}
 

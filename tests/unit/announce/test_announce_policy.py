@@ -66,7 +66,7 @@ def test_a_stuck_robot_is_told_once_by_name_and_where_it_was_going(fleet: Fleet)
     second = robot_event(p, "robot_event_failed_stuck")
     # Then the person hears one announcement, naming the robot and its goal
     assert [a.speech for a in first] == [
-        "Placebot one is stuck on its way to zone b and needs your help."
+        "Placebot one is stuck on its way to zone B and needs your help."
     ]
     assert second == []
     [told] = first
@@ -205,7 +205,7 @@ def test_a_held_finished_task_is_told_at_the_first_chance_even_if_old(fleet: Fle
     clock.advance(241)
     # Then it is still told: an old announcement is late, not lost
     [late] = p.tick()
-    assert late.speech == "Placebot two has finished its task at zone c."
+    assert late.speech == "Placebot two has finished its task at zone C."
     assert late.time - late.opened_at == timedelta(minutes=5)
 
 

@@ -49,8 +49,9 @@ def test_rejected_command_speaks_the_robots_reason(make_skill: Any, robots: Robo
         RobotBehaviour(result="rejected", reason="params.zone: 'A' is blocked by an obstacle"),
     )
     response = make_skill()(load_event("alexa_navigate"), None)
+    # The zone the reason names by id is said by its name.
     assert speech(response) == (
-        "Placebot one refused the command: params.zone: 'A' is blocked by an obstacle."
+        "Placebot one refused the command: params.zone: 'zone A' is blocked by an obstacle."
     )
 
 
