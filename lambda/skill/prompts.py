@@ -224,6 +224,8 @@ QUEUE_ENTRY = "{place}, {task}"
 QUEUE_MORE = "and {count} more"
 CANCELLED_QUEUED = "I cancelled {task}, which was {place} in line."
 CANCELLED_HELD = "I cancelled {task} and stopped {robot}."
+CANCELLED_MANY = "I cancelled the {count} tasks to {zone}."
+CANCELLED_MANY_STOPPED = "I cancelled the {count} tasks to {zone} and stopped {robots}."
 NOTHING_TO_CANCEL = "There is no task to {zone} to cancel."
 NO_DISPATCHER = (
     "Sending a robot without its name needs the fleet dispatcher, which is not running here, "

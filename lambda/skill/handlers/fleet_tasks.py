@@ -208,8 +208,8 @@ class TaskQueueIntentHandler(_FleetHandler):
 
 
 class CancelTaskIntentHandler(_FleetHandler):
-    """ "cancel the delivery to zone b": the newest queued task there, else the one a robot
-    holds (which stops that robot)."""
+    """ "cancel the delivery to zone b": every open task there (a robot holding one is
+    stopped), said with how many and which robots stopped."""
 
     intent_name = "CancelTaskIntent"
 
@@ -224,13 +224,16 @@ class CancelTaskIntentHandler(_FleetHandler):
             tasks = self.desk.tasks()
         except TaskRefused:  # a stack without the dispatcher's routes
             return answer(handler_input, prompts.NO_DISPATCHER)
-        chosen = task_speech.task_to_cancel(tasks, zone.id)
-        cancelled = self.desk.cancel(chosen[0].id) if chosen is not None else None
-        if chosen is None or cancelled is None:
+        cancelled = []
+        for task, place in task_speech.tasks_to_cancel(tasks, zone.id):
+            done = self.desk.cancel(task.id)
+            if done is not None:  # else it ended meanwhile
+                cancelled.append((done, place))
+        if not cancelled:
             return answer(
                 handler_input, prompts.NOTHING_TO_CANCEL.format(zone=vocabulary.zone(zone.id))
             )
-        return answer(handler_input, task_speech.cancel_report(vocabulary, cancelled, chosen[1]))
+        return answer(handler_input, task_speech.cancel_report(vocabulary, cancelled))
 
 
 def _intent(handler_input: HandlerInput):  # type: ignore[no-untyped-def]
