@@ -18,7 +18,9 @@ memory. The rules:
   clears before its turn is not told (a cleared fault is not news), and the log says so.
   At most `max_held` wait at once; past that the last in line is dropped with a warning
   in the log and counted in `PolicyState.dropped`;
-- a finished task (`done`, off by default) is told once, like a fault that never clears.
+- a finished task (`done`, off by default) is told once, like a fault that never clears,
+  and so is a task the fleet gave up because its robot was sent elsewhere by name
+  (`cancelled`, from the dispatcher's `TaskCancelled`): no task leaves without a word.
 
 There is no fleet task queue yet. `Queued` and `Dispatched` are the signals one will
 send (a task id, the robot it is for if any, when it was queued); `tick` tells the tasks
@@ -103,7 +105,23 @@ class Dispatched:
     at: datetime
 
 
-Signal = Opened | Cleared | Finished | Queued | Dispatched
+@dataclass(frozen=True)
+class TaskCancelled:
+    """The fleet gave up task `task` that `thing` held: someone sent `thing` elsewhere by
+    name. `kind` is the task's (`deliver`, `navigate`), `zone` where it was going."""
+
+    task: str
+    thing: str
+    kind: str
+    zone: str
+    at: datetime
+
+
+Signal = Opened | Cleared | Finished | Queued | Dispatched | TaskCancelled
+# What a task is called in an announcement, by its kind.
+TASK_WORDS = {"deliver": "delivery", "navigate": "trip"}
+# Kinds told once and forgotten (nothing clears them: they are news, not a state).
+_ONE_SHOT: frozenset[AnnouncementKind] = frozenset({"done", "cancelled"})
 
 
 def signals_from_event(event: Event) -> list[Signal]:
@@ -233,6 +251,20 @@ class AnnouncePolicy:
                         zone=signal.zone,
                     )
                 )
+        elif isinstance(signal, TaskCancelled):
+            if "cancelled" in self.settings.kinds:
+                self.state.finished.append(
+                    Fault(
+                        subject=signal.task,
+                        kind="cancelled",
+                        thing=signal.thing,
+                        opened_at=signal.at.timestamp(),
+                        seen_at=self._clock().timestamp(),
+                        reason=TASK_WORDS.get(signal.kind, "task"),
+                        zone=signal.zone,
+                    )
+                )
+            self.state.queued = [t for t in self.state.queued if t.task != signal.task]
         elif isinstance(signal, Queued):
             if not any(t.task == signal.task for t in self.state.queued):
                 self.state.queued.append(
@@ -308,7 +340,7 @@ class AnnouncePolicy:
                     self.state.held += 1
                 continue
             told.append(seconds)
-            if fault.kind == "done":
+            if fault.kind in _ONE_SHOT:
                 self.state.finished.remove(fault)
             else:
                 fault.told = True
@@ -325,7 +357,7 @@ class AnnouncePolicy:
         if excess <= 0:
             return
         for fault in self._in_line(untold)[-excess:]:
-            if fault.kind == "done":
+            if fault.kind in _ONE_SHOT:
                 self.state.finished.remove(fault)
             else:
                 fault.dropped = True

@@ -17,6 +17,7 @@ PROMPTS: dict[AnnouncementKind, str] = {
     "failed": "{robot} could not finish its task: {reason}.",
     "offline": "{robot} has gone offline.",
     "waiting": "A task{for_robot} has waited {waited} in the queue.",
+    "cancelled": "{robot} was given another command, so its {reason}{to_zone} is cancelled.",
     "done": "{robot} has finished its task{where}.",
 }
 NO_REASON = "no reason was given"
@@ -65,6 +66,7 @@ def sentence(
         where=where,
         reason=(said or NO_REASON).rstrip("."),
         for_robot=f" for {names.robot(thing)}" if thing else "",
+        to_zone=f" to {names.zone(zone)}" if zone else "",
         waited=_duration(waited_s),
     )
     return text[:1].upper() + text[1:]

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import msgspec
 
+from vahr.announce import TaskCancelled
 from vahr.assistant import SimulatorAssistant
 from vahr.domain.fleet import SPOKEN_LOCALE
 from vahr.errors import VahrError
@@ -40,7 +41,7 @@ from vahr.local.robots import (
 )
 from vahr.plumbing.mqtt import MqttClient
 from vahr.plumbing.ports import ensure_free
-from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
+from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics, utc_now
 from vahr.skill_model.generator import build_interaction_model, build_locale_model, render
 from vahr.twin.shadow_store import ShadowError
 from vahr.twin.stack import LocalStack, StackConfig
@@ -51,6 +52,7 @@ if TYPE_CHECKING:
 
     from vahr.assistant.nlu import InteractionModel
     from vahr.assistant.simulator import AlexaSimulator
+    from vahr.dispatch import Task
     from vahr.domain import Fleet
     from vahr.plumbing.client import Assistant
 
@@ -271,11 +273,21 @@ class LocalSystem:
         first shadow updates already reach it."""
         dataplane, store = self.stack.dataplane, self.stack.store
         assert dataplane is not None and store is not None
+        announcer = self.announcer.announcer if self.announcer is not None else None
+
+        def given_up(task: Task) -> None:
+            # A task whose robot was sent elsewhere by name is told, not dropped silently.
+            if announcer is not None and task.thing is not None:
+                announcer.observe(
+                    [TaskCancelled(task.id, task.thing, task.kind, task.zone, utc_now())]
+                )
+
         self.dispatcher = LocalDispatcher(
             fleet=self.fleet,
             index=store.index,
             endpoint=self.stack.service_endpoint(),
             state_dir=self.config.state_dir,
+            on_given_up=given_up,
         ).start()
         dataplane.typed_routes[TASKS_PATH] = self.dispatcher.api.respond
 

@@ -18,6 +18,7 @@ from vahr.announce import (
     Dispatched,
     PolicyState,
     Queued,
+    TaskCancelled,
     settings_from,
     signals_from_event,
     signals_from_presence,
@@ -345,3 +346,17 @@ def test_bad_settings_are_refused_naming_the_field(
 ) -> None:
     with pytest.raises(ProtocolError, match=rf"^{message}"):
         settings_from(settings)
+
+
+def test_a_task_given_up_for_a_command_by_name_is_told_once_with_its_place(fleet: Fleet) -> None:
+    clock = Clock()
+    p = policy(fleet, clock)
+    # When the fleet gives up placebot2's delivery to zone C (it was sent elsewhere by name)
+    [told] = p.observe([TaskCancelled("t-1", "placebot2", "deliver", "C", T0)])
+    # Then it is told, by the robot's and the zone's names, and only once
+    assert (told.kind, told.thing) == ("cancelled", "placebot2")
+    assert told.speech == (
+        "Placebot two was given another command, so its delivery to zone C is cancelled."
+    )
+    clock.advance(120)
+    assert p.tick() == []

@@ -17,7 +17,7 @@ import { typing } from "./talk.js";
 
 const SHOWN = 2; // alerts drawn at once; the rest wait behind a count
 /** What happened, in a word or two, per kind of announcement. @type {Record<AnnouncementMessage["kind"], string>} */
-const TROUBLES = { stuck: "stuck", failed: "task failed", offline: "offline", waiting: "task waiting", done: "task done" };
+const TROUBLES = { stuck: "stuck", failed: "task failed", offline: "offline", waiting: "task waiting", cancelled: "task cancelled", done: "task done" };
 // A key pressed on one of these does what the element does, not the page's shortcut.
 const CONTROLS = "button, a[href], input, select, textarea, summary, [contenteditable], [role=button]";
 
