@@ -17,12 +17,14 @@ from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_intent_name
 
 from skill import dialog, prompts, task_speech
+from skill.catalog import current_locale
 from skill.responses import answer
 from skill.slots import read_slot
 from skill.task_desk import TaskRefused
 from skill.vocabulary import capitalise, join_choices
 from vahr.dispatch import Order
 from vahr.domain import FLEET_GROUP
+from vahr.domain.fleet import spoken_in
 from vahr.domain.text import normalize, number_in_words
 
 if TYPE_CHECKING:
@@ -122,7 +124,11 @@ class FleetNavigateIntentHandler(_FleetHandler):
         """The group named (None for none), or what to say when it is unknown."""
         fleet = self.runtime.fleet
         groups = {group.id: group for group in fleet.groups if group.id != FLEET_GROUP}
-        names = {normalize(name): group.id for group in groups.values() for name in group.spoken}
+        names = {
+            normalize(name): group.id
+            for group in groups.values()
+            for name in [*group.spoken, *spoken_in(group, current_locale())]
+        }
         reading = read_slot(
             _intent(handler_input), "group", groups, lambda heard: names.get(normalize(heard))
         )
@@ -132,7 +138,7 @@ class FleetNavigateIntentHandler(_FleetHandler):
             return reading.id, ""
         if not groups:
             return None, prompts.NO_GROUPS.format(heard=reading.heard)
-        choices = join_choices([group.spoken[0] for group in groups.values()])
+        choices = join_choices([self._group_name(group_id) for group_id in groups])
         return None, prompts.UNKNOWN_GROUP.format(heard=reading.heard, choices=choices)
 
     def _count(self, handler_input: HandlerInput, group: str | None) -> tuple[int | None, str]:
@@ -157,7 +163,9 @@ class FleetNavigateIntentHandler(_FleetHandler):
         return count, ""
 
     def _group_name(self, group_id: str) -> str:
-        return next(g.spoken[0] for g in self.runtime.fleet.groups if g.id == group_id)
+        """A group's first name in the request's language."""
+        group = next(g for g in self.runtime.fleet.groups if g.id == group_id)
+        return spoken_in(group, current_locale())[0]
 
 
 class ZoneRobotsIntentHandler(_FleetHandler):
