@@ -97,6 +97,14 @@ def run(args: argparse.Namespace) -> int:
             raise VahrError(f"--{flag.replace('_', '-')} {value}: not a usable port")
     if args.sim_speed_factor <= 0:
         raise VahrError("--sim-speed-factor must be more than 0")
+    fleet = read_fleet(args.fleet)
+    if args.fleet is not None and args.robots is not None and args.robots > len(fleet.robots):
+        # Robots made up past a fleet of one's own would drive among its robots under names
+        # nobody gave them (placebot5 in a hospital): a fleet file says what runs.
+        raise VahrError(
+            f"--robots {args.robots}: {args.fleet} has {len(fleet.robots)} robots; give at most "
+            f"{len(fleet.robots)}, or add robots to the file (or use --swarm N)"
+        )
     if args.swarm is not None:
         if args.robots is not None:
             raise VahrError("give either --robots (a process per robot) or --swarm, not both")
@@ -110,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         mqtts_port=args.mqtts_port,
         mqtt_port=args.mqtt_port or None,
         api_port=args.api_port,
-        fleet=read_fleet(args.fleet),
+        fleet=fleet,
         robots=args.robots,
         swarm=args.swarm,
         sim_speed_factor=args.sim_speed_factor,
