@@ -6,6 +6,7 @@ import json
 import signal
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -23,6 +24,10 @@ DEFAULT_STATION_PORT = 8181
 DEFAULT_STATE_DIR = Path(".state")
 # The banner names at most this many robots; a swarm's are given as a range.
 BANNER_ROBOTS = 12
+# One command's same event from several robots within this many seconds is one line.
+COALESCE_S = 0.5
+# That line names this many robots, then counts the rest.
+GROUP_NAMED = 3
 # Robots a swarm builds and brings online per second, at least (measured: docs/local.md).
 SWARM_BUILD_PER_S = 100
 
@@ -134,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
         signum: signal.signal(signum, lambda *_: stopping.set())
         for signum in (signal.SIGINT, signal.SIGTERM)
     }
-    printer = _EventPrinter(args.json)
+    printer = _EventPrinter(args.json, progress=args.log_level == "DEBUG")
     system = LocalSystem(config, on_event=printer.print, start_station=on_local_system)
     try:
         system.start()
@@ -156,6 +161,7 @@ def run(args: argparse.Namespace) -> int:
                 print(f"vahr up: {line}", file=sys.stderr, flush=True)
     finally:
         system.stop()
+        printer.stop()
         for signum, handler in previous.items():
             signal.signal(signum, handler)
     if not args.json:
@@ -210,25 +216,85 @@ def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool, locale:
 class _EventPrinter:
     """Prints robots' events, holding those that come before the endpoints are printed:
     the endpoints are the first line (a contract scripts rely on), and robots that resume
-    work while the system starts must not push it down nor be dropped."""
+    work while the system starts must not push it down nor be dropped.
 
-    def __init__(self, as_json: bool) -> None:
+    With `--json` every event is a line. Otherwise the lines are for a person: progress is
+    chatter, printed only at `--log-level DEBUG`, and one command's same event from several
+    robots within `COALESCE_S` is one line naming them ("rover1, rover2 and 998 more
+    accepted"), so a fleet command to a swarm of 1,000 is a few lines, not thousands."""
+
+    def __init__(self, as_json: bool, *, progress: bool = False) -> None:
         self._as_json = as_json
+        self._progress = progress
         self._lock = threading.Lock()
         self._held: list[Event] | None = []
+        # (command id, event, zone) -> the events gathered, and when the first came.
+        self._groups: dict[tuple[str | None, str, str | None], tuple[float, list[Event]]] = {}
+        self._stopping = threading.Event()
+        self._flusher: threading.Thread | None = None
+        if not as_json:
+            self._flusher = threading.Thread(target=self._flush_loop, daemon=True)
+            self._flusher.start()
 
     def print(self, event: Event) -> None:
+        if not self._as_json and event.event == "progress" and not self._progress:
+            return
         with self._lock:
             if self._held is not None:
                 self._held.append(event)
+                return
+            if not self._as_json:
+                key = (event.command_id, event.event, event.zone)
+                _, events = self._groups.setdefault(key, (time.monotonic(), []))
+                events.append(event)
                 return
         _print_event(event, self._as_json)
 
     def release(self) -> None:
         with self._lock:
             held, self._held = self._held or [], None
-            for event in held:
-                _print_event(event, self._as_json)
+        for event in held:
+            self.print(event)
+
+    def stop(self) -> None:
+        """Print what is still gathered, and stop."""
+        self._stopping.set()
+        if self._flusher is not None:
+            self._flusher.join(timeout=2 * COALESCE_S)
+        self._flush(every=True)
+
+    def _flush_loop(self) -> None:
+        while not self._stopping.wait(COALESCE_S / 4):
+            self._flush()
+
+    def _flush(self, *, every: bool = False) -> None:
+        now = time.monotonic()
+        with self._lock:
+            due = [
+                key
+                for key, (first, _) in self._groups.items()
+                if every or now - first >= COALESCE_S
+            ]
+            groups = [self._groups.pop(key)[1] for key in due]
+        for events in groups:
+            if len(events) == 1:
+                _print_event(events[0], as_json=False)
+            else:
+                _print_group(events)
+
+
+def _print_group(events: list[Event]) -> None:
+    """One line for one command's same event from several robots."""
+    first = events[0]
+    things = list(dict.fromkeys(event.thing for event in events))
+    shown = ", ".join(things[:GROUP_NAMED])
+    named = (
+        f"{shown} and {len(things) - GROUP_NAMED:,} more" if len(things) > GROUP_NAMED else shown
+    )
+    details = _details(first)
+    command = f" [{first.command_id[:8]}]" if first.command_id else ""
+    stamp = first.at.strftime("%H:%M:%S")
+    _emit(f"{stamp} {len(things):,} robots {first.event}: {named} {details}{command}".rstrip())
 
 
 def _print_event(event: Event, as_json: bool) -> None:
@@ -237,6 +303,12 @@ def _print_event(event: Event, as_json: bool) -> None:
 
         _emit(encode(event).decode())
         return
+    command = f" [{event.command_id[:8]}]" if event.command_id else ""
+    stamp = event.at.strftime("%H:%M:%S")
+    _emit(f"{stamp} {event.thing:<10} {event.event:<10} {_details(event)}{command}")
+
+
+def _details(event: Event) -> str:
     details = [
         f"{name}={value}"
         for name, value in (
@@ -250,6 +322,4 @@ def _print_event(event: Event, as_json: bool) -> None:
     ]
     if event.progress is not None:
         details.append(f"progress={event.progress:.0%}")
-    command = f" [{event.command_id[:8]}]" if event.command_id else ""
-    stamp = event.at.strftime("%H:%M:%S")
-    _emit(f"{stamp} {event.thing:<10} {event.event:<10} {' '.join(details)}{command}")
+    return " ".join(details)

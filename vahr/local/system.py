@@ -369,6 +369,10 @@ class LocalSystem:
         notice = time.monotonic() + WAIT_NOTICE_S
         while True:
             if self.readiness.wait(min(max(0.0, deadline - time.monotonic()), 0.5)):
+                log.info(
+                    "ready: %s robots online, the assistant answers",
+                    f"{len(self.fleet.robot_things):,}",
+                )
                 return
             # A robot that exits, or a model that failed, is said at once.
             with self._changed:
