@@ -100,7 +100,8 @@ PROBLEM_REJECTED = "{robot} refused: {reason}"
 PROBLEM_FAILED = "{robot} failed: {reason}"
 PROBLEM_CANCELLED = "{robot} cancelled it"
 PROBLEM_OFFLINE = "{robot} did not answer and seems to be offline"
-PROBLEM_SILENT = "{robot} did not answer"
+# Not "did not answer": a robot may answer a moment after the skill stopped waiting.
+PROBLEM_SILENT = "{robot} had not answered yet"
 NO_REASON = "no reason given"
 
 # Status, one sentence per robot.
@@ -160,7 +161,7 @@ PROBLEMS = {
 }
 PROBLEMS_NONE = "No robot is stuck, failed or offline."
 INDEX_UNAVAILABLE = "Sorry, I could not count the robots just now. Please try again in a moment."
-FLEET_PROBLEMS_MORE = "and {n} more did not confirm"
+FLEET_PROBLEMS_MORE = "and {n} more had not confirmed yet"
 
 # The experiment's weather. The robots recognise these exact openings.
 WEATHER = {weather: f"The weather is {weather}." for weather in WEATHERS}

@@ -330,6 +330,18 @@ def zone_phrase(zone: Zone) -> str:
     return _upper_letters(first)
 
 
+def zone_name_in(zone: Zone, locale: str = SPOKEN_LOCALE) -> str:
+    """The zone's name inside a sentence in `locale`: `zone_phrase` in en-US; in another
+    language its first name there, each word capitalised as written nouns are ("zone a" is
+    "Zone A", "ladezone" "Ladezone"): its sentences are built to need no article."""
+    if locale == SPOKEN_LOCALE:
+        return zone_phrase(zone)
+    names = spoken_in(zone, locale)
+    return " ".join(
+        word.upper() if len(word) == 1 else word.capitalize() for word in names[0].split()
+    )
+
+
 def reason_said(reason: str, zone_id: str | None, zone_name: str) -> str:
     """A robot's reason with the zone it names by id (`zone_id`, the zone its command was
     for: `LastCommand.zone`, an event's `zone`) said by `zone_name`: "goal to PHARMACY

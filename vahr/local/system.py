@@ -119,6 +119,7 @@ class StartStation(Protocol):
         assistant: Assistant,
         read_shadow: Callable[[str], bytes | None],
         tasks_url: str | None = None,
+        locale: str = "en-US",
     ) -> ServedStation: ...
 
 
@@ -329,6 +330,7 @@ class LocalSystem:
             assistant=SimulatorAssistant(self.alexa),
             read_shadow=self._stored_shadow,
             tasks_url=self.stack.api_url + TASKS_PATH if self.dispatcher is not None else None,
+            locale=self.config.locale,
         )
         self.stack.dataplane.redirects["/vahr/dashboard"] = self.station.url
 

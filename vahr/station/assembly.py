@@ -52,6 +52,9 @@ class StationConfig:
     model_file: Path | None = None
     # The dispatcher's task queue (`GET {api}/vahr/tasks`), relayed to the pages; None: not shown.
     tasks_url: str | None = None
+    # The language people speak to the assistant (`vahr up --locale`): the page's words and
+    # the robots' and zones' names default to it.
+    locale: str = "en-US"
 
 
 class Station:
@@ -71,7 +74,7 @@ class Station:
         self.config = config
         self.fleet = fleet
         self.link = link
-        self.feed = feed or Feed(fleet)
+        self.feed = feed or Feed(fleet, locale=config.locale)
         self._read_shadow = read_shadow
         self._turns = turns
         self.desk = Desk(self.feed, self._publish)
@@ -86,7 +89,7 @@ class Station:
             synthesize=_espeak() if shutil.which("espeak-ng") else None,
         )
         self.server = StationServer(
-            self.app, host=config.host, port=config.port, token=config.token
+            self.app, host=config.host, port=config.port, token=config.token, locale=config.locale
         )
         self.tasks = TaskPoller(config.tasks_url, self.feed) if config.tasks_url else None
 

@@ -179,7 +179,13 @@ class _Handler(QuietHandler):
         if station.token is not None and query.get("token"):
             # The page's own later requests (the stream, the API) carry the cookie.
             extra["Set-Cookie"] = f"{COOKIE}={station.token}; Path=/; HttpOnly; SameSite=Strict"
-        self._send(station.file("index.html"), extra)
+        page = station.file("index.html")
+        # The page shows itself in the language people speak to the assistant unless its
+        # reader chose another (static/i18n.js reads `data-locale`).
+        body = page.body.replace(
+            b'<html lang="en">', f'<html lang="en" data-locale="{station.locale}">'.encode(), 1
+        )
+        self._send(Reply(page.status, body, page.content_type), extra)
 
     def _favicon(self, path: str, query: dict[str, str]) -> None:
         self._send(self.server.station.file("favicon.svg"))
@@ -262,10 +268,17 @@ class StationServer:
     """Serve a `StationApp` on host:port in a background thread; `stop()` joins it."""
 
     def __init__(
-        self, app: StationApp, *, host: str = LOOPBACK, port: int, token: str | None = None
+        self,
+        app: StationApp,
+        *,
+        host: str = LOOPBACK,
+        port: int,
+        token: str | None = None,
+        locale: str = "en-US",
     ) -> None:
         self.app = app
         self.host = host
+        self.locale = locale
         # Off the loopback interface the station is reachable by others: a token guards it.
         self.token = token or (None if is_loopback(host) else secrets.token_urlsafe(18))
         pages = [*STATIC.iterdir(), *LOCALES.iterdir()]

@@ -109,7 +109,7 @@ def test_fleet_with_no_robot_answering(make_skill: Any, robots: RobotDoubles) ->
     robots.behave("placebot2", RobotBehaviour(result=None))
     response = make_skill(ack_timeout_s=0.3)(load_event("alexa_navigate_fleet"), None)
     assert speech(response) == (
-        "None of the 2 robots confirmed; placebot one did not answer; placebot two did not answer."
+        "None of the 2 robots confirmed; placebot one had not answered yet; placebot two had not answered yet."
     )
 
 
