@@ -118,8 +118,6 @@ class TaskCancelled:
 
 
 Signal = Opened | Cleared | Finished | Queued | Dispatched | TaskCancelled
-# What a task is called in an announcement, by its kind.
-TASK_WORDS = {"deliver": "delivery", "navigate": "trip"}
 # Kinds told once and forgotten (nothing clears them: they are news, not a state).
 _ONE_SHOT: frozenset[AnnouncementKind] = frozenset({"done", "cancelled"})
 
@@ -260,7 +258,7 @@ class AnnouncePolicy:
                         thing=signal.thing,
                         opened_at=signal.at.timestamp(),
                         seen_at=self._clock().timestamp(),
-                        reason=TASK_WORDS.get(signal.kind, "task"),
+                        reason=signal.kind,
                         zone=signal.zone,
                     )
                 )

@@ -261,7 +261,9 @@ class LocalSystem:
 
         dataplane = self.stack.dataplane
         assert dataplane is not None and self._watcher is not None
-        self.announcer = LocalAnnouncer(self.stack.service_endpoint(), self.fleet).start()
+        self.announcer = LocalAnnouncer(
+            self.stack.service_endpoint(), self.fleet, locale=self.config.locale
+        ).start()
         dataplane.local_routes[("GET", "/vahr/announcements")] = self.announcer.announcer.route
         dataplane.local_routes[("POST", "/vahr/fault")] = FaultInjector(
             self._watcher, self.fleet

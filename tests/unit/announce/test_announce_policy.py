@@ -360,3 +360,38 @@ def test_a_task_given_up_for_a_command_by_name_is_told_once_with_its_place(fleet
     )
     clock.advance(120)
     assert p.tick() == []
+
+
+def test_announcements_are_said_in_the_stacks_language() -> None:
+    from tests.support.fleets import HOSPITAL
+    from vahr.domain import load_fleet
+
+    p = AnnouncePolicy(settings_from({}), Names.of(load_fleet(HOSPITAL), "de-DE"), Clock())
+    [told] = p.observe([TaskCancelled("t-1", "iris", "deliver", "WARD_THREE", T0)])
+    assert told.speech == (
+        "Iris hat einen anderen Befehl bekommen, also ist seine Lieferung nach Station Drei "
+        "storniert."
+    )
+    [failed] = robot_event(
+        p, "robot_event_failed", thing="iris", zone="PHARMACY",
+        reason="goal to PHARMACY aborted: an injected fault",
+    )  # fmt: skip
+    assert failed.speech == (
+        "Iris konnte seinen Auftrag nicht beenden: goal to Apotheke aborted: an injected fault."
+    )
+
+
+def test_every_english_announcement_word_has_a_german_one_with_its_placeholders() -> None:
+    import string
+
+    from vahr.announce.speech import WORDS
+    from vahr.domain.locale import locale_file, read_yaml
+
+    german = read_yaml(locale_file("de-DE", "announcements.yaml"), dict[str, str])
+    assert set(german) == set(WORDS)
+
+    def fields(text: str) -> set[str]:
+        return {name for _, name, _, _ in string.Formatter().parse(text) if name}
+
+    for name, english in WORDS.items():
+        assert fields(german[name]) == fields(english), name
