@@ -46,6 +46,19 @@ import { RobotLayer } from "./robot-layer.js";
 
 /** @typedef {"floor" | "fixtures" | "zones" | "paths" | "robots"} Layer */
 
+/**
+ * One zone's parts on the map.
+ * @typedef {object} DrawnZone
+ * @property {SVGGElement} group
+ * @property {ZoneEntry} zone
+ * @property {number} half half its box's side, in metres
+ * @property {SVGRectElement} body
+ * @property {SVGTextElement} letter
+ * @property {SVGTextElement} name
+ * @property {SVGTextElement} incoming
+ * @property {boolean} big whether its letter is its id or key (else its name, small)
+ */
+
 const SVG = "http://www.w3.org/2000/svg";
 const LABELS_UP_TO = 12; // more robots than this: numbers only, no names under them
 // A zone's letter and name are this many screen pixels high, and its box at least this many
@@ -92,14 +105,19 @@ export class MapView {
     this.onZone = onZone;
     /** @type {Map<string, DrawnRobot>} */
     this.robots = new Map();
-    /** @type {Map<string, {group: SVGGElement, zone: ZoneEntry, half: number, incoming: SVGTextElement}>} */
+    /** @type {Map<string, DrawnZone>} */
     this.zones = new Map();
+    // The floor's size on the screen decides how large a zone's words are drawn.
+    this.resized = new ResizeObserver(() => this.sizeZones());
+    this.resized.observe(svg);
     // Where each robot of a large fleet is heading (a zone id), for the zones' counts.
     /** @type {Map<string, string>} */
     this.heading = new Map();
     this.headingChanged = false;
-    // Metres a screen pixel spans on the floor as drawn.
+    // Metres a screen pixel spans on the floor as drawn, and the floor's drawn extent.
     this.metresPerPx = 0.025;
+    /** @type {{width: number, height: number} | null} */
+    this.extent = null;
     /** @type {Map<string, SVGGElement>} */
     this.arms = new Map();
     /** @type {number | null} */
@@ -144,10 +162,8 @@ export class MapView {
     this.svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
     this.scale = Math.max(1, Math.max(right - left, top - bottom) / 13);
     this.labels = fleet.robots.length <= LABELS_UP_TO;
-    // "meet": the floor is drawn as large as the box allows, one scale for both sides.
-    const box = this.svg.getBoundingClientRect();
-    const fit = Math.min(box.width / (right - left), box.height / (top - bottom));
-    this.metresPerPx = fit > 0 ? 1 / fit : this.scale / 40;
+    this.extent = { width: right - left, height: top - bottom };
+    this.measure();
     this.heading.clear();
     showLegend(".legend-crowd", fleet.robots.length > SVG_ROBOTS_UP_TO);
     showLegend(".legend-key", fleet.robots.length <= SVG_ROBOTS_UP_TO);
@@ -202,28 +218,71 @@ export class MapView {
 
   /** @param {ZoneEntry} zone @param {SVGGElement} parent */
   drawZone(zone, parent) {
-    // The box is the arrival circle's square with room around it; a robot stops at its
-    // centre, so the letter (or key) sits in the top-left corner and the name along the
-    // bottom. On a large floor a box would be a speck: it is at least ZONE_BOX_PX across,
-    // its letter and name ZONE_LETTER_PX and ZONE_NAME_PX high, the name below the box.
-    const px = this.metresPerPx;
-    const half = Math.max(zone.radius + 0.22, (ZONE_BOX_PX / 2) * px);
-    const letterSize = Math.max(0.42, ZONE_LETTER_PX * px), nameSize = Math.max(0.16, ZONE_NAME_PX * px);
-    const { x, y } = zone.pose;
     const group = el("g", { class: `zone${zone.arm === "loader" ? " loading" : ""}`, "data-zone": zone.id, role: "button", "aria-label": zone.name }, parent);
     el("title", {}, group).textContent = zone.name;
-    el("rect", { class: "zone-body", x: x - half, y: -y - half, width: 2 * half, height: 2 * half, rx: Math.min(0.16 * this.scale, half / 3) }, group);
-    const big = zone.id.length <= 2 ? zone.id : zone.key;
-    const letter = el("text", { class: "zone-letter", x: x - half + 0.6 * letterSize, y: -y - half + 0.72 * letterSize, "font-size": big ? letterSize : nameSize }, group);
-    letter.textContent = big || zone.name;
-    if (!big) letter.setAttribute("x", String(x));
-    const inside = nameSize <= 0.2;
-    const name = el("text", { class: `zone-name${inside ? "" : " below"}`, x, y: inside ? -y + half - 0.09 : -y + half + nameSize, "font-size": nameSize }, group);
+    const body = el("rect", { class: "zone-body" }, group);
+    const shown = zone.id.length <= 2 ? zone.id : zone.key;
+    const letter = el("text", { class: "zone-letter" }, group);
+    letter.textContent = shown || zone.name;
+    const name = el("text", { class: "zone-name" }, group);
     name.textContent = zone.name;
     // How many robots are on their way here (a large fleet's robots draw no paths).
-    const incoming = el("text", { class: "zone-incoming", x, y: -y - half - 0.35 * nameSize, "font-size": nameSize, visibility: "hidden" }, group);
+    const incoming = el("text", { class: "zone-incoming", visibility: "hidden" }, group);
     group.addEventListener("click", () => this.onZone(zone.id));
-    this.zones.set(zone.id, { group, zone, half, incoming });
+    const drawn = { group, zone, half: zone.radius + 0.22, body, letter, name, incoming, big: Boolean(shown) };
+    this.zones.set(zone.id, drawn);
+    this.sizeZone(drawn);
+  }
+
+  // The floor's metres per screen pixel, as drawn now ("meet": as large as the box allows).
+  measure() {
+    const box = this.svg.getBoundingClientRect();
+    const { width, height } = this.extent ?? { width: 0, height: 0 };
+    const fit = width > 0 && height > 0 ? Math.min(box.width / width, box.height / height) : 0;
+    this.metresPerPx = fit > 0 ? 1 / fit : this.scale / 40;
+  }
+
+  // The zones drawn again at the floor's size on the screen now.
+  sizeZones() {
+    if (!this.fleet) return;
+    this.measure();
+    for (const drawn of this.zones.values()) this.sizeZone(drawn);
+    if (this.layer) {
+      for (const label of this.layer.labels) {
+        const drawn = [...this.zones.values()].find((z) => z.zone.name === label.name);
+        if (!drawn) continue;
+        label.below = { x: drawn.zone.pose.x, y: drawn.zone.pose.y - drawn.half };
+        label.above = { x: drawn.zone.pose.x, y: drawn.zone.pose.y + drawn.half };
+      }
+      this.layer.dirty = true;
+      this.animate();
+    }
+  }
+
+  // The box is the arrival circle's square with room around it; a robot stops at its
+  // centre, so the letter (or key) sits in the top-left corner and the name along the
+  // bottom. On a large floor a box would be a speck: it is at least ZONE_BOX_PX across, its
+  // letter and name ZONE_LETTER_PX and ZONE_NAME_PX high, the name then below the box.
+  /** @param {DrawnZone} drawn */
+  sizeZone(drawn) {
+    const px = this.metresPerPx;
+    const { zone, body, letter, name, incoming, big } = drawn;
+    const half = Math.max(zone.radius + 0.22, (ZONE_BOX_PX / 2) * px);
+    drawn.half = half;
+    const letterSize = Math.max(0.42, ZONE_LETTER_PX * px), nameSize = Math.max(0.16, ZONE_NAME_PX * px);
+    const { x, y } = zone.pose;
+    for (const [key, value] of Object.entries({ x: x - half, y: -y - half, width: 2 * half, height: 2 * half, rx: Math.min(0.16 * this.scale, half / 3) })) put(body, key, value);
+    put(letter, "x", big ? x - half + 0.6 * letterSize : x);
+    put(letter, "y", -y - half + 0.72 * letterSize);
+    put(letter, "font-size", big ? letterSize : nameSize);
+    const inside = nameSize <= 0.2;
+    name.classList.toggle("below", !inside);
+    put(name, "x", x);
+    put(name, "y", inside ? -y + half - 0.09 : -y + half + 0.2 * nameSize);
+    put(name, "font-size", nameSize);
+    put(incoming, "x", x);
+    put(incoming, "y", -y - half - 0.35 * nameSize);
+    put(incoming, "font-size", nameSize);
   }
 
   /** @param {string} zoneId @param {Point} at @param {SVGGElement} parent */

@@ -360,6 +360,7 @@ const lineOf = new WeakMap();
 export function sourceName(source) {
   if (source === "alexa") return t("the assistant");
   if (source === "console") return t("keyboard and mouse");
+  if (source === "dispatcher") return t("the dispatcher");
   if (source.startsWith("robot:")) return source.slice(6);
   return source;
 }
