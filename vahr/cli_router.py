@@ -55,7 +55,15 @@ def add_logging_flag(parser: argparse.ArgumentParser) -> None:
     )
 
 
+# Libraries whose INFO lines are no news to a person ("Found credentials in environment
+# variables" on every skill start): heard from at WARNING unless everything is asked for.
+QUIET_LIBRARIES = ("botocore", "boto3", "urllib3")
+
+
 def setup_logging(level: str) -> None:
     logging.basicConfig(
         level=level, format="%(asctime)s %(levelname)s %(name)s: %(message)s", stream=sys.stderr
     )
+    if level != "DEBUG":
+        for name in QUIET_LIBRARIES:
+            logging.getLogger(name).setLevel(max(logging.WARNING, logging.getLevelName(level)))

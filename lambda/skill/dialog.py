@@ -46,12 +46,14 @@ def ask_robot(
     handler_input: HandlerInput,
     runtime: SkillRuntime,
     reading: SlotReading,
-    question: str = prompts.ASK_ROBOT,
+    question: str | None = None,
     *,
     include_fleet: bool = True,
     preface: str = "",
 ) -> Response:
-    """Elicit a robot, listing the choices; say first when the last answer was unknown."""
+    """Elicit a robot, listing the choices; say first when the last answer was unknown.
+    `question` defaults to ASK_ROBOT, read now: in the request's language."""
+    question = prompts.ASK_ROBOT if question is None else question
     if reading.choices:
         names = [runtime.vocabulary.robot(thing) for thing in reading.choices]
         return _ask(handler_input, runtime, reading.name, which_of(names))
@@ -89,13 +91,15 @@ def ask_zone(
     handler_input: HandlerInput,
     runtime: SkillRuntime,
     reading: SlotReading,
-    question: str = prompts.ASK_ZONE,
+    question: str | None = None,
     *,
     robot_id: str | None = None,
     deliverable: bool = False,
     preface: str = "",
 ) -> Response:
-    """Elicit a zone, listing the choices (only delivery zones when `deliverable`)."""
+    """Elicit a zone, listing the choices (only delivery zones when `deliverable`).
+    `question` defaults to ASK_ZONE, read now: in the request's language."""
+    question = prompts.ASK_ZONE if question is None else question
     heard_as = [z for z in reading.choices if not (deliverable and z == LOADING)]
     if len(heard_as) > 1:
         names = [runtime.vocabulary.zone(zone_id) for zone_id in heard_as]

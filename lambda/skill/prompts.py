@@ -100,14 +100,18 @@ PROBLEM_REJECTED = "{robot} refused: {reason}"
 PROBLEM_FAILED = "{robot} failed: {reason}"
 PROBLEM_CANCELLED = "{robot} cancelled it"
 PROBLEM_OFFLINE = "{robot} did not answer and seems to be offline"
-PROBLEM_SILENT = "{robot} did not answer"
+# Not "did not answer": a robot may answer a moment after the skill stopped waiting.
+PROBLEM_SILENT = "{robot} had not answered yet"
 NO_REASON = "no reason given"
 
 # Status, one sentence per robot.
 STATUS_NEVER_REPORTED = "{robot} has not reported yet."
 STATUS_OFFLINE = "{robot} seems to be offline."
 STATUS_OFFLINE_LAST_SEEN = "{robot} seems to be offline; it was last seen in {zone}."
+STATUS_OFFLINE_LAST_SEEN_NEAR = "{robot} seems to be offline; it was last seen near {zone}."
 STATUS_IDLE_IN = "{robot} is idle in {zone}."
+# Between zones: the nearest zone to the robot's reported pose.
+STATUS_IDLE_NEAR = "{robot} is idle near {zone}."
 STATUS_IDLE = "{robot} is idle."
 STATUS_CARRYING = "{robot} is carrying a package to {zone}."
 STATUS_FETCHING = "{robot} is on its way to the loading zone to pick up a package."
@@ -120,8 +124,10 @@ STATUS_WAITING_WEATHER = "{robot} is waiting to hear the weather."
 STATUS_WAITING_TURN = "{robot} is waiting for its turn to deliver to {zone}."
 STATUS_WAITING = "{robot} is waiting."
 STATUS_STOPPED_IN = "{robot} is stopped in {zone}."
+STATUS_STOPPED_NEAR = "{robot} is stopped near {zone}."
 STATUS_STOPPED = "{robot} is stopped."
 STATUS_STUCK_TO = "{robot} is stuck on its way to {zone}."
+STATUS_STUCK_NEAR = "{robot} is stuck near {zone}."
 STATUS_STUCK = "{robot} is stuck."
 STATUS_ERROR_REASON = "{robot} has a problem: {reason}."
 STATUS_ERROR = "{robot} has a problem."
@@ -155,7 +161,7 @@ PROBLEMS = {
 }
 PROBLEMS_NONE = "No robot is stuck, failed or offline."
 INDEX_UNAVAILABLE = "Sorry, I could not count the robots just now. Please try again in a moment."
-FLEET_PROBLEMS_MORE = "and {n} more did not confirm"
+FLEET_PROBLEMS_MORE = "and {n} more had not confirmed yet"
 
 # The experiment's weather. The robots recognise these exact openings.
 WEATHER = {weather: f"The weather is {weather}." for weather in WEATHERS}
@@ -223,6 +229,8 @@ QUEUE_ENTRY = "{place}, {task}"
 QUEUE_MORE = "and {count} more"
 CANCELLED_QUEUED = "I cancelled {task}, which was {place} in line."
 CANCELLED_HELD = "I cancelled {task} and stopped {robot}."
+CANCELLED_MANY = "I cancelled the {count} tasks to {zone}."
+CANCELLED_MANY_STOPPED = "I cancelled the {count} tasks to {zone} and stopped {robots}."
 NOTHING_TO_CANCEL = "There is no task to {zone} to cancel."
 NO_DISPATCHER = (
     "Sending a robot without its name needs the fleet dispatcher, which is not running here, "

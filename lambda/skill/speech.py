@@ -24,8 +24,11 @@ if TYPE_CHECKING:
 DELIVERY_TASKS = ("deliver", "weather_delivery", "sequential_delivery")
 
 
-def _reason(answer: RobotAnswer) -> str:
-    return (answer.reason or prompts.NO_REASON).rstrip(". ")
+def _reason(vocabulary: Vocabulary, answer: RobotAnswer, zone: str | None) -> str:
+    """Why a robot did not confirm, with the command's zone (`zone`) said by its name."""
+    if not answer.reason:
+        return prompts.NO_REASON
+    return vocabulary.reason(answer.reason, zone).rstrip(". ")
 
 
 def _zone_of(item: Publication) -> str | None:
@@ -51,7 +54,7 @@ def command_report(
                 robot=robot, zone=zone_name, after=vocabulary.robot(after) if after else ""
             )
             return capitalise(sentence)
-        return capitalise(_problem(robot, answer, _SINGLE_PROBLEMS))
+        return capitalise(_problem(vocabulary, robot, answer, _SINGLE_PROBLEMS, zone))
     confirmed = [answer for answer in mine if answer.confirmed]
     if len(confirmed) == len(mine):
         robots = (
@@ -63,7 +66,7 @@ def command_report(
     unconfirmed = [answer for answer in mine if not answer.confirmed]
     # A fleet of a thousand cannot hear every missing robot: the first few by name.
     named = [
-        _problem(vocabulary.robot(answer.thing), answer, _FLEET_PROBLEMS)
+        _problem(vocabulary, vocabulary.robot(answer.thing), answer, _FLEET_PROBLEMS, zone)
         for answer in unconfirmed[:FLEET_PROBLEMS_NAMED]
     ]
     if len(unconfirmed) > FLEET_PROBLEMS_NAMED:
@@ -93,29 +96,37 @@ def sequential_report(
 
 
 # A single robot's problem is a sentence of its own; in a fleet answer it is one clause of
-# a list, so the same outcomes are worded shorter.
+# a list, so the same outcomes are worded shorter. By the message's name: each is read when
+# spoken, in the request's language.
 _SINGLE_PROBLEMS = {
-    "rejected": prompts.REJECTED,
-    "failed": prompts.FAILED,
-    "cancelled": prompts.CANCELLED,
-    "offline": prompts.OFFLINE,
-    "silent": prompts.NOT_CONFIRMED,
+    "rejected": "REJECTED",
+    "failed": "FAILED",
+    "cancelled": "CANCELLED",
+    "offline": "OFFLINE",
+    "silent": "NOT_CONFIRMED",
 }
 _FLEET_PROBLEMS = {
-    "rejected": prompts.PROBLEM_REJECTED,
-    "failed": prompts.PROBLEM_FAILED,
-    "cancelled": prompts.PROBLEM_CANCELLED,
-    "offline": prompts.PROBLEM_OFFLINE,
-    "silent": prompts.PROBLEM_SILENT,
+    "rejected": "PROBLEM_REJECTED",
+    "failed": "PROBLEM_FAILED",
+    "cancelled": "PROBLEM_CANCELLED",
+    "offline": "PROBLEM_OFFLINE",
+    "silent": "PROBLEM_SILENT",
 }
 
 
-def _problem(robot: str, answer: RobotAnswer, wording: Mapping[str, str]) -> str:
+def _problem(
+    vocabulary: Vocabulary,
+    robot: str,
+    answer: RobotAnswer,
+    wording: Mapping[str, str],
+    zone: str | None,
+) -> str:
     """Why `answer` is not a confirmation, in `wording`'s sentence for that case."""
     case: str = answer.outcome
     if case not in ("rejected", "failed", "cancelled"):
         case = "offline" if answer.offline else "silent"
-    return wording[case].format(robot=robot, reason=_reason(answer))
+    sentence: str = getattr(prompts, wording[case])
+    return sentence.format(robot=robot, reason=_reason(vocabulary, answer, zone))
 
 
 def status_report(vocabulary: Vocabulary, reads: Sequence[ShadowRead]) -> str:
@@ -132,18 +143,34 @@ def robot_status(vocabulary: Vocabulary, read: ShadowRead) -> str:
     return capitalise(_reported_status(vocabulary, robot, read.shadow.reported))
 
 
+def _nearest_zone(vocabulary: Vocabulary, state: Reported) -> str | None:
+    """The zone nearest the robot's reported pose, by its spoken name (None without one)."""
+    zones = vocabulary.fleet.zones
+    if state.pose is None or not zones:
+        return None
+    pose = state.pose
+    nearest = min(zones, key=lambda z: (z.pose.x - pose.x) ** 2 + (z.pose.y - pose.y) ** 2)
+    return vocabulary.zone(nearest.id)
+
+
 def _reported_status(vocabulary: Vocabulary, robot: str, state: Reported) -> str:
     here = vocabulary.zone(state.zone) if state.zone else None
     there = vocabulary.zone(state.destination) if state.destination else None
+    # Between zones, the nearest place says where the robot is.
+    near = None if here else _nearest_zone(vocabulary, state)
     if not state.connected:
         if here:
             return prompts.STATUS_OFFLINE_LAST_SEEN.format(robot=robot, zone=here)
+        if near:
+            return prompts.STATUS_OFFLINE_LAST_SEEN_NEAR.format(robot=robot, zone=near)
         return prompts.STATUS_OFFLINE.format(robot=robot)
     status = state.status
     if status == "idle":
-        return (prompts.STATUS_IDLE_IN if here else prompts.STATUS_IDLE).format(
-            robot=robot, zone=here
-        )
+        if here:
+            return prompts.STATUS_IDLE_IN.format(robot=robot, zone=here)
+        if near:
+            return prompts.STATUS_IDLE_NEAR.format(robot=robot, zone=near)
+        return prompts.STATUS_IDLE.format(robot=robot)
     if status == "navigating":
         return _moving(robot, state, there)
     if status == "loading":
@@ -157,16 +184,24 @@ def _reported_status(vocabulary: Vocabulary, robot: str, state: Reported) -> str
             return prompts.STATUS_WAITING_TURN.format(robot=robot, zone=there)
         return prompts.STATUS_WAITING.format(robot=robot)
     if status == "stopped":
-        return (prompts.STATUS_STOPPED_IN if here else prompts.STATUS_STOPPED).format(
-            robot=robot, zone=here
-        )
+        if here:
+            return prompts.STATUS_STOPPED_IN.format(robot=robot, zone=here)
+        if near:
+            return prompts.STATUS_STOPPED_NEAR.format(robot=robot, zone=near)
+        return prompts.STATUS_STOPPED.format(robot=robot)
     if status == "stuck":
-        return (prompts.STATUS_STUCK_TO if there else prompts.STATUS_STUCK).format(
-            robot=robot, zone=there
-        )
+        # A stuck robot's task has ended; the zone it was for is its last command's.
+        last = state.last_command
+        goal = there or (vocabulary.zone(last.zone) if last is not None and last.zone else None)
+        if goal:
+            return prompts.STATUS_STUCK_TO.format(robot=robot, zone=goal)
+        if near:
+            return prompts.STATUS_STUCK_NEAR.format(robot=robot, zone=near)
+        return prompts.STATUS_STUCK.format(robot=robot)
     last = state.last_command
     if last is not None and last.reason:
-        return prompts.STATUS_ERROR_REASON.format(robot=robot, reason=last.reason.rstrip(". "))
+        reason = vocabulary.reason(last.reason, last.zone).rstrip(". ")
+        return prompts.STATUS_ERROR_REASON.format(robot=robot, reason=reason)
     return prompts.STATUS_ERROR.format(robot=robot)
 
 

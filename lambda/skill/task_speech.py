@@ -96,20 +96,37 @@ def queue_report(vocabulary: Vocabulary, tasks: Sequence[Task]) -> str:
     return capitalise(listed)
 
 
-def task_to_cancel(tasks: Sequence[Task], zone: str) -> tuple[Task, int] | None:
-    """The task a person most likely means by "cancel the delivery to {zone}": the newest
-    queued one to that zone (with its place in line), else the newest one a robot holds
-    (place 0); None when no open task goes there."""
+def tasks_to_cancel(tasks: Sequence[Task], zone: str) -> list[tuple[Task, int]]:
+    """What "cancel the delivery to {zone}" cancels: every open task to that zone, each
+    with its place in line (0 for one a robot holds), robots' first, then the queue's.
+    One sentence cannot tell two tasks to one zone apart, so all of them go, and the
+    answer says how many and which robots it stopped (docs/dispatch.md)."""
     queued = [task for task in tasks if task.status == "queued"]
-    for place in range(len(queued), 0, -1):
-        if queued[place - 1].zone == zone:
-            return queued[place - 1], place
-    held = [task for task in tasks if task.status == "assigned" and task.zone == zone]
-    return (held[-1], 0) if held else None
+    held = [(task, 0) for task in tasks if task.status == "assigned" and task.zone == zone]
+    waiting = [(task, place) for place, task in enumerate(queued, start=1) if task.zone == zone]
+    return held + waiting
 
 
-def cancel_report(vocabulary: Vocabulary, task: Task, place: int) -> str:
-    name = task_name(vocabulary, task)
-    if place > 0 or task.thing is None:
-        return capitalise(prompts.CANCELLED_QUEUED.format(task=name, place=ordinal(max(place, 1))))
-    return capitalise(prompts.CANCELLED_HELD.format(task=name, robot=vocabulary.robot(task.thing)))
+def cancel_report(vocabulary: Vocabulary, cancelled: Sequence[tuple[Task, int]]) -> str:
+    """ "I cancelled the delivery to zone b and stopped heron.", or for several: "I
+    cancelled the two tasks to zone b and stopped heron and plover."."""
+    if len(cancelled) == 1:
+        task, place = cancelled[0]
+        name = task_name(vocabulary, task)
+        if place > 0 or task.thing is None:
+            sentence = prompts.CANCELLED_QUEUED.format(task=name, place=ordinal(max(place, 1)))
+        else:
+            sentence = prompts.CANCELLED_HELD.format(task=name, robot=vocabulary.robot(task.thing))
+        return capitalise(sentence)
+    zone = vocabulary.zone(cancelled[0][0].zone)
+    stopped = [
+        vocabulary.robot(task.thing) for task, place in cancelled if place == 0 and task.thing
+    ]
+    count = spoken_number(len(cancelled))
+    if stopped:
+        sentence = prompts.CANCELLED_MANY_STOPPED.format(
+            count=count, zone=zone, robots=and_list(stopped)
+        )
+    else:
+        sentence = prompts.CANCELLED_MANY.format(count=count, zone=zone)
+    return capitalise(sentence)

@@ -15,7 +15,15 @@ from typing import TYPE_CHECKING
 from skill import prompts
 from skill.catalog import current_locale
 from vahr.domain import FLEET_GROUP, FLEET_GROUP_NAMES
-from vahr.domain.fleet import SPOKEN_LOCALE, names_by_locale, spoken_in, zone_phrase
+from vahr.domain.fleet import (
+    SPOKEN_LOCALE,
+    names_by_locale,
+    reason_said,
+    spoken_in,
+    zone_name_in,
+    zone_phrase,
+)
+from vahr.domain.locale import SUPPORTED_LOCALES, load_language
 from vahr.domain.text import normalize
 
 if TYPE_CHECKING:
@@ -56,14 +64,6 @@ def join_choices(names: list[str]) -> str:
     return ", ".join(names[:-1]) + f"{serial} {word} " + names[-1]
 
 
-def _named_in_locale(names: list[str]) -> str:
-    # Outside English a zone is called by its first name, its nouns capitalised as written
-    # ("zone a" -> "Zone A", "ladezone" -> "Ladezone"): sentences need no article for it.
-    return " ".join(
-        word.upper() if len(word) == 1 else word.capitalize() for word in names[0].split()
-    )
-
-
 class Vocabulary:
     """Spoken names of the fleet's robots and zones, both ways."""
 
@@ -74,6 +74,11 @@ class Vocabulary:
         self._robot_ids: dict[str, str] = {FLEET: FLEET}
         for name in self.fleet_names:
             self._robot_ids[normalize(name)] = FLEET
+        if group is None:
+            # Without a group `all`, each language's own words for the whole fleet.
+            for locale in SUPPORTED_LOCALES:
+                for name in load_language(locale).fleet_names:
+                    self._robot_ids.setdefault(normalize(name), FLEET)
         self._group = group
         for robot in fleet.robots:
             self._robot_ids[robot.thing.lower()] = robot.thing
@@ -99,17 +104,26 @@ class Vocabulary:
         """What to call a robot (or the fleet) in speech, in lower case."""
         locale = current_locale()
         if thing == FLEET:
-            if locale != SPOKEN_LOCALE and self._group is not None:
-                return normalize(spoken_in(self._group, locale)[0])
+            if locale != SPOKEN_LOCALE:
+                names = (
+                    spoken_in(self._group, locale)
+                    if self._group is not None
+                    else load_language(locale).fleet_names
+                )
+                return normalize(names[0])
             return normalize(self.fleet_names[0])
         return normalize(self.fleet.spoken_name(thing, locale))
 
     def zone(self, zone_id: str) -> str:
         locale = current_locale()
         if locale != SPOKEN_LOCALE and zone_id in self.fleet.zone_ids:
-            zone = next(zone for zone in self.fleet.zones if zone.id == zone_id)
-            return _named_in_locale(spoken_in(zone, locale))
+            return zone_name_in(self.fleet.zone(zone_id), locale)
         return self._zone_names.get(zone_id, f"zone {zone_id}")
+
+    def reason(self, reason: str, zone_id: str | None) -> str:
+        """A robot's reason as said: the zone it names by id (`zone_id`, the zone the
+        command was for) by its spoken name, in the request's language."""
+        return reason_said(reason, zone_id, self.zone(zone_id)) if zone_id else reason
 
     def spelled(self, zone_id: str) -> str | None:
         """The spelling-alphabet word a zone named by a letter answers to ("bravo" for

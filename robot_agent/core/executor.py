@@ -131,7 +131,9 @@ class Executor:
             previous.cancel()
         self._current = command
         accepted: dict[str, Any] = {
-            "last_command": LastCommand(command.id, command.action, "accepted"),
+            "last_command": LastCommand(
+                command.id, command.action, "accepted", zone=_destination(command)
+            ),
             "task": command.action if command.is_motion else None,
             "destination": _destination(command),
             # Where the robot is now: the preempted task halts here and its final update,
@@ -217,7 +219,7 @@ class Executor:
             last = self.state.last_command
             if last is not None and last.id == current.id:
                 changes["last_command"] = LastCommand(
-                    current.id, current.action, "cancelled", reason
+                    current.id, current.action, "cancelled", reason, last.zone
                 )
             self._update(**changes)
         await self.backend.close()
@@ -504,8 +506,10 @@ class Executor:
     def _close(
         self, command: Command, result: Result, reason: str | None, *, status: Status
     ) -> None:
+        # A failure names the zone it was for: its reason names it by id.
+        zone = None if result == "done" else self._zone_of(command)
         self._update(status=status, **self._closing(command, result, reason))
-        self._emit(result, command, reason=reason)
+        self._emit(result, command, reason=reason, zone=zone)
         if self._current is command:
             self._current = None
 
@@ -516,8 +520,15 @@ class Executor:
         # A ping may have become the last command meanwhile; only our own entry is closed.
         last = self.state.last_command
         if last is None or last.id == command.id or last.action == "ping":
-            changes["last_command"] = LastCommand(command.id, command.action, result, reason)
+            changes["last_command"] = LastCommand(
+                command.id, command.action, result, reason, self._zone_of(command)
+            )
         return changes
+
+    def _zone_of(self, command: Command) -> str | None:
+        """The zone `command` is for: its own, or where it turned out to go (a weather
+        delivery's zone, known once the weather is)."""
+        return _destination(command) or self.state.destination
 
     def _update(self, **changes: Any) -> None:
         new = msgspec.structs.replace(self.state, **changes)

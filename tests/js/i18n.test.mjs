@@ -41,3 +41,31 @@ test("the English words are the page's own", () => {
     for (const value of Object.values(attributes)) assert.ok(PAGE.includes(`"${value}"`), value);
   }
 });
+
+// What the scripts write (`t`, `tNodes`) and say to the assistant (`said`), by their English
+// wording: each in every other locale, with the same placeholders.
+const STATIC = new URL("../../vahr/station/static/", import.meta.url);
+const scripts = ["alerts-view", "conversation", "map", "panel", "robots", "station", "talk", "tasks", "tasks-view"]
+  .map((name) => readFileSync(new URL(`${name}.js`, STATIC), "utf8"));
+const used = (pattern) => new Set(scripts.flatMap((text) => [...text.matchAll(pattern)].map((m) => m[1])));
+const placeholders = (text) => [...text.matchAll(/\{(\w+)\}/g)].map((m) => m[1]).sort();
+
+test("every sentence the scripts write is in every locale, with its placeholders", () => {
+  const strings = used(/\b(?:t|tr|tNodes)\("((?:[^"\\]|\\.)*)"/g);
+  assert.ok(strings.size > 100, "the scripts' sentences were found");
+  for (const locale of SUPPORTED.filter((code) => code !== "en-US")) {
+    const table = words(locale).strings;
+    for (const english of strings) {
+      assert.ok(english in table, `${locale} lacks "${english}"`);
+      assert.deepEqual(placeholders(table[english]), placeholders(english), english);
+    }
+  }
+});
+
+test("what the page says to the assistant is in the assistant's every language", () => {
+  const utterances = used(/\bsaid\("((?:[^"\\]|\\.)*)"/g);
+  assert.ok(utterances.size >= 2);
+  for (const locale of SUPPORTED.filter((code) => code !== "en-US")) {
+    for (const english of utterances) assert.ok(english in words(locale).utterances, `${locale} lacks "${english}"`);
+  }
+});

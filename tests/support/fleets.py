@@ -8,6 +8,8 @@ from pathlib import Path
 FLEETS_DIR = Path(__file__).resolve().parents[1] / "fleets"
 # Six made-up robots (birds) in a bakery, with a group besides the whole fleet.
 SIX_ROBOTS = FLEETS_DIR / "six_robots.yaml"
+# Four robots in a small hospital, with places named as staff say them and German names.
+HOSPITAL = FLEETS_DIR / "hospital.yaml"
 
 # tests/fleets/bad/NAME.yaml -> the error, naming the entry and the reason.
 BAD_FLEETS = {

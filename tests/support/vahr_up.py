@@ -56,21 +56,29 @@ class Up:
                 return event
 
 
-def start_up(state: Path, *extra: str, plaintext: bool = False) -> Up:
+def start_up(
+    state: Path,
+    *extra: str,
+    plaintext: bool = False,
+    env: dict[str, str] | None = None,
+    timeout_s: float = START_TIMEOUT_S,
+) -> Up:
     """`vahr up --json --no-voice` with every port free and `extra` flags (which may give a
     port of their own, or 0 for none: the last flag wins). Never a default port: another
     `vahr up` on this machine (a developer's, another test's) may hold it. `plaintext`
-    opens the plaintext development listener too (`--dev-plaintext`), on a free port."""
+    opens the plaintext development listener too (`--dev-plaintext`), on a free port; `env`
+    adds to the environment (an empty model cache: `XDG_CACHE_HOME`); `timeout_s` bounds
+    the start."""
     listener = ["--dev-plaintext", "--mqtt-port", str(free_port())] if plaintext else []
     process = spawn(
         [*VAHR, "up", "--json", "--no-voice", "--state-dir", str(state),
          "--api-port", str(free_port()), "--mqtts-port", str(free_port()),
          *listener, "--station-port", str(free_port()), *extra],
-        started_for=state, cwd=ROOT, env=clean_env(), stdout=subprocess.PIPE,
+        started_for=state, cwd=ROOT, env={**clean_env(), **(env or {})}, stdout=subprocess.PIPE,
         stderr=(state / "up.err").open("w"),
         text=True,
     )  # fmt: skip
-    first = _first_line(process, START_TIMEOUT_S)
+    first = _first_line(process, timeout_s)
     if not first:
         stop_up(process)
         raise AssertionError(f"vahr up did not start: {(state / 'up.err').read_text()}")
@@ -94,11 +102,12 @@ def _first_line(process: subprocess.Popen[str], timeout_s: float) -> str:
         return ""
 
 
-def say(api: str, utterance: str) -> dict[str, Any]:
-    """`vahr say --json` against `api`: the turn it prints."""
+def say(api: str, utterance: str, *flags: str) -> dict[str, Any]:
+    """`vahr say --json` against `api` (with `flags`, such as `--locale de-DE`): the turn it
+    prints."""
     result = subprocess.run(
-        [*VAHR, "say", "--json", "--api", api, utterance],
-        cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=30, check=True,
+        [*VAHR, "say", "--json", "--api", api, *flags, utterance],
+        cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=60, check=True,
     )  # fmt: skip
     turn: dict[str, Any] = json.loads(result.stdout)
     return turn

@@ -65,7 +65,10 @@ def test_reported_state_round_trips_through_a_shadow_document() -> None:
     assert body["clientToken"] == "t-1"
     reported = body["state"]["reported"]
     assert {"status", "zone", "cargo", "last_command", "connected"} <= reported.keys()
-    assert reported["last_command"] == {"id": "c-1", "action": "deliver", "result": "accepted"}
+    # Every field of the last command is sent, null included (a shadow merge deletes it).
+    assert reported["last_command"] == {
+        "id": "c-1", "action": "deliver", "result": "accepted", "reason": None, "zone": None,
+    }  # fmt: skip
     document = {"state": {"reported": reported}, "metadata": {}, "version": 7, "timestamp": 1}
     shadow = robot_shadow_from_payload(json.dumps(document).encode())
     assert shadow.reported == state

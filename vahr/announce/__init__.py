@@ -18,6 +18,7 @@ from vahr.announce.policy import (
     PolicyState,
     Queued,
     Signal,
+    TaskCancelled,
     signals_from_event,
     signals_from_presence,
 )
@@ -33,6 +34,7 @@ __all__ = [
     "PolicyState",
     "Queued",
     "Signal",
+    "TaskCancelled",
     "settings_from",
     "signals_from_event",
     "signals_from_presence",

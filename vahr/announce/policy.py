@@ -18,7 +18,9 @@ memory. The rules:
   clears before its turn is not told (a cleared fault is not news), and the log says so.
   At most `max_held` wait at once; past that the last in line is dropped with a warning
   in the log and counted in `PolicyState.dropped`;
-- a finished task (`done`, off by default) is told once, like a fault that never clears.
+- a finished task (`done`, off by default) is told once, like a fault that never clears,
+  and so is a task the fleet gave up because its robot was sent elsewhere by name
+  (`cancelled`, from the dispatcher's `TaskCancelled`): no task leaves without a word.
 
 There is no fleet task queue yet. `Queued` and `Dispatched` are the signals one will
 send (a task id, the robot it is for if any, when it was queued); `tick` tells the tasks
@@ -103,7 +105,21 @@ class Dispatched:
     at: datetime
 
 
-Signal = Opened | Cleared | Finished | Queued | Dispatched
+@dataclass(frozen=True)
+class TaskCancelled:
+    """The fleet gave up task `task` that `thing` held: someone sent `thing` elsewhere by
+    name. `kind` is the task's (`deliver`, `navigate`), `zone` where it was going."""
+
+    task: str
+    thing: str
+    kind: str
+    zone: str
+    at: datetime
+
+
+Signal = Opened | Cleared | Finished | Queued | Dispatched | TaskCancelled
+# Kinds told once and forgotten (nothing clears them: they are news, not a state).
+_ONE_SHOT: frozenset[AnnouncementKind] = frozenset({"done", "cancelled"})
 
 
 def signals_from_event(event: Event) -> list[Signal]:
@@ -115,8 +131,9 @@ def signals_from_event(event: Event) -> list[Signal]:
         reason = event.reason or ""
         if reason.startswith(STUCK_PREFIX):
             # The executor ends a stuck task as failed; that is the same fault.
-            return [Opened(thing, "stuck", at, reason=reason[len(STUCK_PREFIX) :].strip())]
-        return [Opened(thing, "failed", at, reason=event.reason)]
+            stuck = reason[len(STUCK_PREFIX) :].strip()
+            return [Opened(thing, "stuck", at, reason=stuck, zone=event.zone)]
+        return [Opened(thing, "failed", at, reason=event.reason, zone=event.zone)]
     signals: list[Signal] = []
     if event.event in _CLEARS_TASK_FAULTS:
         signals.append(Cleared(thing, _TASK_FAULTS, at))
@@ -232,6 +249,20 @@ class AnnouncePolicy:
                         zone=signal.zone,
                     )
                 )
+        elif isinstance(signal, TaskCancelled):
+            if "cancelled" in self.settings.kinds:
+                self.state.finished.append(
+                    Fault(
+                        subject=signal.task,
+                        kind="cancelled",
+                        thing=signal.thing,
+                        opened_at=signal.at.timestamp(),
+                        seen_at=self._clock().timestamp(),
+                        reason=signal.kind,
+                        zone=signal.zone,
+                    )
+                )
+            self.state.queued = [t for t in self.state.queued if t.task != signal.task]
         elif isinstance(signal, Queued):
             if not any(t.task == signal.task for t in self.state.queued):
                 self.state.queued.append(
@@ -307,7 +338,7 @@ class AnnouncePolicy:
                     self.state.held += 1
                 continue
             told.append(seconds)
-            if fault.kind == "done":
+            if fault.kind in _ONE_SHOT:
                 self.state.finished.remove(fault)
             else:
                 fault.told = True
@@ -324,7 +355,7 @@ class AnnouncePolicy:
         if excess <= 0:
             return
         for fault in self._in_line(untold)[-excess:]:
-            if fault.kind == "done":
+            if fault.kind in _ONE_SHOT:
                 self.state.finished.remove(fault)
             else:
                 fault.dropped = True

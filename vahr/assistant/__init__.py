@@ -18,7 +18,8 @@ experiment out of them (pyproject.toml, docs/architecture.md):
 - `weigh_recognition`, `Weighed` and `Weighing` (`nbest`): a recognizer's N best weighed
   into one understanding, unsure robots and zones asked about; `agreement`: two
   recognizers' readings acted on when they agree, and `disputed`: the values they heard
-  differently asked about; `request_reader` reads words as a
+  differently asked about; `stop_heard`: a stop either ear heard clearly, acted on;
+  `request_reader` reads words as a
   request, and `Understanding` is what any reading gives.
 """
 
@@ -26,11 +27,13 @@ from vahr.assistant.background import built_in_phrases
 from vahr.assistant.commands_seen import CommandLog
 from vahr.assistant.envelope import Identity
 from vahr.assistant.nbest import (
+    STOP_INTENT,
     Weighed,
     Weighing,
     agreement,
     disputed,
     request_reader,
+    stop_heard,
     weigh_recognition,
 )
 from vahr.assistant.nlu import DEFAULT_MODEL, InteractionModel, Understanding
@@ -49,6 +52,7 @@ RULE_SLOTS = {"sunny": SUNNY_ZONE.name, "rainy": RAINY_ZONE.name}
 __all__ = [
     "DEFAULT_MODEL",
     "RULE_SLOTS",
+    "STOP_INTENT",
     "AlexaSimulator",
     "CommandLog",
     "Identity",
@@ -61,6 +65,7 @@ __all__ = [
     "agreement",
     "disputed",
     "request_reader",
+    "stop_heard",
     "built_in_phrases",
     "confirmation_phrases",
     "load_skill_handler",

@@ -23,7 +23,8 @@ The four constants are chosen on the tuning voices only (`bench/station_hearing.
 docs/push-to-talk.md).
 
 A second recognizer that errs differently (Whisper, beside pocketsphinx) is used by
-`agreement`: a request both transcripts read alike is acted on without weighing.
+`agreement`: a request both transcripts read alike is acted on without weighing; and by
+`stop_heard`: a stop either ear hears clearly is acted on, as stopping is always safe.
 """
 
 from __future__ import annotations
@@ -33,9 +34,9 @@ from collections import defaultdict
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
-from vahr.assistant.nlu import SlotValue, Understanding
+from vahr.assistant.nlu import CONFIDENCE_THRESHOLD, SlotValue, Understanding
 from vahr.domain.invocation import FALLBACK_INTENT
-from vahr.skill_model.intents import ROBOT_TYPE, ZONE_TYPE
+from vahr.skill_model.intents import EMERGENCY_STOP, ROBOT_TYPE, ZONE_TYPE
 from vahr.speech.stt import Hypothesis
 
 if TYPE_CHECKING:
@@ -63,6 +64,8 @@ MIN_INTENT_CONFIDENCE = 0.9
 # Chosen with the two above; 0.3 until the NLU learnt "the robot" requests and the roles'
 # confidence (the rule then chose 0.2 over 0.3, the other two unchanged).
 MIN_WORD_POSTERIOR = 0.2
+# The request that halts robots: acted on when either ear hears it clearly (`stop_heard`).
+STOP_INTENT = EMERGENCY_STOP.name
 # Slot types whose value moves a robot somewhere: never acted on when unsure.
 MOVING_TYPES = frozenset({ROBOT_TYPE, ZONE_TYPE})
 # A rival value is offered in the question only when it holds this share of the weight.
@@ -80,6 +83,9 @@ class Weighed:
     readings: int
     # Heard alike by two recognizers (`agreement`) rather than weighed from the N best.
     agreed: bool = False
+    # The words the understanding was read from, when not the first ear's best transcript
+    # (a stop only the second ear heard clearly, `stop_heard`).
+    words: str | None = None
 
     def to_json(self) -> dict[str, object]:
         return {
@@ -88,6 +94,7 @@ class Weighed:
             "slots": {name: round(p, 3) for name, p in self.slot_confidence.items()},
             "readings": self.readings,
             "agreed": self.agreed,
+            **({"words": self.words} if self.words is not None else {}),
         }
 
 
@@ -190,6 +197,26 @@ def agreement(
         return None
     confidence = {name: 1.0 for name, _ in _moving(model, first)[1]}
     return Weighed(first, 1.0, confidence, 2, agreed=True)
+
+
+def stop_heard(
+    model: InteractionModel,
+    heard: str,
+    reading: Callable[[str], Understanding] | None = None,
+) -> Weighed | None:
+    """`heard` (one ear's transcript) read as a stop, when it clearly is one: the stop
+    intent at the NLU's own confidence threshold, its robot (if named) heard as one value.
+    A stop is the one request where acting is always safe, so a stop either ear hears
+    clearly is acted on even when the other ear heard something else or nothing it
+    understood (docs/voice.md measures the wrong stops this costs). None otherwise."""
+    read = reading or request_reader(model)
+    understood = read(heard)
+    if understood.intent != STOP_INTENT or understood.confidence < CONFIDENCE_THRESHOLD:
+        return None
+    if any(value.alternatives or not value.resolved for value in understood.slots.values()):
+        return None
+    confidence = {name: 1.0 for name in understood.slots}
+    return Weighed(understood, understood.confidence, confidence, 1, words=heard)
 
 
 def disputed(

@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING, Any
 import yaml
 
 from vahr.assistant import envelope
+from vahr.assistant.deadline import TurnDeadline, TurnNotStarted
 from vahr.assistant.localized import invocation_patterns
 from vahr.assistant.nlu import Understanding, normalize_utterance
 from vahr.domain.invocation import FALLBACK_INTENT
@@ -251,6 +252,8 @@ class AlexaSimulator:
         # speaker -> (when, the skill's last command) of that speaker's latest turn.
         self._recent: dict[str, tuple[float, Any]] = {}
         self._origin = "say"
+        # The deadline of the turn under way, when its asker said how long they wait.
+        self._deadline: TurnDeadline | None = None
         longest = max((len(text.split()) for text in model.training[0]), default=0)
         self._longest_words = RAMBLE_FACTOR * longest
         # The language spoken: the request's locale, and how the skill is addressed in it.
@@ -273,6 +276,7 @@ class AlexaSimulator:
         origin: str = "say",
         heard: dict[str, Any] | None = None,
         understanding: Understanding | None = None,
+        deadline: TurnDeadline | None = None,
     ) -> Turn:
         """Speak one utterance; returns the skill's answer and what the turn did.
 
@@ -280,14 +284,33 @@ class AlexaSimulator:
         travel with the turn to `on_turn`. `understanding`, when given, is used instead of
         understanding the words (a recognizer that weighed several hearings built it);
         while a slot is elicited it is an answer when its intent is the pending one or
-        it names the slot alone (`pending` says which).
+        it names the slot alone (`pending` says which). With a `deadline`, a turn that
+        cannot start by its `start_by` (another turn held the simulator, the language
+        model was still being built) raises TurnNotStarted having done nothing, and
+        `may_publish` says whether its commands may still go out.
         """
         with self._lock:
+            if deadline is not None and deadline.start_left() < 0:
+                raise TurnNotStarted(
+                    "the assistant could not start on it while you waited; nothing was sent "
+                    "to the robots"
+                )
             self._origin = origin
-            turn = self._say(utterance, understanding)
+            self._deadline = deadline
+            try:
+                turn = self._say(utterance, understanding)
+            finally:
+                self._deadline = None
             turn.origin, turn.heard = origin, heard
             self._announce(turn)
             return turn
+
+    def may_publish(self) -> bool:
+        """Whether a command of the turn under way may still be sent: False once the
+        person who spoke has stopped waiting for the answer (the data plane then refuses
+        it, so what they were told failed is never done later)."""
+        deadline = self._deadline
+        return deadline is None or deadline.may_publish()
 
     def reading(self, utterance: str) -> Understanding:
         """What `utterance` would be understood as if said now, without saying it: while

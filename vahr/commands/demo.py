@@ -170,7 +170,7 @@ def run(args: argparse.Namespace) -> int:
         )
         started = time.perf_counter()
         with LocalSystem(config, on_event=events.record) as system:
-            system.wait_online()
+            system.wait_ready()
             boot_s = time.perf_counter() - started
             if not args.json:
                 print(

@@ -179,7 +179,7 @@ def _on_own_stack(
                     "the voice method needs the room assistant (espeak-ng); "
                     "install it or rehearse against a running `vahr up`"
                 )
-            system.wait_online()
+            system.wait_ready()
             announce(f"stack up: {', '.join(system.fleet.robot_things)} at x{args.speed_factor:g}")
             assert system.stack.mqtt_url is not None
             return run_study(

@@ -6,6 +6,7 @@ import json
 import signal
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -25,6 +26,10 @@ DEFAULT_STATE_DIR = Path(".state")
 PLAINTEXT_PORT = 1883
 # The banner names at most this many robots; a swarm's are given as a range.
 BANNER_ROBOTS = 12
+# One command's same event from several robots within this many seconds is one line.
+COALESCE_S = 0.5
+# That line names this many robots, then counts the rest.
+GROUP_NAMED = 3
 # Robots a swarm builds and brings online per second, at least (measured: docs/local.md).
 SWARM_BUILD_PER_S = 100
 
@@ -96,7 +101,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
     from vahr.local.robots import SWARM_MAX
-    from vahr.local.system import LocalSystem, SystemConfig
+    from vahr.local.system import READY_TIMEOUT_S, LocalSystem, SystemConfig
     from vahr.station.deployment import on_local_system
 
     setup_logging(args.log_level)
@@ -116,6 +121,14 @@ def run(args: argparse.Namespace) -> int:
             raise VahrError(f"--{flag.replace('_', '-')} {value}: not a usable port")
     if args.sim_speed_factor <= 0:
         raise VahrError("--sim-speed-factor must be more than 0")
+    fleet = read_fleet(args.fleet)
+    if args.fleet is not None and args.robots is not None and args.robots > len(fleet.robots):
+        # Robots made up past a fleet of one's own would drive among its robots under names
+        # nobody gave them (placebot5 in a hospital): a fleet file says what runs.
+        raise VahrError(
+            f"--robots {args.robots}: {args.fleet} has {len(fleet.robots)} robots; give at most "
+            f"{len(fleet.robots)}, or add robots to the file (or use --swarm N)"
+        )
     if args.swarm is not None:
         if args.robots is not None:
             raise VahrError("give either --robots (a process per robot) or --swarm, not both")
@@ -130,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
         mqtt_port=mqtt_port,
         api_port=args.api_port,
         api_hosts=frozenset(args.api_host),
-        fleet=read_fleet(args.fleet),
+        fleet=fleet,
         robots=args.robots,
         swarm=args.swarm,
         sim_speed_factor=args.sim_speed_factor,
@@ -146,25 +159,29 @@ def run(args: argparse.Namespace) -> int:
         signum: signal.signal(signum, lambda *_: stopping.set())
         for signum in (signal.SIGINT, signal.SIGTERM)
     }
-    printer = _EventPrinter(args.json)
+    printer = _EventPrinter(args.json, progress=args.log_level == "DEBUG")
     system = LocalSystem(config, on_event=printer.print, start_station=on_local_system)
     try:
         system.start()
         if system.stack.recovered:
             print(f"vahr up: recovered: {system.stack.recovered}", file=sys.stderr, flush=True)
-        # A swarm's robots come online together once it has built them all.
-        system.wait_online(30.0 + (args.swarm or 0) / SWARM_BUILD_PER_S)
+        # The endpoints are printed only once the system can take a command: every robot
+        # online (a swarm's together, once it has built them all) and the assistant able to
+        # answer. A first start learns the fleet's names and the robots' hearing (cached
+        # for the next), which on a busy machine takes minutes rather than seconds.
+        system.wait_ready(READY_TIMEOUT_S + (args.swarm or 0) / SWARM_BUILD_PER_S, on_wait=_waiting)
         endpoints = system.endpoints()
         if args.json:
             _emit(json.dumps(endpoints))
         else:
-            _emit(_banner(endpoints, system.fleet, system.voice_enabled))
+            _emit(_banner(endpoints, system.fleet, system.voice_enabled, args.locale))
         printer.release()
         while not stopping.wait(0.5):
             for line in system.supervise():
                 print(f"vahr up: {line}", file=sys.stderr, flush=True)
     finally:
         system.stop()
+        printer.stop()
         for signum, handler in previous.items():
             signal.signal(signum, handler)
     if not args.json:
@@ -190,20 +207,35 @@ def _plaintext_port(args: argparse.Namespace) -> int | None:
     return int(port)
 
 
+def _waiting(awaiting: list[str]) -> None:
+    print(f"vahr up: starting; waiting for {'; '.join(awaiting)}", file=sys.stderr, flush=True)
+
+
 def _emit(line: str) -> None:
     print(line, flush=True)
 
 
-def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
+def example_command(fleet: Fleet, locale: str) -> str:
+    """`vahr say` of a first command in the fleet's own words and the locale's language:
+    its first robot to its first zone but LOADING, as `vahr say` must be given it."""
+    from vahr.domain.fleet import SPOKEN_LOCALE, spoken_in
+    from vahr.domain.locale import load_language
+
+    zone = next((z for z in fleet.zones if z.id != "LOADING"), fleet.zones[0])
+    sentence = load_language(locale).example_command.format(
+        robot=spoken_in(fleet.robots[0], locale)[0], zone=spoken_in(zone, locale)[0]
+    )
+    flag = "" if locale == SPOKEN_LOCALE else f" --locale {locale}"
+    return f'vahr say{flag} "{sentence}"'
+
+
+def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool, locale: str) -> str:
     things = fleet.robot_things
     named = (
         ", ".join(things)
         if len(things) <= BANNER_ROBOTS
         else (f"{things[0]} .. {things[-1]} ({len(things):,} robots)")
     )
-    # An example in the fleet's own words: its first robot to its first zone but LOADING.
-    zone = next((z for z in fleet.zones if z.id != "LOADING"), fleet.zones[0])
-    example = f"send {fleet.robots[0].spoken[0]} to {zone.spoken[0]}"
     lines = [
         "VAHR is up on this machine.",
         f"  data plane  {endpoints['api']}   (AWS_ENDPOINT_URL_IOT_DATA_PLANE)",
@@ -216,7 +248,7 @@ def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
     lines += [
         f"  station     {endpoints['station'] or '(off)'}   (the operator station page)",
         f"  robots      {named} (sim backend{', room voice' if voice else ''})",
-        f'  talk to it: vahr say "{example}"   (Ctrl-C stops everything)',
+        f"  talk to it: {example_command(fleet, locale)}   (Ctrl-C stops everything)",
     ]
     return "\n".join(lines)
 
@@ -224,25 +256,85 @@ def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool) -> str:
 class _EventPrinter:
     """Prints robots' events, holding those that come before the endpoints are printed:
     the endpoints are the first line (a contract scripts rely on), and robots that resume
-    work while the system starts must not push it down nor be dropped."""
+    work while the system starts must not push it down nor be dropped.
 
-    def __init__(self, as_json: bool) -> None:
+    With `--json` every event is a line. Otherwise the lines are for a person: progress is
+    chatter, printed only at `--log-level DEBUG`, and one command's same event from several
+    robots within `COALESCE_S` is one line naming them ("rover1, rover2 and 998 more
+    accepted"), so a fleet command to a swarm of 1,000 is a few lines, not thousands."""
+
+    def __init__(self, as_json: bool, *, progress: bool = False) -> None:
         self._as_json = as_json
+        self._progress = progress
         self._lock = threading.Lock()
         self._held: list[Event] | None = []
+        # (command id, event, zone) -> the events gathered, and when the first came.
+        self._groups: dict[tuple[str | None, str, str | None], tuple[float, list[Event]]] = {}
+        self._stopping = threading.Event()
+        self._flusher: threading.Thread | None = None
+        if not as_json:
+            self._flusher = threading.Thread(target=self._flush_loop, daemon=True)
+            self._flusher.start()
 
     def print(self, event: Event) -> None:
+        if not self._as_json and event.event == "progress" and not self._progress:
+            return
         with self._lock:
             if self._held is not None:
                 self._held.append(event)
+                return
+            if not self._as_json:
+                key = (event.command_id, event.event, event.zone)
+                _, events = self._groups.setdefault(key, (time.monotonic(), []))
+                events.append(event)
                 return
         _print_event(event, self._as_json)
 
     def release(self) -> None:
         with self._lock:
             held, self._held = self._held or [], None
-            for event in held:
-                _print_event(event, self._as_json)
+        for event in held:
+            self.print(event)
+
+    def stop(self) -> None:
+        """Print what is still gathered, and stop."""
+        self._stopping.set()
+        if self._flusher is not None:
+            self._flusher.join(timeout=2 * COALESCE_S)
+        self._flush(every=True)
+
+    def _flush_loop(self) -> None:
+        while not self._stopping.wait(COALESCE_S / 4):
+            self._flush()
+
+    def _flush(self, *, every: bool = False) -> None:
+        now = time.monotonic()
+        with self._lock:
+            due = [
+                key
+                for key, (first, _) in self._groups.items()
+                if every or now - first >= COALESCE_S
+            ]
+            groups = [self._groups.pop(key)[1] for key in due]
+        for events in groups:
+            if len(events) == 1:
+                _print_event(events[0], as_json=False)
+            else:
+                _print_group(events)
+
+
+def _print_group(events: list[Event]) -> None:
+    """One line for one command's same event from several robots."""
+    first = events[0]
+    things = list(dict.fromkeys(event.thing for event in events))
+    shown = ", ".join(things[:GROUP_NAMED])
+    named = (
+        f"{shown} and {len(things) - GROUP_NAMED:,} more" if len(things) > GROUP_NAMED else shown
+    )
+    details = _details(first)
+    command = f" [{first.command_id[:8]}]" if first.command_id else ""
+    stamp = first.at.strftime("%H:%M:%S")
+    _emit(f"{stamp} {len(things):,} robots {first.event}: {named} {details}{command}".rstrip())
 
 
 def _print_event(event: Event, as_json: bool) -> None:
@@ -251,6 +343,12 @@ def _print_event(event: Event, as_json: bool) -> None:
 
         _emit(encode(event).decode())
         return
+    command = f" [{event.command_id[:8]}]" if event.command_id else ""
+    stamp = event.at.strftime("%H:%M:%S")
+    _emit(f"{stamp} {event.thing:<10} {event.event:<10} {_details(event)}{command}")
+
+
+def _details(event: Event) -> str:
     details = [
         f"{name}={value}"
         for name, value in (
@@ -264,6 +362,4 @@ def _print_event(event: Event, as_json: bool) -> None:
     ]
     if event.progress is not None:
         details.append(f"progress={event.progress:.0%}")
-    command = f" [{event.command_id[:8]}]" if event.command_id else ""
-    stamp = event.at.strftime("%H:%M:%S")
-    _emit(f"{stamp} {event.thing:<10} {event.event:<10} {' '.join(details)}{command}")
+    return " ".join(details)

@@ -126,8 +126,13 @@ class Dispatcher:
         publish: Publish,
         clock: Callable[[], datetime] = lambda: datetime.now(UTC),
         path_length: PathLength = straight_line,
+        on_given_up: Callable[[Task], None] | None = None,
     ) -> None:
+        """`on_given_up` is told each task the fleet gives up without being asked (its
+        robot was sent elsewhere by name), so that it is announced: no task leaves the
+        fleet's hands without a word."""
         self.fleet = fleet
+        self.on_given_up = on_given_up
         self.store = store
         self.candidates = candidates
         self.publish = publish
@@ -192,7 +197,9 @@ class Dispatcher:
                 # The robot took our command and now reports another: someone gave it a
                 # command by name, which preempted the task. (Before the acknowledgment, an
                 # older command's update may still be on its way: that is no preemption.)
-                self.store.finish(held.id, outcome="preempted")
+                given_up = self.store.finish(held.id, outcome="preempted")
+                if given_up is not None and self.on_given_up is not None:
+                    self.on_given_up(given_up)
             else:
                 return None
             self._acknowledged.discard(held.id)

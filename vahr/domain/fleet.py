@@ -318,17 +318,49 @@ def spoken_in(entry: Robot | Zone | Group, locale: str = SPOKEN_LOCALE) -> list[
 
 
 def zone_phrase(zone: Zone) -> str:
-    """The zone's name as it reads inside a sentence, in en-US: "zone A", "the loading
-    zone" (its first name with "zone" in it, "the ..." preferred; single letters capitals,
-    as they are spoken as letters)."""
+    """The zone's name as it reads inside a sentence, in en-US: its first spoken name as
+    the fleet file writes it ("ward three", "the pharmacy", "zone A"), with "the" before it
+    when the file also lists it so ("loading zone" is "the loading zone" when the file
+    writes both). Single letters are capitals, as they are spoken as letters; a name that
+    is a letter alone is "zone X", since a letter cannot stand in a sentence."""
     names = [normalize(name) for name in zone.spoken]
-    with_zone = [name for name in names if "zone" in name.split()]
-    preferred = [name for name in with_zone if name.startswith("the ")] or with_zone
-    if preferred:
-        return _upper_letters(preferred[0])
-    if len(zone.id) <= 2:
-        return f"zone {zone.id}"
-    return _upper_letters(names[0] if names[0].startswith("the ") else f"the {names[0]}")
+    first = names[0]
+    if len(first) == 1:
+        return f"zone {first.upper()}"
+    if not first.startswith("the ") and f"the {first}" in names:
+        first = f"the {first}"
+    return _upper_letters(first)
+
+
+def zone_name_in(zone: Zone, locale: str = SPOKEN_LOCALE) -> str:
+    """The zone's name inside a sentence in `locale`: `zone_phrase` in en-US; in another
+    language its first name there, each word capitalised as written nouns are ("zone a" is
+    "Zone A", "ladezone" "Ladezone"): its sentences are built to need no article."""
+    if locale == SPOKEN_LOCALE:
+        return zone_phrase(zone)
+    names = spoken_in(zone, locale)
+    return " ".join(
+        word.upper() if len(word) == 1 else word.capitalize() for word in names[0].split()
+    )
+
+
+def reason_said(reason: str, zone_id: str | None, zone_name: str) -> str:
+    """A robot's reason with the zone it names by id (`zone_id`, the zone its command was
+    for: `LastCommand.zone`, an event's `zone`) said by `zone_name`: "goal to PHARMACY
+    aborted" is "goal to the pharmacy aborted". Only that id, as a whole word, is replaced,
+    and not where the name is said already ("no path to zone A" stays as it is)."""
+    if not zone_id:
+        return reason
+    ends_with_id = zone_name.lower().endswith(zone_id.lower())
+    lead = zone_name[: len(zone_name) - len(zone_id)].lower() if ends_with_id else None
+
+    def said(match: re.Match[str]) -> str:
+        if lead and reason[: match.start()].lower().endswith(lead):
+            return match.group(0)
+        return zone_name
+
+    word = rf"(?<![A-Za-z0-9_]){re.escape(zone_id)}(?![A-Za-z0-9_])"
+    return re.sub(word, said, reason)
 
 
 def _upper_letters(name: str) -> str:

@@ -87,6 +87,13 @@ class Language(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     weather: WeatherWords
     speech: Speech
     invocation: Invocation
+    # A first command in this language, with the fleet's names filled in (`vahr up`'s
+    # banner suggests it): "send {robot} to {zone}".
+    example_command: str = "send {robot} to {zone}"
+    # What people call the whole fleet when the fleet file gives no group `all`.
+    fleet_names: list[str] = msgspec.field(
+        default_factory=lambda: ["all robots", "every robot", "everyone"]
+    )
 
     def weather_words(self) -> dict[str, tuple[str, ...]]:
         """Every word that names each weather: the sampled words, then the heard ones."""

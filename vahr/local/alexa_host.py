@@ -1,6 +1,13 @@
 """The Alexa simulator served on the local stack: `POST /vahr/say` on the data plane runs
 an utterance through the simulated Echo and the skill in-process, and every exchange is
-published on `topics.ASSISTANT_TURNS` for the operator station's conversation."""
+published on `topics.ASSISTANT_TURNS` for the operator station's conversation.
+
+A say request may carry `timeout_s`, how long its asker waits for the answer (`vahr say`
+sends it). The turn waits for the system to be ready (`Readiness`) only as long as it can
+still finish in that time; a turn that cannot start is refused with 503 and does nothing,
+and a command it would publish after the asker stopped waiting is refused at the data
+plane (`vahr.assistant.deadline`). So a reply that says a request failed is never followed
+by a robot carrying it out."""
 
 from __future__ import annotations
 
@@ -10,14 +17,20 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
+from vahr.assistant.deadline import TurnDeadline, TurnNotStarted
 from vahr.protocol import ProtocolError, topics
 from vahr.protocol.station_topics import ORIGIN_PATTERN, Heard
+from vahr.twin.dataplane import ApiError
 
 if TYPE_CHECKING:
     from pathlib import Path
 
     from vahr.assistant.simulator import AlexaSimulator, Turn
+    from vahr.local.readiness import Readiness
     from vahr.twin.stack import LocalStack
+
+# How long a say request that gives no `timeout_s` waits for the system to be ready.
+DEFAULT_START_WAIT_S = 30.0
 
 
 def serve_alexa(
@@ -28,9 +41,11 @@ def serve_alexa(
     fleet_file: Path | None = None,
     log_level: str = "WARNING",
     locale: str = "en-US",
+    readiness: Readiness | None = None,
 ) -> AlexaSimulator:
     """Serve the Alexa simulator (and the skill, in-process) at `POST /vahr/say`, in
-    `locale`: its understanding data, and the locale of every request it sends."""
+    `locale`: its understanding data, and the locale of every request it sends. A say
+    request waits for `readiness` (every robot online, the language model built)."""
     # The NLU's libraries load here, not when `vahr.local` is imported.
     from vahr.assistant.commands_seen import CommandLog
     from vahr.assistant.envelope import Identity
@@ -73,6 +88,15 @@ def serve_alexa(
         locale=locale,
     )
 
+    def gate(topic: str, payload: bytes) -> None:
+        # Before the command log: a refused command is no command of the turn.
+        if not simulator.may_publish() and _is_command(topic):
+            raise ApiError(
+                504, "the person who asked stopped waiting for the answer; the command is not sent"
+            )
+
+    dataplane.publish_starters.insert(0, gate)
+
     def say(request: dict[str, Any]) -> tuple[int, dict[str, Any]]:
         utterance = request.get("utterance")
         if request.get("end_session"):
@@ -86,12 +110,38 @@ def serve_alexa(
             return 400, {"code": 400, "message": message}
         try:
             origin, heard = _speaker(request)
+            deadline = _deadline(request)
         except ProtocolError as err:
             return 400, {"code": 400, "message": str(err)}
-        return 200, simulator.say(utterance, origin=origin, heard=heard).to_json()
+        if readiness is not None:
+            waiting = deadline.start_left() if deadline else DEFAULT_START_WAIT_S
+            if not readiness.wait(max(0.0, waiting)):
+                what = "; ".join(readiness.awaiting())
+                message = f"vahr up is still starting (waiting for {what}); nothing was sent"
+                return 503, {"code": 503, "message": message}
+        try:
+            turn = simulator.say(utterance, origin=origin, heard=heard, deadline=deadline)
+        except TurnNotStarted as err:
+            return 503, {"code": 503, "message": str(err)}
+        return 200, turn.to_json()
 
     dataplane.local_routes[("POST", "/vahr/say")] = say
     return simulator
+
+
+def _deadline(request: dict[str, Any]) -> TurnDeadline | None:
+    """The turn's deadline from the request's `timeout_s` (None when it gives none)."""
+    timeout = request.get("timeout_s")
+    if timeout is None:
+        return None
+    if isinstance(timeout, bool) or not isinstance(timeout, int | float) or not timeout > 0:
+        raise ProtocolError("timeout_s", "must be a number of seconds more than 0")
+    return TurnDeadline.within(float(timeout))
+
+
+def _is_command(topic: str) -> bool:
+    parsed = topics.parse_robot_topic(topic)
+    return topic == topics.FLEET_CMD or (parsed is not None and parsed[1] == "cmd")
 
 
 def _speaker(request: dict[str, Any]) -> tuple[str, dict[str, Any] | None]:

@@ -52,9 +52,11 @@ class Announcer:
         *,
         clock: Callable[[], datetime] = utc_now,
         publish: Callable[[Announcement], None] | None = None,
+        locale: str = "en-US",
     ) -> None:
+        """Announcements are said in `locale`, the language people speak to the assistant."""
         self.settings = settings or AnnounceSettings()
-        self._policy = AnnouncePolicy(self.settings, Names.of(fleet), clock)
+        self._policy = AnnouncePolicy(self.settings, Names.of(fleet, locale), clock)
         self._history: deque[Announcement] = deque(maxlen=self.settings.history)
         self._listeners: list[Callable[[Announcement], None]] = []
         self._publish = publish
@@ -154,9 +156,10 @@ class LocalAnnouncer:
         settings: AnnounceSettings | None = None,
         *,
         tick_s: float = TICK_S,
+        locale: str = "en-US",
     ) -> None:
         self._client = MqttClient(endpoint, client_id=identities.ANNOUNCER)
-        self.announcer = Announcer(fleet, settings, publish=self._publish)
+        self.announcer = Announcer(fleet, settings, publish=self._publish, locale=locale)
         self._tick_s = tick_s
         self._stopping = threading.Event()
         self._ticker: threading.Thread | None = None

@@ -38,8 +38,10 @@ from vahr.protocol.errors import from_validation_error
 from vahr.twin import identities
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from pathlib import Path
 
+    from vahr.dispatch import Task
     from vahr.domain import Fleet
     from vahr.plumbing.mqtt import MqttEndpoint
     from vahr.protocol import Command
@@ -164,13 +166,24 @@ class LocalDispatcher:
     worker thread that hands robots' updates to the core. A context manager."""
 
     def __init__(
-        self, *, fleet: Fleet, index: FleetIndex, endpoint: MqttEndpoint, state_dir: Path
+        self,
+        *,
+        fleet: Fleet,
+        index: FleetIndex,
+        endpoint: MqttEndpoint,
+        state_dir: Path,
+        on_given_up: Callable[[Task], None] | None = None,
     ) -> None:
+        """`on_given_up`: told each task given up because its robot was sent elsewhere."""
         self.tasks = SqliteTaskStore.in_state_dir(state_dir)
         self.candidates = IndexCandidates(index, fleet)
         self._client = MqttClient(endpoint, client_id=identities.DISPATCHER)
         self.dispatcher = Dispatcher(
-            fleet=fleet, store=self.tasks, candidates=self.candidates, publish=self._publish
+            fleet=fleet,
+            store=self.tasks,
+            candidates=self.candidates,
+            publish=self._publish,
+            on_given_up=on_given_up,
         )
         self.api = TasksApi(self.dispatcher)
         self._updates: queue.SimpleQueue[str | None] = queue.SimpleQueue()

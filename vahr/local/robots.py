@@ -64,14 +64,15 @@ def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
             )
         )
     things = [robot.thing for robot in robots]
+    # Each group keeps its names in every language; only its members change.
     groups = [
-        Group(id=group.id, spoken=group.spoken, robots=[t for t in group.robots if t in things])
+        msgspec.structs.replace(group, robots=[t for t in group.robots if t in things])
         for group in base.groups
     ]
     if not any(group.id == FLEET_GROUP for group in groups):
         groups.append(Group(id=FLEET_GROUP, spoken=["all robots"], robots=things))
     groups = [
-        Group(id=g.id, spoken=g.spoken, robots=things if g.id == FLEET_GROUP else g.robots)
+        msgspec.structs.replace(g, robots=things) if g.id == FLEET_GROUP else g
         for g in groups
         if g.robots or g.id == FLEET_GROUP
     ]

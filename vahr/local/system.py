@@ -23,12 +23,14 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import msgspec
 
+from vahr.announce import TaskCancelled
 from vahr.assistant import SimulatorAssistant
 from vahr.domain.fleet import SPOKEN_LOCALE
 from vahr.errors import VahrError
 from vahr.local.alexa_host import serve_alexa
 from vahr.local.announce_host import LocalAnnouncer
 from vahr.local.dispatch_host import TASKS_PATH, LocalDispatcher
+from vahr.local.readiness import Readiness
 from vahr.local.robots import (
     ProgressRate,
     RobotProcesses,
@@ -39,7 +41,7 @@ from vahr.local.robots import (
 )
 from vahr.plumbing.mqtt import MqttClient
 from vahr.plumbing.ports import ensure_free
-from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
+from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics, utc_now
 from vahr.skill_model.generator import build_interaction_model, build_locale_model, render
 from vahr.twin import identities
 from vahr.twin.shadow_store import ShadowError
@@ -49,13 +51,22 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
+    from vahr.assistant.nlu import InteractionModel
     from vahr.assistant.simulator import AlexaSimulator
+    from vahr.dispatch import Task
     from vahr.domain import Fleet
     from vahr.plumbing.client import Assistant
 
 log = logging.getLogger(__name__)
 
 ROOM_VOICE = "robot_agent.voice.factories:room"
+# How long a start waits for the robots and the assistant before it gives up: a first
+# start on a busy 2-core machine (every model learnt, nothing cached yet) took minutes.
+READY_TIMEOUT_S = 300.0
+# While waiting to be ready, what is awaited is told this often (seconds).
+WAIT_NOTICE_S = 10.0
+# Robots named in what the system waits for; the rest are counted.
+AWAITED_NAMED = 6
 # A part that dies more often than this is not restarted again: `vahr up` stops and says why.
 RESTART_LIMIT = 5
 RESTART_WINDOW_S = 60.0
@@ -111,6 +122,7 @@ class StartStation(Protocol):
         assistant: Assistant,
         read_shadow: Callable[[str], bytes | None],
         tasks_url: str | None = None,
+        locale: str = "en-US",
     ) -> ServedStation: ...
 
 
@@ -136,6 +148,7 @@ class LocalSystem:
             self.fleet: Fleet = generated_fleet(config.swarm, config.fleet)
         else:
             self.fleet = fleet_of(config.robots, config.fleet)
+        self.readiness = Readiness(self._awaiting)
         self.stack = LocalStack(
             StackConfig(
                 state_dir=config.state_dir,
@@ -143,7 +156,8 @@ class LocalSystem:
                 mqtt_port=config.mqtt_port,
                 api_port=config.api_port,
                 api_hosts=config.api_hosts,
-            )
+            ),
+            awaiting=self.readiness.awaiting,
         )
         self.robots: RobotProcesses | SwarmProcess | None = None
         self.alexa: AlexaSimulator | None = None
@@ -157,6 +171,7 @@ class LocalSystem:
         self._online: dict[str, bool] = {}
         self._changed = threading.Condition()
         self._restarts: dict[str, deque[float]] = {}
+        self._room_model: InteractionModel | None = None
 
     @property
     def voice_enabled(self) -> bool:
@@ -202,6 +217,7 @@ class LocalSystem:
                 fleet_file=fleet_file,
                 log_level=cfg.log_level,
                 locale=cfg.locale,
+                readiness=self.readiness,
             )
             assert self.stack.dataplane is not None and self.stack.ca is not None
             self.stack.dataplane.local_routes[("GET", "/vahr/status")] = self._status
@@ -252,7 +268,7 @@ class LocalSystem:
         dataplane = self.stack.dataplane
         assert dataplane is not None and self._watcher is not None
         self.announcer = LocalAnnouncer(
-            self.stack.service_endpoint(identities.ANNOUNCER), self.fleet
+            self.stack.service_endpoint(identities.ANNOUNCER), self.fleet, locale=self.config.locale
         ).start()
         dataplane.local_routes[("GET", "/vahr/announcements")] = self.announcer.announcer.route
         dataplane.local_routes[("POST", "/vahr/fault")] = FaultInjector(
@@ -266,11 +282,21 @@ class LocalSystem:
         first shadow updates already reach it."""
         dataplane, store = self.stack.dataplane, self.stack.store
         assert dataplane is not None and store is not None
+        announcer = self.announcer.announcer if self.announcer is not None else None
+
+        def given_up(task: Task) -> None:
+            # A task whose robot was sent elsewhere by name is told, not dropped silently.
+            if announcer is not None and task.thing is not None:
+                announcer.observe(
+                    [TaskCancelled(task.id, task.thing, task.kind, task.zone, utc_now())]
+                )
+
         self.dispatcher = LocalDispatcher(
             fleet=self.fleet,
             index=store.index,
             endpoint=self.stack.service_endpoint(identities.DISPATCHER),
             state_dir=self.config.state_dir,
+            on_given_up=given_up,
         ).start()
         dataplane.typed_routes[TASKS_PATH] = self.dispatcher.api.respond
 
@@ -285,6 +311,7 @@ class LocalSystem:
         if self.config.locale != SPOKEN_LOCALE:
             # Robots ask in English whatever the people speak: the room's Echo is English.
             model = InteractionModel(build_interaction_model(self.fleet), background=True)
+            self._room_model = model
         from vahr.assistant.envelope import Identity
 
         # Another Echo (its own user and device) of the same skill.
@@ -318,6 +345,7 @@ class LocalSystem:
             assistant=SimulatorAssistant(self.alexa),
             read_shadow=self._stored_shadow,
             tasks_url=self.stack.api_url + TASKS_PATH if self.dispatcher is not None else None,
+            locale=self.config.locale,
         )
         self.stack.dataplane.redirects["/vahr/dashboard"] = self.station.url
 
@@ -336,14 +364,7 @@ class LocalSystem:
                 missing = [t for t in self.fleet.robot_things if not self._online.get(t)]
                 if not missing:
                     return
-                exited = self.robots.exited() if self.robots else {}
-                # A robot's own process, or the swarm's, which runs every robot.
-                for thing in [*missing, SwarmProcess.SWARM]:
-                    if thing in exited and self.robots is not None:
-                        raise VahrError(
-                            f"robot {thing} exited with code {exited[thing]}: "
-                            f"{self.robots.last_log_line(thing)}"
-                        )
+                self._check_exits(missing)
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     raise VahrError(
@@ -351,6 +372,70 @@ class LocalSystem:
                         f"(logs in {self.config.state_dir / 'robots'})"
                     )
                 self._changed.wait(min(remaining, 0.5))
+
+    def wait_ready(
+        self,
+        timeout_s: float = READY_TIMEOUT_S,
+        *,
+        on_wait: Callable[[list[str]], None] | None = None,
+    ) -> None:
+        """Block until the system can take a command (every robot online, the assistant
+        able to answer), or raise VahrError naming what it still waited for. `on_wait` is
+        told what is awaited every `WAIT_NOTICE_S` seconds while waiting."""
+        deadline = time.monotonic() + timeout_s
+        notice = time.monotonic() + WAIT_NOTICE_S
+        while True:
+            if self.readiness.wait(min(max(0.0, deadline - time.monotonic()), 0.5)):
+                log.info(
+                    "ready: %s robots online, the assistant answers",
+                    f"{len(self.fleet.robot_things):,}",
+                )
+                return
+            # A robot that exits, or a model that failed, is said at once.
+            with self._changed:
+                self._check_exits([t for t in self.fleet.robot_things if not self._online.get(t)])
+            self._check_models()
+            if time.monotonic() >= deadline:
+                raise VahrError(
+                    f"not ready within {timeout_s:.0f} s: still waiting for "
+                    f"{'; '.join(self.readiness.awaiting())} (logs in {self.config.state_dir})"
+                )
+            if on_wait is not None and time.monotonic() >= notice:
+                on_wait(self.readiness.awaiting())
+                notice = time.monotonic() + WAIT_NOTICE_S
+
+    def _check_exits(self, missing: list[str]) -> None:
+        """Raise VahrError naming a robot of `missing` whose process exited (or the swarm's,
+        which runs every robot), with its last log line."""
+        exited = self.robots.exited() if self.robots else {}
+        for thing in [*missing, SwarmProcess.SWARM]:
+            if thing in exited and self.robots is not None:
+                raise VahrError(
+                    f"robot {thing} exited with code {exited[thing]}: "
+                    f"{self.robots.last_log_line(thing)}"
+                )
+
+    def _awaiting(self) -> list[str]:
+        """What the system still waits for before it can take a command, in words."""
+        awaiting = []
+        with self._changed:
+            offline = [t for t in self.fleet.robot_things if not self._online.get(t)]
+        if offline:
+            named = ", ".join(offline[:AWAITED_NAMED])
+            more = len(offline) - AWAITED_NAMED
+            awaiting.append(
+                f"robots to come online: {named}" + (f" and {more:,} more" if more > 0 else "")
+            )
+        models = [self.alexa.model if self.alexa is not None else None, self._room_model]
+        if self.alexa is None or any(m is not None and not m.ready for m in models):
+            awaiting.append("the assistant to learn the fleet's names")
+        return awaiting
+
+    def _check_models(self) -> None:
+        """Raise VahrError when a language model failed to build (it will never be ready)."""
+        for model in (self.alexa.model if self.alexa else None, self._room_model):
+            if model is not None and model.ready:
+                model.wait_ready(0)
 
     def supervise(self) -> list[str]:
         """Restart the broker or a robot whose process died; one line for each restart.

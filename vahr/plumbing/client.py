@@ -29,12 +29,20 @@ from vahr.errors import VahrError
 
 DEFAULT_API = "http://127.0.0.1:8180"
 TIMEOUT_S = 15.0  # more than Alexa's 8 s, so the skill's own timeout is what shows
+# How long `vahr say` waits for its answer. It tells the stack (`timeout_s`), which starts
+# the turn only while it can still answer in time and sends no command after it: a say
+# that fails here is never carried out later (vahr.assistant.deadline).
+SAY_TIMEOUT_S = 30.0
 SAY_PATH = "/vahr/say"
 
 # One exchange as `vahr say --json` prints it ("speech", "intent", "slots", "commands",
 # "latency_ms", "session_open", "request_type", "reprompt", "origin", "heard"), with the
 # "utterance" said.
 Turn = dict[str, Any]
+
+
+class NoAnswerInTime(VahrError):
+    """The server took the request and gave no answer within the caller's timeout."""
 
 
 def default_api() -> str:
@@ -68,6 +76,11 @@ def call(
         raise VahrError(f"{api} answered {err.code}: {message}") from err
     except (urllib.error.URLError, TimeoutError, ConnectionError) as err:
         reason = getattr(err, "reason", err)
+        if isinstance(reason, TimeoutError):
+            # The server took the request but did not answer in time: it is there.
+            raise NoAnswerInTime(
+                f"{api} did not answer {method} {path} within {timeout_s:g} s"
+            ) from err
         raise VahrError(
             f"nothing answers at {api} ({reason}); start the system with `vahr up`"
         ) from err
@@ -79,13 +92,26 @@ def say(api: str, utterance: str, locale: str | None = None) -> dict[str, Any]:
     """The turn's JSON, with `latency_ms` measured here: utterance in to reply out.
     `locale` is the language spoken; the system refuses one it was not started in."""
     started = time.perf_counter()
-    body = (
-        {"utterance": utterance} if locale is None else {"utterance": utterance, "locale": locale}
-    )
-    turn = call(api, "POST", SAY_PATH, body)
+    body: dict[str, Any] = {"utterance": utterance, "timeout_s": SAY_TIMEOUT_S}
+    if locale is not None:
+        body["locale"] = locale
+    turn = _say_call(api, body, SAY_TIMEOUT_S)
     turn["skill_ms"] = turn.get("latency_ms")
     turn["latency_ms"] = round((time.perf_counter() - started) * 1000, 1)
     return turn
+
+
+def _say_call(api: str, body: dict[str, Any], timeout_s: float) -> dict[str, Any]:
+    """`POST /vahr/say` waiting `timeout_s` (which the body tells the stack). A stack that
+    did not answer in time sends no command of this request after it, and the error says
+    so."""
+    try:
+        return call(api, "POST", SAY_PATH, body, timeout_s=timeout_s)
+    except NoAnswerInTime as err:
+        raise NoAnswerInTime(
+            f"{api} gave no answer within {timeout_s:g} s, so it sends no command for this "
+            "request from now on; ask where the robots are before you say it again"
+        ) from err
 
 
 class Assistant(Protocol):
@@ -100,17 +126,21 @@ class Assistant(Protocol):
 class HttpAssistant:
     """A running local stack's `POST /vahr/say` (`vahr up`'s `api` URL)."""
 
-    def __init__(self, api_url: str, timeout_s: float = TIMEOUT_S) -> None:
+    def __init__(self, api_url: str, timeout_s: float = SAY_TIMEOUT_S) -> None:
         self.api_url = api_url
         self.timeout_s = timeout_s
 
     def ask(
         self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
     ) -> Turn:
-        body: dict[str, Any] = {"utterance": utterance, "origin": origin}
+        body: dict[str, Any] = {
+            "utterance": utterance,
+            "origin": origin,
+            "timeout_s": self.timeout_s,
+        }
         if heard is not None:
             body["heard"] = heard
-        turn = call(self.api_url, "POST", SAY_PATH, body, timeout_s=self.timeout_s)
+        turn = _say_call(self.api_url, body, self.timeout_s)
         return _with_utterance(turn, utterance, f"{self.api_url}{SAY_PATH}")
 
 
@@ -118,7 +148,7 @@ class SayCommandAssistant:
     """`vahr say --json` against the local stack's API (`origin` and `heard` are not passed
     on: the command speaks as "say")."""
 
-    def __init__(self, api_url: str | None, timeout_s: float = TIMEOUT_S) -> None:
+    def __init__(self, api_url: str | None, timeout_s: float = SAY_TIMEOUT_S + 10.0) -> None:
         self.api_url = api_url
         self.timeout_s = timeout_s
 

@@ -15,8 +15,15 @@ import msgspec
 from vahr.protocol.errors import from_validation_error
 from vahr.protocol.messages import Timestamp, check_payload
 
-AnnouncementKind = Literal["stuck", "failed", "offline", "waiting", "done"]
-ANNOUNCEMENT_KINDS: tuple[AnnouncementKind, ...] = ("stuck", "failed", "offline", "waiting", "done")
+AnnouncementKind = Literal["stuck", "failed", "offline", "waiting", "cancelled", "done"]
+ANNOUNCEMENT_KINDS: tuple[AnnouncementKind, ...] = (
+    "stuck",
+    "failed",
+    "offline",
+    "waiting",
+    "cancelled",
+    "done",
+)
 # Alexa's referenceId allows letters, digits and '~', 1 to 100 characters.
 ReferenceId = Annotated[str, msgspec.Meta(pattern=r"^[A-Za-z0-9~]{1,100}$")]
 

@@ -29,13 +29,20 @@ class Battery(msgspec.Struct, frozen=True):
     charging: bool = False
 
 
-class LastCommand(msgspec.Struct, frozen=True, omit_defaults=True):
-    """The last command a robot saw and what became of it. `id` is what the skill waits for."""
+class LastCommand(msgspec.Struct, frozen=True):
+    """The last command a robot saw and what became of it. `id` is what the skill waits for.
+
+    Every field is sent, `null` included: a shadow update merges objects key by key, so a
+    reason left out would keep the reason of an earlier command (null deletes it). `zone`
+    is the zone the command was for; its `reason` names that zone by this id, which speech
+    and the station replace with the zone's spoken name (`vahr.domain.fleet.reason_said`).
+    """
 
     id: str
     action: str
     result: Result
     reason: str | None = None
+    zone: str | None = None
 
 
 class Reported(msgspec.Struct, frozen=True):

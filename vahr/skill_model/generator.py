@@ -15,7 +15,7 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from vahr.domain import FLEET_GROUP, FLEET_GROUP_NAMES
+from vahr.domain import FLEET_GROUP, FLEET_GROUP_NAMES, Group
 from vahr.domain.fleet import spoken_in
 from vahr.domain.invocation import INVOCATION_NAME
 from vahr.domain.locale import load_language
@@ -356,11 +356,16 @@ def in_locale(fleet: Fleet, locale: str) -> Fleet:
     (its `spoken_by_locale` names, else the en-US ones)."""
     import msgspec
 
+    groups = [msgspec.structs.replace(g, spoken=spoken_in(g, locale)) for g in fleet.groups]
+    if not any(group.id == FLEET_GROUP_ID for group in groups):
+        # The whole fleet by the language's own words, not English ones.
+        names = load_language(locale).fleet_names
+        groups.append(Group(id=FLEET_GROUP_ID, spoken=names, robots=list(fleet.robot_things)))
     return msgspec.structs.replace(
         fleet,
         robots=[msgspec.structs.replace(r, spoken=spoken_in(r, locale)) for r in fleet.robots],
         zones=[msgspec.structs.replace(z, spoken=spoken_in(z, locale)) for z in fleet.zones],
-        groups=[msgspec.structs.replace(g, spoken=spoken_in(g, locale)) for g in fleet.groups],
+        groups=groups,
     )
 
 

@@ -11,6 +11,7 @@ scikit-learn takes 2-3 s to import on the lab machine, more than a start-up may 
 fitted model is exported as plain numbers (vocabulary, idf, weights, intercepts, inverse
 temperature) and cached on disk as JSON under a hash of the training data and the recipe;
 answering needs only this module, and scikit-learn is imported only when the cache is cold.
+Processes that want the same model at once train it once (`training_lock`).
 The Alexa simulator's intent classifier (`vahr.assistant.intent_classifier`) and the
 robot's sense check of what it heard (`robot_agent.voice.sense`) are both this.
 `tests/unit/local/test_intent_classifier.py` (many classes) and `tests/unit/voice/
@@ -19,6 +20,8 @@ test_sense.py` (two) hold the export to scikit-learn's own probabilities.
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import hashlib
 import json
 import math
@@ -29,7 +32,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Iterator
 
     Analyzer = Callable[[str], list[str]]
 
@@ -148,16 +151,18 @@ def load_or_train(
     is skipped."""
     key = training_key(recipe, texts, labels)
     file = (cache_dir / f"{name}-{key[:24]}.json") if cache_dir else None
-    if file is not None:
-        try:
-            exported = json.loads(file.read_text(encoding="utf-8"))
-            if exported.get("key") == key:
-                return TextClassifier(exported, analyzer), True
-        except (OSError, ValueError):
-            pass
-    exported = export(fit(texts, labels, analyzer))
-    exported["key"] = key
-    if file is not None:
+    if file is None:
+        return TextClassifier(_trained(texts, labels, analyzer, key), analyzer), False
+    cached = _cached(file, key)
+    if cached is not None:
+        return TextClassifier(cached, analyzer), True
+    # Processes that want the same model at once (the robots of `vahr up` on a first start)
+    # train it once: the first holds the lock while it trains, the others then read it.
+    with training_lock(file):
+        cached = _cached(file, key)
+        if cached is not None:
+            return TextClassifier(cached, analyzer), True
+        exported = _trained(texts, labels, analyzer, key)
         try:
             file.parent.mkdir(parents=True, exist_ok=True)
             partial = file.with_suffix(f".{os.getpid()}.tmp")
@@ -166,6 +171,38 @@ def load_or_train(
         except OSError:
             pass
     return TextClassifier(exported, analyzer), False
+
+
+def _cached(file: Path, key: str) -> dict[str, Any] | None:
+    try:
+        exported: dict[str, Any] = json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return exported if exported.get("key") == key else None
+
+
+def _trained(texts: list[str], labels: list[str], analyzer: Analyzer, key: str) -> dict[str, Any]:
+    exported = export(fit(texts, labels, analyzer))
+    exported["key"] = key
+    return exported
+
+
+@contextlib.contextmanager
+def training_lock(file: Path) -> Iterator[None]:
+    """Hold an exclusive lock for `file`'s training across processes (a lock file beside
+    it); without a writable cache directory, no lock (each process trains its own)."""
+    try:
+        file.parent.mkdir(parents=True, exist_ok=True)
+        handle = file.with_suffix(".lock").open("a")
+    except OSError:
+        yield
+        return
+    with handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def fit(texts: list[str], labels: list[str], analyzer: Analyzer) -> Any:

@@ -55,6 +55,9 @@ class StationConfig:
     # HTTPS served here, or the HTTPS address of a reverse proxy in front (server.py).
     tls: ServerTls | None = None
     public_origin: str | None = None
+    # The language people speak to the assistant (`vahr up --locale`): the page's words and
+    # the robots' and zones' names default to it.
+    locale: str = "en-US"
 
 
 class Station:
@@ -74,7 +77,7 @@ class Station:
         self.config = config
         self.fleet = fleet
         self.link = link
-        self.feed = feed or Feed(fleet)
+        self.feed = feed or Feed(fleet, locale=config.locale)
         self._read_shadow = read_shadow
         self._turns = turns
         self.desk = Desk(self.feed, self._publish)
@@ -95,6 +98,7 @@ class Station:
             token=config.token,
             tls=config.tls,
             public_origin=config.public_origin,
+            locale=config.locale,
         )
         self.tasks = TaskPoller(config.tasks_url, self.feed) if config.tasks_url else None
 

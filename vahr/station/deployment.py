@@ -121,11 +121,13 @@ def on_local_system(
     assistant: Assistant,
     read_shadow: Callable[[str], bytes | None],
     tasks_url: str | None = None,
+    locale: str = "en-US",
 ) -> Station:
     """`vahr up`'s station, started: on the stack's broker, the simulator in-process, shadows
-    read from the store, every turn seen on the broker, the task queue from `tasks_url`."""
+    read from the store, every turn seen on the broker, the task queue from `tasks_url`, its
+    words and names in the stack's `locale`."""
     return Station(
-        StationConfig(port=port, tasks_url=tasks_url),
+        StationConfig(port=port, tasks_url=tasks_url, locale=locale),
         fleet,
         link=link,
         assistant=assistant,

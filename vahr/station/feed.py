@@ -52,6 +52,7 @@ from typing import TYPE_CHECKING, Any
 import msgspec
 
 from vahr.domain import FLEET_GROUP
+from vahr.domain.fleet import SPOKEN_LOCALE, spoken_in, zone_name_in
 from vahr.protocol import ProtocolError, decode_command, decode_event, decode_presence, topics
 from vahr.protocol.announcements import Announcement, decode_announcement
 from vahr.protocol.station_topics import (
@@ -193,18 +194,28 @@ class Subscriber:
             self._ready.notify()
 
 
-def fleet_view(fleet: Fleet) -> FleetView:
-    """The fleet as the page draws it: robots with their keys, zones with theirs, the floor."""
-    zone_keys: dict[str, str] = {}
+def zone_keys(fleet: Fleet, locale: str = SPOKEN_LOCALE) -> dict[str, str]:
+    """A key for each zone, a letter no other zone has: the first of its id's letters that
+    is free, else of its name's ("LOADING" L, "LAB" A when L is taken). A zone left without
+    one (every letter taken) is clicked."""
+    keys: dict[str, str] = {}
     for zone in fleet.zones:
-        key = zone.id[0]
-        if key not in zone_keys.values():
-            zone_keys[zone.id] = key
+        letters = [c for c in zone.id + zone_name_in(zone, locale).upper() if "A" <= c <= "Z"]
+        key = next((c for c in letters if c not in keys.values()), None)
+        if key is not None:
+            keys[zone.id] = key
+    return keys
+
+
+def fleet_view(fleet: Fleet, locale: str = SPOKEN_LOCALE) -> FleetView:
+    """The fleet as the page draws it: robots with their keys, zones with theirs, the floor;
+    names in `locale`, as the assistant says them."""
+    keys = zone_keys(fleet, locale)
     return FleetView(
         robots=[
             RobotEntry(
                 thing=robot.thing,
-                name=robot.spoken[0],
+                name=spoken_in(robot, locale)[0],
                 key=str(index + 1) if index < 9 else None,
                 start=robot.start,
             )
@@ -213,11 +224,11 @@ def fleet_view(fleet: Fleet) -> FleetView:
         zones=[
             ZoneEntry(
                 id=zone.id,
-                name=zone.spoken[0],
+                name=zone_name_in(zone, locale),
                 pose=zone.pose,
                 radius=zone.radius,
                 arm=zone.arm,
-                key=zone_keys.get(zone.id),
+                key=keys.get(zone.id),
             )
             for zone in fleet.zones
         ],
@@ -229,9 +240,11 @@ def fleet_view(fleet: Fleet) -> FleetView:
 class Feed:
     """The station's view of the fleet, the conversation and the experiment."""
 
-    def __init__(self, fleet: Fleet, *, clock: Callable[[], float] = now_ms) -> None:
+    def __init__(
+        self, fleet: Fleet, *, clock: Callable[[], float] = now_ms, locale: str = SPOKEN_LOCALE
+    ) -> None:
         self.fleet = fleet
-        self.view = fleet_view(fleet)
+        self.view = fleet_view(fleet, locale)
         self._clock = clock
         self._things = frozenset(fleet.robot_things)
         self._lock = threading.Lock()

@@ -224,7 +224,13 @@ class _Handler(QuietHandler):
                 {"Set-Cookie": station.cookie(), "Location": path + (f"?{rest}" if rest else "")},
             )
             return
-        self._send(station.file("index.html"))
+        page = station.file("index.html")
+        # The page shows itself in the language people speak to the assistant unless its
+        # reader chose another (static/i18n.js reads `data-locale`).
+        body = page.body.replace(
+            b'<html lang="en">', f'<html lang="en" data-locale="{station.locale}">'.encode(), 1
+        )
+        self._send(Reply(page.status, body, page.content_type))
 
     def _favicon(self, path: str, query: dict[str, str]) -> None:
         self._send(self.server.station.file("favicon.svg"))
@@ -316,10 +322,12 @@ class StationServer:
         tls: ServerTls | None = None,
         public_origin: str | None = None,
         idle_timeout_s: float = IDLE_TIMEOUT_S,
+        locale: str = "en-US",
     ) -> None:
         self.app = app
         self.host = host
         self.tls = tls
+        self.locale = locale
         # Where people open the page when a reverse proxy stands in front (its scheme, name
         # and port): its requests' Origin is this one.
         self.public_origin = public_origin.rstrip("/") if public_origin else None

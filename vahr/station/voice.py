@@ -1,7 +1,8 @@
 """Push-to-talk: a WAV clip from the page in; what was heard and what the assistant answered out.
 
 The page records while the button (or the space bar) is held and uploads 16 kHz mono
-16-bit WAV. The clip is checked (a WAV, at most `MAX_CLIP_S` long) and transcribed offline
+16-bit WAV; any other PCM WAV (a file a person recorded, espeak-ng's 22,050 Hz) is converted
+once. The clip is checked (a WAV, at most `MAX_CLIP_S` long) and transcribed offline
 by a recognizer whose vocabulary comes from the skill's interaction model
 (`vocabulary.py`). Its N best transcripts are each understood by the simulator's NLU and
 weighed into one understanding (`vahr.assistant.nbest`): an intent heard with too little of the
@@ -31,12 +32,14 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any, Protocol
 
 from vahr.assistant import (
+    STOP_INTENT,
     SimulatorAssistant,
     Weighed,
     Weighing,
     agreement,
     disputed,
     request_reader,
+    stop_heard,
     weigh_recognition,
 )
 from vahr.domain.invocation import FALLBACK_INTENT
@@ -68,27 +71,28 @@ ORIGIN = "station-voice"
 
 
 def read_clip(data: bytes) -> Audio:
-    """The clip as 16 kHz mono 16-bit audio; RequestError (415, 400) for anything else."""
+    """The clip as 16 kHz mono 16-bit audio, from any PCM WAV a person has (espeak-ng's
+    22,050 Hz, a phone's 44.1 kHz stereo, 8-bit, float): what the page sends is read as it
+    is, anything else converted once (`Audio.from_wav`, sox). RequestError 415 for a file
+    that is no WAV, 400 for one that is not readable as audio, 413 for one too long."""
     if data[:4] != b"RIFF" or data[8:12] != b"WAVE":
-        raise RequestError(415, "the clip is not a WAV file")
+        raise RequestError(415, "the clip is not a WAV file (push-to-talk takes a WAV of speech)")
+    shape: tuple[int, int, int] | None = None
     try:
         with wave.open(io.BytesIO(data), "rb") as clip:
             shape = (clip.getnchannels(), clip.getsampwidth(), clip.getframerate())
-            frames = clip.getnframes()
-            pcm = clip.readframes(frames)
-    except (wave.Error, EOFError, RuntimeError) as err:
-        # The wave module raises a bare RuntimeError for a chunk whose size points past the
-        # end of the file (its chunk reader cannot seek there).
-        reason = err or "a chunk is cut short"
-        raise RequestError(400, f"the WAV file is not readable: {reason}") from err
-    if shape != (1, SAMPLE_WIDTH, SAMPLE_RATE):
-        channels, width, rate = shape
-        raise RequestError(
-            415,
-            f"the clip is {channels} channel(s), {8 * width}-bit, {rate} Hz; "
-            f"push-to-talk sends mono 16-bit {SAMPLE_RATE} Hz",
-        )
-    audio = Audio(pcm[: len(pcm) - len(pcm) % SAMPLE_WIDTH])
+            pcm = clip.readframes(clip.getnframes())
+    except (wave.Error, EOFError, RuntimeError):
+        # A float or extensible WAV, which the wave module cannot read, or a broken one (a
+        # chunk whose size points past the end raises a bare RuntimeError): sox says which.
+        pass
+    if shape == (1, SAMPLE_WIDTH, SAMPLE_RATE):
+        audio = Audio(pcm[: len(pcm) - len(pcm) % SAMPLE_WIDTH])
+    else:
+        try:
+            audio = Audio.from_wav(data)
+        except SpeechError as err:
+            raise RequestError(400, f"the WAV file is not readable as audio: {err}") from err
     if audio.seconds > MAX_CLIP_S:
         raise RequestError(413, f"the clip is {audio.seconds:.1f} s; at most {MAX_CLIP_S:g} s")
     return audio
@@ -190,8 +194,9 @@ class PushToTalk:
         second = self.second_ear()
         if second is None or not recognition.accepted or not recognition.text:
             return recognition, None
-        if self._reader()(recognition.text).intent == FALLBACK_INTENT:
-            return recognition, None
+        # Also when the first ear's words read as nothing the skill does: the second may
+        # hear a stop the first misheard ("stop all the robots right now" heard as "all the
+        # robots now"), and a stop either ear hears clearly is acted on (`stop_heard`).
         try:
             return recognition, second.transcribe(audio)
         except Exception:  # the second ear is a help: never the reason a press fails
@@ -239,6 +244,11 @@ class PushToTalk:
         weighed = weigh_recognition(model, recognition, reading=read)
         if not second:
             return weighed
+        if weighed.understanding.intent != STOP_INTENT:
+            # A stop either ear hears clearly is acted on: stopping is always safe.
+            stop = stop_heard(model, second, read)
+            if stop is not None:
+                return stop
         return replace(weighed, understanding=disputed(model, weighed.understanding, read(second)))
 
     def handle(self, wav: bytes) -> dict[str, Any]:
@@ -269,7 +279,7 @@ class PushToTalk:
         if understanding.intent == FALLBACK_INTENT:
             return self._not_caught(result)
         heard["accepted"] = True
-        turn = self._ask(recognition.text, heard, weighed)
+        turn = self._ask(weighed.words or recognition.text, heard, weighed)
         result["turn"] = turn
         if turn.get("intent") not in (None, FALLBACK_INTENT):
             result.update(understood=True, speech=turn.get("speech") or "")

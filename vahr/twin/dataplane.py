@@ -88,6 +88,10 @@ class DataPlane:
         # What `GET /vahr/health` answers; the system adds what a client must adopt (the
         # robots' `sim_speed_factor`).
         self.health: Json = {"ok": True}
+        # What the system still waits for before it can take a command (robots coming
+        # online, the assistant's language model); while any, `GET /vahr/health` answers
+        # 503 naming them. None: a bare stack, ready once it serves.
+        self.awaiting: Callable[[], list[str]] | None = None
         # Path prefixes whose routes answer (status, body, AWS error type) themselves: the
         # IoT control plane's fleet-indexing calls (boto3's `iot` client), whose error
         # names the status alone does not tell.
@@ -203,7 +207,12 @@ class DataPlane:
 
     def _local(self, method: str, path: str, body: bytes) -> tuple[int, bytes]:
         if (method, path) == ("GET", "/vahr/health"):
-            return 200, _encode(self.health)
+            awaiting = self.awaiting() if self.awaiting is not None else []
+            if awaiting:
+                message = f"still starting: waiting for {'; '.join(awaiting)}"
+                answer = {**self.health, "ok": False, "ready": False, "awaiting": awaiting}
+                return 503, _encode({**answer, "code": 503, "message": message})
+            return 200, _encode({**self.health, "ready": True})
         if (method, path) == ("GET", "/vahr/meter"):
             return 200, _encode(self.meter.snapshot())
         if (method, path) == ("POST", "/vahr/meter/reset"):

@@ -25,6 +25,7 @@ from vahr.twin.shadow_service import ShadowService
 from vahr.twin.shadow_store import ShadowStore
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from pathlib import Path
 
 
@@ -47,8 +48,13 @@ class StackConfig:
 class LocalStack:
     """AWS IoT Core's part of the system on 127.0.0.1. Use as a context manager."""
 
-    def __init__(self, config: StackConfig) -> None:
+    def __init__(
+        self, config: StackConfig, *, awaiting: Callable[[], list[str]] | None = None
+    ) -> None:
+        """`awaiting` says what the system built on this stack still waits for before it
+        can take a command (`GET /vahr/health` answers 503 until nothing)."""
         self.config = config
+        self._awaiting = awaiting
         self.meter = Meter()
         self.ca: LocalCA | None = None
         self.broker: Mosquitto | None = None
@@ -151,6 +157,7 @@ class LocalStack:
                 client.publish(topic, payload, qos=qos, retain=retain, wait=qos > 0)
 
             self.dataplane = DataPlane(self.shadows, publish, self.meter)
+            self.dataplane.awaiting = self._awaiting
             self._server = DataPlaneServer(
                 self.dataplane, cfg.api_port, hosts=cfg.api_hosts
             ).start()

@@ -17,12 +17,14 @@ from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_intent_name
 
 from skill import dialog, prompts, task_speech
+from skill.catalog import current_locale
 from skill.responses import answer
 from skill.slots import read_slot
 from skill.task_desk import TaskRefused
 from skill.vocabulary import capitalise, join_choices
 from vahr.dispatch import Order
 from vahr.domain import FLEET_GROUP
+from vahr.domain.fleet import spoken_in
 from vahr.domain.text import normalize, number_in_words
 
 if TYPE_CHECKING:
@@ -122,7 +124,11 @@ class FleetNavigateIntentHandler(_FleetHandler):
         """The group named (None for none), or what to say when it is unknown."""
         fleet = self.runtime.fleet
         groups = {group.id: group for group in fleet.groups if group.id != FLEET_GROUP}
-        names = {normalize(name): group.id for group in groups.values() for name in group.spoken}
+        names = {
+            normalize(name): group.id
+            for group in groups.values()
+            for name in [*group.spoken, *spoken_in(group, current_locale())]
+        }
         reading = read_slot(
             _intent(handler_input), "group", groups, lambda heard: names.get(normalize(heard))
         )
@@ -132,7 +138,7 @@ class FleetNavigateIntentHandler(_FleetHandler):
             return reading.id, ""
         if not groups:
             return None, prompts.NO_GROUPS.format(heard=reading.heard)
-        choices = join_choices([group.spoken[0] for group in groups.values()])
+        choices = join_choices([self._group_name(group_id) for group_id in groups])
         return None, prompts.UNKNOWN_GROUP.format(heard=reading.heard, choices=choices)
 
     def _count(self, handler_input: HandlerInput, group: str | None) -> tuple[int | None, str]:
@@ -157,7 +163,9 @@ class FleetNavigateIntentHandler(_FleetHandler):
         return count, ""
 
     def _group_name(self, group_id: str) -> str:
-        return next(g.spoken[0] for g in self.runtime.fleet.groups if g.id == group_id)
+        """A group's first name in the request's language."""
+        group = next(g for g in self.runtime.fleet.groups if g.id == group_id)
+        return spoken_in(group, current_locale())[0]
 
 
 class ZoneRobotsIntentHandler(_FleetHandler):
@@ -208,8 +216,8 @@ class TaskQueueIntentHandler(_FleetHandler):
 
 
 class CancelTaskIntentHandler(_FleetHandler):
-    """ "cancel the delivery to zone b": the newest queued task there, else the one a robot
-    holds (which stops that robot)."""
+    """ "cancel the delivery to zone b": every open task there (a robot holding one is
+    stopped), said with how many and which robots stopped."""
 
     intent_name = "CancelTaskIntent"
 
@@ -224,13 +232,16 @@ class CancelTaskIntentHandler(_FleetHandler):
             tasks = self.desk.tasks()
         except TaskRefused:  # a stack without the dispatcher's routes
             return answer(handler_input, prompts.NO_DISPATCHER)
-        chosen = task_speech.task_to_cancel(tasks, zone.id)
-        cancelled = self.desk.cancel(chosen[0].id) if chosen is not None else None
-        if chosen is None or cancelled is None:
+        cancelled = []
+        for task, place in task_speech.tasks_to_cancel(tasks, zone.id):
+            done = self.desk.cancel(task.id)
+            if done is not None:  # else it ended meanwhile
+                cancelled.append((done, place))
+        if not cancelled:
             return answer(
                 handler_input, prompts.NOTHING_TO_CANCEL.format(zone=vocabulary.zone(zone.id))
             )
-        return answer(handler_input, task_speech.cancel_report(vocabulary, cancelled, chosen[1]))
+        return answer(handler_input, task_speech.cancel_report(vocabulary, cancelled))
 
 
 def _intent(handler_input: HandlerInput):  # type: ignore[no-untyped-def]

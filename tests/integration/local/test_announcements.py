@@ -59,7 +59,7 @@ def wait_for(condition: Callable[[], Any], timeout_s: float = 20.0) -> Any:
 
 def test_health_tells_the_robots_speed_factor(up: Up) -> None:
     assert call(up.endpoints["api"], "GET", "/vahr/health") == {
-        "ok": True, "sim_speed_factor": SPEED,
+        "ok": True, "ready": True, "sim_speed_factor": SPEED,
     }  # fmt: skip
 
 
@@ -78,7 +78,7 @@ def test_a_robot_made_stuck_is_announced_once_naming_it_and_its_goal(up: Up) -> 
     time.sleep(1.0)
     told = [a for a in announcements(up) if a["thing"] == "placebot1"]
     assert [(a["kind"], a["speech"]) for a in told] == [
-        ("stuck", "Placebot one is stuck on its way to zone b and needs your help.")
+        ("stuck", "Placebot one is stuck on its way to zone B and needs your help.")
     ]
     assert set(told[0]) >= {"id", "time", "thing", "kind", "speech", "reason", "opened_at"}
 

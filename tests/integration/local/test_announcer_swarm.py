@@ -167,7 +167,7 @@ def test_one_fault_one_announcement_under_a_100_robot_swarm(
     )  # fmt: skip
     assert_stays(heard, first_round)
     stuck = next(a for a in heard.told if a.thing == STUCK[0])
-    assert stuck.speech == "Swarm 1 is stuck on its way to zone a and needs your help."
+    assert stuck.speech == "Swarm 1 is stuck on its way to zone A and needs your help."
     failed = next(a for a in heard.told if a.thing == FAILED[0])
     assert (
         failed.speech == "Swarm 11 could not finish its task: goal to A aborted: an injected fault."

@@ -128,7 +128,7 @@ def test_a_stuck_robot_raises_an_alert_that_a_key_acknowledges_on_every_page(
     alert = operator.get_by_role("alert").filter(has_text="placebot one")
     alert.wait_for(timeout=WAIT_S * 1000)
     assert "stuck" in alert.inner_text().lower()
-    assert "Placebot one is stuck on its way to zone b" in alert.inner_text()
+    assert "Placebot one is stuck on its way to zone B" in alert.inner_text()
     # And the robot is ringed on the map, marked in the list, and the page beeped
     assert ringed(operator, "placebot1") and not ringed(operator, "placebot2")
     row = operator.locator('.robot-row[data-thing="placebot1"]')

@@ -181,7 +181,7 @@ def test_any_robot_then_a_zone_asks_the_assistant_to_send_a_robot_there(
     zone_c.click()
     # Then the assistant is asked as a person would ask it, and its answer is shown
     eventually(lambda: assistant.asked, "the assistant asked")
-    assert assistant.asked == [("send a robot to zone c", "station")]
+    assert assistant.asked == [("send a robot to zone C", "station")]
     eventually(lambda: "It is sunny." in page.locator("#panel-status").inner_text(), "reply shown")
     # And selecting a robot leaves "any robot"
     page.keyboard.press("1")

@@ -18,6 +18,7 @@ from vahr.announce import (
     Dispatched,
     PolicyState,
     Queued,
+    TaskCancelled,
     settings_from,
     signals_from_event,
     signals_from_presence,
@@ -66,7 +67,7 @@ def test_a_stuck_robot_is_told_once_by_name_and_where_it_was_going(fleet: Fleet)
     second = robot_event(p, "robot_event_failed_stuck")
     # Then the person hears one announcement, naming the robot and its goal
     assert [a.speech for a in first] == [
-        "Placebot one is stuck on its way to zone b and needs your help."
+        "Placebot one is stuck on its way to zone B and needs your help."
     ]
     assert second == []
     [told] = first
@@ -205,7 +206,7 @@ def test_a_held_finished_task_is_told_at_the_first_chance_even_if_old(fleet: Fle
     clock.advance(241)
     # Then it is still told: an old announcement is late, not lost
     [late] = p.tick()
-    assert late.speech == "Placebot two has finished its task at zone c."
+    assert late.speech == "Placebot two has finished its task at zone C."
     assert late.time - late.opened_at == timedelta(minutes=5)
 
 
@@ -345,3 +346,52 @@ def test_bad_settings_are_refused_naming_the_field(
 ) -> None:
     with pytest.raises(ProtocolError, match=rf"^{message}"):
         settings_from(settings)
+
+
+def test_a_task_given_up_for_a_command_by_name_is_told_once_with_its_place(fleet: Fleet) -> None:
+    clock = Clock()
+    p = policy(fleet, clock)
+    # When the fleet gives up placebot2's delivery to zone C (it was sent elsewhere by name)
+    [told] = p.observe([TaskCancelled("t-1", "placebot2", "deliver", "C", T0)])
+    # Then it is told, by the robot's and the zone's names, and only once
+    assert (told.kind, told.thing) == ("cancelled", "placebot2")
+    assert told.speech == (
+        "Placebot two was given another command, so its delivery to zone C is cancelled."
+    )
+    clock.advance(120)
+    assert p.tick() == []
+
+
+def test_announcements_are_said_in_the_stacks_language() -> None:
+    from tests.support.fleets import HOSPITAL
+    from vahr.domain import load_fleet
+
+    p = AnnouncePolicy(settings_from({}), Names.of(load_fleet(HOSPITAL), "de-DE"), Clock())
+    [told] = p.observe([TaskCancelled("t-1", "iris", "deliver", "WARD_THREE", T0)])
+    assert told.speech == (
+        "Iris hat einen anderen Befehl bekommen, also ist seine Lieferung nach Station Drei "
+        "storniert."
+    )
+    [failed] = robot_event(
+        p, "robot_event_failed", thing="iris", zone="PHARMACY",
+        reason="goal to PHARMACY aborted: an injected fault",
+    )  # fmt: skip
+    assert failed.speech == (
+        "Iris konnte seinen Auftrag nicht beenden: goal to Apotheke aborted: an injected fault."
+    )
+
+
+def test_every_english_announcement_word_has_a_german_one_with_its_placeholders() -> None:
+    import string
+
+    from vahr.announce.speech import WORDS
+    from vahr.domain.locale import locale_file, read_yaml
+
+    german = read_yaml(locale_file("de-DE", "announcements.yaml"), dict[str, str])
+    assert set(german) == set(WORDS)
+
+    def fields(text: str) -> set[str]:
+        return {name for _, name, _, _ in string.Formatter().parse(text) if name}
+
+    for name, english in WORDS.items():
+        assert fields(german[name]) == fields(english), name

@@ -240,7 +240,7 @@ def test_each_announcement_alexa_took_is_published_for_the_operator_station(
     assert topic == topics.ASSISTANT_ANNOUNCEMENTS
     told = decode_announcement(payload)
     assert told.id == first["told"][0] == alexa.events[0]["referenceId"]
-    assert told.speech == "Placebot one is stuck on its way to zone b and needs your help."
+    assert told.speech == "Placebot one is stuck on its way to zone B and needs your help."
 
 
 class RefusedPublish:

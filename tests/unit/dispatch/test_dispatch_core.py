@@ -320,6 +320,26 @@ def test_a_robot_that_takes_a_command_by_name_gives_its_task_up(
     assert dispatcher.store.get(task.id).outcome == "preempted"  # type: ignore[union-attr]
 
 
+def test_a_task_given_up_for_a_command_by_name_is_told_not_dropped(
+    dispatcher: Dispatcher, robots: Robots
+) -> None:
+    told: list[Task] = []
+    dispatcher.on_given_up = told.append
+    # Given a delivery a robot acknowledged
+    [task] = dispatcher.submit(Order(kind="deliver", zone="FAR")).assigned
+    assert task.thing is not None
+    dispatcher.observe(robots.set(task.thing, last_command_id=task.id, last_result="accepted"))
+    assert told == []
+    # When the robot is sent elsewhere by name
+    dispatcher.observe(robots.set(task.thing, last_command_id="by-name", last_result="accepted"))
+    # Then the task given up is handed on to be announced, once
+    assert [(t.id, t.thing, t.kind, t.zone, t.status) for t in told] == [
+        (task.id, task.thing, "deliver", "FAR", "cancelled")
+    ]
+    dispatcher.observe(robots.set(task.thing, last_command_id="by-name", last_result="done"))
+    assert len(told) == 1
+
+
 def test_an_update_from_before_the_acknowledgment_is_no_preemption(
     dispatcher: Dispatcher, robots: Robots
 ) -> None:

@@ -63,6 +63,6 @@ def test_held_announcements_are_told_later_and_counted_in_the_history(fleet: Fle
     # And the one that waited is told when the window allows, on the topic and in the history
     clock.now += timedelta(seconds=60)
     [late] = announcer.tick()
-    assert late.speech == "Placebot two has finished its task at zone c."
+    assert late.speech == "Placebot two has finished its task at zone C."
     assert [a.kind for a in published] == ["stuck", "done"]
     assert [a["kind"] for a in announcer.route({})[1]["announcements"]] == ["stuck", "done"]

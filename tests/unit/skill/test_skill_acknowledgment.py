@@ -49,8 +49,9 @@ def test_rejected_command_speaks_the_robots_reason(make_skill: Any, robots: Robo
         RobotBehaviour(result="rejected", reason="params.zone: 'A' is blocked by an obstacle"),
     )
     response = make_skill()(load_event("alexa_navigate"), None)
+    # The zone the reason names by id is said by its name.
     assert speech(response) == (
-        "Placebot one refused the command: params.zone: 'A' is blocked by an obstacle."
+        "Placebot one refused the command: params.zone: 'zone A' is blocked by an obstacle."
     )
 
 
@@ -108,7 +109,7 @@ def test_fleet_with_no_robot_answering(make_skill: Any, robots: RobotDoubles) ->
     robots.behave("placebot2", RobotBehaviour(result=None))
     response = make_skill(ack_timeout_s=0.3)(load_event("alexa_navigate_fleet"), None)
     assert speech(response) == (
-        "None of the 2 robots confirmed; placebot one did not answer; placebot two did not answer."
+        "None of the 2 robots confirmed; placebot one had not answered yet; placebot two had not answered yet."
     )
 
 

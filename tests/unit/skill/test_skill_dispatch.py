@@ -206,6 +206,23 @@ def test_cancelling_a_task_a_robot_holds_stops_that_robot(
     assert sent[-1] == (thing, sent[-1][1]) and sent[-1][1].action == "stop"
 
 
+def test_cancelling_with_two_robots_heading_there_cancels_both_and_says_so(
+    skill: Callable[[dict[str, Any]], dict[str, Any]],
+    sent: list[tuple[str, Command]],
+    desk: CoreDesk,
+) -> None:
+    # Given two robots sent to the shop
+    skill(intent("FleetNavigateIntent", zone=("the shop", "SHOP"), count=("two", "2")))
+    going = [task.thing for task in desk.tasks()]
+    assert len(going) == 2
+    # When the person cancels "the delivery to the shop"
+    spoken = said(skill, intent("CancelTaskIntent", zone=("the shop", "SHOP")))
+    # Then no task to the shop is left, both robots were stopped, and the answer says so
+    assert desk.tasks() == []
+    assert sorted(thing for thing, command in sent if command.action == "stop") == sorted(going)
+    assert spoken == f"I cancelled the two tasks to the shop and stopped {going[0]} and {going[1]}."
+
+
 def test_a_group_sends_each_member_and_says_which_are_busy(
     skill: Callable[[dict[str, Any]], dict[str, Any]], robots: Robots
 ) -> None:

@@ -194,7 +194,7 @@ def test_a_fleet_command_reply_names_only_the_first_few_unconfirmed() -> None:
     assert said == (
         "993 of 1,000 robots confirmed; rover 1 did not answer and seems to be offline; "
         "rover 2 did not answer and seems to be offline; rover 3 did not answer and seems to "
-        "be offline; and 4 more did not confirm."
+        "be offline; and 4 more had not confirmed yet."
     )
 
 
@@ -296,7 +296,7 @@ def test_a_command_to_a_thousand_robots_is_confirmed_by_the_index(
     # Then the reply counts the 994 that confirmed and names the first of the six that did not
     assert said == (
         "994 of 1,000 robots confirmed; rover 5 refused: its battery is low; rover 6 refused: "
-        "its battery is low; rover 7 did not answer; and 3 more did not confirm."
+        "its battery is low; rover 7 had not answered yet; and 3 more had not confirmed yet."
     )
     # And not one shadow was read to find out
     assert "http.shadow.get" not in json.dumps(meter.snapshot())

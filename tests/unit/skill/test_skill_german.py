@@ -4,11 +4,13 @@ message of the English one with the same placeholders."""
 
 from __future__ import annotations
 
+import ast
 import string
+from pathlib import Path
 from typing import Any
 
 import pytest
-from skill_testkit import RobotDoubles, reprompt, speech
+from skill_testkit import RobotBehaviour, RobotDoubles, reprompt, speech
 
 from skill import catalog, prompts
 from tests.conftest import load_event
@@ -94,3 +96,75 @@ def test_a_german_zone_question_offers_the_spelling_alphabet_in_german(skill: An
     response = skill(event, None)
     assert speech(response) == "Zone B oder Zone D?"
     assert reprompt(response) == "Zone B oder Zone D? Du kannst auch bravo oder delta sagen."
+
+
+def test_the_german_catalog_names_no_message_english_lacks() -> None:
+    # A message renamed in English and not in German is spoken in English to Germans.
+    english = set(_messages())
+    stale = sorted(set(catalog.replies("de-DE")) - english)
+    assert stale == []
+
+
+@pytest.mark.usefixtures("aws")
+def test_a_german_request_missing_its_zone_is_asked_in_german(skill: Any) -> None:
+    # Given "Schick Roboter zwei" (no zone), in German
+    event = load_event("alexa_navigate_missing_zone")
+    event["request"]["locale"] = "de-DE"
+    response = skill(event, None)
+    # Then the question is German, with the zones' German names
+    assert speech(response) == ("In welche Zone: Ladezone, Zone A, Zone B, Zone C oder Zone D?")
+
+
+@pytest.mark.usefixtures("aws")
+def test_a_german_fallback_is_answered_in_german(skill: Any) -> None:
+    event = load_event("alexa_fallback")
+    event["request"]["locale"] = "de-DE"
+    assert speech(skill(event, None)).startswith("Tut mir leid, dabei kann Roboterflotte")
+
+
+def test_a_robot_refusing_a_german_command_is_said_in_german(
+    skill: Any, robots: RobotDoubles
+) -> None:
+    robots.behave("placebot1", RobotBehaviour(result="rejected", reason="busy"))
+    response = skill(load_event("alexa_navigate_de"), None)
+    assert speech(response) == "Placebot eins hat den Befehl abgelehnt: busy."
+
+
+def _import_time_reads(tree: ast.Module) -> list[str]:
+    """`prompts.NAME` read when a module is imported: at module or class level, or as a
+    parameter's default, where it is English whatever the request's locale."""
+    found: list[str] = []
+
+    def reads(node: ast.AST) -> list[str]:
+        return [
+            f"{sub.attr} (line {sub.lineno})"
+            for sub in ast.walk(node)
+            if isinstance(sub, ast.Attribute)
+            and isinstance(sub.value, ast.Name)
+            and sub.value.id == "prompts"
+        ]
+
+    def visit(body: list[ast.stmt]) -> None:
+        for statement in body:
+            if isinstance(statement, ast.FunctionDef | ast.AsyncFunctionDef):
+                args = statement.args
+                for default in [*args.defaults, *(d for d in args.kw_defaults if d)]:
+                    found.extend(reads(default))
+            elif isinstance(statement, ast.ClassDef):
+                visit(statement.body)
+            else:
+                found.extend(reads(statement))
+
+    visit(tree.body)
+    return found
+
+
+def test_no_message_is_read_before_the_request_says_its_language() -> None:
+    skill_dir = Path(prompts.__file__).parent
+    early = {
+        str(path.relative_to(skill_dir)): reads
+        for path in sorted(skill_dir.rglob("*.py"))
+        if path.name != "prompts.py"
+        and (reads := _import_time_reads(ast.parse(path.read_text(encoding="utf-8"))))
+    }
+    assert early == {}

@@ -378,7 +378,7 @@ def test_an_announcement_reaches_pages_as_an_alert_and_in_the_conversation(feed:
     (told,) = [PAGE.decode(m) for m in page.take(0) or []]
     assert isinstance(told, AnnouncementMessage)
     assert (told.thing, told.kind, told.robots) == ("placebot1", "stuck", ["placebot1"])
-    assert told.speech == "Placebot one is stuck on its way to zone b and needs your help."
+    assert told.speech == "Placebot one is stuck on its way to zone B and needs your help."
     # And a page opened now starts with it as an open alert, and in the conversation
     snapshot = feed.snapshot()
     assert [a["id"] for a in snapshot["alerts"]] == [told.id]

@@ -4,6 +4,7 @@ words are pronounced, and what the page is answered for speech, silence and nons
 from __future__ import annotations
 
 import io
+import subprocess
 import threading
 import wave
 from typing import TYPE_CHECKING, Any
@@ -19,6 +20,8 @@ from vahr.station.vocabulary import load_model, sentences
 from vahr.station.voice import SORRY, PushToTalk, read_clip
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from vahr.domain import Fleet
     from vahr.speech.audio import Audio
 
@@ -64,13 +67,34 @@ def test_a_16_khz_mono_clip_is_read() -> None:
 
 
 @pytest.mark.parametrize(
+    "clip",
+    [
+        wav(rate=22_050, seconds=2.0),  # espeak-ng's own rate
+        wav(channels=2, rate=44_100, seconds=2.0),  # a phone's recording
+        wav(width=1, rate=8_000, seconds=2.0),  # 8-bit
+    ],
+)
+def test_any_pcm_wav_a_person_has_is_read_at_16_khz_mono(clip: bytes) -> None:
+    audio = read_clip(clip)
+    assert audio.seconds == pytest.approx(2.0, abs=0.01)
+
+
+def test_espeak_ngs_own_wav_is_read(tmp_path: Path) -> None:
+    # `espeak-ng -w FILE` writes 22,050 Hz mono, which a user may well post as it is
+    out = tmp_path / "stop.wav"
+    subprocess.run(["espeak-ng", "-w", str(out), "stop all the robots"], check=True)
+    with wave.open(str(out), "rb") as native:
+        assert native.getframerate() == 22_050
+    assert read_clip(out.read_bytes()).seconds > 0.5
+
+
+@pytest.mark.parametrize(
     ("data", "status", "words"),
     [
         (b"ID3 an mp3 file", 415, "not a WAV file"),
-        (wav(channels=2), 415, "2 channel(s), 16-bit, 16000 Hz"),
-        (wav(rate=44_100), 415, "44100 Hz"),
         (wav(seconds=21.0), 413, "at most 20 s"),
-        (b"RIFF\x00\x00\x00\x00WAVEjunk", 400, "not readable"),
+        (wav(rate=44_100, seconds=21.0), 413, "at most 20 s"),
+        (b"RIFF\x00\x00\x00\x00WAVEjunk", 400, "not readable as audio"),
     ],
 )
 def test_any_other_clip_is_refused_with_one_line(data: bytes, status: int, words: str) -> None:
@@ -271,6 +295,44 @@ def test_a_zone_the_second_ear_heard_otherwise_is_asked_about(
         assert utterance == "send placebot one to zone d" and result["understood"] is True
     else:
         assert assistant.asked == [] and result["speech"] == asked
+
+
+def test_a_stop_only_the_second_ear_heard_clearly_is_acted_on() -> None:
+    # Given pocketsphinx heard "all the robots now" (nothing the skill does), and Whisper
+    # heard the whole request word for word
+    assistant = Assistant("EmergencyStopIntent")
+    first = Recognition("all the robots now", 0.7, True,
+                        hypotheses=(Hypothesis("all the robots now", 0.0),))  # fmt: skip
+    ears = PushToTalk(
+        assistant, lambda: Heard(first), lambda: SecondEar("Stop all the robots right now.")
+    )
+    result = ears.handle(wav())
+    # Then the stop goes to the assistant, in the words the second ear heard
+    ((utterance, _, sent),) = assistant.asked
+    assert utterance == "Stop all the robots right now."
+    assert sent is not None and sent["weighed"]["intent"] == "EmergencyStopIntent"
+    assert result["understood"] is True
+
+
+def test_a_stop_the_second_ear_heard_wins_over_another_request() -> None:
+    # The first ear is sure of a navigation; the second clearly heard a stop: stopping is
+    # always safe, so the stop is what is done
+    assistant = Assistant("EmergencyStopIntent")
+    sure = Recognition("send placebot one to zone d", 0.9, True,
+                       hypotheses=(Hypothesis("send placebot one to zone d", 0.0),))  # fmt: skip
+    ears = PushToTalk(assistant, lambda: Heard(sure), lambda: SecondEar("Stop placebot one."))
+    ears.handle(wav())
+    ((utterance, _, _),) = assistant.asked
+    assert utterance == "Stop placebot one."
+
+
+def test_talk_of_other_things_heard_by_both_ears_sends_nothing() -> None:
+    assistant = Assistant("AMAZON.FallbackIntent")
+    other = Recognition("what a lovely day", 0.7, True,
+                        hypotheses=(Hypothesis("what a lovely day", 0.0),))  # fmt: skip
+    ears = PushToTalk(assistant, lambda: Heard(other), lambda: SecondEar("What a lovely day."))
+    result = ears.handle(wav())
+    assert assistant.asked == [] and result["understood"] is False
 
 
 def test_a_second_ear_that_cannot_be_made_leaves_the_first_alone(

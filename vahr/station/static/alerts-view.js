@@ -7,6 +7,7 @@
 // every page lets the alert go. alerts.js decides what is shown; this draws it.
 
 import { post, reason, replyVoice } from "./api.js";
+import { t } from "./i18n.js";
 import { AlertQueue } from "./alerts.js";
 import { clock, node } from "./dom.js";
 import { typing } from "./talk.js";
@@ -17,7 +18,7 @@ import { typing } from "./talk.js";
 
 const SHOWN = 2; // alerts drawn at once; the rest wait behind a count
 /** What happened, in a word or two, per kind of announcement. @type {Record<AnnouncementMessage["kind"], string>} */
-const TROUBLES = { stuck: "stuck", failed: "task failed", offline: "offline", waiting: "task waiting", done: "task done" };
+const TROUBLES = { stuck: t("stuck"), failed: t("task failed"), offline: t("offline"), waiting: t("task waiting"), cancelled: t("task cancelled"), done: t("task done") };
 // A key pressed on one of these does what the element does, not the page's shortcut.
 const CONTROLS = "button, a[href], input, select, textarea, summary, [contenteditable], [role=button]";
 
@@ -97,7 +98,7 @@ export class AlertsView {
     this.box.replaceChildren(...alerts.slice(0, SHOWN).map((alert, index) => this.draw(alert, index === 0)));
     if (alerts.length > SHOWN) {
       const more = alerts.length - SHOWN;
-      this.box.appendChild(node("p", "alerts-more", `${more} more ${more === 1 ? "alert" : "alerts"} behind these: acknowledge one to see the next.`));
+      this.box.appendChild(node("p", "alerts-more", more === 1 ? t("1 more alert behind these: acknowledge one to see the next.") : t("{count} more alerts behind these: acknowledge one to see the next.", { count: more })));
     }
     this.box.hidden = alerts.length === 0;
     this.onChange(this.queue.troubled());
@@ -106,7 +107,7 @@ export class AlertsView {
   /** @param {Alert} alert @param {boolean} top */
   draw(alert, top) {
     const { latest } = alert;
-    const name = latest.thing ? this.names[latest.thing] || latest.thing : "The fleet";
+    const name = latest.thing ? this.names[latest.thing] || latest.thing : t("The fleet");
     const item = node("div", "alert");
     item.setAttribute("role", "alert");
     item.dataset.trouble = latest.kind;
@@ -116,16 +117,16 @@ export class AlertsView {
     const words = node("div", "alert-words");
     const title = node("div", "alert-title");
     title.append(node("strong", "alert-robot", name), node("span", "alert-trouble", TROUBLES[latest.kind] || latest.kind));
-    if (alert.count > 1) title.appendChild(node("span", "alert-count", `${alert.count} times`));
+    if (alert.count > 1) title.appendChild(node("span", "alert-count", t("{count} times", { count: alert.count })));
     title.appendChild(node("time", "", clock(latest.time)));
     words.append(title, node("div", "alert-speech", latest.speech));
-    const ack = node("button", "btn btn-small alert-ack", "Acknowledge");
+    const ack = node("button", "btn btn-small alert-ack", t("Acknowledge"));
     ack.type = "button";
     ack.dataset.interaction = `acknowledge alert ${alert.key}`;
-    ack.setAttribute("aria-label", `Acknowledge: ${latest.speech}`);
+    ack.setAttribute("aria-label", `${t("Acknowledge")}: ${latest.speech}`);
     if (top) {
       ack.appendChild(node("kbd", "", "Enter"));
-      ack.title = "Acknowledge (Enter)";
+      ack.title = t("Acknowledge (Enter)");
     }
     ack.addEventListener("click", () => this.acknowledge(alert));
     item.append(words, ack);

@@ -40,7 +40,7 @@
  * @property {string} id
  * @property {string} time
  * @property {string|null} thing
- * @property {"done"|"failed"|"offline"|"stuck"|"waiting"} kind
+ * @property {"cancelled"|"done"|"failed"|"offline"|"stuck"|"waiting"} kind
  * @property {number} priority
  * @property {string} speech
  * @property {string|null} reason
@@ -228,11 +228,17 @@
 
 /**
  * The last command a robot saw and what became of it. `id` is what the skill waits for.
+ *
+ * Every field is sent, `null` included: a shadow update merges objects key by key, so a reason
+ * left out would keep the reason of an earlier command (null deletes it). `zone` is the zone
+ * the command was for; its `reason` names that zone by this id, which speech and the station
+ * replace with the zone's spoken name (`vahr.domain.fleet.reason_said`).
  * @typedef {object} LastCommand
  * @property {string} id
  * @property {string} action
  * @property {"accepted"|"cancelled"|"done"|"failed"|"rejected"} result
  * @property {string|null} [reason]
+ * @property {string|null} [zone]
  */
 
 /**

@@ -8,16 +8,17 @@ import { clock, node } from "./dom.js";
 import { zoneText } from "./map.js";
 import { sourceName } from "./robots.js";
 import { CONVERSATION_LIMIT } from "./contract.js";
+import { t } from "./i18n.js";
 
 /** @import { AnnouncementMessage, CommandMessage, ConversationEntry, EventMessage, FleetView, TurnMessage } from "./contract.js" */
 
 /** @type {Record<string, string>} */
 const ORIGINS = {
-  "station-voice": "You, by voice",
-  station: "You, typed",
-  "station-weather": "Weather button",
+  "station-voice": t("You, by voice"),
+  station: t("You, typed"),
+  "station-weather": t("Weather button"),
   say: "vahr say",
-  console: "Console",
+  console: t("Console"),
 };
 const FALLBACK = "AMAZON.FallbackIntent";
 const ENTRIES_KEPT = CONVERSATION_LIMIT; // as many as the station keeps for a new page
@@ -81,7 +82,7 @@ export class Conversation {
     this.refreshers.clear();
     this.filters.replaceChildren();
     /** @type {Array<[string | null, string]>} */
-    const chips = [[null, "All"], ...fleet.robots.slice(0, 8).map((r) => /** @type {[string, string]} */ ([r.thing, r.name]))];
+    const chips = [[null, t("All")], ...fleet.robots.slice(0, 8).map((r) => /** @type {[string, string]} */ ([r.thing, r.name]))];
     for (const [thing, label] of chips) {
       const chip = node("button", "chip", label);
       chip.type = "button";
@@ -120,7 +121,7 @@ export class Conversation {
     let empty = this.list.querySelector(".empty");
     if (shown && empty) empty.remove();
     if (!shown && !empty) {
-      empty = node("li", "empty", this.filter ? "Nothing with this robot yet." : "Nothing said yet. Hold “Hold to talk”, type below, or use vahr say.");
+      empty = node("li", "empty", this.filter ? t("Nothing with this robot yet.") : t("Nothing said yet. Hold “Hold to talk”, type below, or use vahr say."));
       this.list.appendChild(empty);
     }
   }
@@ -169,46 +170,46 @@ export class Conversation {
   /** @param {string} commandId */
   commandLine(commandId) {
     const command = this.commands[commandId];
-    if (!command) return `command ${commandId.slice(0, 8)}`;
-    const zone = command.params?.zone ? ` to ${zoneText(command.params.zone)}` : "";
-    const who = command.target === "fleet" ? "every robot" : this.names[command.target] || command.target;
+    if (!command) return t("command {id}", { id: commandId.slice(0, 8) });
+    const zone = command.params?.zone ? ` → ${zoneText(command.params.zone)}` : "";
+    const who = command.target === "fleet" ? t("every robot") : this.names[command.target] || command.target;
     const acks = Object.entries(command.acks || {});
-    let how = "waiting for an acknowledgment";
+    let how = t("waiting for an acknowledgment");
     if (acks.length) {
       const worst = Math.max(...acks.map(([, ack]) => ack.latency_ms));
       const rejected = acks.filter(([, ack]) => ack.event === "rejected").map(([thing]) => this.names[thing] || thing);
-      how = rejected.length ? `rejected by ${rejected.join(", ")}` : `acknowledged in ${Math.round(worst)} ms`;
+      how = rejected.length ? t("rejected by {robots}", { robots: rejected.join(", ") }) : t("acknowledged in {ms} ms", { ms: Math.round(worst) });
       if (command.target === "fleet") how += ` (${acks.length}/${command.robots.length})`;
     }
-    return `${who}: ${command.action}${zone} · ${how}`;
+    return `${who}: ${t(command.action)}${zone} · ${how}`;
   }
 
   /** @param {TurnMessage} message */
   turn(message) {
     const item = node("li", "entry turn");
-    item.append(node("span", "who", ORIGINS[message.origin ?? ""] || message.origin || "Someone"), node("time", "", clock(message.at ?? Date.now())));
+    item.append(node("span", "who", ORIGINS[message.origin ?? ""] || message.origin || t("Someone")), node("time", "", clock(message.at ?? Date.now())));
     const said = node("div", "said");
-    said.appendChild(quoted(message.utterance || "(session ended)"));
+    said.appendChild(quoted(message.utterance || t("(session ended)")));
     item.appendChild(said);
     if (message.heard) {
       const sure = Math.round((message.heard.confidence ?? 0) * 100);
-      item.appendChild(node("div", "heard", `${Number(message.heard.seconds ?? 0).toFixed(1)} s clip · the recognizer was ${sure}% sure`));
+      item.appendChild(node("div", "heard", t("{seconds} s clip · the recognizer was {sure}% sure", { seconds: Number(message.heard.seconds ?? 0).toFixed(1), sure })));
     }
     const understood = node("div", "understood");
     if (message.intent) understood.appendChild(node("span", `tag intent${message.intent === FALLBACK ? " bad" : ""}`, message.intent));
     for (const [name, slot] of Object.entries(message.slots || {})) {
       if (!slot) continue;
-      const resolved = slot.id ? ` → ${slot.id}` : slot.value ? " (no match)" : "";
+      const resolved = slot.id ? ` → ${slot.id}` : slot.value ? ` (${t("no match")})` : "";
       understood.appendChild(node("span", "tag", `${name}: ${slot.value ?? "—"}${resolved}`));
     }
     if (understood.children.length) item.appendChild(understood);
-    item.appendChild(node("div", `reply${message.intent === FALLBACK ? " sorry" : ""}`, message.speech || "(no reply)"));
+    item.appendChild(node("div", `reply${message.intent === FALLBACK ? " sorry" : ""}`, message.speech || t("(no reply)")));
     const meta = node("div", "meta");
     item.appendChild(meta);
     const ids = message.commands || [];
     const redraw = () => {
-      const parts = [`reply in ${Math.round(message.latency_ms ?? 0)} ms`];
-      parts.push(ids.length ? ids.map((id) => this.commandLine(id)).join(" · ") : "no command");
+      const parts = [t("reply in {ms} ms", { ms: Math.round(message.latency_ms ?? 0) })];
+      parts.push(ids.length ? ids.map((id) => this.commandLine(id)).join(" · ") : t("no command"));
       meta.textContent = parts.join(" · ");
     };
     if (ids.length) for (const id of ids) this.watch(id, redraw);
@@ -220,7 +221,7 @@ export class Conversation {
   command(message) {
     const robotSource = message.source.startsWith("robot:");
     const item = node("li", `entry ${robotSource ? "robot-exchange" : "console"}`);
-    const who = robotSource ? `${this.names[message.source.slice(6)] || message.source.slice(6)}, to a robot` : sourceName(message.source).replace(/^./, (c) => c.toUpperCase());
+    const who = robotSource ? t("{robot}, to a robot", { robot: this.names[message.source.slice(6)] || message.source.slice(6) }) : sourceName(message.source).replace(/^./, (c) => c.toUpperCase());
     item.append(node("span", "who", who), node("time", "", clock(message.seen ?? Date.now())));
     const said = node("div", "said");
     item.appendChild(said);
@@ -233,7 +234,7 @@ export class Conversation {
   announcement(message) {
     const item = node("li", "entry announcement");
     item.dataset.trouble = message.kind;
-    item.append(node("span", "who", "The assistant, unprompted"), node("time", "", clock(message.time)));
+    item.append(node("span", "who", t("The assistant, unprompted")), node("time", "", clock(message.time)));
     item.appendChild(node("div", "reply", message.speech));
     return item;
   }
@@ -244,15 +245,15 @@ export class Conversation {
     const item = node("li", "entry robot-exchange");
     let who, body;
     if (message.event === "said") {
-      who = `${name} to the assistant`;
+      who = t("{robot} to the assistant", { robot: name });
       body = quoted(message.text || "");
     } else if (message.event === "heard") {
-      who = `The assistant to ${name}`;
-      body = quoted(message.text || "(nothing heard)");
+      who = t("The assistant to {robot}", { robot: name });
+      body = quoted(message.text || t("(nothing heard)"));
     } else {
-      who = `${name} understood`;
-      const sure = message.confidence !== undefined && message.confidence !== null ? ` (${Math.round(message.confidence * 100)}% sure)` : "";
-      body = node("span", `tag ${message.intent && message.intent !== "unknown" ? "ok" : "bad"}`, `${message.intent || "nothing"}${sure}`);
+      who = t("{robot} understood", { robot: name });
+      const sure = message.confidence !== undefined && message.confidence !== null ? ` (${t("{sure}% sure", { sure: Math.round(message.confidence * 100) })})` : "";
+      body = node("span", `tag ${message.intent && message.intent !== "unknown" ? "ok" : "bad"}`, `${message.intent || t("nothing")}${sure}`);
     }
     item.append(node("span", "who", who), node("time", "", clock(message.at ?? Date.now())));
     const said = node("div", "said");

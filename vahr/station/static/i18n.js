@@ -2,9 +2,13 @@
 // The station's words in the reader's language. Each locale's words are
 // vahr/station/locales/<locale>.json (served as /static/<locale>.json): the page's text by
 // CSS selector ("text", "html" for our own markup, "after" for the text right after an
-// element, "attr" for attributes). The language is the one chosen in the page's selector
-// (kept in localStorage), else the browser's first language VAHR speaks, else English.
-// The page is written in English, so English needs nothing applied.
+// element, "attr" for attributes), and "strings", what the scripts write (`t`), by their
+// English wording with `{name}` placeholders. The language is the one chosen in the page's
+// selector (kept in localStorage), else the one people speak to the assistant (the
+// station's `data-locale` on <html>, `vahr up --locale`), else the browser's first language
+// VAHR speaks, else English. The page is written in English, so English needs nothing.
+// This module waits for the words before any other is evaluated (a top-level await), so a
+// script's `t()` is never English by accident.
 
 export const SUPPORTED = ["en-US", "de-DE"];
 export const DEFAULT_LOCALE = "en-US";
@@ -37,6 +41,8 @@ export function chooseLocale(saved, languages) {
  * @property {Record<string, string>} html
  * @property {Record<string, string>} after
  * @property {Record<string, Record<string, string>>} attr
+ * @property {Record<string, string>} [strings]
+ * @property {Record<string, string>} [utterances]
  */
 
 /**
@@ -103,9 +109,64 @@ async function wordsOf(locale) {
   return /** @type {Words} */ (await answer.json());
 }
 
+const inBrowser = typeof document !== "undefined" && typeof window !== "undefined";
+
+/** The locale the page shows (English outside a browser). */
+export const LOCALE = inBrowser
+  ? chooseLocale(localStorage.getItem(STORAGE_KEY), [
+      ...(document.documentElement.dataset.locale ? [document.documentElement.dataset.locale] : []),
+      ...(navigator.languages ?? [navigator.language]),
+    ])
+  : DEFAULT_LOCALE;
+
+/** The language people speak to the assistant (`vahr up --locale`), whatever the page shows. */
+export const SPOKEN_LOCALE = inBrowser ? chooseLocale(null, [document.documentElement.dataset.locale ?? DEFAULT_LOCALE]) : DEFAULT_LOCALE;
+
+/** The shown locale's words; null for English, which the scripts are written in. */
+const SHOWN = inBrowser && LOCALE !== DEFAULT_LOCALE ? await wordsOf(LOCALE) : null;
+/** The assistant's language's words, for what the page says to it on the reader's behalf. */
+const SPOKEN = SPOKEN_LOCALE === LOCALE ? SHOWN : inBrowser && SPOKEN_LOCALE !== DEFAULT_LOCALE ? await wordsOf(SPOKEN_LOCALE) : null;
+
+/**
+ * `english` in the page's language, its `{name}` placeholders filled from `values`.
+ * @param {string} english
+ * @param {Record<string, string | number>} [values]
+ * @returns {string}
+ */
+export function t(english, values = {}) {
+  const template = SHOWN?.strings?.[english] ?? english;
+  return template.replace(/\{(\w+)\}/g, (whole, name) => (name in values ? String(values[name]) : whole));
+}
+
+/**
+ * What the page says to the assistant for the reader ("send a robot to {zone}"), in the
+ * assistant's language, which may not be the page's.
+ * @param {string} english
+ * @param {Record<string, string | number>} [values]
+ */
+export function said(english, values = {}) {
+  const template = SPOKEN?.utterances?.[english] ?? english;
+  return template.replace(/\{(\w+)\}/g, (whole, name) => (name in values ? String(values[name]) : whole));
+}
+
+/**
+ * `english`'s translation with its `{name}` placeholders replaced by nodes (keys as <kbd>),
+ * in the order the language puts them: "hold {space} to talk", "{space} halten zum Sprechen".
+ * @param {string} english
+ * @param {Record<string, Node>} nodes
+ * @returns {Node[]}
+ */
+export function tNodes(english, nodes) {
+  const template = SHOWN?.strings?.[english] ?? english;
+  return template.split(/(\{\w+\})/).filter(Boolean).map((part) => {
+    const name = part.match(/^\{(\w+)\}$/)?.[1];
+    return name && nodes[name] ? nodes[name] : document.createTextNode(part);
+  });
+}
+
 async function start() {
-  const locale = chooseLocale(localStorage.getItem(STORAGE_KEY), navigator.languages ?? [navigator.language]);
-  const shown = await wordsOf(locale);
+  const locale = LOCALE;
+  const shown = SHOWN ?? (await wordsOf(locale));
   const names = Object.fromEntries(
     await Promise.all(SUPPORTED.map(async (code) => [code, code === locale ? shown.name : (await wordsOf(code)).name])),
   );

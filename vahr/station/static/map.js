@@ -10,6 +10,7 @@
 // easing into a report that disagrees, never jumping or sliding back.
 
 import { clock } from "./dom.js";
+import { t } from "./i18n.js";
 import { Motion, angleDelta, distance } from "./motion.js";
 import { RobotLayer } from "./robot-layer.js";
 
@@ -45,8 +46,24 @@ import { RobotLayer } from "./robot-layer.js";
 
 /** @typedef {"floor" | "fixtures" | "zones" | "paths" | "robots"} Layer */
 
+/**
+ * One zone's parts on the map.
+ * @typedef {object} DrawnZone
+ * @property {SVGGElement} group
+ * @property {ZoneEntry} zone
+ * @property {number} half half its box's side, in metres
+ * @property {SVGRectElement} body
+ * @property {SVGTextElement} letter
+ * @property {SVGTextElement} name
+ * @property {SVGTextElement} incoming
+ * @property {boolean} big whether its letter is its id or key (else its name, small)
+ */
+
 const SVG = "http://www.w3.org/2000/svg";
 const LABELS_UP_TO = 12; // more robots than this: numbers only, no names under them
+// A zone's letter and name are this many screen pixels high, and its box at least this many
+// across, whatever the floor's size: a thousand robots' floor is as readable as four's.
+const ZONE_LETTER_PX = 18, ZONE_NAME_PX = 12, ZONE_BOX_PX = 34;
 // Frames a second the map moves robots at: smooth for a few, calmer (and cheaper) for many.
 const FRAME_MS_FEW = 0, FRAME_MS_MANY = 50, MANY = 20;
 // More robots than this are drawn on a canvas: SVG's per-element styling and layout cost
@@ -88,8 +105,19 @@ export class MapView {
     this.onZone = onZone;
     /** @type {Map<string, DrawnRobot>} */
     this.robots = new Map();
-    /** @type {Map<string, {group: SVGGElement, zone: ZoneEntry, half: number}>} */
+    /** @type {Map<string, DrawnZone>} */
     this.zones = new Map();
+    // The floor's size on the screen decides how large a zone's words are drawn.
+    this.resized = new ResizeObserver(() => this.sizeZones());
+    this.resized.observe(svg);
+    // Where each robot of a large fleet is heading (a zone id), for the zones' counts.
+    /** @type {Map<string, string>} */
+    this.heading = new Map();
+    this.headingChanged = false;
+    // Metres a screen pixel spans on the floor as drawn, and the floor's drawn extent.
+    this.metresPerPx = 0.025;
+    /** @type {{width: number, height: number} | null} */
+    this.extent = null;
     /** @type {Map<string, SVGGElement>} */
     this.arms = new Map();
     /** @type {number | null} */
@@ -134,6 +162,11 @@ export class MapView {
     this.svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
     this.scale = Math.max(1, Math.max(right - left, top - bottom) / 13);
     this.labels = fleet.robots.length <= LABELS_UP_TO;
+    this.extent = { width: right - left, height: top - bottom };
+    this.measure();
+    this.heading.clear();
+    showLegend(".legend-crowd", fleet.robots.length > SVG_ROBOTS_UP_TO);
+    showLegend(".legend-key", fleet.robots.length <= SVG_ROBOTS_UP_TO);
 
     const layers = /** @type {Record<Layer, SVGGElement>} */ ({});
     for (const name of /** @type {Layer[]} */ (["floor", "fixtures", "zones", "paths", "robots"])) layers[name] = el("g", { class: `layer-${name}` }, this.svg);
@@ -154,8 +187,15 @@ export class MapView {
     for (const [zoneId, at] of Object.entries(floor.arms || {})) this.drawArm(zoneId, at, layers.fixtures);
     if (floor.led) this.drawLed(floor.led, layers.fixtures);
     const layer = this.layer;
+    this.svg.classList.toggle("map-crowded", Boolean(layer));
     if (layer) {
       for (const robot of fleet.robots) layer.add(robot.thing, robot.start);
+      layer.labels = [...this.zones.values()].map(({ zone, half }) => ({
+        below: { x: zone.pose.x, y: zone.pose.y - half },
+        above: { x: zone.pose.x, y: zone.pose.y + half },
+        name: zone.name,
+        incoming: "",
+      }));
       this.animate();
     } else {
       fleet.robots.forEach((robot, index) => this.drawRobot(robot, index, layers));
@@ -168,7 +208,7 @@ export class MapView {
     const length = distance(start, end);
     const angle = (-Math.atan2(end.y - start.y, end.x - start.x) * 180) / Math.PI;
     const group = el("g", { class: "conveyor", transform: `translate(${start.x} ${-start.y}) rotate(${angle})` }, parent);
-    el("title", {}, group).textContent = "Conveyor";
+    el("title", {}, group).textContent = t("Conveyor");
     el("rect", { class: "conveyor-belt", x: 0, y: -width / 2, width: length, height: width, rx: 0.04 }, group);
     for (let s = 0.18; s < length - 0.05; s += 0.26) {
       const h = width * 0.28;
@@ -178,21 +218,71 @@ export class MapView {
 
   /** @param {ZoneEntry} zone @param {SVGGElement} parent */
   drawZone(zone, parent) {
-    // The box is the arrival circle's square with room around it; a robot stops at its
-    // centre, so the letter sits in the top-left corner and the name along the bottom.
-    const half = zone.radius + 0.22;
-    const { x, y } = zone.pose;
-    const group = el("g", { class: `zone${zone.arm === "loader" ? " loading" : ""}`, "data-zone": zone.id, role: "button", "aria-label": `Zone ${zone.name}` }, parent);
+    const group = el("g", { class: `zone${zone.arm === "loader" ? " loading" : ""}`, "data-zone": zone.id, role: "button", "aria-label": zone.name }, parent);
     el("title", {}, group).textContent = zone.name;
-    el("rect", { class: "zone-body", x: x - half, y: -y - half, width: 2 * half, height: 2 * half, rx: 0.16 }, group);
-    const big = zone.id.length <= 2 ? zone.id : zone.key;
-    const letter = el("text", { class: "zone-letter", x: x - half + 0.26, y: -y - half + 0.3, "font-size": big ? 0.42 : 0.2 }, group);
-    letter.textContent = big || zone.name;
-    if (!big) letter.setAttribute("x", String(x));
-    const name = el("text", { class: "zone-name", x, y: -y + half - 0.09, "font-size": 0.16 }, group);
+    const body = el("rect", { class: "zone-body" }, group);
+    const shown = zone.id.length <= 2 ? zone.id : zone.key;
+    const letter = el("text", { class: "zone-letter" }, group);
+    letter.textContent = shown || zone.name;
+    const name = el("text", { class: "zone-name" }, group);
     name.textContent = zone.name;
+    // How many robots are on their way here (a large fleet's robots draw no paths).
+    const incoming = el("text", { class: "zone-incoming", visibility: "hidden" }, group);
     group.addEventListener("click", () => this.onZone(zone.id));
-    this.zones.set(zone.id, { group, zone, half });
+    const drawn = { group, zone, half: zone.radius + 0.22, body, letter, name, incoming, big: Boolean(shown) };
+    this.zones.set(zone.id, drawn);
+    this.sizeZone(drawn);
+  }
+
+  // The floor's metres per screen pixel, as drawn now ("meet": as large as the box allows).
+  measure() {
+    const box = this.svg.getBoundingClientRect();
+    const { width, height } = this.extent ?? { width: 0, height: 0 };
+    const fit = width > 0 && height > 0 ? Math.min(box.width / width, box.height / height) : 0;
+    this.metresPerPx = fit > 0 ? 1 / fit : this.scale / 40;
+  }
+
+  // The zones drawn again at the floor's size on the screen now.
+  sizeZones() {
+    if (!this.fleet) return;
+    this.measure();
+    for (const drawn of this.zones.values()) this.sizeZone(drawn);
+    if (this.layer) {
+      for (const label of this.layer.labels) {
+        const drawn = [...this.zones.values()].find((z) => z.zone.name === label.name);
+        if (!drawn) continue;
+        label.below = { x: drawn.zone.pose.x, y: drawn.zone.pose.y - drawn.half };
+        label.above = { x: drawn.zone.pose.x, y: drawn.zone.pose.y + drawn.half };
+      }
+      this.layer.dirty = true;
+      this.animate();
+    }
+  }
+
+  // The box is the arrival circle's square with room around it; a robot stops at its
+  // centre, so the letter (or key) sits in the top-left corner and the name along the
+  // bottom. On a large floor a box would be a speck: it is at least ZONE_BOX_PX across, its
+  // letter and name ZONE_LETTER_PX and ZONE_NAME_PX high, the name then below the box.
+  /** @param {DrawnZone} drawn */
+  sizeZone(drawn) {
+    const px = this.metresPerPx;
+    const { zone, body, letter, name, incoming, big } = drawn;
+    const half = Math.max(zone.radius + 0.22, (ZONE_BOX_PX / 2) * px);
+    drawn.half = half;
+    const letterSize = Math.max(0.42, ZONE_LETTER_PX * px), nameSize = Math.max(0.16, ZONE_NAME_PX * px);
+    const { x, y } = zone.pose;
+    for (const [key, value] of Object.entries({ x: x - half, y: -y - half, width: 2 * half, height: 2 * half, rx: Math.min(0.16 * this.scale, half / 3) })) put(body, key, value);
+    put(letter, "x", big ? x - half + 0.6 * letterSize : x);
+    put(letter, "y", -y - half + 0.72 * letterSize);
+    put(letter, "font-size", big ? letterSize : nameSize);
+    const inside = nameSize <= 0.2;
+    name.classList.toggle("below", !inside);
+    put(name, "x", x);
+    put(name, "y", inside ? -y + half - 0.09 : -y + half + 0.2 * nameSize);
+    put(name, "font-size", nameSize);
+    put(incoming, "x", x);
+    put(incoming, "y", -y - half - 0.35 * nameSize);
+    put(incoming, "font-size", nameSize);
   }
 
   /** @param {string} zoneId @param {Point} at @param {SVGGElement} parent */
@@ -200,7 +290,7 @@ export class MapView {
     const zone = this.fleet?.zones.find((z) => z.id === zoneId);
     if (!zone) return;
     const group = el("g", { class: "arm" }, parent);
-    el("title", {}, group).textContent = zone.arm === "loader" ? "Loading arm" : `Unloading arm of zone ${zone.id}`;
+    el("title", {}, group).textContent = zone.arm === "loader" ? t("Loading arm") : t("Unloading arm of {zone}", { zone: zone.name });
     const length = Math.min(0.45, distance(at, zone.pose) * 0.6);
     const toward = Math.atan2(zone.pose.y - at.y, zone.pose.x - at.x);
     el("line", { class: "arm-link", x1: at.x, y1: -at.y, x2: at.x + length * Math.cos(toward), y2: -(at.y + length * Math.sin(toward)) }, group);
@@ -211,9 +301,9 @@ export class MapView {
   /** @param {Point} at @param {SVGGElement} parent */
   drawLed(at, parent) {
     const group = el("g", { class: "led" }, parent);
-    el("title", {}, group).textContent = "Task III LED: lights when both robots delivered to D in order";
+    el("title", {}, group).textContent = t("Task III LED: lights when both robots delivered to D in order");
     el("circle", { class: "led-body", cx: at.x, cy: -at.y, r: 0.13 }, group);
-    el("text", { class: "led-label", x: at.x - 0.22, y: -at.y + 0.06, "font-size": 0.17, "text-anchor": "end" }, group).textContent = "task III LED";
+    el("text", { class: "led-label", x: at.x - 0.22, y: -at.y + 0.06, "font-size": 0.17, "text-anchor": "end" }, group).textContent = t("task III LED");
     this.led = group;
   }
 
@@ -255,7 +345,14 @@ export class MapView {
   /** @param {string} thing @param {RobotView} robot */
   update(thing, robot) {
     if (this.layer) {
-      this.layer.update(thing, robot.online === false ? "offline" : robot.reported?.status || "idle", Boolean(robot.reported?.cargo));
+      const status = robot.online === false ? "offline" : robot.reported?.status || "idle";
+      this.layer.update(thing, status, Boolean(robot.reported?.cargo));
+      const goal = status === "navigating" ? robot.reported?.destination : null;
+      if ((this.heading.get(thing) ?? null) !== (goal ?? null)) {
+        if (goal) this.heading.set(thing, goal);
+        else this.heading.delete(thing);
+        this.headingChanged = true;
+      }
       return;
     }
     const drawn = this.robots.get(thing);
@@ -333,7 +430,32 @@ export class MapView {
     }
     // A robot's new status is painted in the frame it arrived in, not the next slow tick.
     if (this.layer?.dirty) this.layer.draw(now());
+    if (this.headingChanged) this.countIncoming();
     for (const [zoneId, arm] of this.arms) arm.classList.toggle("working", working.has(zoneId));
+  }
+
+  // Each zone says how many robots are on their way to it ("→ 1,000"): a large fleet's
+  // motion is a crowd of dots, and this is where it is going.
+  countIncoming() {
+    this.headingChanged = false;
+    /** @type {Map<string, number>} */
+    const counts = new Map();
+    for (const zone of this.heading.values()) counts.set(zone, (counts.get(zone) ?? 0) + 1);
+    for (const [id, { incoming, zone }] of this.zones) {
+      const count = counts.get(id) ?? 0;
+      put(incoming, "visibility", count ? "visible" : "hidden");
+      if (incoming.dataset.count === String(count)) continue;
+      incoming.dataset.count = String(count);
+      const shown = count.toLocaleString("en-US");
+      const title = el("title");
+      title.textContent = t("{count} robots on their way to {zone}", { count: shown, zone: zone.name });
+      incoming.replaceChildren(document.createTextNode(count ? `→ ${shown}` : ""), title);
+      const label = this.layer?.labels.find((l) => l.name === zone.name);
+      if (label) {
+        label.incoming = count ? `→ ${shown}` : "";
+        if (this.layer) this.layer.dirty = true;
+      }
+    }
   }
 
   // -- moving ----------------------------------------------------------------------------
@@ -458,15 +580,37 @@ export function zoneText(id) {
 export function describe(state, { where = true } = {}) {
   const { status, reported } = state;
   if (status === "offline") {
-    return `offline · last seen ${clock(state.lastSeen, "never")}`;
+    return t("offline · last seen {when}", { when: clock(state.lastSeen, t("never")) });
   }
   if (status === "navigating") {
     const fraction = state.progress?.progress;
-    const to = reported.destination ? `to ${zoneText(reported.destination)}` : "driving";
+    const to = reported.destination ? t("to {zone}", { zone: zoneText(reported.destination) }) : t("driving");
     return fraction !== undefined && fraction !== null ? `${to} · ${Math.round(fraction * 100)}%` : to;
   }
-  if (status === "idle") return where && reported.zone ? `at ${zoneText(reported.zone)}` : "idle";
-  if (status === "loading") return "loading";
-  if (status === "unloading") return `unloading at ${zoneText(reported.zone)}`;
-  return status;
+  if (status === "idle") return where && reported.zone ? t("at {zone}", { zone: zoneText(reported.zone) }) : t("idle");
+  if (status === "loading") return t("loading");
+  if (status === "unloading") return t("unloading at {zone}", { zone: zoneText(reported.zone) });
+  return t(status);
+}
+
+/**
+ * A robot's reason as a person reads it: the zone it names by id (`zoneId`, the zone its
+ * command was for) by the zone's name, unless the name is said already ("no path to zone
+ * A"). As the skill says it (vahr.domain.fleet.reason_said).
+ * @param {string} reason
+ * @param {string | null | undefined} zoneId
+ */
+export function reasonSaid(reason, zoneId) {
+  const name = zoneId ? zoneNames[zoneId] : undefined;
+  if (!zoneId || !name) return reason;
+  const lead = name.toLowerCase().endsWith(zoneId.toLowerCase()) ? name.slice(0, name.length - zoneId.length).toLowerCase() : null;
+  const id = zoneId.replace(/[.*+?^${}()|[\]\\]/g, "\\$&");
+  return reason.replace(new RegExp(`(?<![A-Za-z0-9_])${id}(?![A-Za-z0-9_])`, "g"), (match, offset) =>
+    lead && reason.slice(0, offset).toLowerCase().endsWith(lead) ? match : name,
+  );
+}
+
+/** Show or hide the legend's entries that `selector` finds. @param {string} selector @param {boolean} shown */
+function showLegend(selector, shown) {
+  for (const item of document.querySelectorAll(selector)) /** @type {HTMLElement} */ (item).hidden = !shown;
 }

@@ -1,12 +1,14 @@
 // @ts-check
 // The keyboard-and-mouse panel: the paper's baseline method. Select a robot (a click on the
-// map or here, or keys 1-9), then a zone (a click, or its key: A-D, L) to send it there; the
+// map or here, or its number key), then a zone (a click, or its letter key, which the fleet
+// decides: `keysHint` says them above the panel) to send it there; the
 // arms load and unload on arrival. Esc stops every robot. "Ask the weather" asks the
 // assistant, as the paper's keyboard participants did. "Any robot" (key 0), then a zone,
 // asks the assistant to send a robot there, as a person would say it: the fleet's dispatcher
 // picks the robot, or queues the task when none is free.
 
 import { post, reason } from "./api.js";
+import { said, t, tNodes } from "./i18n.js";
 import { statusColour, zoneText } from "./map.js";
 import { typing } from "./talk.js";
 
@@ -31,14 +33,57 @@ import { typing } from "./talk.js";
 
 // The words the panel sends and shows for "any robot" (one place, for translation).
 const ANY = {
-  label: "Any robot",
+  label: t("Any robot"),
   key: "0",
-  /** @param {string} zone the zone as spoken ("zone c", "loading zone") */
-  utterance: (zone) => `send a robot to ${zone}`,
+  /** @param {string} zone the zone as spoken ("zone c", "loading zone"), in the assistant's language */
+  utterance: (zone) => said("send a robot to {zone}", { zone }),
   /** @param {string} zone */
-  title: (zone) => `Send any free robot to ${zone}`,
-  select: "Any robot selected: click a zone (or press its key) to send the free robot nearest it.",
+  title: (zone) => t("Send any free robot to {zone}", { zone }),
+  select: t("Any robot selected: click a zone (or press its key) to send the free robot nearest it."),
 };
+
+/**
+ * The keys this fleet's panel answers to, said once above it: its robots' numbers, its
+ * zones' letters (runs of consecutive letters as "A–D"), stop and talk.
+ * @param {FleetView} fleet
+ * @returns {Node[]}
+ */
+export function keysHint(fleet) {
+  const numbers = fleet.robots.map((robot) => robot.key).filter((k) => k !== null && k !== undefined);
+  const letters = fleet.zones.map((zone) => zone.key).filter((k) => k !== null && k !== undefined);
+  /** @type {Node[]} */
+  const out = [document.createTextNode(`${t("Keys:")} `)];
+  /** @param {string[]} keys */
+  const keyRun = (keys) => {
+    /** @type {Node[]} */
+    const nodes = [];
+    keys.forEach((k, i) => {
+      if (i > 0) nodes.push(document.createTextNode(k === "–" || keys[i - 1] === "–" ? "" : ", "));
+      nodes.push(k === "–" ? document.createTextNode("–") : key(k));
+    });
+    return nodes;
+  };
+  if (numbers.length) out.push(...keyRun(numbers.length > 2 ? [numbers[0], "–", numbers[numbers.length - 1]] : numbers), document.createTextNode(` ${t("robot")} · `));
+  out.push(key(ANY.key), document.createTextNode(` ${t("any robot")} · `));
+  if (letters.length) out.push(...keyRun(runs(letters)), document.createTextNode(` ${t("zone")} · `));
+  out.push(key("Esc"), document.createTextNode(` ${t("stop all")} · `));
+  out.push(...tNodes("hold {space} to talk", { space: key(t("Space")) }));
+  return out;
+}
+
+/** Letters with runs of three or more consecutive ones as first, "–", last. @param {string[]} letters */
+function runs(letters) {
+  /** @type {string[]} */
+  const out = [];
+  for (let i = 0; i < letters.length; ) {
+    let j = i;
+    while (j + 1 < letters.length && letters[j + 1].charCodeAt(0) === letters[j].charCodeAt(0) + 1) j += 1;
+    if (j - i >= 2) out.push(letters[i], "–", letters[j]);
+    else out.push(...letters.slice(i, j + 1));
+    i = j + 1;
+  }
+  return out;
+}
 
 /** @param {string | undefined} label @param {string} [className] */
 function button(label, className = "btn") {
@@ -117,8 +162,8 @@ export class Panel {
     if (fleet.robots.length > this.robotButtons.size) {
       const select = document.createElement("select");
       select.className = "robot-select";
-      select.setAttribute("aria-label", "Any robot");
-      select.appendChild(new Option(`All ${fleet.robots.length} robots…`, ""));
+      select.setAttribute("aria-label", t("Any robot"));
+      select.appendChild(new Option(t("All {count} robots…", { count: fleet.robots.length.toLocaleString("en-US") }), ""));
       for (const robot of fleet.robots) select.appendChild(new Option(robot.name, robot.thing));
       select.addEventListener("change", () => { if (select.value) this.onSelect(select.value); });
       this.robotsBox.appendChild(select);
@@ -129,12 +174,14 @@ export class Panel {
       const made = button(undefined, letter ? "btn btn-key" : "btn");
       if (zone.key) made.appendChild(key(zone.key));
       if (!letter) made.appendChild(document.createTextNode(zoneLabel(zone)));
-      made.setAttribute("aria-label", `Zone ${zone.id === zone.key ? zone.id : zone.name}`);
+      made.setAttribute("aria-label", zoneLabel(zone));
       made.dataset.zone = zone.id;
       made.addEventListener("click", () => this.navigate(this.selected, zone.id));
       this.zonesBox.appendChild(made);
       this.zoneButtons.set(zone.id, made);
     }
+    // The keys this fleet answers to (not a fixed "1–9, A–D, L"), unless a session's note shows.
+    if (this.note.dataset.session !== "true") this.note.replaceChildren(...keysHint(fleet));
     this.refresh();
   }
 
@@ -171,6 +218,7 @@ export class Panel {
     this.ordersAllowed = allowed;
     this.note.dataset.session = note ? "true" : "false";
     if (note) this.note.textContent = note;
+    else if (this.fleet) this.note.replaceChildren(...keysHint(this.fleet));
     this.refresh();
   }
 
@@ -178,7 +226,8 @@ export class Panel {
     for (const made of this.zoneButtons?.values() ?? []) {
       made.disabled = !(this.selected || this.anyRobot) || !this.ordersAllowed;
       const zone = made.dataset.zone;
-      made.title = this.selected ? `Send ${this.names[this.selected]} to ${zone}` : this.anyRobot ? ANY.title(String(zone)) : `Zone ${zone}: select a robot first`;
+      const name = zoneText(zone ?? "");
+      made.title = this.selected ? t("Send {robot} to {zone}", { robot: this.names[this.selected], zone: name }) : this.anyRobot ? ANY.title(name) : t("{zone}: select a robot first", { zone: name });
     }
   }
 
@@ -200,7 +249,7 @@ export class Panel {
     try {
       const { id } = await sent;
       this.pending.set(id, describe);
-      this.tell(`${describe}: sent, waiting for the robot.`);
+      this.tell(t("{what}: sent, waiting for the robot.", { what: describe }));
       // The robot may have answered before the station did.
       for (const [thing, ack] of Object.entries(this.commands[id]?.acks || {})) this.acknowledged(id, thing, ack);
       return id;
@@ -214,11 +263,11 @@ export class Panel {
   navigate(thing, zone) {
     if (!thing && this.anyRobot) return this.ordersAllowed ? this.sendAny(zone) : undefined;
     if (!thing) {
-      this.tell("Select a robot first: click it on the map, or press its number.", true);
+      this.tell(t("Select a robot first: click it on the map, or press its number."), true);
       return;
     }
     if (!this.ordersAllowed) return;
-    return this.order({ robot: thing, action: "navigate", zone }, `${this.names[thing]} to ${zoneText(zone)}`);
+    return this.order({ robot: thing, action: "navigate", zone }, t("{robot} to {zone}", { robot: this.names[thing], zone: zoneText(zone) }));
   }
 
   // Ask the assistant to send a robot to `zone`, as a person would say it.
@@ -231,10 +280,10 @@ export class Panel {
       (turn) => ({ speech: turn.speech, intent: turn.intent, commands: turn.commands || [] }),
       (err) => ({ error: err.message }),
     ));
-    this.tell(`${ANY.label} to ${zoneText(zone)}…`);
+    this.tell(`${t("{robot} to {zone}", { robot: ANY.label, zone: zoneText(zone) })}…`);
     try {
       const turn = await sent;
-      this.tell(`The assistant: “${turn.speech}”`);
+      this.tell(t("The assistant: “{speech}”", { speech: turn.speech }));
     } catch (err) {
       this.tell(reason(err), true);
     }
@@ -246,8 +295,8 @@ export class Panel {
     this.interactions.attach(sent.then((answer) => ({ commands: [answer.id] }), (err) => ({ error: err.message })));
     try {
       const { id } = await sent;
-      this.pending.set(id, "Stop all");
-      this.tell("Stop all: sent.");
+      this.pending.set(id, t("Stop all"));
+      this.tell(t("Stop all: sent."));
     } catch (err) {
       this.tell(reason(err), true);
     }
@@ -256,15 +305,15 @@ export class Panel {
   async askWeather() {
     this.weatherButton.disabled = true;
     /** @type {Promise<SayReply>} */
-    const sent = post("/api/say", { utterance: "what is the weather", origin: "station-weather" });
+    const sent = post("/api/say", { utterance: said("what is the weather"), origin: "station-weather" });
     this.interactions.attach(sent.then(
       (turn) => ({ asks: true, speech: turn.speech, intent: turn.intent, commands: turn.commands || [] }),
       (err) => ({ asks: true, error: err.message }),
     ));
-    this.tell("Asking the assistant for the weather…");
+    this.tell(t("Asking the assistant for the weather…"));
     try {
       const turn = await sent;
-      this.tell(`The assistant: “${turn.speech}”`);
+      this.tell(t("The assistant: “{speech}”", { speech: turn.speech }));
       const { speak } = await import("./api.js");
       await speak(turn.speech);
     } catch (err) {
@@ -280,8 +329,8 @@ export class Panel {
     const describe = this.pending.get(id);
     if (!describe) return;
     const name = this.names[thing] || thing;
-    if (ack.event === "rejected") this.tell(`${describe}: ${name} rejected it.`, true);
-    else this.tell(`${describe}: acknowledged by ${name} in ${Math.round(ack.latency_ms)} ms.`);
+    if (ack.event === "rejected") this.tell(t("{what}: {robot} rejected it.", { what: describe, robot: name }), true);
+    else this.tell(t("{what}: acknowledged by {robot} in {ms} ms.", { what: describe, robot: name, ms: Math.round(ack.latency_ms) }));
   }
 
   /** @param {KeyboardEvent} event */
@@ -314,6 +363,6 @@ export class Panel {
 // "Zone A" for a one-letter zone, else its spoken name with a capital ("Loading zone").
 /** @param {ZoneEntry} zone */
 export function zoneLabel(zone) {
-  if (zone.id.length === 1) return `Zone ${zone.id}`;
+  if (zone.id.length === 1) return t("Zone {id}", { id: zone.id });
   return zone.name.charAt(0).toUpperCase() + zone.name.slice(1);
 }

@@ -11,6 +11,16 @@ import { Motion } from "./motion.js";
 /** @import { Cluster, Placed } from "./cluster.js" */
 /** @import { Point } from "./contract.js" */
 
+/**
+ * A zone's words drawn over the robots (a crowd must not hide where it is): its name below
+ * its box, and how many robots are on their way to it above.
+ * @typedef {object} ZoneLabel
+ * @property {Point} below the point under its box, on the floor
+ * @property {Point} above the point over its box
+ * @property {string} name
+ * @property {string} incoming "" when none is on its way
+ */
+
 // A robot's dot, a crowd's smallest mark, and how near a click must be, in CSS pixels.
 const DOT_PX = 4.5, CROWD_PX = 6.5, REACH_PX = 12;
 // Robots closer than this on the screen are one mark; a crowd's mark stays inside its square.
@@ -50,6 +60,8 @@ export class RobotLayer {
     this.troubled = new Map();
     /** @type {Record<string, string>} */
     this.colours = {};
+    /** @type {ZoneLabel[]} */
+    this.labels = [];
     this.dirty = true;
     // Where the floor is on the screen, read again only when it may have moved: reading it
     // each frame would make the browser lay out the page each time a robot's line changed.
@@ -145,7 +157,29 @@ export class RobotLayer {
     context.textBaseline = "middle";
     context.font = "600 10px system-ui, sans-serif";
     for (const mark of this.marks) this.drawMark(mark, toScreen);
+    this.drawLabels(toScreen);
     return busy;
+  }
+
+  /** The zones' names and counts, over the robots, with a halo. @param {(at: Point) => Point} toScreen */
+  drawLabels(toScreen) {
+    const context = this.context;
+    context.lineJoin = "round";
+    context.lineWidth = 4;
+    context.strokeStyle = "rgba(255, 255, 255, 0.9)";
+    for (const label of this.labels) {
+      const below = toScreen(label.below), above = toScreen(label.above);
+      context.font = "500 12px system-ui, sans-serif";
+      context.fillStyle = this.colours.label || "#3d4a5c";
+      context.strokeText(label.name, below.x, below.y + 9);
+      context.fillText(label.name, below.x, below.y + 9);
+      if (label.incoming) {
+        context.font = "700 12px system-ui, sans-serif";
+        context.fillStyle = this.colours.navigating;
+        context.strokeText(label.incoming, above.x, above.y - 9);
+        context.fillText(label.incoming, above.x, above.y - 9);
+      }
+    }
   }
 
   /** @param {Cluster} mark @param {(at: Point) => Point} toScreen */

@@ -10,7 +10,8 @@
 // zone (search.js); the list shows the matches, best first, and a click on one selects it.
 
 import { clock, node } from "./dom.js";
-import { describe, statusColour, zoneText } from "./map.js";
+import { t } from "./i18n.js";
+import { describe, reasonSaid, statusColour, zoneText } from "./map.js";
 import { findRobots } from "./search.js";
 import { VirtualList } from "./virtual-list.js";
 
@@ -29,13 +30,13 @@ const REFILTER_MS = 1000;
 
 // The words this view shows (one place, for translation).
 const WORDS = {
-  none: "No robot matches.",
-  anyStatus: "any status",
-  anyZone: "any zone",
+  none: t("No robot matches."),
+  anyStatus: t("any status"),
+  anyZone: t("any zone"),
   /** @param {number} shown @param {number} all */
-  count: (shown, all) => (shown === all ? `${all} robots` : `${shown} of ${all} robots`),
+  count: (shown, all) => (shown === all ? t("{all} robots", { all }) : t("{shown} of {all} robots", { shown, all })),
   /** @param {string} name */
-  select: (name) => `Select ${name}`,
+  select: (name) => t("Select {name}", { name }),
 };
 // The statuses a search can ask for, in the legend's order.
 const STATUSES = ["idle", "navigating", "loading", "unloading", "waiting", "stopped", "stuck", "error", "offline"];
@@ -124,7 +125,7 @@ export class RobotsPanel {
     /** @type {ReturnType<typeof setTimeout> | null} */
     this.refilter = null;
     search.none.textContent = WORDS.none;
-    search.status.replaceChildren(new Option(WORDS.anyStatus, ""), ...STATUSES.map((status) => new Option(status, status)));
+    search.status.replaceChildren(new Option(WORDS.anyStatus, ""), ...STATUSES.map((status) => new Option(t(status), status)));
     const find = () => this.find();
     search.input.addEventListener("input", find);
     search.status.addEventListener("change", find);
@@ -191,8 +192,8 @@ export class RobotsPanel {
       row.dataset.thing = robot.thing;
       const badge = node("button", "badge", robot.key ?? String(index + 1));
       badge.type = "button";
-      badge.title = `Select ${robot.name}`;
-      badge.setAttribute("aria-label", `Select ${robot.name}`);
+      badge.title = WORDS.select(robot.name);
+      badge.setAttribute("aria-label", WORDS.select(robot.name));
       badge.addEventListener("click", () => this.onSelect(robot.thing));
       const presence = node("span", "presence");
       const presenceText = node("span");
@@ -200,7 +201,7 @@ export class RobotsPanel {
       const facts = node("div", "facts");
       const status = node("span", "status-text");
       const zone = node("b");
-      const zoneFact = node("span", "", "zone ");
+      const zoneFact = node("span", "", t("zone") + " ");
       zoneFact.appendChild(zone);
       const cargo = node("span");
       facts.append(status, zoneFact, cargo);
@@ -215,7 +216,7 @@ export class RobotsPanel {
       const last = node("div", "last");
       const details = node("details");
       const raw = node("pre");
-      details.append(node("summary", "", "Reported shadow"), raw);
+      details.append(node("summary", "", t("Reported shadow")), raw);
       // The raw shadow is written only while someone looks at it.
       details.addEventListener("toggle", () => { if (details.open) raw.textContent = JSON.stringify(parts.reported, null, 2); });
       row.append(badge, node("span", "name", robot.name), presence, facts, task, last, details);
@@ -275,7 +276,7 @@ export class RobotsPanel {
     put(line.status.style, "color", `var(--${statusColour(status)})`);
     put(line.zone, "textContent", reported.zone ? zoneText(reported.zone) : "");
     line.cargo.hidden = !reported.cargo;
-    if (reported.cargo) put(line.cargo, "textContent", "package");
+    if (reported.cargo) put(line.cargo, "textContent", t("package"));
   }
 
   /** @param {string | null} thing */
@@ -316,19 +317,19 @@ export class RobotsPanel {
     const colour = `var(--${statusColour(status)})`;
     if (parts.row.dataset.status !== status) parts.row.dataset.status = status;
     put(parts.badge.style, "background", colour);
-    put(parts.presenceText, "textContent", online ? "online" : online === false ? `offline · seen ${clock(robot.last_seen, "never")}` : "not heard yet");
+    put(parts.presenceText, "textContent", online ? t("online") : online === false ? t("offline · seen {when}", { when: clock(robot.last_seen, t("never")) }) : t("not heard yet"));
     parts.presence.classList.toggle("online", Boolean(online));
     put(parts.status, "textContent", describe({ status, reported, lastSeen: robot.last_seen, progress: robot.progress }, { where: false }));
     put(parts.status.style, "color", colour);
     put(parts.zone, "textContent", reported.zone ? zoneText(reported.zone) : "—");
-    put(parts.cargo, "textContent", reported.cargo ? "package" : "no package");
+    put(parts.cargo, "textContent", reported.cargo ? t("package") : t("no package"));
     put(parts.cargo, "className", reported.cargo ? "cargo-tag" : "");
 
     const last = reported.last_command;
     const working = Boolean(reported.task);
     parts.task.hidden = !working;
     if (working) {
-      put(parts.taskWhat, "textContent", `${reported.task}${reported.destination ? ` → ${zoneText(reported.destination)}` : ""}`);
+      put(parts.taskWhat, "textContent", `${t(reported.task ?? "")}${reported.destination ? ` → ${zoneText(reported.destination)}` : ""}`);
       const fraction = robot.progress?.progress;
       const driving = status === "navigating" && fraction !== undefined && fraction !== null;
       parts.bar.hidden = parts.percent.hidden = !driving;
@@ -338,13 +339,15 @@ export class RobotsPanel {
       }
       const command = last ? commands[last.id] : null;
       parts.source.hidden = !command?.source;
-      if (command?.source) put(parts.source, "textContent", `by ${shortSource(command.source)}`);
+      if (command?.source) put(parts.source, "textContent", t("by {who}", { who: shortSource(command.source) }));
     }
     if (last) {
-      put(parts.last, "textContent", `Last: ${last.action} ${last.result}${last.reason ? `: ${last.reason}` : ""}`);
+      // The reason names its zone by id; a person reads the zone's name.
+      const why = last.reason ? `: ${reasonSaid(last.reason, last.zone)}` : "";
+      put(parts.last, "textContent", t("Last: {action} {result}", { action: t(last.action), result: t(last.result) }) + why);
       parts.last.classList.toggle("bad", ["rejected", "failed"].includes(last.result));
     } else {
-      put(parts.last, "textContent", "Last: no command yet");
+      put(parts.last, "textContent", t("Last: no command yet"));
     }
     if (parts.details.open) put(parts.raw, "textContent", JSON.stringify(reported, null, 2));
   }
@@ -355,15 +358,16 @@ const lineOf = new WeakMap();
 
 /** Who sent a command, in words. @param {string} source */
 export function sourceName(source) {
-  if (source === "alexa") return "the assistant";
-  if (source === "console") return "keyboard and mouse";
+  if (source === "alexa") return t("the assistant");
+  if (source === "console") return t("keyboard and mouse");
+  if (source === "dispatcher") return t("the dispatcher");
   if (source.startsWith("robot:")) return source.slice(6);
   return source;
 }
 
 /** @param {string} source */
 function shortSource(source) {
-  if (source === "alexa") return "voice";
-  if (source === "console") return "keyboard";
+  if (source === "alexa") return t("voice");
+  if (source === "console") return t("keyboard");
   return sourceName(source);
 }

@@ -8,6 +8,7 @@ import { COMMANDS_LIMIT, DRIVE_ENDS, EXCHANGE_EVENTS } from "./contract.js";
 import { Conversation } from "./conversation.js";
 import { byId } from "./dom.js";
 import { ExperimentView, watchInteractions } from "./experiment.js";
+import { t } from "./i18n.js";
 import { Interactions } from "./interactions.js";
 import { MapView, setZoneNames, zoneText } from "./map.js";
 import { applyChange } from "./changes.js";
@@ -99,8 +100,8 @@ function select(thing) {
   robots.select(store.selected);
   panel.select(store.selected);
   byId("map-hint", HTMLElement).textContent = store.selected
-    ? `${names[store.selected]} selected: click a zone (or press its key) to send it there.`
-    : "Click a robot, then a zone to send it there.";
+    ? t("{robot} selected: click a zone (or press its key) to send it there.", { robot: names[store.selected] })
+    : t("Click a robot, then a zone to send it there.");
 }
 
 // -- drawing changes, at most once a frame ---------------------------------------------
@@ -244,7 +245,7 @@ function onExperiment(status) {
   experiment.update(status);
   map.setLed(store.experiment?.led_on);
   const voiceSession = store.experiment && store.experiment.method !== "keyboard";
-  panel.allowOrders(!voiceSession, voiceSession ? "Voice session: orders are given by voice. The panel selects and stops robots." : null);
+  panel.allowOrders(!voiceSession, voiceSession ? t("Voice session: orders are given by voice. The panel selects and stops robots.") : null);
 }
 
 /** What the page does with each message, by its type. @type {{[T in PageMessage["type"]]: (message: Extract<PageMessage, {type: T}>) => void}} */
@@ -286,10 +287,10 @@ function connect() {
   const state = byId("link-state", HTMLElement);
   const label = /** @type {HTMLElement} */ (state.querySelector(".label"));
   const stream = new EventSource("/api/stream");
-  stream.onopen = () => { state.dataset.state = "live"; label.textContent = "Live"; };
+  stream.onopen = () => { state.dataset.state = "live"; label.textContent = t("Live"); };
   stream.onerror = () => {
     state.dataset.state = stream.readyState === EventSource.CLOSED ? "lost" : "connecting";
-    label.textContent = stream.readyState === EventSource.CLOSED ? "Disconnected: reload the page" : "Reconnecting…";
+    label.textContent = stream.readyState === EventSource.CLOSED ? t("Disconnected: reload the page") : t("Reconnecting…");
   };
   stream.onmessage = (event) => {
     for (const message of /** @type {PageMessage[]} */ (JSON.parse(event.data))) {

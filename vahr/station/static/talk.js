@@ -3,6 +3,7 @@
 // microphone as 16 kHz mono 16-bit PCM, sends it as a WAV file, and shows what was heard,
 // how sure the recognizer was, and the assistant's reply, which it then speaks.
 
+import { t } from "./i18n.js";
 import { ApiError, hush, postWav, reason, speak } from "./api.js";
 
 /** @import { VoiceReply } from "./api.js" */
@@ -79,7 +80,7 @@ export class Talk {
     this.busy = false;
     if (!navigator.mediaDevices?.getUserMedia) {
       button.disabled = true;
-      this.say("Push-to-talk needs a microphone and a secure page: open the station on this computer (http://127.0.0.1) or over https.");
+      this.say(t("Push-to-talk needs a microphone and a secure page: open the station on this computer (http://127.0.0.1) or over https."));
       return;
     }
     button.addEventListener("pointerdown", (event) => {
@@ -120,8 +121,8 @@ export class Talk {
     const recording = { chunks: [], pressedAt, interaction, released: false, ready: null };
     this.recording = recording;
     this.button.dataset.state = "listening";
-    this.label.textContent = "Listening… let go to send";
-    this.say("Listening…");
+    this.label.textContent = t("Listening… let go to send");
+    this.say(t("Listening…"));
     recording.ready = this.open(recording).catch((err) => {
       recording.error = err;
     });
@@ -167,14 +168,14 @@ export class Talk {
     const rate = RATE;
     this.busy = true;
     this.button.dataset.state = "thinking";
-    this.label.textContent = "Understanding…";
+    this.label.textContent = t("Understanding…");
     const { interaction } = recording;
     interaction.counts = true;
     try {
-      if (recording.error) throw new ApiError(`The microphone is not available: ${reason(recording.error)}`);
+      if (recording.error) throw new ApiError(t("The microphone is not available: {why}", { why: reason(recording.error) }));
       if (Date.now() - recording.pressedAt < SHORTEST_MS || !recording.chunks.length) {
         interaction.counts = false;
-        this.say("Hold the button while you speak, and let go when you are done.");
+        this.say(t("Hold the button while you speak, and let go when you are done."));
         return;
       }
       const result = await postWav(wavFile(recording.chunks, rate));
@@ -203,7 +204,7 @@ export class Talk {
     this.busy = false;
     if (this.recording) return;
     this.button.dataset.state = "idle";
-    this.label.textContent = "Hold to talk";
+    this.label.textContent = t("Hold to talk");
   }
 
   /** @param {VoiceReply} result */
@@ -214,9 +215,9 @@ export class Talk {
       const said = document.createElement("span");
       said.className = "transcript";
       said.textContent = `“${heard.transcript}”`;
-      this.state.append("Heard ", said, ` (${Math.round(heard.confidence * 100)}% sure). `);
+      this.state.append(`${t("Heard")} `, said, ` (${t("{sure}% sure", { sure: Math.round(heard.confidence * 100) })}). `);
     } else {
-      this.state.append("Heard no speech. ");
+      this.state.append(`${t("Heard no speech.")} `);
     }
     const reply = document.createElement("span");
     reply.className = "reply";

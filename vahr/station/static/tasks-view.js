@@ -3,16 +3,17 @@
 // when the deployment has a dispatcher; "nothing queued" when its queue is empty.
 
 import { node } from "./dom.js";
+import { t } from "./i18n.js";
 import { taskLines } from "./tasks.js";
 
 /** @import { TasksMessage } from "./contract.js" */
 
 // The words this view shows (one place, for translation).
 const WORDS = {
-  empty: "Nothing queued: every task has a robot.",
+  empty: t("Nothing queued: every task has a robot."),
   /** @param {number} queued @param {number} doing */
-  count: (queued, doing) => `${queued} queued · ${doing} under way`,
-  status: { queued: "queued", assigned: "under way", done: "done", cancelled: "cancelled" },
+  count: (queued, doing) => t("{queued} queued · {doing} under way", { queued, doing }),
+  status: { queued: t("queued"), assigned: t("under way"), done: t("done"), cancelled: t("cancelled") },
 };
 
 export class TasksView {
