@@ -30,6 +30,7 @@ if TYPE_CHECKING:
     from robot_agent.link.mqtt5 import Mqtt5Link
     from robot_agent.voice.port import Voice
     from vahr.domain import Fleet
+    from vahr.navigation import FleetFloor
     from vahr.protocol.link import Link
 
 
@@ -44,7 +45,19 @@ def build_backend(config: AgentConfig, fleet: Fleet, clock: ScaledClock) -> Navi
                 "install ros-core and python3-move-base-msgs, then run make setup"
             ) from err
         return Ros1Backend(config.ros, start=fleet.robot(thing).start)
-    return SimBackend(start=fleet.robot(thing).start, clock=clock, settings=config.sim)
+    return SimBackend(
+        start=fleet.robot(thing).start, clock=clock, settings=config.sim, floor=robot_floor(fleet)
+    )
+
+
+def robot_floor(fleet: Fleet) -> FleetFloor | None:
+    """The fleet's map, read and checked, for a simulated robot to plan on; None for a
+    drawn floor (the robot drives straight). A bad map is a VahrError in one line."""
+    if fleet.floor is None or fleet.floor.map is None:
+        return None
+    from vahr.navigation import load_floor
+
+    return load_floor(fleet)
 
 
 def build_voice(config: AgentConfig, link: Link) -> Voice | None:

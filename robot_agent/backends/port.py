@@ -24,11 +24,15 @@ class Progress:
     from a backend that keeps the time of its own motion (the simulator): the executor then
     judges "no progress" by that time, which a busy process cannot advance without the
     motion advancing too. None: the backend does not, and the executor's clock is used.
+    A backend that plans on a map also gives `path` (the planned points to the goal, new
+    whenever it plans again) and `eta_s` (seconds left along it).
     """
 
     fraction: float
     pose: Pose
     at: float | None = None
+    path: tuple[tuple[float, float], ...] | None = None
+    eta_s: float | None = None
 
 
 class NavigationFailed(Exception):
@@ -50,6 +54,14 @@ class NavigationBackend(Protocol):
 
     async def halt(self) -> None:
         """Stop moving at once and drop any active goal."""
+
+    def close_zones(self, closed: frozenset[str]) -> None:
+        """The zones closed now: a backend that plans drives around their areas from now
+        on (a drive under way plans again); one that does not may ignore it."""
+
+    async def leave(self, zone: Zone, on_progress: Callable[[Progress], None]) -> None:
+        """Drive out of `zone`'s area (it closed with the robot inside) to the nearest
+        place outside it; return at once where the backend does not plan."""
 
     async def close(self) -> None:
         """Release the backend's resources (threads, nodes, connections)."""

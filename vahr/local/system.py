@@ -28,7 +28,7 @@ from vahr.domain.fleet import SPOKEN_LOCALE
 from vahr.errors import VahrError
 from vahr.local.alexa_host import serve_alexa
 from vahr.local.announce_host import LocalAnnouncer
-from vahr.local.dispatch_host import TASKS_PATH, LocalDispatcher
+from vahr.local.dispatch_host import TASKS_PATH, ZONES_PATH, LocalDispatcher
 from vahr.local.robots import (
     ProgressRate,
     RobotProcesses,
@@ -265,6 +265,7 @@ class LocalSystem:
             state_dir=self.config.state_dir,
         ).start()
         dataplane.typed_routes[TASKS_PATH] = self.dispatcher.api.respond
+        dataplane.typed_routes[ZONES_PATH] = self.dispatcher.zones_api.respond
 
     def _start_room(self) -> None:
         """The assistant robots talk to: a second simulated Echo on the same skill."""

@@ -43,6 +43,9 @@ class Reported(msgspec.Struct, frozen=True):
     destination: str | None = None
     task: str | None = None
     pose: ReportedPose | None = None
+    # The way a robot driving on a map is taking: its planned path's points from where it
+    # planned to its goal, in the map frame (`[[x, y], ...]`); None when not driving one.
+    path: list[tuple[float, float]] | None = None
 
     def to_payload(self, client_token: str | None = None) -> bytes:
         """The body of a shadow update reporting this whole state."""
