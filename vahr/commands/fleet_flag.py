@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from vahr.domain import Fleet, load_fleet
+from vahr.domain.fleet import map_beside
 from vahr.errors import VahrError
 from vahr.protocol import ProtocolError
 
@@ -44,7 +45,7 @@ def read_fleet(path: Path | None) -> Fleet:
     except OSError as err:
         raise VahrError(f"{path}: cannot read the fleet file ({err.strerror})") from err
     try:
-        return Fleet.from_yaml(text)
+        return map_beside(Fleet.from_yaml(text), path)
     except ProtocolError as err:
         # The whole file's faults ("is not valid YAML") need no field name after the file's.
         said = err.reason if err.field == "fleet" else str(err)

@@ -284,15 +284,19 @@ class Dispatcher:
         return self.robot_freed(state.thing)
 
     def robot_freed(self, thing: str) -> Task | None:
-        """Give `thing` the first queued task it may take (first come, first served). When
-        another dispatcher got there first, the next one; None when nothing is left."""
+        """Give `thing` the first queued task it may take (first come, first served): not
+        one into a closed zone, nor, on a map, one it has no path to. When another
+        dispatcher got there first, the next one; None when nothing is left."""
+        pending = self.store.pending()
+        if not pending:
+            return None
         closed = self._closed()
         state = None
-        for task in self.store.pending():
+        on_map = self.fleet.floor is not None and self.fleet.floor.map is not None
+        for task in pending:
             if not task.allows(thing) or self._blocked(task, closed):
                 continue
-            if self.fleet.floor is not None and self.fleet.floor.map is not None:
-                # On a map, only a task the robot has a path to.
+            if on_map:
                 state = state or self.candidates.state(thing)
                 if state is not None and not rank(
                     self.fleet, task, [state], limit=1, routes=self.routes_for(closed)
@@ -307,10 +311,13 @@ class Dispatcher:
 
     def drain(self) -> list[Task]:
         """Give every queued task that a free robot may take to the best such robot (at
-        start-up, after a restart, when a robot comes back online)."""
+        start-up, after a restart, when a robot comes back online, when a zone opens)."""
+        pending = self.store.pending()
+        if not pending:
+            return []
         given = []
         closed = self._closed()
-        for task in self.store.pending():
+        for task in pending:
             if self._blocked(task, closed):
                 continue
             taken = self._give(task, closed)

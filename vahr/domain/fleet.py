@@ -472,10 +472,15 @@ def load_fleet(path: str | os.PathLike[str] | None = None) -> Fleet:
             text = stream.read()
     except OSError as err:
         raise ProtocolError("fleet", f"cannot read {file}: {err.strerror}") from err
-    fleet = Fleet.from_yaml(text)
+    return map_beside(Fleet.from_yaml(text), file)
+
+
+def map_beside(fleet: Fleet, fleet_file: str | os.PathLike[str]) -> Fleet:
+    """The fleet with its floor's map (a path relative to the fleet file, as the contract
+    says) made absolute, so it reads the same from any directory and any copy of the fleet."""
     floor = fleet.floor
-    if floor is not None and floor.map is not None and not os.path.isabs(floor.map):  # noqa: PTH117
-        here = os.path.dirname(os.path.abspath(file))  # noqa: PTH100, PTH120
-        absolute = os.path.normpath(os.path.join(here, floor.map))  # noqa: PTH118
-        fleet = msgspec.structs.replace(fleet, floor=msgspec.structs.replace(floor, map=absolute))
-    return fleet
+    if floor is None or floor.map is None or os.path.isabs(floor.map):  # noqa: PTH117
+        return fleet
+    here = os.path.dirname(os.path.abspath(os.fspath(fleet_file)))  # noqa: PTH100, PTH120
+    absolute = os.path.normpath(os.path.join(here, floor.map))  # noqa: PTH118
+    return msgspec.structs.replace(fleet, floor=msgspec.structs.replace(floor, map=absolute))

@@ -37,6 +37,7 @@ from vahr.local.robots import (
     generated_fleet,
     write_fleet,
 )
+from vahr.navigation import load_floor
 from vahr.plumbing.mqtt import MqttClient
 from vahr.plumbing.ports import ensure_free
 from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics
@@ -133,6 +134,9 @@ class LocalSystem:
             self.fleet: Fleet = generated_fleet(config.swarm, config.fleet)
         else:
             self.fleet = fleet_of(config.robots, config.fleet)
+        # A fleet on a map: the map read and the fleet checked against it before anything
+        # starts, so a bad map stops `vahr up` in one line (vahr.navigation.MapError).
+        load_floor(self.fleet)
         self.stack = LocalStack(
             StackConfig(
                 state_dir=config.state_dir,

@@ -169,10 +169,13 @@ class FleetFloor:
         areas kept out: one search per zone, cached by the planner."""
         return PlannedRoutes(self.planner(closed))
 
-    def parking(self, count: int, *, spacing: float, clear_of_zones: float) -> list[Pose]:
+    def parking(
+        self, count: int, *, spacing: float, clear_of_zones: float, avoid: Iterable[Pose] = ()
+    ) -> list[Pose]:
         """`count` places robots may start at, on a square lattice `spacing` apart over the
         drivable cells reachable from the first robot's start, each at least
-        `clear_of_zones` metres from every zone; MapError when the map holds fewer."""
+        `clear_of_zones` metres from every zone and `spacing` from every pose in `avoid`;
+        MapError when the map holds fewer."""
         from scipy.ndimage import label
 
         from vahr.domain.fleet import Pose
@@ -189,6 +192,8 @@ class FleetFloor:
         ys = grid.origin_y + (rows + 0.5) * grid.resolution
         for zone in self.fleet.zones:
             usable &= np.hypot(xs - zone.pose.x, ys - zone.pose.y) >= clear_of_zones
+        for pose in avoid:
+            usable &= np.hypot(xs - pose.x, ys - pose.y) >= spacing
         spots = [
             Pose(round(float(x), 3), round(float(y), 3))
             for x, y in zip(xs[usable], ys[usable], strict=True)

@@ -165,6 +165,12 @@ class GoalField:
             self._search = search
             self._metres = cumulative * planner.resolution
 
+    def metres(self) -> np.ndarray:
+        """Every cell's path length to the goal (math.inf where none), row 0 at the bottom."""
+        if self._metres is None:
+            return np.full(self.planner.drivable.shape, np.inf)
+        return self._metres
+
     @property
     def reachable(self) -> bool:
         """Whether the goal itself is a place a robot may stand (else nothing reaches it)."""
