@@ -19,7 +19,15 @@ from skill.config import SkillConfig
 from skill.task_desk import TaskRefused
 from tests.conftest import load_event
 from tests.support.fleets import SIX_ROBOTS
-from vahr.dispatch import Dispatcher, DispatchError, Order, RobotState, Submission, Task
+from vahr.dispatch import (
+    Dispatcher,
+    DispatchError,
+    Order,
+    RobotState,
+    Submission,
+    Task,
+    ZoneChange,
+)
 from vahr.domain import load_fleet
 from vahr.local.task_store import SqliteTaskStore
 
@@ -69,6 +77,15 @@ class CoreDesk:
 
     def cancel(self, task_id: str) -> Task | None:
         return self.dispatcher.cancel(task_id)
+
+    def closed_zones(self) -> list[str]:
+        return self.dispatcher.closed_zones()
+
+    def set_zone(self, zone: str, *, closed: bool) -> ZoneChange:
+        try:
+            return self.dispatcher.set_zone(zone, closed=closed)
+        except DispatchError as err:
+            raise TaskRefused(400, str(err), err.code) from err
 
 
 @pytest.fixture

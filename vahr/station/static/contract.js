@@ -83,7 +83,8 @@
  * What a robot did, published on `vahr/robots/{thing}/events`.
  *
  * Only the fields that apply are sent: `zone` for arrived/loaded/delivered, `reason` for
- * rejected/failed/stuck/cancelled, `progress` (0..1) for progress, `text` for what was said or
+ * rejected/failed/stuck/cancelled, `progress` (0..1 of the path's length) and `eta_s` (seconds
+ * left along the path, where the robot knows it) for progress, `text` for what was said or
  * heard, `intent` and `confidence` for interpreted.
  * @typedef {object} Event
  * @property {"accepted"|"arrived"|"cancelled"|"delivered"|"done"|"failed"|"heard"|"interpreted"|"loaded"|"progress"|"rejected"|"said"|"stopped"|"stuck"|"waiting"} event
@@ -98,6 +99,7 @@
  * @property {string|null} [text]
  * @property {string|null} [intent]
  * @property {number|null} [confidence]
+ * @property {number|null} [eta_s]
  */
 
 /**
@@ -119,6 +121,7 @@
  * @property {string|null} [text]
  * @property {string|null} [intent]
  * @property {number|null} [confidence]
+ * @property {number|null} [eta_s]
  */
 
 /**
@@ -162,25 +165,47 @@
  */
 
 /**
- * The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`).
+ * The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`), and the map
+ * when the floor is one.
  * @typedef {object} FleetView
  * @property {Array<RobotEntry>} robots
  * @property {Array<ZoneEntry>} zones
  * @property {Floor} floor
  * @property {string} experiment_thing
+ * @property {FloorMap|null} map
  */
 
 /**
- * The floor as drawn: the rectangle from `origin` of `width` by `height` metres, its walls, the
+ * The floor: the rectangle from `origin` of `width` by `height` metres, its walls, the
  * conveyor, where each zone's arm stands (by zone id) and the task III LED.
+ *
+ * With `map` (a ROS map_server YAML, relative to the fleet file; `load_fleet` makes it
+ * absolute) the map is the floor: `width`, `height` and `origin` are the map's, filled in by
+ * `vahr.navigation` when it reads it, and `robot_radius` is how far robots keep from anything
+ * that is not free space. Without a map, `width` and `height` are required.
  * @typedef {object} Floor
- * @property {number} width
- * @property {number} height
+ * @property {number|null} width
+ * @property {number|null} height
  * @property {Point} origin
  * @property {Array<Segment>} walls
  * @property {Conveyor|null} conveyor
  * @property {Record<string, Point>} arms
  * @property {Point|null} led
+ * @property {string|null} map
+ * @property {number} robot_radius
+ */
+
+/**
+ * A floor that is a map: its picture (`image`, a PNG the station serves: occupied cells dark,
+ * free ones light, unknown ones clear) laid from `origin` at `resolution` metres a pixel,
+ * `columns` by `rows`; `known` is the part that is not unknown, which the page zooms to.
+ * @typedef {object} FloorMap
+ * @property {string} image
+ * @property {Point} origin
+ * @property {number} resolution
+ * @property {number} columns
+ * @property {number} rows
+ * @property {MapExtent} known
  */
 
 /**
@@ -224,6 +249,15 @@
  */
 
 /**
+ * A rectangle of the map frame, in metres.
+ * @typedef {object} MapExtent
+ * @property {number} left
+ * @property {number} bottom
+ * @property {number} right
+ * @property {number} top
+ */
+
+/**
  * A point on the floor in the `map` frame, in metres.
  * @typedef {object} Point
  * @property {number} x
@@ -259,6 +293,7 @@
  * @property {string|null} [destination]
  * @property {string|null} [task]
  * @property {ReportedPose|null} [pose]
+ * @property {Array<[number, number]>|null} [path]
  */
 
 /**
@@ -372,13 +407,14 @@
 
 /**
  * The fleet's task queue, sent when it changed: every task the dispatcher lists (`GET
- * {api}/vahr/tasks`, `vahr.dispatch.core.Task`: what is to be done where, its state, the robot
- * that took it), in its order; `available` is False when the deployment has no dispatcher to
- * ask.
+ * {api}/vahr/tasks`, `vahr.dispatch.Task`: what is to be done where, its state, the robot that
+ * took it), in its order, and the zones closed now; `available` is False when the deployment
+ * has no dispatcher to ask.
  * @typedef {object} TasksMessage
  * @property {"tasks"} type
  * @property {Array<Task>} tasks
  * @property {boolean} available
+ * @property {Array<string>} closed
  */
 
 /**
@@ -409,6 +445,7 @@
  * @property {number} radius
  * @property {"loader"|"unloader"|null} arm
  * @property {string|null} key
+ * @property {Array<Point>|null} area
  */
 
 /** @typedef {SnapshotMessage|RobotsMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage|AnnouncementMessage|AlertAcknowledgedMessage|TasksMessage} PageMessage */
