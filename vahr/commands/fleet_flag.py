@@ -52,6 +52,19 @@ def read_fleet(path: Path | None) -> Fleet:
         raise VahrError(f"{path}: {said}") from err
 
 
+def read_fleet_on_its_floor(path: Path | None) -> Fleet:
+    """`read_fleet`, and a floor that is a map read and the fleet checked against it: a
+    bad map, or a robot or zone where no robot can be on it, is one line naming the file."""
+    from vahr.navigation import MapError, load_floor
+
+    fleet = read_fleet(path)
+    try:
+        load_floor(fleet)
+    except MapError as err:
+        raise VahrError(f"{path or 'fleet.yaml'}: {err}") from err
+    return fleet
+
+
 def served_fleet(api: str) -> Fleet | None:
     """The fleet the local stack at `api` runs, or None when `api` serves none (AWS's
     iot-data endpoint, a stack from before the route, nothing at all)."""

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from vahr.cli_router import add_logging_flag, setup_logging
-from vahr.commands.fleet_flag import add_fleet_flag, read_fleet
+from vahr.commands.fleet_flag import add_fleet_flag, read_fleet_on_its_floor
 
 if TYPE_CHECKING:
     import argparse
@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
         mqtts_port=args.mqtts_port,
         mqtt_port=args.mqtt_port or None,
         api_port=args.api_port,
-        fleet=read_fleet(args.fleet),
+        fleet=read_fleet_on_its_floor(args.fleet),
         robots=args.robots,
         swarm=args.swarm,
         sim_speed_factor=args.sim_speed_factor,
