@@ -1,8 +1,10 @@
 """`vahr up --fleet` on a map of its own, as a user meets it: two rooms with a wall between
 them and a gap at its top. "send a robot to zone a" picks the robot nearer by path, not the
 one nearer in a straight line; a robot sent round the wall is never reported inside it and
-arrives; a closed zone moves nobody and the reply says so; an opened one works again. A bad
-map, or a zone in a wall, stops `vahr up` in one line with nothing started."""
+arrives; a closed zone moves nobody and the reply says so; an opened one works again. The
+station (real headless Chromium) draws the map under the robots, a moving robot's path, and
+closes and opens a zone with its switch. A bad map, or a zone in a wall, stops `vahr up` in
+one line with nothing started. The station test writes docs/images/station-floor-map.png."""
 
 from __future__ import annotations
 
@@ -12,6 +14,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pytest
 
+from playwright.sync_api import sync_playwright
+
+from tests.support.browser import Watch, launch
 from tests.support.floor_maps import OCCUPIED, two_rooms, write_map
 from tests.support.vahr_up import ROOT, VAHR, Up, clean_env, say, start_up, stop_up
 from vahr.navigation import load_map
@@ -113,6 +118,50 @@ def test_a_closed_zone_moves_nobody_and_the_reply_says_so_until_it_opens(up: Up)
     turn = say(api, "send a robot to zone b")
     assert turn["speech"].endswith("is on its way to zone B.")
     assert drive(up, dispatched(up, "B"))[-1]["zone"] == "B"
+
+
+def test_the_station_draws_the_map_a_robots_path_and_a_zone_it_closes(up: Up) -> None:
+    api, station = up.endpoints["api"], up.endpoints["station"]
+    with sync_playwright() as playwright:
+        browser = launch(playwright)
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 800})
+            watch = Watch(page)
+            page.goto(station)
+            page.locator('#link-state[data-state="live"]').wait_for(timeout=15_000)
+            # The map is drawn at its scale: 10 m by 5 m from the origin, its picture loaded
+            image = page.locator("image.floor-map")
+            assert image.get_attribute("href") == "/api/map.png"
+            assert [image.get_attribute(a) for a in ("x", "y", "width", "height")] == [
+                "0", "-5", "10", "5"
+            ]  # fmt: skip
+            size = page.evaluate(
+                "fetch('/api/map.png').then(r => r.blob()).then(createImageBitmap)"
+                ".then(b => [b.width, b.height])"
+            )
+            assert size == [200, 100]
+            # When the left rover is sent to the zone in the other room
+            where = call(api, "GET", "/things/left/shadow")["state"]["reported"]["pose"]
+            other = "a" if where["x"] < 5.0 else "b"
+            turn = say(api, f"send rover one to zone {other}")
+            [command_id] = turn["commands"]
+            # Then its path is drawn ahead of it, round the wall: more than one leg
+            path = page.locator("polyline.path[visibility=visible]")
+            path.wait_for(timeout=15_000)
+            assert len((path.get_attribute("points") or "").split()) >= 3
+            page.screenshot(path=str(ROOT / "docs/images/station-floor-map.png"))
+            drive(up, command_id)
+            # When zone B's switch is pressed, zone B is closed and drawn so
+            page.locator('#zone-switches button[data-zone="B"]').click()
+            page.locator('g.zone.closed[data-zone="B"]').wait_for(timeout=15_000)
+            assert call(api, "GET", "/vahr/zones") == {"closed": ["B"]}
+            # and pressed again, it opens
+            page.locator('#zone-switches button[data-zone="B"][aria-pressed="true"]').click()
+            page.locator('g.zone.closed[data-zone="B"]').wait_for(state="detached", timeout=15_000)
+            assert call(api, "GET", "/vahr/zones") == {"closed": []}
+            assert watch.problems == []
+        finally:
+            browser.close()
 
 
 def up_with(fleet: Path, state: Path) -> subprocess.CompletedProcess[str]:
