@@ -114,3 +114,49 @@ zones:
         wall_right=WALL_X_M + WALL_HALF_M,
         gap_bottom=GAP_BOTTOM_M,
     )
+
+
+def warehouse_shades(columns: int, rows: int, *, resolution: float = RESOLUTION) -> np.ndarray:
+    """A made-up warehouse, `columns` x `rows` cells: outer walls, then racks 1 m deep and 8 m
+    long in rows 4 m apart, with 2.5 m cross aisles between them and clear bands 6 m wide
+    along the west and east walls, where the zones are."""
+    shades = np.full((rows, columns), FREE, dtype=np.uint8)
+    wall = max(2, round(0.1 / resolution))
+    shades[:wall, :] = shades[-wall:, :] = shades[:, :wall] = shades[:, -wall:] = OCCUPIED
+    cell = 1.0 / resolution
+    band, depth, length, pitch, cross = (round(m * cell) for m in (6.0, 1.0, 8.0, 4.0, 2.5))
+    for top in range(band, rows - band - depth, pitch):
+        for left in range(band, columns - band - length, length + cross):
+            shades[top : top + depth, left : left + length] = OCCUPIED
+    return shades
+
+
+def warehouse(directory: Path, columns: int, rows: int, *, robots: int = 2) -> Path:
+    """The warehouse map and a fleet of `robots` rovers on it (parked on its free ground by
+    `vahr up`'s rule), zones LOADING on the west wall and A-D on the east one; the fleet
+    file's path."""
+    shades = warehouse_shades(columns, rows)
+    map_file = write_map(directory, shades, name="warehouse")
+    width, height = columns * RESOLUTION, rows * RESOLUTION
+    zones = [("LOADING", "loading zone", 2.0, height / 2, 3.1416)]
+    zones += [
+        (letter, f"zone {letter.lower()}", width - 2.0, height * (4 - i - 0.5) / 4, 0.0)
+        for i, letter in enumerate("ABCD")
+    ]
+    zone_lines = "".join(
+        f"  - {{id: {zid}, spoken: [{name}], pose: {{x: {x:.2f}, y: {y:.2f}, theta: {t}}}, "
+        f"radius: 0.4}}\n"
+        for zid, name, x, y, t in zones
+    )
+    fleet = directory / "fleet.yaml"
+    fleet.write_text(
+        f"floor: {{map: {map_file.name}, robot_radius: 0.25}}\n"
+        f"robots:\n  - {{thing: rover1, spoken: [rover one], start: {{x: 3.0, y: 3.0}}}}\n"
+        f"zones:\n{zone_lines}"
+    )
+    if robots > 1:
+        from vahr.domain import load_fleet
+        from vahr.local.robots import fleet_of, write_fleet
+
+        write_fleet(fleet_of(robots, load_fleet(fleet)), fleet)
+    return fleet

@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pytest
-
 from playwright.sync_api import sync_playwright
 
 from tests.support.browser import Watch, launch
