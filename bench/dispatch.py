@@ -128,8 +128,8 @@ def _run(robots: int, tasks: int, seed: int, fleet: Fleet | None) -> dict[str, f
     if floor is not None:
         # Every zone's one search, before timing the choices (done once, then cached).
         began = time.perf_counter()
-        for zone in fleet.zones:
-            routes.field(zone)
+        for place in fleet.zones:
+            routes.field(place)
         search_s = time.perf_counter() - began
     candidates = IndexCandidates(index, fleet)
     sent: list[tuple[str, Command]] = []

@@ -71,6 +71,21 @@ class GridField:
         value = self._values[row * grid.columns + column]
         return math.inf if value == NO_PATH else value * grid.unit_m
 
+    def distances(self, xs: list[float], ys: list[float]) -> list[float]:
+        """`distance` of many points: what `rank` asks of 1,000 robots at once."""
+        grid, values, floor, inf = self._routes, self._values, math.floor, math.inf
+        left, bottom, cell = grid.origin_x, grid.origin_y, grid.cell_m
+        rows, columns, unit = grid.rows, grid.columns, grid.unit_m
+        lengths = []
+        for x, y in zip(xs, ys, strict=True):
+            column, row = floor((x - left) / cell), floor((y - bottom) / cell)
+            if 0 <= row < rows and 0 <= column < columns:
+                value = values[row * columns + column]
+                lengths.append(inf if value == NO_PATH else value * unit)
+            else:
+                lengths.append(inf)
+        return lengths
+
 
 class GridRoutes:
     """`vahr.dispatch.Routes` from a distances file (see the module docstring)."""

@@ -66,7 +66,9 @@ def straight_line(start: Pose, end: Pose) -> float:
 
 
 class DistanceField(Protocol):
-    """Path lengths to one goal from anywhere on the floor, from one search."""
+    """Path lengths to one goal from anywhere on the floor, from one search. A field may
+    also answer many points at once (`distances(xs, ys)`, a list of the same lengths), which
+    `rank` then uses: 1,000 robots are one call."""
 
     def distance(self, x: float, y: float) -> float:
         """Metres along the path from (x, y) to the goal; math.inf when none leads there."""
@@ -148,19 +150,27 @@ def rank(
     first = pickup or drop
     rest = routes.field(drop).distance(pickup.pose.x, pickup.pose.y) if pickup is not None else 0.0
     allowed = frozenset(task.robots)
-    hypot, fx, fy = math.hypot, first.pose.x, first.pose.y
-    straight = isinstance(routes, StraightRoutes)
-    to_first = routes.field(first).distance
-    keyed: list[tuple[bool, float, str, RobotState]] = []
-    for robot in robots:
-        if allowed and robot.thing not in allowed:
-            continue
-        pose = robot.pose if robot.pose is not None else robot_pose(fleet, robot)
-        cost = (hypot(pose.x - fx, pose.y - fy) if straight else to_first(pose.x, pose.y)) + rest
-        if cost == math.inf:
-            continue
-        # False sorts before True: idle robots first.
-        keyed.append((robot.status not in IDLE_STATUSES, cost, robot.thing, robot))
+    candidates = [robot for robot in robots if not allowed or robot.thing in allowed]
+    poses = [
+        robot.pose if robot.pose is not None else robot_pose(fleet, robot) for robot in candidates
+    ]
+    if isinstance(routes, StraightRoutes):
+        hypot, fx, fy = math.hypot, first.pose.x, first.pose.y
+        costs = [hypot(pose.x - fx, pose.y - fy) for pose in poses]
+    else:
+        field = routes.field(first)
+        many = getattr(field, "distances", None)
+        if many is not None:
+            costs = many([pose.x for pose in poses], [pose.y for pose in poses])
+        else:
+            costs = [field.distance(pose.x, pose.y) for pose in poses]
+    inf = math.inf
+    # False sorts before True: idle robots first. A robot no path leads from is left out.
+    keyed: list[tuple[bool, float, str, RobotState]] = [
+        (robot.status not in IDLE_STATUSES, cost + rest, robot.thing, robot)
+        for robot, cost in zip(candidates, costs, strict=True)
+        if cost != inf
+    ]
     # Tuples compare field by field and thing names are unique, so the states themselves
     # are never compared.
     if limit is None:

@@ -91,8 +91,9 @@ def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
         if g.robots or g.id == FLEET_GROUP
     ]
     # The robots added start west of the floor the file draws: it grows to hold them.
-    drawn = base.floor is not None and base.floor.map is None
-    grown = base.floor.covering([robot.start for robot in robots]) if drawn else base.floor
+    grown = base.floor
+    if grown is not None and grown.map is None:
+        grown = grown.covering([robot.start for robot in robots])
     return Fleet(
         robots=robots,
         zones=base.zones,

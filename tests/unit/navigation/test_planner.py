@@ -151,3 +151,11 @@ def test_a_map_is_named_relative_to_its_fleet_file(rooms: TwoRooms) -> None:
     assert floor is not None
     drawn = floor.drawn()
     assert (drawn.width, drawn.height, drawn.origin) == (10.0, 5.0, Point(0.0, 0.0))
+
+
+def test_many_robots_are_measured_in_one_call_as_one_by_one(floor: FleetFloor) -> None:
+    zone_a = floor.fleet.zone("A").pose
+    field = floor.open.field(zone_a.x, zone_a.y)
+    points = [(4.3, 0.8), (9.0, 4.0), (5.0, 1.0), (-3.0, 1.0), (6.0, 0.8), (0.4, 4.6)]
+    xs, ys = [x for x, _ in points], [y for _, y in points]
+    assert field.distances(xs, ys) == [field.distance(x, y) for x, y in points]
