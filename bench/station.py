@@ -505,7 +505,14 @@ versions are counted.
 {chr(10).join(rows)}
 {talk}"""
     title = "Operator station: a fleet on the map, push-to-talk"
-    if args.section != "station":
+    if args.map:
+        body = (
+            "\nThe floor is a map (`--map`): a made-up warehouse sized for the fleet "
+            "(tests/support/floor_maps.py), its occupancy image drawn under the robots, "
+            "which drive their planned paths on it.\n" + body
+        )
+        title = f"Operator station on a map: {args.robots:,} robots, the map drawn"
+    elif args.section != "station":
         title = f"Operator station: {args.robots:,} robots for {args.minutes:g} minutes"
     write_section(args.section, title, body, script="station")
 
