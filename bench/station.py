@@ -507,9 +507,9 @@ versions are counted.
     title = "Operator station: a fleet on the map, push-to-talk"
     if args.map:
         body = (
-            "\nThe floor is a map (`--map`): a made-up warehouse sized for the fleet "
-            "(tests/support/floor_maps.py), its occupancy image drawn under the robots, "
-            "which drive their planned paths on it.\n" + body
+            "\nThe floor is a map (`--map`): a made-up warehouse sized for the fleet\n"
+            "(tests/support/floor_maps.py), its occupancy image drawn under the robots, which\n"
+            "drive their planned paths on it.\n" + body
         )
         title = f"Operator station on a map: {args.robots:,} robots, the map drawn"
     elif args.section != "station":
