@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import multiprocessing
 import os
 import signal
@@ -52,6 +53,7 @@ from playwright.sync_api import sync_playwright  # noqa: E402
 
 from tests.support.browser import launch  # noqa: E402
 from tests.support.swarm_runner import swarm_fleet  # noqa: E402
+from vahr.domain import load_fleet  # noqa: E402
 from vahr.local.alexa_host import serve_alexa
 from vahr.plumbing.lifetime import spawn  # noqa: E402
 from vahr.plumbing.mqtt import MqttClient, MqttEndpoint  # noqa: E402
@@ -97,12 +99,16 @@ def stack_process(state: str, ports: tuple[int, int, int], ready: Any, stop: Any
         stop.wait(7200)
 
 
-def swarm_process(broker: str, size: int, ready: Any, stop: Any) -> None:
-    """The robots, in their own process as robots are on their own machines."""
+def swarm_process(
+    broker: str, size: int, ready: Any, stop: Any, base_file: str | None = None
+) -> None:
+    """The robots, in their own process as robots are on their own machines; with
+    `base_file`, on that fleet's map."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     from tests.support.swarm_runner import SwarmThread
 
-    with SwarmThread(broker=broker, count=size, speed_factor=SPEED_FACTOR):
+    base = load_fleet(base_file) if base_file else None
+    with SwarmThread(broker=broker, count=size, speed_factor=SPEED_FACTOR, base=base):
         ready.set()
         stop.wait(7200)
 
@@ -196,6 +202,10 @@ def main() -> int:
         "figures without writing docs/benchmarks.md",
     )  # fmt: skip
     parser.add_argument(
+        "--map", action="store_true",
+        help="the robots on a warehouse map the page draws under them (a floor that is a map)",
+    )  # fmt: skip
+    parser.add_argument(
         "--section", default="station",
         help="the section of docs/benchmarks.md to write (a long memory run keeps its own)",
     )  # fmt: skip
@@ -235,7 +245,17 @@ def measure(args: argparse.Namespace) -> tuple[list[float], dict[str, Any]]:
         microphone = state / "microphone.wav"
         microphone.write_bytes(clip.to_wav())
         fleet_file = state / "fleet.yaml"
-        fleet_file.write_bytes(msgspec.yaml.encode(swarm_fleet(args.robots)))
+        base_file = None
+        if args.map:
+            # A warehouse map sized for the fleet: the page draws it under the robots, and
+            # the robots drive their planned paths on it.
+            from tests.support.floor_maps import warehouse
+
+            side = math.ceil(max(20.0, math.sqrt(args.robots) * 0.6 * 1.9 + 14.0) / 0.05)
+            (state / "map").mkdir()
+            base_file = str(warehouse(state / "map", side, side, robots=1))
+        base = load_fleet(base_file) if base_file else None
+        fleet_file.write_bytes(msgspec.yaml.encode(swarm_fleet(args.robots, base=base)))
         ports = (free_port(), free_port(), free_port())
         broker, api = f"mqtt://127.0.0.1:{ports[1]}", f"http://127.0.0.1:{ports[2]}"
         stack_ready, swarm_ready = context.Event(), context.Event()
@@ -250,7 +270,10 @@ def measure(args: argparse.Namespace) -> tuple[list[float], dict[str, Any]]:
             if not stack_ready.wait(60):
                 raise RuntimeError("the stack did not start")
             parts.append(
-                context.Process(target=swarm_process, args=(broker, args.robots, swarm_ready, stop))
+                context.Process(
+                    target=swarm_process,
+                    args=(broker, args.robots, swarm_ready, stop, base_file),
+                )
             )
             parts[1].start()
             if not swarm_ready.wait(120 + args.robots / 50):
@@ -482,7 +505,14 @@ versions are counted.
 {chr(10).join(rows)}
 {talk}"""
     title = "Operator station: a fleet on the map, push-to-talk"
-    if args.section != "station":
+    if args.map:
+        body = (
+            "\nThe floor is a map (`--map`): a made-up warehouse sized for the fleet\n"
+            "(tests/support/floor_maps.py), its occupancy image drawn under the robots, which\n"
+            "drive their planned paths on it.\n" + body
+        )
+        title = f"Operator station on a map: {args.robots:,} robots, the map drawn"
+    elif args.section != "station":
         title = f"Operator station: {args.robots:,} robots for {args.minutes:g} minutes"
     write_section(args.section, title, body, script="station")
 

@@ -263,9 +263,10 @@ class DispatchUsage:
     # task, measured on the handler under moto (tests/support/dispatch_meter.py; checked by
     # tests/unit/dispatcher/test_dispatcher_costs.py). The submit: the task's PutItem (1
     # write), the assignment's transaction of two items (4: transactions bill twice), two
-    # consistent Queries of the open tasks and a GetItem (3 reads); the robot-freed event:
-    # the closing transaction of three items (6 writes), three Queries and a GetItem (4).
-    table_reads: float = 7.0
+    # consistent Queries of the open tasks, one of the closed zones and a GetItem (4
+    # reads); the robot-freed event: the closing transaction of three items (6 writes),
+    # three Queries and a GetItem (4).
+    table_reads: float = 8.0
     table_writes: float = 11.0
     # The robot's shadow updates while it does one task (LabUsage: a delivery sends 9).
     # Each is a rule triggered (the rule's topic filter matches every classic shadow's

@@ -10,7 +10,10 @@ The bundle holds three functions' code roots: `skill/` (from `lambda/skill`, han
 `vahr/errors.py`, the wire contract `vahr/protocol`, the domain `vahr/domain`, the dispatch
 core `vahr/dispatch` for the skill and the dispatcher, and `vahr/announce` for the
 announcer), `fleet.yaml` as
-`vahr/domain/fleet.yaml` (where `vahr.domain.fleet` looks for it), and the runtime
+`vahr/domain/fleet.yaml` (where `vahr.domain.fleet` looks for it) with, for a fleet on
+a map, its zones' distance fields beside it (`vahr/domain/fleet-distances.bin`, written by
+`infra/floor_distances.py`: the dispatcher ranks by path length without numpy), and the
+runtime
 dependencies installed from wheels built for the Lambda runtime (CPython 3.12 on Amazon
 Linux), so no Docker is needed. boto3 comes from the Lambda runtime and awscrt must stay
 out: botocore imports awscrt whenever it is present, which costs cold start.
@@ -69,6 +72,8 @@ CODE_ROOTS = {
 }
 # Where `vahr.domain.fleet` looks for the bundled fleet definition.
 FLEET_IN_BUNDLE = "vahr/domain/fleet.yaml"
+# Where `vahr.dispatch.grid_routes` looks for a map fleet's distances (BUNDLED_FILE).
+DISTANCES_IN_BUNDLE = "vahr/domain/fleet-distances.bin"
 LOCALES_IN_BUNDLE = "vahr/domain/locales"
 _IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".mypy_cache", ".pytest_cache")
 _REQUIREMENT = re.compile(r"^\s*([A-Za-z0-9][A-Za-z0-9._-]*)\s*==\s*([^\s;#]+)")
@@ -156,7 +161,31 @@ def source_hash(
         digest.update(name.encode() + b"\0")
         if source.exists():
             digest.update(source.read_bytes())
+    # A map's distances change with the map: its YAML and image count too.
+    for source in _map_files(fleet_file or REPO_ROOT / "fleet.yaml"):
+        digest.update(source.read_bytes())
     return digest.hexdigest()
+
+
+def _map_files(fleet_file: Path) -> list[Path]:
+    """The map YAML and image the fleet's floor names, if any."""
+    from vahr.domain import load_fleet
+    from vahr.navigation.occupancy import MapFile
+
+    try:
+        floor = load_fleet(fleet_file).floor
+    except ValueError:
+        return []
+    if floor is None or floor.map is None:
+        return []
+    import msgspec
+
+    map_yaml = Path(floor.map)
+    try:
+        image = map_yaml.parent / msgspec.yaml.decode(map_yaml.read_bytes(), type=MapFile).image
+    except (OSError, msgspec.ValidationError, msgspec.DecodeError):
+        return [map_yaml] if map_yaml.is_file() else []
+    return [path for path in (map_yaml, image) if path.is_file()]
 
 
 def _install_dependencies(
@@ -240,6 +269,22 @@ def _check_bundle(out_dir: Path) -> None:
                 )
 
 
+def _write_floor_distances(fleet_file: Path, out_dir: Path) -> None:
+    """For a fleet on a map, its zones' distance fields, where the dispatcher reads them."""
+    from vahr.domain import load_fleet
+    from vahr.protocol import ProtocolError
+
+    try:
+        fleet = load_fleet(fleet_file)
+    except ProtocolError as err:
+        raise VahrError(f"fleet file {fleet_file}: {err}") from err
+    if fleet.floor is None or fleet.floor.map is None:
+        return
+    from infra.floor_distances import write_distances
+
+    write_distances(fleet, out_dir / DISTANCES_IN_BUNDLE)
+
+
 def _tree_size(root: Path) -> tuple[int, int]:
     files = [path for path in root.rglob("*") if path.is_file()]
     return len(files), sum(path.stat().st_size for path in files)
@@ -308,6 +353,7 @@ def build(
         destination = out_dir / name
         destination.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(source, destination)
+    _write_floor_distances(fleet_file, out_dir)
     _check_bundle(out_dir)
     if compile_with is not None:
         precompile(out_dir, compile_with)

@@ -1,10 +1,11 @@
 """One robot on a link: decode commands, de-duplicate, execute, and report on the wire.
 
 `RobotAgent` is the glue between the transport (`Link`, `ShadowSync`) and the pure
-`Executor`. It subscribes to the robot's command topic, the fleet topic and its peers'
-events, turns every payload into a command or a `rejected` report, and publishes the
-executor's events (`vahr/robots/{thing}/events`, `delivered` retained so a peer that starts
-waiting later still sees it) and states (the shadow).
+`Executor`. It subscribes to the robot's command topic, the fleet topic, the fleet's closed
+zones (`vahr/fleet/zones`, retained) and its peers' events, turns every payload into a
+command or a `rejected` report, and publishes the executor's events
+(`vahr/robots/{thing}/events`, `delivered` retained so a peer that starts waiting later
+still sees it) and states (the shadow).
 """
 
 from __future__ import annotations
@@ -17,7 +18,15 @@ from typing import TYPE_CHECKING, Any
 from robot_agent.core.executor import Executor
 from robot_agent.core.in_flight import INTERRUPTED_REASON, InFlight
 from robot_agent.link.shadow import ShadowSync
-from vahr.protocol import Presence, ProtocolError, decode_command, decode_event, encode, topics
+from vahr.protocol import (
+    Presence,
+    ProtocolError,
+    decode_command,
+    decode_event,
+    decode_zone_closures,
+    encode,
+    topics,
+)
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -89,6 +98,7 @@ class RobotAgent:
         """Add this robot's routes and connection callbacks to the link."""
         self.link.add_route(topics.robot_cmd(self.thing), self.on_command)
         self.link.add_route(topics.FLEET_CMD, self.on_command)
+        self.link.add_route(topics.FLEET_ZONES, self.on_zone_closures)
         if self._listen_to_peers:
             self.link.add_route(topics.ALL_EVENTS, self.on_peer_event)
         self.link.on_connected(self.on_connected)
@@ -118,6 +128,15 @@ class RobotAgent:
             "%s: command %s %s from %s", self.thing, command.id, command.action, command.source
         )
         self.executor.execute(command)
+
+    def on_zone_closures(self, topic: str, payload: bytes) -> None:
+        """The zones closed now (retained, so also on every connection)."""
+        try:
+            closures = decode_zone_closures(payload)
+        except ProtocolError as err:
+            log.warning("%s: ignoring malformed zone closures: %s", self.thing, err)
+            return
+        self.executor.close_zones(frozenset(closures.closed))
 
     def on_peer_event(self, topic: str, payload: bytes) -> None:
         # Most events are progress ticks; only deliveries matter, so skip decoding the rest.

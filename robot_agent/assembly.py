@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from robot_agent.link.mqtt5 import Mqtt5Link
     from robot_agent.voice.port import Voice
     from vahr.domain import Fleet
+    from vahr.navigation import FleetFloor
     from vahr.protocol.link import Link
 
 
@@ -54,7 +55,19 @@ def build_backend(config: AgentConfig, fleet: Fleet, clock: ScaledClock) -> Navi
                 "from .venv-ros2 (make setup makes it), or next to the robot's own ROS 2"
             ) from err
         return Nav2Backend(config.nav2, start=fleet.robot(thing).start)
-    return SimBackend(start=fleet.robot(thing).start, clock=clock, settings=config.sim)
+    return SimBackend(
+        start=fleet.robot(thing).start, clock=clock, settings=config.sim, floor=robot_floor(fleet)
+    )
+
+
+def robot_floor(fleet: Fleet) -> FleetFloor | None:
+    """The fleet's map, read and checked, for a simulated robot to plan on; None for a
+    drawn floor (the robot drives straight). A bad map is a VahrError in one line."""
+    if fleet.floor is None or fleet.floor.map is None:
+        return None
+    from vahr.navigation import load_floor
+
+    return load_floor(fleet)
 
 
 def build_voice(config: AgentConfig, link: Link) -> Voice | None:

@@ -22,6 +22,7 @@ import uuid
 from typing import TYPE_CHECKING, Any
 
 from robot_agent.agent import RobotAgent
+from robot_agent.assembly import robot_floor
 from robot_agent.backends.sim import SimBackend
 from robot_agent.backends.sim_ticker import SimTicker
 from robot_agent.clock import ScaledClock
@@ -116,12 +117,18 @@ class Swarm:
         # Looked up once: Fleet.robot is a linear search, quadratic over 10,000 robots.
         starts = {robot.thing: robot.start for robot in self.fleet.robots}
         decode = _DecodedOnce(self.fleet)
+        # One map and its searches serve every robot (a goal's field is computed once).
+        floor = robot_floor(self.fleet)
         for thing in self.things:
             recent = RecentIds(
                 self._state_dir / thing / "recent-ids.json" if self._state_dir else None
             )
             backend = SimBackend(
-                start=starts[thing], clock=self.clock, settings=self._sim, ticker=self.ticker
+                start=starts[thing],
+                clock=self.clock,
+                settings=self._sim,
+                ticker=self.ticker,
+                floor=floor,
             )
             agent = _LoggedAgent(
                 self._on_event,

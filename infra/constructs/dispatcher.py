@@ -132,6 +132,17 @@ class Dispatcher(Construct):
                 ],
             )
         )
+        closures = stack.format_arn(
+            service="iot", resource="topic", resource_name=topics.FLEET_ZONES
+        )
+        self.role.add_to_policy(
+            iam.PolicyStatement(
+                # The zones closed now, retained for robots that connect later.
+                sid="TellRobotsClosedZones",
+                actions=["iot:Publish", "iot:RetainPublish"],
+                resources=[closures],
+            )
+        )
         self.function, self.log_group = python_function(
             self,
             config=config,

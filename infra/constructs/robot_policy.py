@@ -45,6 +45,8 @@ def robot_topics() -> dict[str, list[str]]:
     listen = [
         _own(topics.robot_cmd(_MARK)),
         topics.FLEET_CMD,
+        # The zones closed now, retained by the dispatcher function (read only).
+        topics.FLEET_ZONES,
         _any_robot(topics.ALL_EVENTS),
         _any_robot(topics.ALL_PRESENCE),
         *(_own(topics.shadow(_MARK, op)) for op in SHADOW_RESPONSES),

@@ -25,9 +25,11 @@ from dispatcher.requests import (
     OPERATIONS,
     Answer,
     Cancel,
+    ListClosed,
     ListPending,
     ListTasks,
     RobotUpdate,
+    SetZone,
     SkillRequest,
     Submit,
     is_robot_update,
@@ -36,6 +38,7 @@ from dispatcher.requests import (
 from dispatcher.robot_updates import robot_freed
 from dispatcher.task_table import TaskTable
 from vahr.dispatch import Dispatcher, DispatchError
+from vahr.dispatch.grid_routes import DistancesError, floor_routes
 from vahr.domain import load_fleet
 from vahr.protocol.errors import ProtocolError, from_validation_error
 
@@ -51,11 +54,18 @@ def runtime() -> Dispatcher:
         fleet = load_fleet(config.fleet_file)
     except ProtocolError as err:
         raise ConfigError(f"the fleet file {config.fleet_file or '(bundled)'}: {err}") from err
+    try:
+        routes = floor_routes(fleet, config.distances_file)
+    except DistancesError as err:
+        raise ConfigError(f"the fleet's map: {err}") from err
+    channel = CommandChannel(config.iot_data_endpoint)
     return Dispatcher(
         fleet=fleet,
         store=TaskTable(config.table, closed_task_days=config.closed_task_days),
         candidates=FleetSearch(index_name=config.index_name),
-        publish=CommandChannel(config.iot_data_endpoint),
+        publish=channel,
+        routes=lambda closed: routes,
+        publish_closures=channel.closures,
     )
 
 
@@ -108,7 +118,10 @@ def on_robot_update(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, 
 def on_tick(dispatcher: Dispatcher) -> dict[str, Any]:
     """Once a minute: queued tasks go to robots that are free now. A robot freed while its
     rule event was lost (dead-lettered, or the function failed) would otherwise wait for its
-    next change; with nothing queued this is one read of the queue and nothing more."""
+    next change; with nothing queued this is one read of the queue and nothing more. The
+    closed zones are told again (retained), so two changes published out of order by two
+    invocations agree with the table within a minute."""
+    dispatcher.announce_closures()
     given = dispatcher.drain()
     for task in given:
         log.info("task %s (%s to %s) given to %s", task.id, task.kind, task.zone, task.thing)
@@ -122,9 +135,16 @@ def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
         except DispatchError as err:
             raise BadRequest(str(err), error=err.code) from err
     if isinstance(request, ListTasks):
-        return Answer(200, {"tasks": dispatcher.tasks()})
+        return Answer(200, {"tasks": dispatcher.tasks(), "closed": dispatcher.closed_zones()})
     if isinstance(request, ListPending):
         return Answer(200, {"tasks": dispatcher.pending()})
+    if isinstance(request, ListClosed):
+        return Answer(200, {"closed": dispatcher.closed_zones()})
+    if isinstance(request, SetZone):
+        try:
+            return Answer(200, dispatcher.set_zone(request.zone, closed=request.closed))
+        except DispatchError as err:
+            raise BadRequest(str(err), error=err.code) from err
     assert isinstance(request, Cancel)
     cancelled = dispatcher.cancel(request.task_id)
     if cancelled is None:

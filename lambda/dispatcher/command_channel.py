@@ -1,4 +1,5 @@
-"""Commands to robots through iot-data Publish (QoS 1): the dispatcher's `Publish` port."""
+"""Commands to robots through iot-data Publish (QoS 1): the dispatcher's `Publish` port,
+and the zones closed now, retained on `vahr/fleet/zones` (its `PublishClosures` port)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from dispatcher.errors import PublishError
 from vahr.protocol import encode, topics
 
 if TYPE_CHECKING:
-    from vahr.protocol.messages import Command
+    from vahr.protocol.messages import Command, ZoneClosures
 
 CLIENT_CONFIG = Config(
     connect_timeout=2.0, read_timeout=3.0, retries={"mode": "standard", "total_max_attempts": 3}
@@ -34,3 +35,11 @@ class CommandChannel:
             self._client.publish(topic=topic, qos=1, payload=encode(command))
         except (ClientError, BotoCoreError) as err:
             raise PublishError(f"cannot publish command {command.id} to {topic}: {err}") from err
+
+    def closures(self, closures: ZoneClosures) -> None:
+        """Publish the zones closed now, retained (a robot that connects later reads it)."""
+        topic = topics.FLEET_ZONES
+        try:
+            self._client.publish(topic=topic, qos=1, retain=True, payload=encode(closures))
+        except (ClientError, BotoCoreError) as err:
+            raise PublishError(f"cannot publish the closed zones to {topic}: {err}") from err

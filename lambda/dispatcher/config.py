@@ -6,6 +6,7 @@
 | `VAHR_IOT_DATA_ENDPOINT` | boto3's default | iot-data endpoint commands are published at |
 | `VAHR_FLEET_INDEX` | `AWS_Things` | the fleet index searched for candidate robots |
 | `VAHR_FLEET_FILE` | bundled fleet.yaml | the fleet definition (zones, groups, floor) |
+| `VAHR_DISTANCES_FILE` | bundled fleet-distances.bin | a map fleet's zone distances (grid_routes) |
 | `VAHR_CLOSED_TASK_DAYS` | 30 | how long a finished or cancelled task stays readable |
 | `VAHR_LOG_LEVEL` | INFO | DEBUG, INFO, WARNING or ERROR |
 """
@@ -18,6 +19,7 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from dispatcher.errors import ConfigError
+from vahr.dispatch.grid_routes import BUNDLED_FILE
 
 if TYPE_CHECKING:
     from collections.abc import Mapping
@@ -32,6 +34,7 @@ class DispatcherConfig(msgspec.Struct, frozen=True, kw_only=True):
     iot_data_endpoint: str | None = None
     index_name: str = THING_INDEX
     fleet_file: str | None = None
+    distances_file: str = BUNDLED_FILE
     closed_task_days: int = 30
     log_level: str = "INFO"
 
@@ -59,6 +62,7 @@ class DispatcherConfig(msgspec.Struct, frozen=True, kw_only=True):
             iot_data_endpoint=endpoint,
             index_name=env.get("VAHR_FLEET_INDEX", "").strip() or THING_INDEX,
             fleet_file=env.get("VAHR_FLEET_FILE", "").strip() or None,
+            distances_file=env.get("VAHR_DISTANCES_FILE", "").strip() or BUNDLED_FILE,
             closed_task_days=days,
             log_level=level,
         )

@@ -46,8 +46,19 @@ class Cancel(msgspec.Struct, frozen=True, tag_field="operation", tag="cancel"):
     task_id: str
 
 
-SkillRequest = Submit | ListTasks | ListPending | Cancel
-OPERATIONS = ("submit", "tasks", "pending", "cancel")
+class ListClosed(msgspec.Struct, frozen=True, tag_field="operation", tag="zones"):
+    pass
+
+
+class SetZone(msgspec.Struct, frozen=True, tag_field="operation", tag="zone"):
+    """Close (`closed: true`) or open a zone."""
+
+    zone: str
+    closed: bool
+
+
+SkillRequest = Submit | ListTasks | ListPending | Cancel | ListClosed | SetZone
+OPERATIONS = ("submit", "tasks", "pending", "cancel", "zones", "zone")
 
 
 class RobotUpdate(msgspec.Struct, frozen=True, kw_only=True):

@@ -7,6 +7,7 @@ One table, keyed by `section` (partition) and `id` (sort):
 | `open` | task id | a queued or assigned task: `task` (its JSON), `status`, `version` |
 | `closed` | task id | a done or cancelled task, kept until `expires_at` (the table's TTL) |
 | `robot` | thing | the robot's claim on its one assigned task: `task_id` |
+| `zone` | zone id | a zone closed at run time, since `closed_at` |
 
 Every open task lives in one partition, so the queue is one strongly consistent Query
 (a fleet's queue is tens of tasks, far below a partition's 3,000 reads a second), and a
@@ -38,7 +39,7 @@ if TYPE_CHECKING:
 CLIENT_CONFIG = Config(
     connect_timeout=2.0, read_timeout=3.0, retries={"mode": "standard", "total_max_attempts": 3}
 )
-OPEN, CLOSED, ROBOT = "open", "closed", "robot"
+OPEN, CLOSED, ROBOT, ZONE = "open", "closed", "robot", "zone"
 # A change that lost a race to another writer reads the task again and decides anew; a
 # task is written by a handful of invocations at most, so a few rounds settle it.
 ATTEMPTS = 4
@@ -152,6 +153,51 @@ class TaskTable:
     def active(self) -> list[Task]:
         assigned = [task for task in self._all_open() if task.status == "assigned"]
         return sorted(assigned, key=lambda task: (task.assigned_at or "", task.id))
+
+    def close_zone(self, zone: str, *, at: str) -> bool:
+        try:
+            self._client.put_item(
+                TableName=self._table,
+                Item={"section": {"S": ZONE}, "id": {"S": zone}, "closed_at": {"S": at}},
+                ConditionExpression="attribute_not_exists(id)",
+            )
+        except ClientError as err:
+            if _code(err) == "ConditionalCheckFailedException":
+                return False
+            raise StoreError(f"cannot close zone {zone}: {_message(err)}") from err
+        except BotoCoreError as err:
+            raise StoreError(f"cannot close zone {zone}: {err}") from err
+        return True
+
+    def open_zone(self, zone: str) -> bool:
+        try:
+            answer = self._client.delete_item(
+                TableName=self._table,
+                Key={"section": {"S": ZONE}, "id": {"S": zone}},
+                ReturnValues="ALL_OLD",
+            )
+        except (ClientError, BotoCoreError) as err:
+            raise StoreError(f"cannot open zone {zone}: {_message(err)}") from err
+        return "Attributes" in answer
+
+    def closed_zones(self) -> list[str]:
+        query: dict[str, Any] = {
+            "TableName": self._table,
+            "KeyConditionExpression": "#section = :zone",
+            "ExpressionAttributeNames": {"#section": "section"},
+            "ExpressionAttributeValues": {":zone": {"S": ZONE}},
+            "ConsistentRead": True,
+        }
+        zones: list[str] = []
+        while True:
+            try:
+                page = self._client.query(**query)
+            except (ClientError, BotoCoreError) as err:
+                raise StoreError(f"cannot read the closed zones: {_message(err)}") from err
+            zones.extend(item["id"]["S"] for item in page.get("Items", []))
+            if "LastEvaluatedKey" not in page:
+                return sorted(zones)
+            query["ExclusiveStartKey"] = page["LastEvaluatedKey"]
 
     # --- inside ---------------------------------------------------------------------------
 

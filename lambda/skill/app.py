@@ -48,6 +48,7 @@ from skill.handlers.sequential_delivery import SequentialDeliveryIntentHandler
 from skill.handlers.status import ProblemRobotsIntentHandler, StatusIntentHandler
 from skill.handlers.weather_delivery import WeatherDeliveryIntentHandler
 from skill.handlers.weather_question import WeatherIntentHandler
+from skill.handlers.zone_closure import CloseZoneIntentHandler, OpenZoneIntentHandler
 from skill.interceptors import (
     CorrelationIdInterceptor,
     LocaleInterceptor,
@@ -79,11 +80,12 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
     return [
         # A denied intent is answered before its own handler could act on it.
         DeniedIntentHandler(),
-        NavigateIntentHandler(runtime),
+        # A command naming a robot asks the dispatcher (`desk`) whether its zone is closed.
+        NavigateIntentHandler(runtime, desk),
         # A delivery naming no robot goes to the fleet; one naming a robot, as before.
-        FleetDeliverHandler(runtime, desk, named=DeliverIntentHandler(runtime)),
+        FleetDeliverHandler(runtime, desk, named=DeliverIntentHandler(runtime, desk)),
         WeatherDeliveryIntentHandler(runtime),
-        SequentialDeliveryIntentHandler(runtime),
+        SequentialDeliveryIntentHandler(runtime, desk),
         StatusIntentHandler(runtime),
         ProblemRobotsIntentHandler(runtime),
         EmergencyStopIntentHandler(runtime),
@@ -93,7 +95,9 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
         IdleRobotsIntentHandler(runtime, desk),
         TaskQueueIntentHandler(runtime, desk),
         CancelTaskIntentHandler(runtime, desk),
-        CorrectionIntentHandler(runtime),
+        CloseZoneIntentHandler(runtime, desk),
+        OpenZoneIntentHandler(runtime, desk),
+        CorrectionIntentHandler(runtime, desk),
         UndoIntentHandler(runtime),
         LaunchRequestHandler(runtime),
         HelpIntentHandler(runtime),

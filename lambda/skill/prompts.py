@@ -245,6 +245,27 @@ NO_FREE_ROBOT = "No robot is free to go just now, so I sent none."
 DISPATCH_REFUSED = "The dispatcher refused: {reason}."
 ASK_ORIGIN = "From which zone: {choices}?"
 
+# Zones closed at run time: "close zone b", "open zone b".
+ZONE_CLOSED = "{zone} is closed, so I sent no robot there."
+ZONE_NOW_CLOSED = "{zone} is closed. No robot will be sent there until it opens."
+ZONE_ALREADY_CLOSED = "{zone} was already closed."
+ZONE_NOW_OPEN = "{zone} is open again."
+ZONE_ALREADY_OPEN = "{zone} was not closed."
+# What waits for a closed zone, and what went when it opened.
+ZONE_WAITING = {
+    1: "One queued task to it waits until it opens.",
+    2: "{count} queued tasks to it wait until it opens.",
+}
+ZONE_GIVEN = {
+    1: "{robots} took the task that waited for it.",
+    2: "{robots} took the tasks that waited for it.",
+}
+# A queued task to a closed zone, read out in the queue.
+QUEUE_ENTRY_WAITING = "{place}, {task}, waiting until {zone} opens"
+NO_ZONE_DESK = (
+    "Closing a zone needs the fleet dispatcher, which is not running here, so nothing changed."
+)
+
 # The word before the last of several choices ("zone a, zone b, or zone c"), and of several
 # robots listed ("heron, plover and curlew").
 OR = "or"

@@ -1,13 +1,15 @@
 """The skill's port to the fleet dispatcher, `TaskDesk`, and its two adapters.
 
 The dispatcher (docs/dispatch.md) gives tasks without a robot's name to the best free robot
-or queues them. The skill only submits an order, reads the tasks and cancels one:
+or queues them, and keeps the zones closed at run time. The skill only submits an order,
+reads the tasks, cancels one, and reads, closes and opens zones:
 
-- `HttpTaskDesk`: the local stack's data plane, `POST|GET {data_endpoint}/vahr/tasks` and
-  `DELETE {data_endpoint}/vahr/tasks/{id}` (urllib; `vahr up`);
+- `HttpTaskDesk`: the local stack's data plane, `POST|GET {data_endpoint}/vahr/tasks`,
+  `DELETE {data_endpoint}/vahr/tasks/{id}`, `GET {data_endpoint}/vahr/zones` and `POST
+  {data_endpoint}/vahr/zones/{zone}` (urllib; `vahr up`);
 - `LambdaTaskDesk`: the dispatcher function on AWS, invoked synchronously with
-  `{"operation": "submit"|"tasks"|"cancel", ...}` and answering `{"status", "body"}`, the
-  same status and body as the local routes (lambda/dispatcher/requests.py).
+  `{"operation": "submit"|"tasks"|"cancel"|"zones"|"zone", ...}` and answering `{"status",
+  "body"}`, the same status and body as the local routes (lambda/dispatcher/requests.py).
 
 `task_desk(config)` picks one: the function when `VAHR_DISPATCHER_FUNCTION` is set (the CDK
 stack sets it), else the data endpoint when it is a local `http://` one, else None (no
@@ -27,7 +29,7 @@ from urllib.parse import quote
 import msgspec
 
 from skill.errors import GatewayError, SkillError
-from vahr.dispatch import DispatchErrorCode, Order, Submission, Task
+from vahr.dispatch import DispatchErrorCode, Order, Submission, Task, ZoneChange
 
 if TYPE_CHECKING:
     from skill.config import SkillConfig
@@ -35,6 +37,7 @@ if TYPE_CHECKING:
 # The skill answers within Alexa's 8 s; a dispatcher slower than this is unreachable.
 DESK_TIMEOUT_S = 4.0
 TASKS_PATH = "/vahr/tasks"
+ZONES_PATH = "/vahr/zones"
 
 
 class TaskRefused(SkillError):
@@ -62,9 +65,21 @@ class TaskDesk(Protocol):
         """Cancel an open task (its robot, if any, is stopped); None when it is not open."""
         ...
 
+    def closed_zones(self) -> list[str]:
+        """The zones closed now."""
+        ...
+
+    def set_zone(self, zone: str, *, closed: bool) -> ZoneChange:
+        """Close or open a zone; TaskRefused for a zone the fleet does not have."""
+        ...
+
 
 class _TaskList(msgspec.Struct):
     tasks: list[Task]
+
+
+class _Closed(msgspec.Struct):
+    closed: list[str]
 
 
 class _Cancelled(msgspec.Struct):
@@ -96,6 +111,7 @@ class HttpTaskDesk:
 
     def __init__(self, endpoint: str, *, timeout_s: float = DESK_TIMEOUT_S) -> None:
         self.url = endpoint.rstrip("/") + TASKS_PATH
+        self.zones_url = endpoint.rstrip("/") + ZONES_PATH
         self.timeout_s = timeout_s
 
     def _call(self, method: str, url: str, body: bytes | None = None) -> tuple[int, bytes]:
@@ -124,6 +140,15 @@ class HttpTaskDesk:
         if status == 404:
             return None
         return _read(status, body, _Cancelled).task  # type: ignore[no-any-return]
+
+    def closed_zones(self) -> list[str]:
+        status, body = self._call("GET", self.zones_url)
+        return _read(status, body, _Closed).closed  # type: ignore[no-any-return]
+
+    def set_zone(self, zone: str, *, closed: bool) -> ZoneChange:
+        url = f"{self.zones_url}/{quote(zone, safe='')}"
+        status, body = self._call("POST", url, msgspec.json.encode({"closed": closed}))
+        return _read(status, body, ZoneChange)  # type: ignore[no-any-return]
 
 
 class LambdaTaskDesk:
@@ -175,6 +200,14 @@ class LambdaTaskDesk:
         if status == 404:
             return None
         return _read(status, body, _Cancelled).task  # type: ignore[no-any-return]
+
+    def closed_zones(self) -> list[str]:
+        status, body = self._invoke({"operation": "zones"})
+        return _read(status, body, _Closed).closed  # type: ignore[no-any-return]
+
+    def set_zone(self, zone: str, *, closed: bool) -> ZoneChange:
+        status, body = self._invoke({"operation": "zone", "zone": zone, "closed": closed})
+        return _read(status, body, ZoneChange)  # type: ignore[no-any-return]
 
 
 def task_desk(config: SkillConfig) -> TaskDesk | None:

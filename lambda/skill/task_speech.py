@@ -1,4 +1,5 @@
-"""What the skill says about fleet tasks (pure): a submission, the queue, a cancellation.
+"""What the skill says about fleet tasks (pure): a submission, the queue, a cancellation, a
+zone closed or opened.
 
 Sentences come from `skill.prompts`; robots are called by their first spoken name and
 zones as `skill.vocabulary` says them. Places in line are ordinals ("first in line").
@@ -16,7 +17,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from skill.vocabulary import Vocabulary
-    from vahr.dispatch import Order, Submission, Task
+    from vahr.dispatch import Order, Submission, Task, ZoneChange
 
 # The queue is read out to this many tasks; the rest are counted.
 QUEUE_READ_MAX = 5
@@ -80,15 +81,26 @@ def submission_report(vocabulary: Vocabulary, order: Order, submission: Submissi
     return " ".join(capitalise(sentence) for sentence in sentences)
 
 
-def queue_report(vocabulary: Vocabulary, tasks: Sequence[Task]) -> str:
-    """The queue, next first: "2 queued: first, the delivery to the oven; second, ..."."""
+def queue_report(
+    vocabulary: Vocabulary, tasks: Sequence[Task], *, closed: Sequence[str] = ()
+) -> str:
+    """The queue, next first: "2 queued: first, the delivery to the oven; second, ...". A
+    task into a `closed` zone is said to wait until the zone opens."""
     queued = [task for task in tasks if task.status == "queued"]
     if not queued:
         return prompts.QUEUE_EMPTY
-    entries = [
-        prompts.QUEUE_ENTRY.format(place=ordinal(place), task=task_name(vocabulary, task))
-        for place, task in enumerate(queued[:QUEUE_READ_MAX], start=1)
-    ]
+    entries = []
+    for place, task in enumerate(queued[:QUEUE_READ_MAX], start=1):
+        name = task_name(vocabulary, task)
+        shut = next((zone for zone in (task.pickup, task.zone) if zone in closed), None)
+        if shut is None:
+            entries.append(prompts.QUEUE_ENTRY.format(place=ordinal(place), task=name))
+        else:
+            entries.append(
+                prompts.QUEUE_ENTRY_WAITING.format(
+                    place=ordinal(place), task=name, zone=vocabulary.zone(shut)
+                )
+            )
     if len(queued) > QUEUE_READ_MAX:
         entries.append(prompts.QUEUE_MORE.format(count=len(queued) - QUEUE_READ_MAX))
     wording = prompts.QUEUE_LISTED[min(len(queued), 2)]
@@ -130,3 +142,22 @@ def cancel_report(vocabulary: Vocabulary, cancelled: Sequence[tuple[Task, int]])
     else:
         sentence = prompts.CANCELLED_MANY.format(count=count, zone=zone)
     return capitalise(sentence)
+
+
+def zone_change_report(vocabulary: Vocabulary, change: ZoneChange) -> str:
+    """ "Zone B is closed. No robot will be sent there until it opens. One queued task to
+    it waits until it opens." / "Zone B is open again. Heron took the task that waited."."""
+    zone = vocabulary.zone(change.zone)
+    if change.closed:
+        first = prompts.ZONE_NOW_CLOSED if change.changed else prompts.ZONE_ALREADY_CLOSED
+    else:
+        first = prompts.ZONE_NOW_OPEN if change.changed else prompts.ZONE_ALREADY_OPEN
+    sentences = [first.format(zone=zone)]
+    if change.given:
+        robots = [vocabulary.robot(task.thing) for task in change.given if task.thing]
+        wording = prompts.ZONE_GIVEN[min(len(change.given), 2)]
+        sentences.append(wording.format(robots=and_list(robots)))
+    if change.closed and change.waiting:
+        wording = prompts.ZONE_WAITING[min(len(change.waiting), 2)]
+        sentences.append(wording.format(count=spoken_number(len(change.waiting))))
+    return " ".join(capitalise(sentence) for sentence in sentences)

@@ -282,6 +282,16 @@ class Nav2Backend:
                 self.settings.action,
             )
 
+    def close_zones(self, closed: frozenset[str]) -> None:
+        # Nav2 plans on the robot's own costmaps: a closed area is kept out there, by a
+        # keepout filter (nav2_costmap_2d's KeepoutFilter with its filter mask), not by
+        # this backend. The executor still refuses and ends tasks into a closed zone.
+        return None
+
+    async def leave(self, zone: Zone, on_progress: Callable[[Progress], None]) -> None:
+        # Where to go out of an area is the robot's own planner's to say; see close_zones.
+        return None
+
     async def close(self) -> None:
         await self.halt()
         self._stopping.set()

@@ -28,12 +28,16 @@ class Progress:
     judges "no progress" by that time, which a busy process cannot advance without the
     motion advancing too. None: the backend does not, and the executor's clock is used.
     `eta_s` and `distance_remaining_m` are the navigation server's own estimates (Nav2's
-    `estimated_time_remaining` and `distance_remaining`), where it gives them.
+    `estimated_time_remaining` and `distance_remaining`), where it gives them; a simulated
+    robot on a map gives `eta_s` as the seconds left along its path. A backend that plans
+    on a map also gives `path` (the planned points to the goal, new whenever it plans
+    again).
     """
 
     fraction: float
     pose: Pose
     at: float | None = None
+    path: tuple[tuple[float, float], ...] | None = None
     eta_s: float | None = None
     distance_remaining_m: float | None = None
 
@@ -80,6 +84,14 @@ class NavigationBackend(Protocol):
 
     async def halt(self) -> None:
         """Stop moving at once and drop any active goal."""
+
+    def close_zones(self, closed: frozenset[str]) -> None:
+        """The zones closed now: a backend that plans drives around their areas from now
+        on (a drive under way plans again); one that does not may ignore it."""
+
+    async def leave(self, zone: Zone, on_progress: Callable[[Progress], None]) -> None:
+        """Drive out of `zone`'s area (it closed with the robot inside) to the nearest
+        place outside it; return at once where the backend does not plan."""
 
     async def close(self) -> None:
         """Release the backend's resources (threads, nodes, connections)."""

@@ -156,6 +156,15 @@ class Ros1Backend:
             # and cancel travel on two topics, in no order between them).
             self._client.cancel_goals_at_and_before_time(rospy.Time.now())
 
+    def close_zones(self, closed: frozenset[str]) -> None:
+        # move_base plans on the robot's own costmaps: a closed area is kept out there (a
+        # keepout filter or a costmap layer), not by this backend.
+        return None
+
+    async def leave(self, zone: Zone, on_progress: Callable[[Progress], None]) -> None:
+        # Where to go out of an area is the robot's own planner's to say; see close_zones.
+        return None
+
     async def close(self) -> None:
         await self.halt()
         if self.settings.shutdown_node_on_close:

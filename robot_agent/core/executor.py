@@ -108,6 +108,8 @@ class Executor:
         )
         self._task: asyncio.Task[None] | None = None
         self._current: Command | None = None
+        # The zones closed now (`close_zones`): no command takes the robot into one.
+        self.closed: frozenset[str] = frozenset()
 
     # -- inputs -------------------------------------------------------------------------
 
@@ -115,6 +117,10 @@ class Executor:
         """Start `command` now: preempt or stop what runs, acknowledge, and run it."""
         if isinstance(command, SequentialDelivery) and command.params.after == self.thing:
             self.reject(command.id, command.action, "params.after: a robot cannot wait for itself")
+            return
+        closed = self._closed_on_the_way(command)
+        if closed is not None:
+            self.reject(command.id, command.action, f"zone {closed} is closed")
             return
         if isinstance(command, Ping):
             # Accepted and done at the same instant: one shadow update says both (the skill
@@ -125,9 +131,11 @@ class Executor:
             self._emit("done", command)
             return
         previous = self._task
-        if previous is not None and not previous.done() and self._current is not None:
-            reason = f"preempted by {command.action} {command.id}"
-            self._emit("cancelled", self._current, reason=reason)
+        if previous is not None and not previous.done():
+            if self._current is not None:
+                reason = f"preempted by {command.action} {command.id}"
+                self._emit("cancelled", self._current, reason=reason)
+            # Else the robot is leaving a closed zone on its own: a command takes over.
             previous.cancel()
         self._current = command
         accepted: dict[str, Any] = {
@@ -192,6 +200,91 @@ class Executor:
     def report_battery(self, battery: Battery) -> None:
         """Record the battery as the backend read it; the shadow hears of it when it changes."""
         self._update(battery=battery)
+
+    def close_zones(self, closed: frozenset[str]) -> None:
+        """The zones closed now (the fleet's retained `ZoneClosures`). The backend plans
+        around their areas; a task whose way leads into one ends `failed`; a robot inside
+        one leaves it."""
+        closed = frozenset(zone for zone in closed if zone in self.fleet.zone_ids)
+        if closed == self.closed:
+            return
+        self.closed = closed
+        self.backend.close_zones(closed)
+        if not closed:
+            return
+        command = self._current
+        if command is not None and self.busy:
+            blocked = self._closed_ahead(command)
+            if blocked is None:
+                return
+            self._abandon(command, f"zone {blocked} was closed")
+        previous = self._task
+        self._task = asyncio.get_running_loop().create_task(
+            self._leave_closed(previous), name=f"{self.thing}:leave"
+        )
+
+    def _closed_on_the_way(self, command: Command) -> str | None:
+        """The closed zone a new command would take the robot into, if any."""
+        if not self.closed or not command.is_motion:
+            return None
+        return self._closed_ahead(command, running=False)
+
+    def _closed_ahead(self, command: Command, *, running: bool = True) -> str | None:
+        zone = _destination(command)
+        if zone is None and running and isinstance(command, WeatherDelivery):
+            # Its zone is decided by the weather, then shown as the destination.
+            zone = self.state.destination
+        ahead = [zone] if zone else []
+        # A delivery fetches its package at LOADING first, unless it has it already.
+        delivers = isinstance(command, Deliver | SequentialDelivery | WeatherDelivery)
+        if delivers and not self.state.cargo:
+            ahead.insert(0, "LOADING")
+        return next((zone for zone in ahead if zone in self.closed), None)
+
+    def _abandon(self, command: Command, reason: str) -> None:
+        """End the running task `failed` with `reason` now (its robot halts)."""
+        self._current = None
+        if self._task is not None:
+            self._task.cancel()
+        self._update(status="idle", **self._closing(command, "failed", reason))
+        self._emit("failed", command, reason=reason)
+
+    async def _leave_closed(self, previous: asyncio.Task[None] | None) -> None:
+        """Drive out of every closed zone the robot is in (the backend knows where that is;
+        it returns at once where the robot is not in one)."""
+        if previous is not None and not previous.done():
+            await _settled(previous)
+        for zone_id in sorted(self.closed):
+            zone = self.fleet.zone(zone_id)
+            leaving = False
+
+            def on_progress(progress: Progress) -> None:
+                # Called only while the robot drives out (never when it is not inside).
+                nonlocal leaving
+                changes: dict[str, Any] = {"pose": _pose(progress.pose)}
+                if not leaving:
+                    leaving = True
+                    changes.update(status="navigating", zone=None, destination=None)
+                if progress.path is not None:
+                    changes["path"] = [tuple(point) for point in progress.path]
+                self._update(**changes)
+
+            try:
+                await self.backend.leave(zone, on_progress)
+            except asyncio.CancelledError:
+                await self.backend.halt()
+                self._update(pose=_pose(self.backend.pose), path=None)
+                raise
+            except NavigationFailed as err:
+                log.warning("%s: could not leave closed zone %s: %s", self.thing, zone_id, err)
+            if leaving:
+                here = self.fleet.zone_at(self.backend.pose)
+                self._update(
+                    status="idle",
+                    zone=here.id if here else None,
+                    pose=_pose(self.backend.pose),
+                    path=None,
+                )
 
     def set_connected(self, connected: bool) -> None:
         """Record the link state; the link publishes the full state itself on connect."""
@@ -259,7 +352,7 @@ class Executor:
         except asyncio.CancelledError:
             # Preempted or stopped: the `cancelled` event went out when it was decided.
             await self.backend.halt()
-            self._update(pose=_pose(self.backend.pose))
+            self._update(pose=_pose(self.backend.pose), path=None)
             raise
         except TaskFailed as failure:
             await self.backend.halt()
@@ -278,6 +371,7 @@ class Executor:
             status="stopped",
             task=None,
             destination=None,
+            path=None,
             pose=_pose(self.backend.pose),
             last_command=LastCommand(command.id, command.action, "done"),
         )
@@ -290,7 +384,7 @@ class Executor:
         )
         if self.backend.pose.distance_to(zone.pose) > zone.radius:
             await self._navigate_watched(command, zone)
-        self._update(status="navigating", zone=zone.id, pose=_pose(self.backend.pose))
+        self._update(status="navigating", zone=zone.id, pose=_pose(self.backend.pose), path=None)
         self._emit("arrived", command, zone=zone.id, pose=self.backend.pose)
 
     async def _navigate_watched(self, command: Command, zone: Zone) -> None:
@@ -339,6 +433,9 @@ class Executor:
                     stalled = True
                     wake_up()
             last_progress = progress
+            if progress.path is not None:
+                # A new plan (at the start, or after a zone closed): the shadow says it.
+                self._update(path=[tuple(point) for point in progress.path])
             fraction = min(max(progress.fraction, 0.0), 1.0)
             # Both bounds must hold (see ExecutorSettings); `step` is compared with a little
             # slack so that float steps of exactly a quarter still count as a quarter. The
@@ -417,6 +514,10 @@ class Executor:
 
     async def _deliver(self, command: Command, zone: Zone) -> None:
         loading = self.fleet.zone("LOADING")
+        # A weather delivery learns its zone only now; a zone closed is not driven into.
+        for place in (zone,) if self.state.cargo else (loading, zone):
+            if place.id in self.closed:
+                raise TaskFailed(f"zone {place.id} is closed")
         if not self.state.cargo:
             await self._drive(command, loading)
             await self._load(command, loading)
@@ -515,7 +616,7 @@ class Executor:
 
     def _closing(self, command: Command, result: Result, reason: str | None) -> dict[str, Any]:
         """The state changes that end `command` with `result`."""
-        changes: dict[str, Any] = {"task": None, "destination": None}
+        changes: dict[str, Any] = {"task": None, "destination": None, "path": None}
         changes["pose"] = _pose(self.backend.pose)
         # A ping may have become the last command meanwhile; only our own entry is closed.
         last = self.state.last_command

@@ -218,6 +218,8 @@ def test_the_function_may_keep_tasks_search_the_index_and_command_the_fleet_only
         ("Allow", "iot:SearchIndex", INDEX),
         ("Allow", "iot:Publish", f"{IOT}:topic/vahr/robots/placebot1/cmd"),
         ("Allow", "iot:Publish", f"{IOT}:topic/vahr/robots/placebot2/cmd"),
+        ("Allow", "iot:Publish", f"{IOT}:topic/vahr/fleet/zones"),
+        ("Allow", "iot:RetainPublish", f"{IOT}:topic/vahr/fleet/zones"),
         ("Allow", "sqs:SendMessage", f"<{queue_id}.Arn>"),
         ("Allow", "logs:CreateLogStream", f"<{group_id}.Arn>"),
         ("Allow", "logs:PutLogEvents", f"<{group_id}.Arn>"),

@@ -15,7 +15,7 @@ from template_tools import bare_stack, resources, role_grants
 from infra.config import InfraConfig
 from infra.constructs.dispatcher import Dispatcher
 from infra.constructs.task_table import TaskTable
-from tests.support.dispatch_meter import measure_dispatch
+from tests.support.dispatch_meter import measure_dispatch, measure_zone_change
 from vahr.domain import load_fleet
 
 if TYPE_CHECKING:
@@ -43,7 +43,10 @@ def needed(
     if operation == "SearchIndex":
         return {("iot:SearchIndex", f"{IOT}:index/{params.get('indexName', 'AWS_Things')}")}
     if operation == "Publish":
-        return {("iot:Publish", f"{IOT}:topic/{params['topic']}")}
+        topic = f"{IOT}:topic/{params['topic']}"
+        if params.get("retain"):
+            return {("iot:Publish", topic), ("iot:RetainPublish", topic)}
+        return {("iot:Publish", topic)}
     raise AssertionError(f"an unexpected call: {service} {operation}")
 
 
@@ -79,11 +82,14 @@ def test_every_call_of_a_task_is_allowed_and_every_right_is_used(
         for effect, action, resource in role_grants(template, role_id)
         if effect == "Allow" and not action.startswith(("logs:", "sqs:"))
     }
-    # When the real handler dispatches a task to placebot1 or placebot2 and closes it
+    # When the real handler dispatches a task to placebot1 or placebot2 and closes it, and
+    # (on another table) closes a zone
     with mock_aws():
         measured = measure_dispatch(2)
+    with mock_aws():
+        zone_change = measure_zone_change()
     used: set[tuple[str, str]] = set()
-    for meter in (measured.submit, measured.freed):
+    for meter in (measured.submit, measured.freed, zone_change):
         for service, operation, params in meter.requests:
             used |= needed(service, operation, params, table)
     # Then each call is allowed
@@ -95,4 +101,4 @@ def test_every_call_of_a_task_is_allowed_and_every_right_is_used(
     assert publish_rights == {
         ("iot:Publish", f"{IOT}:topic/vahr/robots/{thing}/cmd")
         for thing in load_fleet().robot_things
-    }
+    } | {("iot:Publish", f"{IOT}:topic/vahr/fleet/zones")}

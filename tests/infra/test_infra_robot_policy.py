@@ -45,8 +45,8 @@ def test_the_policy_states_exactly_the_robot_rights(document: dict[str, Any]) ->
     # Then they are exactly these, all Allow, no more
     me = "${iot:Connection.Thing.ThingName}"
     listen = [
-        f"vahr/robots/{me}/cmd", "vahr/fleet/cmd", "vahr/robots/*/events", "vahr/robots/*/presence",
-        *(f"$aws/things/{me}/shadow/{op}" for op in SHADOW_RESPONSES),
+        f"vahr/robots/{me}/cmd", "vahr/fleet/cmd", "vahr/fleet/zones", "vahr/robots/*/events",
+        "vahr/robots/*/presence", *(f"$aws/things/{me}/shadow/{op}" for op in SHADOW_RESPONSES),
     ]  # fmt: skip
     expected = {
         ("Allow", "iot:Connect", f"{PREFIX}:client/{me}"),

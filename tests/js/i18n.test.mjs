@@ -45,7 +45,7 @@ test("the English words are the page's own", () => {
 // What the scripts write (`t`, `tNodes`) and say to the assistant (`said`), by their English
 // wording: each in every other locale, with the same placeholders.
 const STATIC = new URL("../../vahr/station/static/", import.meta.url);
-const scripts = ["alerts-view", "conversation", "map", "panel", "robots", "station", "talk", "tasks", "tasks-view"]
+const scripts = ["alerts-view", "conversation", "map", "panel", "robots", "station", "talk", "tasks", "tasks-view", "zones-view"]
   .map((name) => readFileSync(new URL(`${name}.js`, STATIC), "utf8"));
 const used = (pattern) => new Set(scripts.flatMap((text) => [...text.matchAll(pattern)].map((m) => m[1])));
 const placeholders = (text) => [...text.matchAll(/\{(\w+)\}/g)].map((m) => m[1]).sort();

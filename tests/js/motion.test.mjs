@@ -141,3 +141,32 @@ describe("stale updates", () => {
     near(motion.position(clock.ms + 500), drawn);
   });
 });
+
+describe("a robot driving a planned path", () => {
+  test("is drawn along the path's legs, round the corner, never across it", () => {
+    const clock = manualClock();
+    const motion = new Motion({ x: 0, y: 0 }, clock.now);
+    // Given a path from (0, 0) up to (0, 2), then across to (2, 2), the goal
+    const route = [{ x: 0, y: 0 }, { x: 0, y: 2 }, { x: 2, y: 2 }];
+    motion.report({ x: 0, y: 0 }, { x: 2, y: 2 }, route);
+    // When three seconds pass at the default speed (1.5 m)
+    clock.ms += 3000;
+    // Then it is drawn on the first leg, not on the straight line to the goal
+    near(motion.position(clock.ms), { x: 0, y: 3 * DEFAULT_SPEED });
+    // And five seconds later (4 m in all, the path's length) at the goal, having turned the corner
+    clock.ms += 5000;
+    near(motion.position(clock.ms), { x: 2, y: 2 });
+    assert.deepEqual(motion.remaining(clock.ms), [{ x: 2, y: 2 }]);
+  });
+
+  test("a report half way along the second leg leaves only the rest ahead", () => {
+    const clock = manualClock();
+    const motion = new Motion({ x: 0, y: 0 }, clock.now);
+    const route = [{ x: 0, y: 0 }, { x: 0, y: 2 }, { x: 2, y: 2 }];
+    motion.report({ x: 0, y: 0 }, { x: 2, y: 2 }, route);
+    clock.ms += 6000; // drawn at (1, 2) at the default speed
+    motion.report({ x: 1, y: 2 }, { x: 2, y: 2 }, route);
+    assert.deepEqual(motion.remaining(clock.ms).at(-1), { x: 2, y: 2 });
+    assert.ok(motion.remaining(clock.ms).every((point) => point.y === 2), "nothing behind it is ahead");
+  });
+});

@@ -180,3 +180,23 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
         }
         app.handle({"thing": task["thing"], "reported": done}, dispatcher(freed_meter))
     return DispatchMeasure(robots, submit_meter, freed_meter, task["thing"])
+
+
+def measure_zone_change() -> CallMeter:
+    """Zone B closed through the function's handler (on an empty table): the calls it makes,
+    the closures' retained publish among them."""
+    dynamodb = boto3.client("dynamodb", region_name=REGION)
+    _create_table(dynamodb)
+    meter = CallMeter()
+    channel = CommandChannel(client=meter.watch(boto3.client("iot-data", region_name=REGION)))
+    core = Dispatcher(
+        fleet=load_fleet(),
+        store=TaskTable(TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION))),
+        candidates=FleetSearch(client=boto3.client("iot", region_name=REGION)),
+        publish=channel,
+        publish_closures=channel.closures,
+        clock=lambda: datetime.now(UTC),
+    )
+    answer = app.handle({"operation": "zone", "zone": "B", "closed": True}, core)
+    assert answer["body"]["changed"] is True, answer
+    return meter

@@ -25,6 +25,7 @@ from robot_agent.swarm import CONNECT_TIMEOUT_S, STOP_TIMEOUT_S
 from robot_agent.swarm import Swarm as ProductSwarm
 from vahr.domain import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
 from vahr.errors import VahrError
+from vahr.navigation import load_floor
 
 if TYPE_CHECKING:
     from vahr.protocol import Reported
@@ -35,19 +36,24 @@ __all__ = ["CONNECT_TIMEOUT_S", "STOP_TIMEOUT_S", "Swarm", "SwarmThread", "swarm
 def swarm_fleet(count: int, *, prefix: str = "swarm", base: Fleet | None = None) -> Fleet:
     """A fleet of `count` robots `{prefix}0001`.. on the zones of `base` (default fleet.yaml).
 
-    Robots start in a grid of 1 m spacing west of the loading zone, so none starts in a zone.
+    Robots start in a grid of 1 m spacing west of the loading zone, so none starts in a zone;
+    on a `base` whose floor is a map, parked on its free ground instead.
     """
     if count < 1:
         raise VahrError("a swarm needs at least one robot")
     base = base or load_fleet()
     width = max(len(str(count)), 4)
+    floor = load_floor(base)
+    if floor is not None:
+        starts = floor.parking(count, spacing=0.6, clear_of_zones=0.8)
+    else:
+        starts = [
+            Pose(-1.0 - (index - 1) // 50, float((index - 1) % 50), 0.0)
+            for index in range(1, count + 1)
+        ]
     robots = [
-        Robot(
-            thing=f"{prefix}{index:0{width}d}",
-            spoken=[f"{prefix} {index}"],
-            start=Pose(-1.0 - (index - 1) // 50, float((index - 1) % 50), 0.0),
-        )
-        for index in range(1, count + 1)
+        Robot(thing=f"{prefix}{index:0{width}d}", spoken=[f"{prefix} {index}"], start=start)
+        for index, start in enumerate(starts, start=1)
     ]
     things = [robot.thing for robot in robots]
     return Fleet(
@@ -55,16 +61,23 @@ def swarm_fleet(count: int, *, prefix: str = "swarm", base: Fleet | None = None)
         zones=base.zones,
         groups=[Group(id=FLEET_GROUP, spoken=["all robots"], robots=things)],
         experiment_thing=base.experiment_thing,
-        # The floor grows to hold the swarm's grid west of it (every start must lie on it).
-        floor=base.floor.covering([robot.start for robot in robots]) if base.floor else None,
+        # A drawn floor grows to hold the swarm's grid west of it (every start must lie on
+        # it); a map holds the robots parked on it.
+        floor=(
+            base.floor.covering([robot.start for robot in robots])
+            if base.floor and floor is None
+            else base.floor
+        ),
     ).validate()
 
 
 class Swarm(ProductSwarm):
     """`count` robots `{prefix}0001`.. of `swarm_fleet` on one link (robot_agent.swarm)."""
 
-    def __init__(self, *, count: int, prefix: str = "swarm", **arguments: Any) -> None:
-        super().__init__(fleet=swarm_fleet(count, prefix=prefix), **arguments)
+    def __init__(
+        self, *, count: int, prefix: str = "swarm", base: Fleet | None = None, **arguments: Any
+    ) -> None:
+        super().__init__(fleet=swarm_fleet(count, prefix=prefix, base=base), **arguments)
 
 
 class SwarmThread:

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from vahr.domain import Fleet, load_fleet
+from vahr.domain.fleet import map_beside
 from vahr.errors import VahrError
 from vahr.protocol import ProtocolError
 
@@ -44,11 +45,24 @@ def read_fleet(path: Path | None) -> Fleet:
     except OSError as err:
         raise VahrError(f"{path}: cannot read the fleet file ({err.strerror})") from err
     try:
-        return Fleet.from_yaml(text)
+        return map_beside(Fleet.from_yaml(text), path)
     except ProtocolError as err:
         # The whole file's faults ("is not valid YAML") need no field name after the file's.
         said = err.reason if err.field == "fleet" else str(err)
         raise VahrError(f"{path}: {said}") from err
+
+
+def read_fleet_on_its_floor(path: Path | None) -> Fleet:
+    """`read_fleet`, and a floor that is a map read and the fleet checked against it: a
+    bad map, or a robot or zone where no robot can be on it, is one line naming the file."""
+    from vahr.navigation import MapError, load_floor
+
+    fleet = read_fleet(path)
+    try:
+        load_floor(fleet)
+    except MapError as err:
+        raise VahrError(f"{path or 'fleet.yaml'}: {err}") from err
+    return fleet
 
 
 def served_fleet(api: str) -> Fleet | None:

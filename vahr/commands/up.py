@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from vahr.cli_router import add_logging_flag, setup_logging
-from vahr.commands.fleet_flag import add_fleet_flag, read_fleet
+from vahr.commands.fleet_flag import add_fleet_flag, read_fleet_on_its_floor
 
 if TYPE_CHECKING:
     import argparse
@@ -121,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
             raise VahrError(f"--{flag.replace('_', '-')} {value}: not a usable port")
     if args.sim_speed_factor <= 0:
         raise VahrError("--sim-speed-factor must be more than 0")
-    fleet = read_fleet(args.fleet)
+    fleet = read_fleet_on_its_floor(args.fleet)
     if args.fleet is not None and args.robots is not None and args.robots > len(fleet.robots):
         # Robots made up past a fleet of one's own would drive among its robots under names
         # nobody gave them (placebot5 in a hospital): a fleet file says what runs.

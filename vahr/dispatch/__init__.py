@@ -4,21 +4,37 @@ Lambda (lambda/dispatcher) run the same core.
 
 - `tasks`: `Order`, `Task` and the four changes of its state, `Submission`, `DispatchError`
   with its `code`;
-- `ranking`: the cost of a robot for a task (`task_cost`) and the ranking (`rank`);
-- `dispatcher`: the `Dispatcher` and the three ports it reaches the world through
-  (`TaskStore`, `Candidates`, `Publish`).
+- `ranking`: the cost of a robot for a task (`task_cost`), the ranking (`rank`) and the
+  path lengths it ranks by (`Routes`, `DistanceField`; `STRAIGHT` on a drawn floor);
+- `dispatcher`: the `Dispatcher` and the ports it reaches the world through (`TaskStore`,
+  `Candidates`, `Publish`, `PublishClosures`), and what closing a zone did (`ZoneChange`);
+- `grid_routes`: path lengths on a map read from the distances `vahr.navigation` wrote
+  (the dispatcher Lambda's, which carries no numpy).
 
 It imports the domain and the wire contract only: the Lambda bundle carries it.
 """
 
 from __future__ import annotations
 
-from vahr.dispatch.dispatcher import Candidates, Dispatcher, Publish, TaskStore
+from vahr.dispatch.dispatcher import (
+    Candidates,
+    Dispatcher,
+    Publish,
+    PublishClosures,
+    RoutesFor,
+    TaskStore,
+    ZoneChange,
+)
 from vahr.dispatch.ranking import (
     BUSY_STATUSES,
     IDLE_STATUSES,
+    STRAIGHT,
+    DistanceField,
     PathLength,
     RobotState,
+    Routes,
+    StraightLine,
+    StraightRoutes,
     rank,
     robot_pose,
     straight_line,
@@ -45,20 +61,28 @@ __all__ = [
     "IDLE_STATUSES",
     "PICKUP_ZONE",
     "SOURCE",
+    "STRAIGHT",
     "Candidates",
     "DispatchError",
     "DispatchErrorCode",
     "Dispatcher",
+    "DistanceField",
     "Order",
     "Outcome",
     "PathLength",
     "Publish",
+    "PublishClosures",
     "RobotState",
+    "Routes",
+    "RoutesFor",
+    "StraightLine",
+    "StraightRoutes",
     "Submission",
     "Task",
     "TaskKind",
     "TaskStatus",
     "TaskStore",
+    "ZoneChange",
     "rank",
     "robot_pose",
     "straight_line",

@@ -15,13 +15,15 @@ from collections.abc import Callable
 from datetime import UTC, datetime, timedelta
 from typing import TYPE_CHECKING, Protocol
 
+import msgspec
+
 from vahr.dispatch.ranking import (
     BUSY_STATUSES,
     IDLE_STATUSES,
-    PathLength,
+    STRAIGHT,
     RobotState,
+    Routes,
     rank,
-    straight_line,
 )
 from vahr.dispatch.tasks import (
     FINAL_RESULTS,
@@ -35,7 +37,7 @@ from vahr.dispatch.tasks import (
     timestamp,
 )
 from vahr.domain.fleet import FLEET_GROUP
-from vahr.protocol.messages import Command, new_command
+from vahr.protocol.messages import Command, ZoneClosures, new_command
 
 if TYPE_CHECKING:
     from vahr.domain.fleet import Fleet
@@ -88,6 +90,18 @@ class TaskStore(Protocol):
         """Every `assigned` task, oldest first."""
         ...
 
+    def close_zone(self, zone: str, *, at: str) -> bool:
+        """Record `zone` closed (since `at`); False when it was closed already."""
+        ...
+
+    def open_zone(self, zone: str) -> bool:
+        """Record `zone` open again; False when it was not closed."""
+        ...
+
+    def closed_zones(self) -> list[str]:
+        """The zones closed now, sorted."""
+        ...
+
 
 class Candidates(Protocol):
     """The robots as a fleet index knows them (the local index; IoT fleet indexing)."""
@@ -106,6 +120,23 @@ class Candidates(Protocol):
 # Sends a command to one robot: (thing, command). The local host publishes on the broker,
 # AWS through iot-data. It raises on failure; the dispatcher then gives the task back.
 Publish = Callable[[str, Command], None]
+# Tells every robot which zones are closed now: the retained `ZoneClosures` on
+# `vahr/fleet/zones` (the local broker, or iot-data with retain on AWS).
+PublishClosures = Callable[[ZoneClosures], None]
+# The path lengths on the fleet's floor with these zones closed (`ranking.Routes`).
+RoutesFor = Callable[[frozenset[str]], Routes]
+
+
+class ZoneChange(msgspec.Struct, frozen=True, kw_only=True):
+    """What closing or opening a zone did, as `POST /vahr/zones/{zone}` answers it:
+    `changed` is False when the zone already was so; `waiting` lists the queued tasks that
+    wait for the zone to open (after closing) or that went now (after opening: `given`)."""
+
+    zone: str
+    closed: bool
+    changed: bool
+    waiting: list[Task] = []
+    given: list[Task] = []
 
 
 class Dispatcher:
@@ -125,19 +156,23 @@ class Dispatcher:
         candidates: Candidates,
         publish: Publish,
         clock: Callable[[], datetime] = lambda: datetime.now(UTC),
-        path_length: PathLength = straight_line,
+        routes: RoutesFor | None = None,
+        publish_closures: PublishClosures | None = None,
         on_given_up: Callable[[Task], None] | None = None,
     ) -> None:
-        """`on_given_up` is told each task the fleet gives up without being asked (its
-        robot was sent elsewhere by name), so that it is announced: no task leaves the
-        fleet's hands without a word."""
+        """`routes` gives the path lengths on the floor for a set of closed zones (default:
+        straight lines, a drawn floor); `publish_closures` tells the robots which zones are
+        closed after every change; `on_given_up` is told each task the fleet gives up without
+        being asked (its robot was sent elsewhere by name), so that it is announced: no task
+        leaves the fleet's hands without a word."""
         self.fleet = fleet
         self.on_given_up = on_given_up
         self.store = store
         self.candidates = candidates
         self.publish = publish
         self.clock = clock
-        self.path_length = path_length
+        self.routes_for: RoutesFor = routes or (lambda closed: STRAIGHT)
+        self.publish_closures = publish_closures
         self._acknowledged: set[str] = set()
 
     # --- orders -------------------------------------------------------------------------
@@ -147,12 +182,16 @@ class Dispatcher:
         robot can take now stays queued. Raises DispatchError (nothing stored) when the
         order names an unknown zone or group or asks for more robots than it may have."""
         tasks = self._tasks_for(order)
+        closed = self._closed()
+        for zone in (order.zone, tasks[0].pickup):
+            if zone is not None and zone in closed:
+                raise DispatchError("zone_closed", f"zone {zone} is closed; no robot is sent there")
         for task in tasks:
             self.store.add(task)
         assigned: list[Task] = []
         queued: list[Task] = []
         for task in tasks:
-            taken = self._give(task)
+            taken = self._give(task, closed)
             if taken is None:
                 queued.append(task)
             else:
@@ -177,6 +216,45 @@ class Dispatcher:
         """The queue, next first."""
         return self.store.pending()
 
+    # --- zones --------------------------------------------------------------------------
+
+    def closed_zones(self) -> list[str]:
+        """The zones closed now, sorted."""
+        return self.store.closed_zones()
+
+    def set_zone(self, zone: str, *, closed: bool) -> ZoneChange:
+        """Close or open `zone`. Closed: no task goes there (orders to it are refused, queued
+        ones wait), robots are told (they leave it and drive around its area), and a task
+        whose robot then gives it up waits in the queue again. Opened: robots are told and
+        the queued tasks that waited go to free robots. DispatchError for an unknown zone."""
+        if zone not in self.fleet.zone_ids:
+            raise DispatchError(
+                "unknown_zone",
+                f"there is no zone {zone!r}; zones are {', '.join(self.fleet.zone_ids)}",
+            )
+        at = timestamp(self.clock())
+        changed = self.store.close_zone(zone, at=at) if closed else self.store.open_zone(zone)
+        now_closed = self.store.closed_zones()
+        self.announce_closures(now_closed)
+        if closed:
+            waiting = [task for task in self.store.pending() if zone in (task.zone, task.pickup)]
+            return ZoneChange(zone=zone, closed=True, changed=changed, waiting=waiting)
+        given = [task for task in self.drain() if zone in (task.zone, task.pickup)]
+        waiting = [
+            task
+            for task in self.store.pending()
+            if zone in (task.zone, task.pickup) and not self._blocked(task, set(now_closed))
+        ]
+        return ZoneChange(zone=zone, closed=False, changed=changed, waiting=waiting, given=given)
+
+    def announce_closures(self, closed: list[str] | None = None) -> None:
+        """Tell the robots which zones are closed now (after a change, at start-up, and on
+        AWS once a minute, so a robot never keeps a closure that was lifted)."""
+        if self.publish_closures is None:
+            return
+        zones = self.store.closed_zones() if closed is None else closed
+        self.publish_closures(ZoneClosures(closed=sorted(zones), at=self.clock()))
+
     def tasks(self) -> list[Task]:
         """What the station shows: the tasks robots hold, then the queue."""
         return self.store.active() + self.store.pending()
@@ -192,7 +270,11 @@ class Dispatcher:
                 self._acknowledged.add(held.id)
                 if state.last_result not in FINAL_RESULTS:
                     return None
-                self.store.finish(held.id, outcome=state.last_result)  # type: ignore[arg-type]
+                if state.last_result in ("failed", "rejected") and self._blocked(held):
+                    # The robot gave it up because its zone closed: it waits for the zone.
+                    self.store.release(held.id)
+                else:
+                    self.store.finish(held.id, outcome=state.last_result)  # type: ignore[arg-type]
             elif held.id in self._acknowledged:
                 # The robot took our command and now reports another: someone gave it a
                 # command by name, which preempted the task. (Before the acknowledgment, an
@@ -208,11 +290,24 @@ class Dispatcher:
         return self.robot_freed(state.thing)
 
     def robot_freed(self, thing: str) -> Task | None:
-        """Give `thing` the first queued task it may take (first come, first served). When
-        another dispatcher got there first, the next one; None when nothing is left."""
-        for task in self.store.pending():
-            if not task.allows(thing):
+        """Give `thing` the first queued task it may take (first come, first served): not
+        one into a closed zone, nor, on a map, one it has no path to. When another
+        dispatcher got there first, the next one; None when nothing is left."""
+        pending = self.store.pending()
+        if not pending:
+            return None
+        closed = self._closed()
+        state = None
+        on_map = self.fleet.floor is not None and self.fleet.floor.map is not None
+        for task in pending:
+            if not task.allows(thing) or self._blocked(task, closed):
                 continue
+            if on_map:
+                state = state or self.candidates.state(thing)
+                if state is not None and not rank(
+                    self.fleet, task, [state], limit=1, routes=self.routes_for(closed)
+                ):
+                    continue
             taken = self._assign(task, thing)
             if taken is not None:
                 return taken
@@ -222,10 +317,16 @@ class Dispatcher:
 
     def drain(self) -> list[Task]:
         """Give every queued task that a free robot may take to the best such robot (at
-        start-up, after a restart, when a robot comes back online)."""
+        start-up, after a restart, when a robot comes back online, when a zone opens)."""
+        pending = self.store.pending()
+        if not pending:
+            return []
         given = []
-        for task in self.store.pending():
-            taken = self._give(task)
+        closed = self._closed()
+        for task in pending:
+            if self._blocked(task, closed):
+                continue
+            taken = self._give(task, closed)
             if taken is not None:
                 given.append(taken)
         return given
@@ -336,11 +437,20 @@ class Dispatcher:
             if robot.connected and robot.status in takes and robot.thing not in holding
         ]
 
-    def _give(self, task: Task) -> Task | None:
+    def _closed(self) -> frozenset[str]:
+        return frozenset(self.store.closed_zones())
+
+    def _blocked(self, task: Task, closed: frozenset[str] | set[str] | None = None) -> bool:
+        """Whether `task` leads into a closed zone (its drop, or its pickup)."""
+        closed = self._closed() if closed is None else closed
+        return task.zone in closed or (task.pickup is not None and task.pickup in closed)
+
+    def _give(self, task: Task, closed: frozenset[str] | None = None) -> Task | None:
         """Assign `task` to the best free robot that will take it, trying the next when a
         race is lost; None when no free robot may take it."""
+        closed = self._closed() if closed is None else closed
         free = self._free()
-        for robot in rank(self.fleet, task, free, path_length=self.path_length):
+        for robot in rank(self.fleet, task, free, routes=self.routes_for(closed)):
             taken = self._assign(task, robot.thing)
             if taken is not None:
                 return taken

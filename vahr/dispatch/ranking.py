@@ -1,12 +1,15 @@
 """The cost of a robot for a task, and the ranking of robots by it.
 
 The cost (docs/dispatch.md) is the length of the path from the robot's reported pose to
-the task's pickup zone and from there to its drop zone. VAHR's robots drive straight from
-anywhere to anywhere on the fleet file's floor (the simulator does, and walls are drawn, not
-driven around), so the default path length is the straight line; a host with a planner
-passes its own `path_length`. Robots that are idle rank before robots busy with work the
-dispatcher did not give them (a command by name), whatever the distance; equal costs are
-broken by thing name, so the same state always picks the same robot.
+the task's pickup zone and from there to its drop zone. On a drawn floor robots drive
+straight from anywhere to anywhere (walls are drawn, not driven around), so the path is
+the straight line (`STRAIGHT`). On a map, a host passes `Routes` whose `field(zone)` is the
+planned path length from every point to the zone, from one search from the zone
+(`vahr.navigation` on the local host, `vahr.dispatch.grid_routes` in the Lambda): ranking
+1,000 robots then costs one lookup each. A robot no path leads from is never ranked.
+Robots that are idle rank before robots busy with work the dispatcher did not give them (a
+command by name), whatever the distance; equal costs are broken by thing name, so the
+same state always picks the same robot.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ from __future__ import annotations
 import heapq
 import math
 from collections.abc import Callable, Iterable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import msgspec
 
@@ -22,7 +25,7 @@ from vahr.domain.fleet import Pose
 
 if TYPE_CHECKING:
     from vahr.dispatch.tasks import Task
-    from vahr.domain.fleet import Fleet
+    from vahr.domain.fleet import Fleet, Zone
 
 # Statuses of a robot with nothing to do: ranked before every busy one.
 IDLE_STATUSES = frozenset({"idle", "stopped"})
@@ -58,20 +61,60 @@ PathLength = Callable[[Pose, Pose], float]
 
 
 def straight_line(start: Pose, end: Pose) -> float:
-    """The path length on VAHR's floors: robots drive straight, walls are not obstacles."""
+    """The path length on a drawn floor: robots drive straight, walls are not obstacles."""
     return math.hypot(end.x - start.x, end.y - start.y)
 
 
-def task_cost(
-    fleet: Fleet, pose: Pose, task: Task, path_length: PathLength = straight_line
-) -> float:
+class DistanceField(Protocol):
+    """Path lengths to one goal from anywhere on the floor, from one search. A field may
+    also answer many points at once (`distances(xs, ys)`, a list of the same lengths), which
+    `rank` then uses: 1,000 robots are one call."""
+
+    def distance(self, x: float, y: float) -> float:
+        """Metres along the path from (x, y) to the goal; math.inf when none leads there."""
+        ...
+
+
+class Routes(Protocol):
+    """Path lengths on a fleet's floor, with some zones closed."""
+
+    def field(self, zone: Zone) -> DistanceField:
+        """Every point's path length to `zone`'s pose."""
+        ...
+
+
+class StraightLine:
+    """The distance field of a drawn floor: the straight line to the goal."""
+
+    def __init__(self, goal: Pose) -> None:
+        self.x, self.y = goal.x, goal.y
+
+    def distance(self, x: float, y: float) -> float:
+        return math.hypot(x - self.x, y - self.y)
+
+
+class StraightRoutes:
+    """`Routes` on a drawn floor: straight lines (`straight_line`)."""
+
+    def field(self, zone: Zone) -> DistanceField:
+        return StraightLine(zone.pose)
+
+
+STRAIGHT = StraightRoutes()
+
+
+def task_cost(fleet: Fleet, pose: Pose, task: Task, routes: Routes = STRAIGHT) -> float:
     """Metres a robot at `pose` drives to do `task`: to the pickup (if any), then to the
-    drop zone. A robot already in the drop zone of a navigation costs nothing."""
-    drop = fleet.zone(task.zone).pose
+    drop zone (math.inf when no path leads there). A robot already in the drop zone of a
+    navigation costs nothing."""
+    drop = fleet.zone(task.zone)
+    to_drop = routes.field(drop)
     if task.pickup is None:
-        return path_length(pose, drop)
-    pickup = fleet.zone(task.pickup).pose
-    return path_length(pose, pickup) + path_length(pickup, drop)
+        return to_drop.distance(pose.x, pose.y)
+    pickup = fleet.zone(task.pickup)
+    return routes.field(pickup).distance(pose.x, pose.y) + to_drop.distance(
+        pickup.pose.x, pickup.pose.y
+    )
 
 
 def robot_pose(fleet: Fleet, state: RobotState) -> Pose:
@@ -92,30 +135,42 @@ def rank(
     robots: Iterable[RobotState],
     *,
     limit: int | None = None,
-    path_length: PathLength = straight_line,
+    routes: Routes = STRAIGHT,
 ) -> list[RobotState]:
     """The robots allowed to take `task`, best first: idle before busy, then by cost, then
     by thing name. With `limit`, only the best `limit` (a partial sort: 10,000 robots are
-    ranked without sorting them all).
+    ranked without sorting them all). A robot no path leads from is left out.
 
     The cost is `task_cost`, computed here with the pickup and drop looked up once: the
-    leg from the pickup to the drop is the same for every robot.
+    leg from the pickup to the drop is the same for every robot, and the first leg is one
+    lookup in the first zone's distance field.
     """
-    drop = fleet.zone(task.zone).pose
-    pickup = fleet.zone(task.pickup).pose if task.pickup is not None else None
+    drop = fleet.zone(task.zone)
+    pickup = fleet.zone(task.pickup) if task.pickup is not None else None
     first = pickup or drop
-    rest = path_length(pickup, drop) if pickup is not None else 0.0
+    rest = routes.field(drop).distance(pickup.pose.x, pickup.pose.y) if pickup is not None else 0.0
     allowed = frozenset(task.robots)
-    hypot, fx, fy = math.hypot, first.x, first.y
-    straight = path_length is straight_line
-    keyed: list[tuple[bool, float, str, RobotState]] = []
-    for robot in robots:
-        if allowed and robot.thing not in allowed:
-            continue
-        pose = robot.pose if robot.pose is not None else robot_pose(fleet, robot)
-        to_first = hypot(pose.x - fx, pose.y - fy) if straight else path_length(pose, first)
-        # False sorts before True: idle robots first.
-        keyed.append((robot.status not in IDLE_STATUSES, to_first + rest, robot.thing, robot))
+    candidates = [robot for robot in robots if not allowed or robot.thing in allowed]
+    poses = [
+        robot.pose if robot.pose is not None else robot_pose(fleet, robot) for robot in candidates
+    ]
+    if isinstance(routes, StraightRoutes):
+        hypot, fx, fy = math.hypot, first.pose.x, first.pose.y
+        costs = [hypot(pose.x - fx, pose.y - fy) for pose in poses]
+    else:
+        field = routes.field(first)
+        many = getattr(field, "distances", None)
+        if many is not None:
+            costs = many([pose.x for pose in poses], [pose.y for pose in poses])
+        else:
+            costs = [field.distance(pose.x, pose.y) for pose in poses]
+    inf = math.inf
+    # False sorts before True: idle robots first. A robot no path leads from is left out.
+    keyed: list[tuple[bool, float, str, RobotState]] = [
+        (robot.status not in IDLE_STATUSES, cost + rest, robot.thing, robot)
+        for robot, cost in zip(candidates, costs, strict=True)
+        if cost != inf
+    ]
     # Tuples compare field by field and thing names are unique, so the states themselves
     # are never compared.
     if limit is None:

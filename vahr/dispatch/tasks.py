@@ -23,13 +23,16 @@ SOURCE = "dispatcher"
 
 
 # Why an order cannot be carried out as asked; callers decide on these, never on the text.
-DispatchErrorCode = Literal["unknown_zone", "unknown_group", "bad_count", "too_many", "none_free"]
+DispatchErrorCode = Literal[
+    "unknown_zone", "unknown_group", "bad_count", "too_many", "none_free", "zone_closed"
+]
 
 
 class DispatchError(ValueError):
     """An order that cannot be carried out as asked: an unknown zone or group, a count the
-    fleet cannot meet, no robot free to go now. `code` says which (`DispatchErrorCode`);
-    `str(error)` is one line a person can act on. Nothing was changed."""
+    fleet cannot meet, no robot free to go now, a zone that is closed. `code` says which
+    (`DispatchErrorCode`); `str(error)` is one line a person can act on. Nothing was
+    changed."""
 
     def __init__(self, code: DispatchErrorCode, message: str) -> None:
         super().__init__(message)

@@ -1,8 +1,11 @@
 """The fleet model: robots, zones, groups and the floor, loaded from `fleet.yaml` (a contract).
 
-The floor (`Floor`: size, walls, the conveyor, where the arms and the task III LED stand) is
-what the operator station draws; it is optional, and a fleet file without it gets one
-derived from its zones and robots (`Fleet.layout`).
+The floor (`Floor`) is either drawn (size, walls, the conveyor, where the arms and the task
+III LED stand: what the operator station draws, and robots drive straight across it) or a
+map (`floor: {map: FILE}`, a ROS map_server YAML relative to the fleet file: robots plan
+their paths on it, `vahr.navigation`). It is optional, and a fleet file without it gets a
+drawn one derived from its zones and robots (`Fleet.layout`). This module reads no image:
+the map itself is read, and the fleet checked against it, by `vahr.navigation`.
 """
 
 from __future__ import annotations
@@ -74,29 +77,49 @@ class Conveyor(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     width: Annotated[float, msgspec.Meta(gt=0)] = 0.5
 
 
-class Floor(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
-    """The floor as drawn: the rectangle from `origin` of `width` by `height` metres, its
-    walls, the conveyor, where each zone's arm stands (by zone id) and the task III LED."""
+# How far a robot's body reaches from its centre, unless the floor says: a robot keeps this
+# far from every wall on a map (TurtleBot3 Waffle's footprint is 0.22 m, Burger's 0.105 m).
+ROBOT_RADIUS_M = 0.2
 
-    width: Annotated[float, msgspec.Meta(gt=0)]
-    height: Annotated[float, msgspec.Meta(gt=0)]
+
+class Floor(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """The floor: the rectangle from `origin` of `width` by `height` metres, its walls, the
+    conveyor, where each zone's arm stands (by zone id) and the task III LED.
+
+    With `map` (a ROS map_server YAML, relative to the fleet file; `load_fleet` makes it
+    absolute) the map is the floor: `width`, `height` and `origin` are the map's, filled in
+    by `vahr.navigation` when it reads it, and `robot_radius` is how far robots keep from
+    anything that is not free space. Without a map, `width` and `height` are required."""
+
+    width: Annotated[float, msgspec.Meta(gt=0)] | None = None
+    height: Annotated[float, msgspec.Meta(gt=0)] | None = None
     origin: Point = Point(0.0, 0.0)
     walls: list[Segment] = []
     conveyor: Conveyor | None = None
     arms: dict[str, Point] = {}
     led: Point | None = None
+    map: Annotated[str, msgspec.Meta(min_length=1)] | None = None
+    robot_radius: Annotated[float, msgspec.Meta(gt=0, le=5)] = ROBOT_RADIUS_M
+
+    @property
+    def size(self) -> tuple[float, float]:
+        """(width, height) in metres; a map's before `vahr.navigation` read it is unknown."""
+        if self.width is None or self.height is None:
+            raise ValueError(f"the size of the map {self.map} is known once the map is read")
+        return self.width, self.height
 
     def holds(self, point: Pose | Point) -> bool:
         """Whether `point` lies on the floor's rectangle (its edges included)."""
+        width, height = self.size
         return (
-            self.origin.x <= point.x <= self.origin.x + self.width
-            and self.origin.y <= point.y <= self.origin.y + self.height
+            self.origin.x <= point.x <= self.origin.x + width
+            and self.origin.y <= point.y <= self.origin.y + height
         )
 
     def extent(self) -> str:
         """The rectangle in words, for errors: `x 0 to 10.5, y 0 to 8`."""
-        x, y = self.origin.x, self.origin.y
-        return f"x {x:g} to {x + self.width:g}, y {y:g} to {y + self.height:g}"
+        (x, y), (width, height) = (self.origin.x, self.origin.y), self.size
+        return f"x {x:g} to {x + width:g}, y {y:g} to {y + height:g}"
 
     def covering(self, points: list[Pose]) -> Floor:
         """This floor, its rectangle grown to hold `points` with `FLOOR_MARGIN_M` to spare
@@ -104,10 +127,11 @@ class Floor(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
         outside = [point for point in points if not self.holds(point)]
         if not outside:
             return self
+        width, height = self.size
         left = min([self.origin.x] + [p.x - FLOOR_MARGIN_M for p in outside])
         bottom = min([self.origin.y] + [p.y - FLOOR_MARGIN_M for p in outside])
-        right = max([self.origin.x + self.width] + [p.x + FLOOR_MARGIN_M for p in outside])
-        top = max([self.origin.y + self.height] + [p.y + FLOOR_MARGIN_M for p in outside])
+        right = max([self.origin.x + width] + [p.x + FLOOR_MARGIN_M for p in outside])
+        top = max([self.origin.y + height] + [p.y + FLOOR_MARGIN_M for p in outside])
         return msgspec.structs.replace(
             self, origin=Point(left, bottom), width=right - left, height=top - bottom
         )
@@ -131,7 +155,10 @@ class Robot(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
 
 
 class Zone(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
-    """A place robots drive to. `arm` says whether an arm loads or unloads there."""
+    """A place robots drive to. `arm` says whether an arm loads or unloads there; a robot
+    within `radius` of `pose` has arrived. `area` (a polygon in the map frame, optional) is
+    the room or bay the zone stands for: while the zone is closed, robots on a map drive
+    around it and leave it (`vahr.navigation`). `charger` marks a charging place."""
 
     id: Annotated[str, msgspec.Meta(pattern=r"^[A-Z][A-Z0-9_]{0,31}$")]
     spoken: SpokenNames
@@ -139,6 +166,8 @@ class Zone(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     arm: Literal["loader", "unloader"] | None = None
     radius: Annotated[float, msgspec.Meta(gt=0)] = 0.5
     spoken_by_locale: dict[str, SpokenNames] | msgspec.UnsetType = msgspec.UNSET
+    area: Annotated[list[Point], msgspec.Meta(min_length=3)] | None = None
+    charger: bool = False
 
 
 class Group(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -275,7 +304,8 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
     def layout(self) -> Floor:
         """The floor to draw: `floor` from the file, completed with a derived arm for each
         zone with an arm it does not place; without `floor`, one derived from the zones and
-        the robots' start poses (a rectangle around them with `FLOOR_MARGIN_M` to spare)."""
+        the robots' start poses (a rectangle around them with `FLOOR_MARGIN_M` to spare).
+        A map's floor is drawn once `vahr.navigation` has filled in the map's size."""
         floor = self.floor or _derived_floor(self)
         arms = dict(floor.arms)
         for zone in self.zones:
@@ -404,16 +434,21 @@ def _listed(values: tuple[str, ...]) -> str:
 def _check_reachable(fleet: Fleet) -> None:
     """Every pose is one a simulated robot can stand at or drive to.
 
-    The simulator drives in a straight line from anywhere to anywhere (walls are drawn, not
-    driven around), so a pose is unreachable only when it is not a place at all: a
-    coordinate or heading that is not a finite number, or, when the file gives a `floor`,
-    a point outside its rectangle. Without a floor, the one drawn is derived around every
-    pose, which therefore lies on it.
+    On a drawn floor the simulator drives in a straight line from anywhere to anywhere
+    (walls are drawn, not driven around), so a pose is unreachable only when it is not a
+    place at all: a coordinate or heading that is not a finite number, or, when the file
+    gives a `floor`, a point outside its rectangle. Without a floor, the one drawn is
+    derived around every pose, which therefore lies on it. On a map, whether a pose is in
+    free space and connected to the others is for `vahr.navigation` to say, which reads it.
     """
     floor = fleet.floor
     if floor is not None:
+        if floor.map is None:
+            for field, size in (("floor.width", floor.width), ("floor.height", floor.height)):
+                if size is None:
+                    raise ProtocolError(field, "is required unless floor.map names a map")
         for field, value in (("floor.width", floor.width), ("floor.height", floor.height)):
-            if not math.isfinite(value):
+            if value is not None and not math.isfinite(value):
                 raise ProtocolError(field, "is not a finite number")
         for field, point in _floor_points(floor):
             _check_finite(field, point)
@@ -425,9 +460,13 @@ def _check_reachable(fleet: Fleet) -> None:
         (f"zones.{index}.pose", zone.pose, "no robot can reach it")
         for index, zone in enumerate(fleet.zones)
     ]
+    for index, zone in enumerate(fleet.zones):
+        for corner, point in enumerate(zone.area or []):
+            _check_finite(f"zones.{index}.area.{corner}", point)
+    drawn = floor is not None and floor.map is None
     for field, pose, consequence in places:
         _check_finite(field, pose)
-        if floor is not None and not floor.holds(pose):
+        if drawn and floor is not None and not floor.holds(pose):
             raise ProtocolError(
                 field,
                 f"({pose.x:g}, {pose.y:g}) is outside the floor ({floor.extent()}), "
@@ -458,7 +497,8 @@ def _floor_points(floor: Floor) -> list[tuple[str, Point]]:
 
 
 def load_fleet(path: str | os.PathLike[str] | None = None) -> Fleet:
-    """Read and validate a fleet file (default: the bundled `fleet.yaml`)."""
+    """Read and validate a fleet file (default: the bundled `fleet.yaml`). A map the floor
+    names (`floor.map`) is taken relative to the fleet file and made absolute here."""
     file = os.fspath(path) if path is not None else DEFAULT_FLEET_FILE
     try:
         # pathlib is avoided on purpose: this module is on the Lambda's cold-start path.
@@ -466,4 +506,15 @@ def load_fleet(path: str | os.PathLike[str] | None = None) -> Fleet:
             text = stream.read()
     except OSError as err:
         raise ProtocolError("fleet", f"cannot read {file}: {err.strerror}") from err
-    return Fleet.from_yaml(text)
+    return map_beside(Fleet.from_yaml(text), file)
+
+
+def map_beside(fleet: Fleet, fleet_file: str | os.PathLike[str]) -> Fleet:
+    """The fleet with its floor's map (a path relative to the fleet file, as the contract
+    says) made absolute, so it reads the same from any directory and any copy of the fleet."""
+    floor = fleet.floor
+    if floor is None or floor.map is None or os.path.isabs(floor.map):  # noqa: PTH117
+        return fleet
+    here = os.path.dirname(os.path.abspath(os.fspath(fleet_file)))  # noqa: PTH100, PTH120
+    absolute = os.path.normpath(os.path.join(here, floor.map))  # noqa: PTH118
+    return msgspec.structs.replace(fleet, floor=msgspec.structs.replace(floor, map=absolute))

@@ -10,7 +10,15 @@
 
 The data plane serves it (`TasksApi`) under `/vahr/tasks`: `POST` submits an order
 (answers the `Submission`), `GET` lists the tasks robots hold then the queue
-(`{"tasks": [...]}`), `DELETE /vahr/tasks/{id}` cancels one.
+(`{"tasks": [...], "closed": [zone ids]}`), `DELETE /vahr/tasks/{id}` cancels one; and
+under `/vahr/zones` (`ZonesApi`): `GET` answers `{"closed": [zone ids]}`, `POST
+/vahr/zones/{zone}` with `{"closed": true|false}` closes or opens one (answers the
+`ZoneChange`). Closures live in the same SQLite file, and every change is published,
+retained, on `vahr/fleet/zones` for the robots.
+
+On a map (`floor: {map: FILE}`), the cost of a robot is its planned path's length:
+`vahr.navigation`'s distance field from each zone, one search per zone and set of closed
+zones, cached.
 """
 
 from __future__ import annotations
@@ -32,6 +40,7 @@ from vahr.dispatch import (
 )
 from vahr.domain import Pose
 from vahr.local.task_store import SqliteTaskStore
+from vahr.navigation import load_floor
 from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import encode, topics
 from vahr.protocol.errors import from_validation_error
@@ -44,12 +53,13 @@ if TYPE_CHECKING:
     from vahr.dispatch import Task
     from vahr.domain import Fleet
     from vahr.plumbing.mqtt import MqttEndpoint
-    from vahr.protocol import Command
+    from vahr.protocol import Command, ZoneClosures
     from vahr.twin.fleet_index import FleetIndex, IndexedThing
 
 log = logging.getLogger(__name__)
 
 TASKS_PATH = "/vahr/tasks"
+ZONES_PATH = "/vahr/zones"
 STOP_TIMEOUT_S = 5.0
 
 Answer = tuple[int, bytes, str | None]
@@ -120,7 +130,8 @@ class TasksApi:
     def respond(self, method: str, path: str, body: bytes) -> Answer:
         if path == TASKS_PATH:
             if method == "GET":
-                return _ok({"tasks": self.dispatcher.tasks()})
+                closed = self.dispatcher.closed_zones()
+                return _ok({"tasks": self.dispatcher.tasks(), "closed": closed})
             if method == "POST":
                 return self._submit(body)
             return _error(405, f"{method} is not allowed on {TASKS_PATH}")
@@ -141,6 +152,38 @@ class TasksApi:
             return _error(400, str(from_validation_error(err)))
         try:
             return _ok(self.dispatcher.submit(order))
+        except DispatchError as err:
+            return _error(400, str(err), error=err.code)
+
+
+class ZoneRequest(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """The body of `POST /vahr/zones/{zone}`."""
+
+    closed: bool
+
+
+class ZonesApi:
+    """`/vahr/zones` on the data plane: the zones closed at run time."""
+
+    def __init__(self, dispatcher: Dispatcher) -> None:
+        self.dispatcher = dispatcher
+
+    def respond(self, method: str, path: str, body: bytes) -> Answer:
+        if path == ZONES_PATH:
+            if method == "GET":
+                return _ok({"closed": self.dispatcher.closed_zones()})
+            return _error(405, f"{method} is not allowed on {ZONES_PATH}")
+        zone = path[len(ZONES_PATH) + 1 :]
+        if "/" in zone or not zone:
+            return _error(404, f"No route for {method} {path}")
+        if method != "POST":
+            return _error(405, f'{method} is not allowed on a zone; POST {{"closed": ...}}')
+        try:
+            request = msgspec.json.decode(body or b"{}", type=ZoneRequest)
+        except (msgspec.ValidationError, msgspec.DecodeError) as err:
+            return _error(400, str(from_validation_error(err)))
+        try:
+            return _ok(self.dispatcher.set_zone(zone, closed=request.closed))
         except DispatchError as err:
             return _error(400, str(err), error=err.code)
 
@@ -178,20 +221,28 @@ class LocalDispatcher:
         self.tasks = SqliteTaskStore.in_state_dir(state_dir)
         self.candidates = IndexCandidates(index, fleet)
         self._client = MqttClient(endpoint, client_id=identities.DISPATCHER)
+        floor = load_floor(fleet)
         self.dispatcher = Dispatcher(
             fleet=fleet,
             store=self.tasks,
             candidates=self.candidates,
             publish=self._publish,
             on_given_up=on_given_up,
+            routes=floor.routes if floor is not None else None,
+            publish_closures=self._publish_closures,
         )
         self.api = TasksApi(self.dispatcher)
+        self.zones_api = ZonesApi(self.dispatcher)
         self._updates: queue.SimpleQueue[str | None] = queue.SimpleQueue()
         self._worker: threading.Thread | None = None
 
     def _publish(self, thing: str, command: Command) -> None:
         # Waits for the broker's PUBACK and raises when none comes: the task keeps its place.
         self._client.publish(topics.robot_cmd(thing), encode(command), qos=1, wait=True)
+
+    def _publish_closures(self, closures: ZoneClosures) -> None:
+        # Retained: a robot that starts or reconnects later learns the closures at once.
+        self._client.publish(topics.FLEET_ZONES, encode(closures), qos=1, retain=True, wait=True)
 
     def _on_documents(self, topic: str, payload: bytes) -> None:
         # On paho's network thread: only note which robot changed; the index already holds
@@ -215,8 +266,10 @@ class LocalDispatcher:
         self._client.connect()
         self._worker = threading.Thread(target=self._serve, name="vahr-dispatcher", daemon=True)
         self._worker.start()
-        # What a previous run left: commands assigned but never acknowledged go out again
-        # (same ids: a robot that had one runs it once), then queued tasks to free robots.
+        # What a previous run left: the zones closed (told to the robots, retained), commands
+        # assigned but never acknowledged go out again (same ids: a robot that had one runs
+        # it once), then queued tasks to free robots.
+        self.dispatcher.announce_closures()
         self.dispatcher.resume()
         self.dispatcher.drain()
         return self

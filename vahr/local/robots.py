@@ -22,6 +22,7 @@ import msgspec
 from vahr.domain import FLEET_GROUP, Fleet, Group, Pose, Robot, load_fleet
 from vahr.domain.fleet import Conveyor, Floor, Point, Segment
 from vahr.errors import VahrError
+from vahr.navigation import load_floor
 from vahr.plumbing.lifetime import spawn
 
 if TYPE_CHECKING:
@@ -44,6 +45,10 @@ SWARM_MAX = 4_000
 # The swarm's floor: robots parked on a grid of this spacing, clear of the zones.
 SWARM_SPACING_M = 2.0
 SWARM_ZONE_CLEARANCE_M = 4.0
+# On a map: robots added to a fleet, or a swarm's, park this far apart on free ground and
+# this far from every zone.
+MAP_PARKING_SPACING_M = 0.6
+MAP_PARKING_ZONE_CLEARANCE_M = 0.8
 
 
 def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
@@ -54,13 +59,23 @@ def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
     if count < 1:
         raise VahrError(f"--robots {count}: at least one robot is needed")
     robots = list(base.robots[:count])
-    for index in range(len(robots) + 1, count + 1):
+    added = range(len(robots) + 1, count + 1)
+    floor = load_floor(base)
+    if floor is not None:
+        # On a map, added robots park on free ground between the fleet's robots and zones.
+        spots = floor.parking(
+            len(added),
+            spacing=MAP_PARKING_SPACING_M,
+            clear_of_zones=MAP_PARKING_ZONE_CLEARANCE_M,
+            avoid=[robot.start for robot in robots],
+        )
+    else:
+        # A grid west of the loading zone, 1 m apart, so no robot starts in a zone.
+        spots = [Pose(x=-1.0 - (index - 1) // 20, y=float((index - 1) % 20)) for index in added]
+    for index, spot in zip(added, spots, strict=True):
         robots.append(
             Robot(
-                thing=f"placebot{index}",
-                spoken=[f"placebot {index}", f"robot {index}"],
-                # A grid west of the loading zone, 1 m apart, so no robot starts in a zone.
-                start=Pose(x=-1.0 - (index - 1) // 20, y=float((index - 1) % 20)),
+                thing=f"placebot{index}", spoken=[f"placebot {index}", f"robot {index}"], start=spot
             )
         )
     things = [robot.thing for robot in robots]
@@ -77,13 +92,15 @@ def fleet_of(count: int | None, base: Fleet | None = None) -> Fleet:
         if g.robots or g.id == FLEET_GROUP
     ]
     # The robots added start west of the floor the file draws: it grows to hold them.
-    floor = base.floor.covering([robot.start for robot in robots]) if base.floor else None
+    grown = base.floor
+    if grown is not None and grown.map is None:
+        grown = grown.covering([robot.start for robot in robots])
     return Fleet(
         robots=robots,
         zones=base.zones,
         groups=groups,
         experiment_thing=base.experiment_thing,
-        floor=floor,
+        floor=grown,
     ).validate()
 
 
@@ -95,6 +112,8 @@ def generated_fleet(count: int, base: Fleet | None = None) -> Fleet:
     if not 1 <= count <= SWARM_MAX:
         raise VahrError(f"--swarm {count}: give 1 to {SWARM_MAX:,} robots")
     base = base or load_fleet()
+    if base.floor is not None and base.floor.map is not None:
+        return _generated_on_map(count, base)
     columns = math.ceil(math.sqrt(count))
     rows = math.ceil(count / columns)
     grid_width, grid_height = (columns - 1) * SWARM_SPACING_M, (rows - 1) * SWARM_SPACING_M
@@ -138,6 +157,28 @@ def generated_fleet(count: int, base: Fleet | None = None) -> Fleet:
         groups=[Group(id=FLEET_GROUP, spoken=spoken, robots=[r.thing for r in robots])],
         experiment_thing=base.experiment_thing,
         floor=floor,
+    ).validate()
+
+
+def _generated_on_map(count: int, base: Fleet) -> Fleet:
+    """`count` rovers on `base`'s map, parked on its free ground; the zones are `base`'s."""
+    floor = load_floor(base)
+    assert floor is not None
+    spots = floor.parking(
+        count, spacing=MAP_PARKING_SPACING_M, clear_of_zones=MAP_PARKING_ZONE_CLEARANCE_M
+    )
+    robots = [
+        Robot(thing=f"rover{index}", spoken=[f"rover {index}"], start=spot)
+        for index, spot in enumerate(spots, start=1)
+    ]
+    everyone = next((g for g in base.groups if g.id == FLEET_GROUP), None)
+    spoken = everyone.spoken if everyone is not None else ["all robots"]
+    return Fleet(
+        robots=robots,
+        zones=base.zones,
+        groups=[Group(id=FLEET_GROUP, spoken=spoken, robots=[r.thing for r in robots])],
+        experiment_thing=base.experiment_thing,
+        floor=base.floor,
     ).validate()
 
 

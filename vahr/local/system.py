@@ -29,7 +29,7 @@ from vahr.domain.fleet import SPOKEN_LOCALE
 from vahr.errors import VahrError
 from vahr.local.alexa_host import serve_alexa
 from vahr.local.announce_host import LocalAnnouncer
-from vahr.local.dispatch_host import TASKS_PATH, LocalDispatcher
+from vahr.local.dispatch_host import TASKS_PATH, ZONES_PATH, LocalDispatcher
 from vahr.local.readiness import Readiness
 from vahr.local.robots import (
     ProgressRate,
@@ -39,6 +39,7 @@ from vahr.local.robots import (
     generated_fleet,
     write_fleet,
 )
+from vahr.navigation import load_floor
 from vahr.plumbing.mqtt import MqttClient
 from vahr.plumbing.ports import ensure_free
 from vahr.protocol import Event, ProtocolError, decode_event, decode_presence, topics, utc_now
@@ -149,6 +150,9 @@ class LocalSystem:
         else:
             self.fleet = fleet_of(config.robots, config.fleet)
         self.readiness = Readiness(self._awaiting)
+        # A fleet on a map: the map read and the fleet checked against it before anything
+        # starts, so a bad map stops `vahr up` in one line (vahr.navigation.MapError).
+        load_floor(self.fleet)
         self.stack = LocalStack(
             StackConfig(
                 state_dir=config.state_dir,
@@ -299,6 +303,7 @@ class LocalSystem:
             on_given_up=given_up,
         ).start()
         dataplane.typed_routes[TASKS_PATH] = self.dispatcher.api.respond
+        dataplane.typed_routes[ZONES_PATH] = self.dispatcher.zones_api.respond
 
     def _start_room(self) -> None:
         """The assistant robots talk to: a second simulated Echo on the same skill."""

@@ -1,7 +1,8 @@
 """The local stack's fleet task queue: `vahr.dispatch.TaskStore` over SQLite.
 
 One row per task, in `tasks.sqlite3` in the state directory, so the queue and who holds
-which task survive a restart of `vahr up`. Every conditional change is one SQL statement
+which task survive a restart of `vahr up`; the zones closed at run time are rows of their
+own table in the same file. Every conditional change is one SQL statement
 (an UPDATE whose WHERE is the condition) inside one `BEGIN IMMEDIATE` transaction, so two
 dispatchers, in threads or in processes sharing the file, cannot give one task to two
 robots or two tasks to one robot: the loser's UPDATE changes no row and it gets None.
@@ -37,6 +38,10 @@ CREATE TABLE IF NOT EXISTS tasks (
 );
 CREATE INDEX IF NOT EXISTS tasks_by_status ON tasks (status, created_at, id);
 CREATE UNIQUE INDEX IF NOT EXISTS one_task_per_robot ON tasks (thing) WHERE status = 'assigned';
+CREATE TABLE IF NOT EXISTS closed_zones (
+    zone TEXT PRIMARY KEY,
+    closed_at TEXT NOT NULL
+);
 """
 
 _decoder = msgspec.json.Decoder(Task)
@@ -146,6 +151,22 @@ class SqliteTaskStore:
     def active(self) -> list[Task]:
         tasks = self._with_status("assigned")
         return sorted(tasks, key=lambda task: (task.assigned_at or "", task.id))
+
+    def close_zone(self, zone: str, *, at: str) -> bool:
+        with self._transaction() as db:
+            cursor = db.execute(
+                "INSERT OR IGNORE INTO closed_zones (zone, closed_at) VALUES (?, ?)", (zone, at)
+            )
+            return cursor.rowcount == 1
+
+    def open_zone(self, zone: str) -> bool:
+        with self._transaction() as db:
+            return db.execute("DELETE FROM closed_zones WHERE zone = ?", (zone,)).rowcount == 1
+
+    def closed_zones(self) -> list[str]:
+        with self._lock:
+            rows = self._db.execute("SELECT zone FROM closed_zones ORDER BY zone").fetchall()
+        return [row[0] for row in rows]
 
     def _with_status(self, status: str) -> list[Task]:
         with self._lock:

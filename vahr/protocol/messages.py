@@ -233,9 +233,10 @@ class Event(msgspec.Struct, frozen=True, kw_only=True, omit_defaults=True):
     """What a robot did, published on `vahr/robots/{thing}/events`.
 
     Only the fields that apply are sent: `zone` for arrived/loaded/delivered, `reason`
-    for rejected/failed/stuck/cancelled, `progress` (0..1) for progress (with `eta_s` and
-    `distance_remaining_m` from a backend that estimates them, such as Nav2), `text` for
-    what was said or heard, `intent` and `confidence` for interpreted.
+    for rejected/failed/stuck/cancelled, `progress` (0..1 of the path's length) for progress
+    (with `eta_s`, seconds left, where the robot knows it, and `distance_remaining_m` from a
+    backend that estimates it, such as Nav2), `text` for what was said or heard, `intent`
+    and `confidence` for interpreted.
     """
 
     event: EventKind
@@ -261,7 +262,17 @@ class Presence(msgspec.Struct, frozen=True):
     at: Timestamp
 
 
+class ZoneClosures(msgspec.Struct, frozen=True):
+    """The zones closed now, retained on `vahr/fleet/zones` by the dispatcher host after
+    every change (`closed`: zone ids, sorted; `at`: when it was decided). No robot is sent
+    into a closed zone; on a map, robots drive around a closed zone's area and leave it."""
+
+    closed: list[str]
+    at: Timestamp
+
+
 _event_decoder = msgspec.json.Decoder(Event)
+_closures_decoder = msgspec.json.Decoder(ZoneClosures)
 _presence_decoder = msgspec.json.Decoder(Presence)
 
 
@@ -280,6 +291,11 @@ def decode_event(payload: bytes | bytearray | memoryview) -> Event:
 
 def decode_presence(payload: bytes | bytearray | memoryview) -> Presence:
     result: Presence = _decode(_presence_decoder, payload)
+    return result
+
+
+def decode_zone_closures(payload: bytes | bytearray | memoryview) -> ZoneClosures:
+    result: ZoneClosures = _decode(_closures_decoder, payload)
     return result
 
 

@@ -59,6 +59,9 @@ class Reported(msgspec.Struct, frozen=True):
     pose: ReportedPose | None = None
     # Reported by a backend that reads the robot's battery (nav2: sensor_msgs/BatteryState).
     battery: Battery | None = None
+    # The way a robot driving on a map is taking: its planned path's points from where it
+    # planned to its goal, in the map frame (`[[x, y], ...]`); None when not driving one.
+    path: list[tuple[float, float]] | None = None
 
     def to_payload(self, client_token: str | None = None) -> bytes:
         """The body of a shadow update reporting this whole state."""

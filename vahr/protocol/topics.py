@@ -5,6 +5,9 @@ from __future__ import annotations
 import re
 
 FLEET_CMD = "vahr/fleet/cmd"
+# The zones closed now (`ZoneClosures`), retained: the dispatcher host publishes it after
+# every change; robots read it (they plan around closed areas and refuse to go into one).
+FLEET_ZONES = "vahr/fleet/zones"
 ALL_ROBOT_CMDS = "vahr/robots/+/cmd"
 ALL_EVENTS = "vahr/robots/+/events"
 ALL_PRESENCE = "vahr/robots/+/presence"

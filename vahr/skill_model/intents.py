@@ -611,6 +611,31 @@ CANCEL_TASK = IntentSpec(
     ),
 )
 
+# Zones closed at run time (docs/floors.md): no robot is sent into a closed zone.
+CLOSE_ZONE = IntentSpec(
+    name="CloseZoneIntent",
+    slots=(ZONE,),
+    essentials=("close {zone}", "block {zone}"),
+    templates=(
+        "[<ask>] (close|shut|block|block off|close off|seal off|lock down|cordon off|fence off) "
+        "{zone} <end>",
+        "[<ask>] (close|shut|block) {zone} (for now|until further notice|to the robots|to all "
+        "robots|for the robots)",
+        "[<ask>] (mark|set) {zone} (as closed|as blocked|as off limits)",
+    ),
+)
+
+OPEN_ZONE = IntentSpec(
+    name="OpenZoneIntent",
+    slots=(ZONE,),
+    essentials=("open {zone}", "reopen {zone}"),
+    templates=(
+        "[<ask>] (open|reopen|unblock|open up) {zone} [again] <end>",
+        "[<ask>] (open|reopen|unblock) {zone} (again|to the robots|for the robots|to all robots)",
+        "[<ask>] (mark|set) {zone} (as open|as open again|as clear)",
+    ),
+)
+
 
 CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     NAVIGATE,
@@ -628,6 +653,8 @@ CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     IDLE_ROBOTS,
     TASK_QUEUE,
     CANCEL_TASK,
+    CLOSE_ZONE,
+    OPEN_ZONE,
 )
 
 BUILT_IN_INTENTS: tuple[str, ...] = (

@@ -13,6 +13,8 @@ Routes (all JSON unless said otherwise; errors are `{"error": "one line"}`):
 | `POST /api/speech` `{"text"}` | the text spoken by espeak-ng, as a WAV file |
 | `POST /api/interaction`, `POST /api/puzzle` | the participant's input, for the session's log |
 | `POST /api/acknowledge` `{"id"}` | an alert acknowledged: `{"acknowledged": [ids]}` |
+| `POST /api/zone` `{"zone", "closed"}` | a zone closed or opened: the dispatcher's `ZoneChange` |
+| `GET /api/map.png` | the map, when the fleet's floor is one (`floor_picture.py`) |
 
 Each JSON body is decoded by msgspec into its route's request type (`json_routes`); an
 empty body is `{}`, unknown fields are ignored, and an error names the field. The page
@@ -43,6 +45,7 @@ if TYPE_CHECKING:
     from vahr.station.controls import Controls
     from vahr.station.desk import Desk
     from vahr.station.feed import Feed
+    from vahr.station.task_queue import ZoneSwitch
     from vahr.station.voice import PushToTalk
 
 log = logging.getLogger(__name__)
@@ -94,6 +97,13 @@ class AcknowledgeRequest(msgspec.Struct, frozen=True):
     id: AlertId
 
 
+class ZoneRequest(msgspec.Struct, frozen=True):
+    """`POST /api/zone`: close (`closed: true`) or open a zone."""
+
+    zone: Word
+    closed: bool
+
+
 # The participant's input: its own message types check it (`Desk.forward`).
 ParticipantRequest = dict[str, Any]
 
@@ -133,8 +143,10 @@ class StationApp:
         assistant: Assistant | None,
         push_to_talk: PushToTalk | None,
         synthesize: Callable[[str], bytes] | None,
+        zones: ZoneSwitch | None = None,
     ) -> None:
         self.feed = feed
+        self.zones = zones
         self.controls = controls
         self.desk = desk
         self.assistant = assistant
@@ -149,6 +161,7 @@ class StationApp:
             "/api/interaction": JsonRoute(ParticipantRequest, self.interaction),
             "/api/puzzle": JsonRoute(ParticipantRequest, self.puzzle),
             "/api/acknowledge": JsonRoute(AcknowledgeRequest, self.acknowledge),
+            "/api/zone": JsonRoute(ZoneRequest, self.zone),
         }
 
     def handle_json(self, method: str, path: str, body: bytes) -> Reply:
@@ -222,6 +235,15 @@ class StationApp:
     def acknowledge(self, request: AcknowledgeRequest) -> Reply:
         """An alert acknowledged on a page: no page shows it from now on."""
         return json_reply({"acknowledged": self.feed.acknowledge(request.id)})
+
+    def zone(self, request: ZoneRequest) -> Reply:
+        """Close or open a zone at the dispatcher (no robot is sent into a closed one)."""
+        if request.zone not in self.feed.fleet.zone_ids:
+            zones = ", ".join(self.feed.fleet.zone_ids)
+            raise RequestError(400, f"zone: {request.zone!r} is not a zone; zones are {zones}")
+        if self.zones is None:
+            raise RequestError(503, "closing a zone needs the fleet dispatcher, which is not here")
+        return json_reply(self.zones.set(request.zone, closed=request.closed))
 
     def voice(self, wav: bytes) -> Reply:
         """Push-to-talk: a WAV clip in, what was heard and answered out."""

@@ -24,7 +24,7 @@ from vahr.station.controls import Controls
 from vahr.station.desk import Desk
 from vahr.station.feed import Feed
 from vahr.station.server import ServerTls, StationServer
-from vahr.station.task_queue import TaskPoller
+from vahr.station.task_queue import TaskPoller, ZoneSwitch
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -83,6 +83,7 @@ class Station:
         self.desk = Desk(self.feed, self._publish)
         self.controls = Controls(fleet, self.desk, self._publish)
         self.push_to_talk = self._push_to_talk(assistant) if config.voice and assistant else None
+        self.tasks = TaskPoller(config.tasks_url, self.feed) if config.tasks_url else None
         self.app = StationApp(
             feed=self.feed,
             controls=self.controls,
@@ -90,6 +91,7 @@ class Station:
             assistant=assistant,
             push_to_talk=self.push_to_talk,
             synthesize=_espeak() if shutil.which("espeak-ng") else None,
+            zones=ZoneSwitch(config.tasks_url, self.tasks) if config.tasks_url else None,
         )
         self.server = StationServer(
             self.app,
@@ -100,7 +102,6 @@ class Station:
             public_origin=config.public_origin,
             locale=config.locale,
         )
-        self.tasks = TaskPoller(config.tasks_url, self.feed) if config.tasks_url else None
 
     def _publish(self, topic: str, payload: bytes) -> None:
         self.link.publish(topic, payload, qos=1)

@@ -133,6 +133,9 @@ def _js_type(schema: dict[str, Any]) -> str:
         return "number"
     if kind in ("boolean", "null"):
         return str(kind)
+    if kind == "array" and "prefixItems" in schema:
+        # A tuple (a path's point, `[x, y]`).
+        return f"[{', '.join(_js_type(item) for item in schema['prefixItems'])}]"
     if kind == "array":
         return f"Array<{_js_type(schema.get('items', {}))}>"
     if kind == "object":

@@ -47,12 +47,14 @@ import logging
 import threading
 import time
 from collections import OrderedDict, deque
+from pathlib import PurePath
 from typing import TYPE_CHECKING, Any
 
 import msgspec
 
 from vahr.domain import FLEET_GROUP
 from vahr.domain.fleet import SPOKEN_LOCALE, spoken_in, zone_name_in
+from vahr.navigation import load_floor
 from vahr.protocol import ProtocolError, decode_command, decode_event, decode_presence, topics
 from vahr.protocol.announcements import Announcement, decode_announcement
 from vahr.protocol.station_topics import (
@@ -63,6 +65,7 @@ from vahr.protocol.station_topics import (
     turn_from_message,
 )
 from vahr.station.changes import merge, own, reported_change
+from vahr.station.floor_picture import FloorPicture, floor_picture
 from vahr.station.page_messages import (
     DRIVE_ENDS,
     EXCHANGE_EVENTS,
@@ -207,9 +210,12 @@ def zone_keys(fleet: Fleet, locale: str = SPOKEN_LOCALE) -> dict[str, str]:
     return keys
 
 
-def fleet_view(fleet: Fleet, locale: str = SPOKEN_LOCALE) -> FleetView:
-    """The fleet as the page draws it: robots with their keys, zones with theirs, the floor;
-    names in `locale`, as the assistant says them."""
+def fleet_view(
+    fleet: Fleet, locale: str = SPOKEN_LOCALE, picture: FloorPicture | None = None
+) -> FleetView:
+    """The fleet as the page draws it: robots with their keys, zones with theirs, the floor
+    (with the map's size, and where its `picture` lies, when the floor is a map); names in
+    `locale`, as the assistant says them."""
     keys = zone_keys(fleet, locale)
     return FleetView(
         robots=[
@@ -229,12 +235,25 @@ def fleet_view(fleet: Fleet, locale: str = SPOKEN_LOCALE) -> FleetView:
                 radius=zone.radius,
                 arm=zone.arm,
                 key=keys.get(zone.id),
+                area=zone.area,
             )
             for zone in fleet.zones
         ],
-        floor=fleet.layout(),
+        floor=_drawn(fleet).layout(),
         experiment_thing=fleet.experiment_thing,
+        map=picture.view if picture is not None else None,
     )
+
+
+def _drawn(fleet: Fleet) -> Fleet:
+    """The fleet with its map's size filled in (a map's floor; the page is told the map's
+    file name, not where it lies on this computer), else as it is."""
+    floor = load_floor(fleet)
+    if floor is None:
+        return fleet
+    drawn = floor.drawn()
+    name = PurePath(drawn.map or "").name
+    return msgspec.structs.replace(fleet, floor=msgspec.structs.replace(drawn, map=name))
 
 
 class Feed:
@@ -244,7 +263,9 @@ class Feed:
         self, fleet: Fleet, *, clock: Callable[[], float] = now_ms, locale: str = SPOKEN_LOCALE
     ) -> None:
         self.fleet = fleet
-        self.view = fleet_view(fleet, locale)
+        # The map's picture, made once: the station serves it (`MAP_PATH`).
+        self.picture = floor_picture(fleet)
+        self.view = fleet_view(fleet, locale, self.picture)
         self._clock = clock
         self._things = frozenset(fleet.robot_things)
         self._lock = threading.Lock()

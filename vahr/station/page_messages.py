@@ -14,7 +14,7 @@ import msgspec
 
 # The page's structs name these in annotations, which msgspec reads at run time.
 from vahr.dispatch import Task  # noqa: TC001
-from vahr.domain.fleet import Floor, Pose  # noqa: TC001
+from vahr.domain.fleet import Floor, Point, Pose  # noqa: TC001
 from vahr.protocol.announcements import Announcement
 from vahr.protocol.messages import Event, EventKind
 from vahr.protocol.station_topics import AssistantTurn, ExperimentStatus  # noqa: TC001
@@ -56,15 +56,42 @@ class ZoneEntry(msgspec.Struct, frozen=True, kw_only=True):
     radius: float
     arm: Literal["loader", "unloader"] | None
     key: str | None
+    # The room or bay the zone stands for (a polygon), drawn and closed with it.
+    area: list[Point] | None = None
+
+
+class MapExtent(msgspec.Struct, frozen=True, kw_only=True):
+    """A rectangle of the map frame, in metres."""
+
+    left: float
+    bottom: float
+    right: float
+    top: float
+
+
+class FloorMap(msgspec.Struct, frozen=True, kw_only=True):
+    """A floor that is a map: its picture (`image`, a PNG the station serves: occupied
+    cells dark, free ones light, unknown ones clear) laid from `origin` at `resolution`
+    metres a pixel, `columns` by `rows`; `known` is the part that is not unknown, which the
+    page zooms to."""
+
+    image: str
+    origin: Point
+    resolution: float
+    columns: int
+    rows: int
+    known: MapExtent
 
 
 class FleetView(msgspec.Struct, frozen=True, kw_only=True):
-    """The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`)."""
+    """The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`), and
+    the map when the floor is one."""
 
     robots: list[RobotEntry]
     zones: list[ZoneEntry]
     floor: Floor
     experiment_thing: str
+    map: FloorMap | None = None
 
 
 class RobotView(msgspec.Struct, kw_only=True):
@@ -98,11 +125,12 @@ class CommandParams(msgspec.Struct, frozen=True, omit_defaults=True):
 class TasksMessage(msgspec.Struct, frozen=True, kw_only=True, tag="tasks", tag_field="type"):
     """The fleet's task queue, sent when it changed: every task the dispatcher lists
     (`GET {api}/vahr/tasks`, `vahr.dispatch.Task`: what is to be done where, its
-    state, the robot that took it), in its order; `available` is False when the deployment
-    has no dispatcher to ask."""
+    state, the robot that took it), in its order, and the zones closed now; `available` is
+    False when the deployment has no dispatcher to ask."""
 
     tasks: list[Task]
     available: bool
+    closed: list[str] = []
 
 
 class SnapshotMessage(msgspec.Struct, kw_only=True, tag="snapshot", tag_field="type"):

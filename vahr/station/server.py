@@ -45,6 +45,7 @@ from urllib.parse import parse_qs, urlencode, urlsplit
 from vahr.plumbing.http_server import QuietHandler, QuietServer, ServerThread
 from vahr.plumbing.ports import LOOPBACK
 from vahr.station.app import Reply, error_reply, json_reply
+from vahr.station.floor_picture import MAP_PATH
 
 if TYPE_CHECKING:
     from vahr.station.app import StationApp
@@ -238,6 +239,13 @@ class _Handler(QuietHandler):
     def _static(self, path: str, query: dict[str, str]) -> None:
         self._send(self.server.station.file(path.removeprefix(STATIC_PATH)))
 
+    def _map(self, path: str, query: dict[str, str]) -> None:
+        picture = self.server.station.app.feed.picture
+        if picture is None:
+            self._send(error_reply(404, "this fleet's floor is not a map"))
+        else:
+            self._send(Reply(200, picture.png, "image/png"))
+
     def _health(self, path: str, query: dict[str, str]) -> None:
         self._send(json_reply({"ok": True}))
 
@@ -347,6 +355,7 @@ class StationServer:
             ("GET", "/index.html"): _Handler._page,
             ("GET", "/favicon.ico"): _Handler._favicon,
             ("GET", "/api/health"): _Handler._health,
+            ("GET", MAP_PATH): _Handler._map,
             ("GET", "/api/snapshot"): _Handler._snapshot,
             ("GET", "/api/stream"): _Handler._stream,
             ("POST", "/api/voice"): _Handler._voice,

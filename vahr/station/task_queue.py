@@ -1,6 +1,8 @@
-"""The fleet's task queue for the station: read from the dispatcher and relayed to the pages.
+"""The fleet's task queue for the station: read from the dispatcher and relayed to the pages;
+and the station's switch that closes and opens zones there.
 
-The dispatcher serves the queue at `GET {api}/vahr/tasks` (`{"tasks": [...]}`). A
+The dispatcher serves the queue at `GET {api}/vahr/tasks` (`{"tasks": [...], "closed":
+[zone ids]}`) and closes a zone at `POST {api}/vahr/zones/{zone}` (`ZoneSwitch`). A
 `TaskPoller` reads it every `EVERY_S` on its own thread and hands it to the feed, which
 sends it to the pages only when it changed (`Feed.set_tasks`): the page never polls, and
 however many pages are open the dispatcher is asked once a period. A deployment without a
@@ -16,10 +18,12 @@ import threading
 import urllib.error
 import urllib.request
 from typing import TYPE_CHECKING
+from urllib.parse import quote
 
 import msgspec
 
 from vahr.dispatch import Task  # noqa: TC001 (msgspec reads it at run time)
+from vahr.station.errors import RequestError
 from vahr.station.page_messages import TasksMessage
 
 if TYPE_CHECKING:
@@ -36,6 +40,7 @@ TASKS_SHOWN = 200
 
 class _Tasks(msgspec.Struct):
     tasks: list[Task]
+    closed: list[str] = []
 
 
 _decoder = msgspec.json.Decoder(_Tasks)
@@ -51,7 +56,8 @@ def read_tasks(url: str, timeout_s: float = TIMEOUT_S) -> TasksMessage:
         if err.code == 404:
             return TasksMessage(tasks=[], available=False)
         raise
-    return TasksMessage(tasks=_decoder.decode(body).tasks[:TASKS_SHOWN], available=True)
+    answer = _decoder.decode(body)
+    return TasksMessage(tasks=answer.tasks[:TASKS_SHOWN], available=True, closed=answer.closed)
 
 
 class TaskPoller:
@@ -91,3 +97,40 @@ class TaskPoller:
         while not self._stopped.is_set():
             self.poll()
             self._stopped.wait(self.every_s)
+
+
+class _Refusal(msgspec.Struct):
+    message: str = "the dispatcher refused"
+
+
+class ZoneSwitch:
+    """Close and open zones at the dispatcher beside `tasks_url` (`POST {api}/vahr/zones/
+    {zone}`), then read the queue again so every page shows the change at once."""
+
+    def __init__(self, tasks_url: str, poller: TaskPoller | None = None) -> None:
+        self.url = tasks_url.removesuffix("/vahr/tasks") + "/vahr/zones"
+        self.poller = poller
+
+    def set(self, zone: str, *, closed: bool) -> dict[str, object]:
+        """The dispatcher's answer (`ZoneChange` as JSON); RequestError when it refused."""
+        request = urllib.request.Request(
+            f"{self.url}/{quote(zone, safe='')}",
+            data=msgspec.json.encode({"closed": closed}),
+            method="POST",
+            headers={"Content-Type": "application/json"},
+        )
+        try:
+            with urllib.request.urlopen(request, timeout=TIMEOUT_S) as answer:  # noqa: S310
+                body = answer.read()
+        except urllib.error.HTTPError as err:
+            try:
+                message = msgspec.json.decode(err.read(), type=_Refusal).message
+            except msgspec.MsgspecError:
+                message = f"the dispatcher answered HTTP {err.code}"
+            raise RequestError(400 if err.code < 500 else 503, message) from err
+        except OSError as err:
+            raise RequestError(503, f"the dispatcher cannot be reached: {err}") from err
+        if self.poller is not None:
+            self.poller.poll()
+        change: dict[str, object] = msgspec.json.decode(body)
+        return change

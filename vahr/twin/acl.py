@@ -50,6 +50,7 @@ def render_acl(*, services: Sequence[str] = SERVICES) -> str:
         f"pattern read {_pattern(topics.robot_cmd(_PLACEHOLDER))}",
         # Shared topics need `pattern`: `topic` lines here would bind to the user above.
         f"pattern read {topics.FLEET_CMD}",
+        f"pattern read {topics.FLEET_ZONES}",
         f"pattern write {_pattern(topics.robot_events(_PLACEHOLDER))}",
         f"pattern write {_pattern(topics.robot_presence(_PLACEHOLDER))}",
         f"pattern read {topics.ALL_EVENTS}",

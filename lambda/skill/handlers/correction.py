@@ -17,6 +17,7 @@ from ask_sdk_core.utils import is_intent_name
 
 from skill import dialog, prompts, session, speech
 from skill.commands import publication
+from skill.handlers.send import closed_reply
 from skill.responses import answer, confirm_slot
 from skill.vocabulary import FLEET, capitalise
 
@@ -28,6 +29,7 @@ if TYPE_CHECKING:
     from skill.runtime import SkillRuntime
     from skill.session import SentCommand
     from skill.slots import SlotReading
+    from skill.task_desk import TaskDesk
 
 CONFIRMED, DENIED = "CONFIRMED", "DENIED"
 
@@ -47,8 +49,9 @@ def _slot_confirmation(handler_input: HandlerInput, name: str) -> str:
 class CorrectionIntentHandler(AbstractRequestHandler):
     """Redirect the last command to the robot or zone the person meant."""
 
-    def __init__(self, runtime: SkillRuntime) -> None:
+    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None = None) -> None:
         self.runtime = runtime
+        self.desk = desk
 
     def can_handle(self, handler_input: HandlerInput) -> bool:
         return bool(is_intent_name("CorrectionIntent")(handler_input))
@@ -100,6 +103,9 @@ class CorrectionIntentHandler(AbstractRequestHandler):
         if (target, zone) == (last.robot, last.zone):
             text = prompts.ALREADY_SO.format(robot=vocabulary.robot(target))
             return answer(handler_input, capitalise(text))
+        refused = closed_reply(self.runtime, self.desk, [zone])
+        if refused is not None:
+            return answer(handler_input, refused)
         params: dict[str, object] | None = {"zone": zone} if zone is not None else None
         items: list[Publication] = []
         if target != last.robot:

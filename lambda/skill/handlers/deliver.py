@@ -15,13 +15,15 @@ if TYPE_CHECKING:
     from ask_sdk_model import Response
 
     from skill.runtime import SkillRuntime
+    from skill.task_desk import TaskDesk
 
 
 class DeliverIntentHandler(AbstractRequestHandler):
     """Load a package at the loading zone and carry it to a zone."""
 
-    def __init__(self, runtime: SkillRuntime) -> None:
+    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None = None) -> None:
         self.runtime = runtime
+        self.desk = desk
 
     def can_handle(self, handler_input: HandlerInput) -> bool:
         return bool(is_intent_name("DeliverIntent")(handler_input))
@@ -41,4 +43,6 @@ class DeliverIntentHandler(AbstractRequestHandler):
                 deliverable=True,
                 preface=prompts.LOADING_IS_NOT_A_DESTINATION if zone.id else "",
             )
-        return send_and_report(handler_input, self.runtime, "deliver", robot.id, {"zone": zone.id})
+        return send_and_report(
+            handler_input, self.runtime, "deliver", robot.id, {"zone": zone.id}, desk=self.desk
+        )

@@ -60,6 +60,9 @@ class _FleetHandler(AbstractRequestHandler):
                 return answer(handler_input, prompts.NO_DISPATCHER)
             if err.error == "none_free":
                 return answer(handler_input, when_none)
+            if err.error == "zone_closed":
+                zone = self.runtime.vocabulary.zone(order.zone)
+                return answer(handler_input, capitalise(prompts.ZONE_CLOSED.format(zone=zone)))
             return answer(handler_input, prompts.DISPATCH_REFUSED.format(reason=str(err)))
         speech = task_speech.submission_report(self.runtime.vocabulary, order, submission)
         return answer(handler_input, speech)
@@ -210,9 +213,11 @@ class TaskQueueIntentHandler(_FleetHandler):
             return answer(handler_input, prompts.NO_DISPATCHER)
         try:
             tasks = self.desk.tasks()
+            closed = self.desk.closed_zones() if tasks else []
         except TaskRefused:  # a stack without the dispatcher's routes
             return answer(handler_input, prompts.NO_DISPATCHER)
-        return answer(handler_input, task_speech.queue_report(self.runtime.vocabulary, tasks))
+        report = task_speech.queue_report(self.runtime.vocabulary, tasks, closed=closed)
+        return answer(handler_input, report)
 
 
 class CancelTaskIntentHandler(_FleetHandler):

@@ -15,13 +15,15 @@ if TYPE_CHECKING:
     from ask_sdk_model import Response
 
     from skill.runtime import SkillRuntime
+    from skill.task_desk import TaskDesk
 
 
 class NavigateIntentHandler(AbstractRequestHandler):
     """Send one robot or the whole fleet to a zone."""
 
-    def __init__(self, runtime: SkillRuntime) -> None:
+    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None = None) -> None:
         self.runtime = runtime
+        self.desk = desk
 
     def can_handle(self, handler_input: HandlerInput) -> bool:
         return bool(is_intent_name("NavigateIntent")(handler_input))
@@ -33,4 +35,6 @@ class NavigateIntentHandler(AbstractRequestHandler):
         zone = dialog.zone(handler_input, self.runtime, "zone")
         if zone.id is None:
             return dialog.ask_zone(handler_input, self.runtime, zone)
-        return send_and_report(handler_input, self.runtime, "navigate", robot.id, {"zone": zone.id})
+        return send_and_report(
+            handler_input, self.runtime, "navigate", robot.id, {"zone": zone.id}, desk=self.desk
+        )

@@ -4,15 +4,18 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from skill import session, speech
+from skill import prompts, session, speech
 from skill.commands import publication
 from skill.responses import answer
+from skill.vocabulary import capitalise
+from skill.zone_guard import closed_zone
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
     from ask_sdk_model import Response
 
     from skill.runtime import SkillRuntime
+    from skill.task_desk import TaskDesk
 
 
 def send_and_report(
@@ -21,9 +24,26 @@ def send_and_report(
     action: str,
     target: str,
     params: dict[str, object] | None = None,
+    *,
+    desk: TaskDesk | None = None,
 ) -> Response:
-    """Publish `action` to one robot (or the fleet) and say what the robots answered."""
+    """Publish `action` to one robot (or the fleet) and say what the robots answered; a
+    command into a zone the dispatcher (`desk`) says is closed is not sent."""
+    zone = (params or {}).get("zone")
+    refused = closed_reply(runtime, desk, [zone if isinstance(zone, str) else None])
+    if refused is not None:
+        return answer(handler_input, refused)
     item = publication(runtime.fleet, action, target, params)
     answers = runtime.robots.send([item])
     session.remember(handler_input, item)
     return answer(handler_input, speech.command_report(runtime.vocabulary, item, answers))
+
+
+def closed_reply(
+    runtime: SkillRuntime, desk: TaskDesk | None, zones: list[str | None]
+) -> str | None:
+    """What to say instead of sending, when one of `zones` is closed now."""
+    closed = closed_zone(desk, zones)
+    if closed is None:
+        return None
+    return capitalise(prompts.ZONE_CLOSED.format(zone=runtime.vocabulary.zone(closed)))

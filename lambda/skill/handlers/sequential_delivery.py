@@ -9,6 +9,7 @@ from ask_sdk_core.utils import is_intent_name
 
 from skill import dialog, prompts, speech
 from skill.commands import sequential
+from skill.handlers.send import closed_reply
 from skill.responses import answer
 from skill.vocabulary import FLEET, capitalise
 
@@ -18,13 +19,15 @@ if TYPE_CHECKING:
 
     from skill.runtime import SkillRuntime
     from skill.slots import SlotReading
+    from skill.task_desk import TaskDesk
 
 
 class SequentialDeliveryIntentHandler(AbstractRequestHandler):
     """The first robot delivers at once; the second delivers once the first has delivered."""
 
-    def __init__(self, runtime: SkillRuntime) -> None:
+    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None = None) -> None:
         self.runtime = runtime
+        self.desk = desk
 
     def can_handle(self, handler_input: HandlerInput) -> bool:
         return bool(is_intent_name("SequentialDeliveryIntent")(handler_input))
@@ -68,6 +71,9 @@ class SequentialDeliveryIntentHandler(AbstractRequestHandler):
         if dialog.delivery_zone_problem(second_zone):
             return self._ask_zone(handler_input, second_zone, second_id)
         assert first_zone.id is not None and second_zone.id is not None
+        refused = closed_reply(runtime, self.desk, [first_zone.id, second_zone.id])
+        if refused is not None:
+            return answer(handler_input, refused)
         items = sequential(runtime.fleet, first.id, first_zone.id, second_id, second_zone.id)
         answers = runtime.robots.send(items)
         return answer(handler_input, speech.sequential_report(runtime.vocabulary, items, answers))

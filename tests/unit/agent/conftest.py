@@ -18,6 +18,7 @@ if TYPE_CHECKING:
     from robot_agent.backends.sim_ticker import SimTicker
     from robot_agent.voice.port import Voice
     from vahr.domain import Fleet
+    from vahr.navigation import FleetFloor
     from vahr.protocol import Event, Reported
 
 
@@ -89,11 +90,14 @@ def make_executor(
     speed: float = SPEED,
     clock: ScaledClock | None = None,
     ticker: SimTicker | None = None,
+    floor: FleetFloor | None = None,
 ) -> tuple[Executor, Recorder, SimBackend]:
     """A robot's executor on the simulator; robots given one `clock` and `ticker` share them
-    (as a swarm's do)."""
+    (as a swarm's do); with `floor`, it plans its paths on that map."""
     clock = clock or ScaledClock(speed)
-    backend = SimBackend(start=fleet.robot(thing).start, clock=clock, settings=sim, ticker=ticker)
+    backend = SimBackend(
+        start=fleet.robot(thing).start, clock=clock, settings=sim, ticker=ticker, floor=floor
+    )
     recorder = Recorder()
     executor = Executor(
         thing=thing,

@@ -220,8 +220,11 @@ def test_cancel_stops_the_robot_and_frees_it(
         ({"operation": "submit"}, 400, "order: is required but missing", None),
         ({"operation": "cancel", "task_id": "nope"}, 404, "no open task 'nope'", None),
         ({"operation": "launch"}, 400,
-         "operation: 'launch' is not one of submit, tasks, pending, cancel", None),
-        ({}, 400, "operation: 'None' is not one of submit, tasks, pending, cancel", None),
+         "operation: 'launch' is not one of submit, tasks, pending, cancel, zones, zone", None),
+        ({}, 400, "operation: 'None' is not one of submit, tasks, pending, cancel, zones, zone",
+         None),
+        ({"operation": "zone", "zone": "Z", "closed": True}, 400,
+         "there is no zone 'Z'; zones are LOADING, A, B, C, D", "unknown_zone"),
     ],
 )  # fmt: skip
 def test_a_request_that_cannot_be_done_is_one_line_and_changes_nothing(
@@ -238,6 +241,7 @@ def test_a_request_that_cannot_be_done_is_one_line_and_changes_nothing(
     refusal = {"code": status, "message": message} | ({"error": error} if error else {})
     assert answer == {"status": status, "body": refusal}
     assert table.pending() == [] and table.active() == [] and len(published) == 0
+    assert table.closed_zones() == []
 
 
 def test_a_malformed_rule_event_or_a_stranger_is_dropped(
@@ -288,7 +292,9 @@ def test_the_lambda_entry_point_builds_its_adapters_from_the_environment(
         # And a missing table is a failed invocation with one line, not an answer
         monkeypatch.setenv("VAHR_TASK_TABLE", "no-such-table")
         app.runtime.cache_clear()
-        with pytest.raises(DispatcherError, match=r"^cannot add task \w+: ResourceNotFound"):
+        with pytest.raises(
+            DispatcherError, match=r"^cannot read the closed zones: ResourceNotFound"
+        ):
             app.lambda_handler({"operation": "submit", "order": {"zone": "A"}}, None)
     finally:
         app.runtime.cache_clear()

@@ -12,6 +12,7 @@ def test_robots_get_only_their_own_topics_by_certificate_name() -> None:
     lines = render_acl().splitlines()
     assert "pattern read vahr/robots/%u/cmd" in lines
     assert "pattern read vahr/fleet/cmd" in lines
+    assert "pattern read vahr/fleet/zones" in lines
     assert "pattern write vahr/robots/%u/events" in lines
     assert "pattern write vahr/robots/%u/presence" in lines
     assert "pattern read vahr/robots/+/events" in lines

@@ -19,7 +19,15 @@ from skill.config import SkillConfig
 from skill.task_desk import TaskRefused
 from tests.conftest import load_event
 from tests.support.fleets import SIX_ROBOTS
-from vahr.dispatch import Dispatcher, DispatchError, Order, RobotState, Submission, Task
+from vahr.dispatch import (
+    Dispatcher,
+    DispatchError,
+    Order,
+    RobotState,
+    Submission,
+    Task,
+    ZoneChange,
+)
 from vahr.domain import load_fleet
 from vahr.local.task_store import SqliteTaskStore
 
@@ -69,6 +77,15 @@ class CoreDesk:
 
     def cancel(self, task_id: str) -> Task | None:
         return self.dispatcher.cancel(task_id)
+
+    def closed_zones(self) -> list[str]:
+        return self.dispatcher.closed_zones()
+
+    def set_zone(self, zone: str, *, closed: bool) -> ZoneChange:
+        try:
+            return self.dispatcher.set_zone(zone, closed=closed)
+        except DispatchError as err:
+            raise TaskRefused(400, str(err), err.code) from err
 
 
 @pytest.fixture
@@ -307,3 +324,51 @@ def test_without_a_dispatcher_the_skill_says_so(aws: None, monkeypatch: pytest.M
     handler = skill_app.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
     response = handler(intent("FleetNavigateIntent", zone=("the shop", "SHOP")), None)
     assert "fleet dispatcher, which is not running here" in speech(response)
+
+
+def test_a_zone_closed_by_voice_takes_no_robot_and_its_queue_waits_until_it_opens(
+    skill: Callable[[dict[str, Any]], dict[str, Any]],
+    robots: Robots,
+    sent: list[tuple[str, Command]],
+    desk: CoreDesk,
+) -> None:
+    # Given every robot busy and a delivery to the oven queued
+    robots.busy(*BAKERY.robot_things)
+    said(skill, intent("DeliverIntent", robot=(None, None), zone=("the oven", "OVEN")))
+    # When the oven is closed
+    close = intent("CloseZoneIntent", zone=("the oven", "OVEN"))
+    assert said(skill, close) == (
+        "The oven is closed. No robot will be sent there until it opens. "
+        "One queued task to it waits until it opens."
+    )
+    assert desk.closed_zones() == ["OVEN"]
+    # Then the queue says what waits for it, and nothing goes there, by name or not
+    assert said(skill, intent("TaskQueueIntent")) == (
+        "One task is queued: first, the delivery to the oven, waiting until the oven opens."
+    )
+    by_name = intent("NavigateIntent", robot=("kestrel", "kestrel"), zone=("the oven", "OVEN"))
+    assert said(skill, by_name) == "The oven is closed, so I sent no robot there."
+    fleet = intent("FleetNavigateIntent", zone=("the oven", "OVEN"))
+    assert said(skill, fleet) == "The oven is closed, so I sent no robot there."
+    assert sent == []
+    # Closing it again says it already was
+    assert said(skill, close) == (
+        "The oven was already closed. One queued task to it waits until it opens."
+    )
+    # When it is opened (every robot still busy), it says so; opening twice says it was open
+    opening = intent("OpenZoneIntent", zone=("the oven", "OVEN"))
+    assert said(skill, opening) == "The oven is open again."
+    assert said(skill, opening) == "The oven was not closed."
+    assert desk.closed_zones() == []
+
+
+def test_closing_a_zone_is_said_in_german(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], desk: CoreDesk
+) -> None:
+    event = intent("CloseZoneIntent", zone=("die backstube", "OVEN"))
+    event["request"]["locale"] = "de-DE"
+    speech_said = said(skill, event)
+    assert speech_said.endswith(
+        "ist gesperrt. Bis sie wieder offen ist, schicke ich keinen Roboter dorthin."
+    )
+    assert desk.closed_zones() == ["OVEN"]

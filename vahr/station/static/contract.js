@@ -90,9 +90,10 @@
  * What a robot did, published on `vahr/robots/{thing}/events`.
  *
  * Only the fields that apply are sent: `zone` for arrived/loaded/delivered, `reason` for
- * rejected/failed/stuck/cancelled, `progress` (0..1) for progress (with `eta_s` and
- * `distance_remaining_m` from a backend that estimates them, such as Nav2), `text` for what was
- * said or heard, `intent` and `confidence` for interpreted.
+ * rejected/failed/stuck/cancelled, `progress` (0..1 of the path's length) for progress (with
+ * `eta_s`, seconds left, where the robot knows it, and `distance_remaining_m` from a backend
+ * that estimates it, such as Nav2), `text` for what was said or heard, `intent` and
+ * `confidence` for interpreted.
  * @typedef {object} Event
  * @property {"accepted"|"arrived"|"cancelled"|"delivered"|"done"|"failed"|"heard"|"interpreted"|"loaded"|"progress"|"rejected"|"said"|"stopped"|"stuck"|"waiting"} event
  * @property {string} thing
@@ -174,25 +175,47 @@
  */
 
 /**
- * The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`).
+ * The fleet as the page draws it: robots, zones and the floor (`Fleet.layout`), and the map
+ * when the floor is one.
  * @typedef {object} FleetView
  * @property {Array<RobotEntry>} robots
  * @property {Array<ZoneEntry>} zones
  * @property {Floor} floor
  * @property {string} experiment_thing
+ * @property {FloorMap|null} map
  */
 
 /**
- * The floor as drawn: the rectangle from `origin` of `width` by `height` metres, its walls, the
+ * The floor: the rectangle from `origin` of `width` by `height` metres, its walls, the
  * conveyor, where each zone's arm stands (by zone id) and the task III LED.
+ *
+ * With `map` (a ROS map_server YAML, relative to the fleet file; `load_fleet` makes it
+ * absolute) the map is the floor: `width`, `height` and `origin` are the map's, filled in by
+ * `vahr.navigation` when it reads it, and `robot_radius` is how far robots keep from anything
+ * that is not free space. Without a map, `width` and `height` are required.
  * @typedef {object} Floor
- * @property {number} width
- * @property {number} height
+ * @property {number|null} width
+ * @property {number|null} height
  * @property {Point} origin
  * @property {Array<Segment>} walls
  * @property {Conveyor|null} conveyor
  * @property {Record<string, Point>} arms
  * @property {Point|null} led
+ * @property {string|null} map
+ * @property {number} robot_radius
+ */
+
+/**
+ * A floor that is a map: its picture (`image`, a PNG the station serves: occupied cells dark,
+ * free ones light, unknown ones clear) laid from `origin` at `resolution` metres a pixel,
+ * `columns` by `rows`; `known` is the part that is not unknown, which the page zooms to.
+ * @typedef {object} FloorMap
+ * @property {string} image
+ * @property {Point} origin
+ * @property {number} resolution
+ * @property {number} columns
+ * @property {number} rows
+ * @property {MapExtent} known
  */
 
 /**
@@ -242,6 +265,15 @@
  */
 
 /**
+ * A rectangle of the map frame, in metres.
+ * @typedef {object} MapExtent
+ * @property {number} left
+ * @property {number} bottom
+ * @property {number} right
+ * @property {number} top
+ */
+
+/**
  * A point on the floor in the `map` frame, in metres.
  * @typedef {object} Point
  * @property {number} x
@@ -278,6 +310,7 @@
  * @property {string|null} [task]
  * @property {ReportedPose|null} [pose]
  * @property {Battery|null} [battery]
+ * @property {Array<[number, number]>|null} [path]
  */
 
 /**
@@ -392,11 +425,13 @@
 /**
  * The fleet's task queue, sent when it changed: every task the dispatcher lists (`GET
  * {api}/vahr/tasks`, `vahr.dispatch.Task`: what is to be done where, its state, the robot that
- * took it), in its order; `available` is False when the deployment has no dispatcher to ask.
+ * took it), in its order, and the zones closed now; `available` is False when the deployment
+ * has no dispatcher to ask.
  * @typedef {object} TasksMessage
  * @property {"tasks"} type
  * @property {Array<Task>} tasks
  * @property {boolean} available
+ * @property {Array<string>} closed
  */
 
 /**
@@ -427,6 +462,7 @@
  * @property {number} radius
  * @property {"loader"|"unloader"|null} arm
  * @property {string|null} key
+ * @property {Array<Point>|null} area
  */
 
 /** @typedef {SnapshotMessage|RobotsMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage|AnnouncementMessage|AlertAcknowledgedMessage|TasksMessage} PageMessage */

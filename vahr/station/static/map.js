@@ -1,5 +1,8 @@
 // @ts-check
 // The floor, top-down, drawn from fleet.yaml, with every robot where it was last reported.
+// A floor that is a map is its picture (the occupancy image, at the map's scale) under the
+// robots, zoomed to the part that is not unknown; a moving robot's planned path is drawn
+// ahead of it, and a closed zone (and its area) is drawn as closed.
 //
 // Up to `SVG_ROBOTS_UP_TO` robots each is an SVG group, a button with its name for screen
 // readers; more are drawn on one canvas over the floor (robot-layer.js), clustered where
@@ -14,7 +17,7 @@ import { t } from "./i18n.js";
 import { Motion, angleDelta, distance } from "./motion.js";
 import { RobotLayer } from "./robot-layer.js";
 
-/** @import { Conveyor, Event, FleetView, Point, Pose, Reported, RobotEntry, RobotView, ZoneEntry } from "./contract.js" */
+/** @import { Conveyor, Event, FleetView, FloorMap, Point, Pose, Reported, RobotEntry, RobotView, ZoneEntry } from "./contract.js" */
 /** @import { ReportedPose } from "./motion.js" */
 
 /**
@@ -36,7 +39,7 @@ import { RobotLayer } from "./robot-layer.js";
  * @property {SVGRectElement} cargo
  * @property {SVGTextElement | null} label
  * @property {SVGTextElement | null} detail
- * @property {SVGLineElement} path
+ * @property {SVGPolylineElement} path
  * @property {SVGCircleElement} destination
  * @property {Motion} motion
  * @property {Partial<RobotState>} state
@@ -56,6 +59,7 @@ import { RobotLayer } from "./robot-layer.js";
  * @property {SVGTextElement} letter
  * @property {SVGTextElement} name
  * @property {SVGTextElement} incoming
+ * @property {SVGPolygonElement | null} area its area, when the fleet gives it one
  * @property {boolean} big whether its letter is its id or key (else its name, small)
  */
 
@@ -107,6 +111,8 @@ export class MapView {
     this.robots = new Map();
     /** @type {Map<string, DrawnZone>} */
     this.zones = new Map();
+    /** The zones closed now. @type {Set<string>} */
+    this.closed = new Set();
     // The floor's size on the screen decides how large a zone's words are drawn.
     this.resized = new ResizeObserver(() => this.sizeZones());
     this.resized.observe(svg);
@@ -147,8 +153,13 @@ export class MapView {
     this.zones.clear();
     this.arms.clear();
     const floor = fleet.floor;
-    const xs = [floor.origin.x, floor.origin.x + floor.width];
-    const ys = [floor.origin.y, floor.origin.y + floor.height];
+    const width = floor.width ?? 0, height = floor.height ?? 0;
+    // A map is drawn around the part of it that is not unknown space; a drawn floor whole.
+    const shown = fleet.map
+      ? fleet.map.known
+      : { left: floor.origin.x, bottom: floor.origin.y, right: floor.origin.x + width, top: floor.origin.y + height };
+    const xs = [shown.left, shown.right];
+    const ys = [shown.bottom, shown.top];
     for (const robot of fleet.robots) { xs.push(robot.start.x); ys.push(robot.start.y); }
     for (const zone of fleet.zones) {
       xs.push(zone.pose.x - zone.radius, zone.pose.x + zone.radius);
@@ -172,12 +183,16 @@ export class MapView {
     for (const name of /** @type {Layer[]} */ (["floor", "fixtures", "zones", "paths", "robots"])) layers[name] = el("g", { class: `layer-${name}` }, this.svg);
     this.layers = layers;
 
-    el("rect", { class: "floor", x: floor.origin.x, y: -(floor.origin.y + floor.height), width: floor.width, height: floor.height }, layers.floor);
-    for (let x = Math.ceil(floor.origin.x); x < floor.origin.x + floor.width; x += 1) {
-      el("line", { class: "grid-line", x1: x, x2: x, y1: -floor.origin.y, y2: -(floor.origin.y + floor.height) }, layers.floor);
-    }
-    for (let y = Math.ceil(floor.origin.y); y < floor.origin.y + floor.height; y += 1) {
-      el("line", { class: "grid-line", y1: -y, y2: -y, x1: floor.origin.x, x2: floor.origin.x + floor.width }, layers.floor);
+    if (fleet.map) {
+      this.drawMap(fleet.map, layers.floor);
+    } else {
+      el("rect", { class: "floor", x: floor.origin.x, y: -(floor.origin.y + height), width, height }, layers.floor);
+      for (let x = Math.ceil(floor.origin.x); x < floor.origin.x + width; x += 1) {
+        el("line", { class: "grid-line", x1: x, x2: x, y1: -floor.origin.y, y2: -(floor.origin.y + height) }, layers.floor);
+      }
+      for (let y = Math.ceil(floor.origin.y); y < floor.origin.y + height; y += 1) {
+        el("line", { class: "grid-line", y1: -y, y2: -y, x1: floor.origin.x, x2: floor.origin.x + width }, layers.floor);
+      }
     }
     for (const wall of floor.walls) {
       el("line", { class: "wall", x1: wall.start.x, y1: -wall.start.y, x2: wall.end.x, y2: -wall.end.y }, layers.floor);
@@ -202,6 +217,17 @@ export class MapView {
     }
   }
 
+  // The map's picture: one image, a pixel a cell, laid at the map's origin and scale (its
+  // first row is the map's top); unknown space is clear, so the page shows through.
+  /** @param {FloorMap} map @param {SVGGElement} parent */
+  drawMap(map, parent) {
+    const width = map.columns * map.resolution, height = map.rows * map.resolution;
+    const { known } = map;
+    el("rect", { class: "floor map-ground", x: known.left, y: -known.top, width: known.right - known.left, height: known.top - known.bottom }, parent);
+    const image = el("image", { class: "floor-map", href: map.image, x: map.origin.x, y: -(map.origin.y + height), width, height, preserveAspectRatio: "none" }, parent);
+    el("title", {}, image).textContent = t("The map the robots plan on");
+  }
+
   /** @param {Conveyor} conveyor @param {SVGGElement} parent */
   drawConveyor(conveyor, parent) {
     const { start, end, width } = conveyor;
@@ -218,6 +244,7 @@ export class MapView {
 
   /** @param {ZoneEntry} zone @param {SVGGElement} parent */
   drawZone(zone, parent) {
+    const area = zone.area ? el("polygon", { class: "zone-area", "data-zone": zone.id, points: zone.area.map((p) => `${p.x},${-p.y}`).join(" ") }, parent) : null;
     const group = el("g", { class: `zone${zone.arm === "loader" ? " loading" : ""}`, "data-zone": zone.id, role: "button", "aria-label": zone.name }, parent);
     el("title", {}, group).textContent = zone.name;
     const body = el("rect", { class: "zone-body" }, group);
@@ -229,9 +256,10 @@ export class MapView {
     // How many robots are on their way here (a large fleet's robots draw no paths).
     const incoming = el("text", { class: "zone-incoming", visibility: "hidden" }, group);
     group.addEventListener("click", () => this.onZone(zone.id));
-    const drawn = { group, zone, half: zone.radius + 0.22, body, letter, name, incoming, big: Boolean(shown) };
+    const drawn = { group, zone, half: zone.radius + 0.22, area, body, letter, name, incoming, big: Boolean(shown) };
     this.zones.set(zone.id, drawn);
     this.sizeZone(drawn);
+    this.showClosed(zone.id);
   }
 
   // The floor's metres per screen pixel, as drawn now ("meet": as large as the box allows).
@@ -285,6 +313,23 @@ export class MapView {
     put(incoming, "font-size", nameSize);
   }
 
+  // The zones closed now: each is drawn crossed out, its area hatched.
+  /** @param {string[]} closed */
+  setClosed(closed) {
+    this.closed = new Set(closed);
+    for (const zoneId of this.zones.keys()) this.showClosed(zoneId);
+  }
+
+  /** @param {string} zoneId */
+  showClosed(zoneId) {
+    const drawn = this.zones.get(zoneId);
+    if (!drawn) return;
+    const closed = this.closed.has(zoneId);
+    drawn.group.classList.toggle("closed", closed);
+    drawn.area?.classList.toggle("closed", closed);
+    put(drawn.group, "aria-label", closed ? t("{zone} (closed)", { zone: drawn.zone.name }) : drawn.zone.name);
+  }
+
   /** @param {string} zoneId @param {Point} at @param {SVGGElement} parent */
   drawArm(zoneId, at, parent) {
     const zone = this.fleet?.zones.find((z) => z.id === zoneId);
@@ -325,7 +370,7 @@ export class MapView {
       label.textContent = robot.name;
       detail = el("text", { class: "robot-detail", y: 0.22 * this.scale, "font-size": 0.18 * this.scale }, group);
     }
-    const path = el("line", { class: "path", visibility: "hidden" }, layers.paths);
+    const path = el("polyline", { class: "path", visibility: "hidden" }, layers.paths);
     const destination = el("circle", { class: "destination", r: 0.36, visibility: "hidden" }, layers.paths);
     group.addEventListener("click", (event) => { event.stopPropagation(); this.onRobot(robot.thing); });
     const motion = new Motion(robot.start);
@@ -374,18 +419,22 @@ export class MapView {
     }
   }
 
-  // A reported pose (from the shadow or an event): move the robot's motion.
+  // A reported pose (from the shadow or an event): move the robot's motion, along the path
+  // it planned when it reported one.
   /**
    * @param {string} thing
    * @param {ReportedPose | null | undefined} pose
    * @param {string | null | undefined} destinationZone
    * @param {boolean} driving
+   * @param {Array<[number, number]> | null} [path] the shadow's `path`
    */
-  report(thing, pose, destinationZone, driving) {
+  report(thing, pose, destinationZone, driving, path = null) {
     const drawn = this.layer ? this.layer.robots.get(thing) : this.robots.get(thing);
     if (!drawn || !pose) return;
-    const target = driving ? this.zonePose(destinationZone) : null;
-    drawn.motion.report(pose, target);
+    const end = path && path.length ? { x: path[path.length - 1][0], y: path[path.length - 1][1] } : null;
+    const target = driving ? end || this.zonePose(destinationZone) : null;
+    const route = driving && path ? path.map(([x, y]) => ({ x, y })) : null;
+    drawn.motion.report(pose, target, route);
     this.animate();
   }
 
@@ -501,10 +550,9 @@ export class MapView {
     put(drawn.path, "visibility", show);
     put(drawn.destination, "visibility", show);
     if (target) {
-      put(drawn.path, "x1", at.x.toFixed(3));
-      put(drawn.path, "y1", (-at.y).toFixed(3));
-      put(drawn.path, "x2", target.x);
-      put(drawn.path, "y2", -target.y);
+      // The way still ahead: from where the robot is drawn through the corners to come.
+      const ahead = [at, ...motion.remaining(t)];
+      put(drawn.path, "points", ahead.map((p) => `${p.x.toFixed(3)},${(-p.y).toFixed(3)}`).join(" "));
       put(drawn.destination, "cx", target.x);
       put(drawn.destination, "cy", -target.y);
     }
@@ -518,7 +566,9 @@ export class MapView {
   placeLabel(drawn, at) {
     const floor = this.fleet?.floor;
     if (!floor) return;
-    const side = at.x > floor.origin.x + floor.width / 2 ? -1 : 1;
+    const known = this.fleet?.map?.known;
+    const middle = known ? (known.left + known.right) / 2 : floor.origin.x + (floor.width ?? 0) / 2;
+    const side = at.x > middle ? -1 : 1;
     let offset = 0.42;
     for (const { zone, half } of this.zones.values()) {
       if (Math.abs(at.x - zone.pose.x) <= half && Math.abs(at.y - zone.pose.y) <= half) {

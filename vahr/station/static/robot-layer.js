@@ -191,15 +191,19 @@ export class RobotLayer {
     const radius = single ? DOT_PX : Math.min(CELL_PX / 2 - 1, CROWD_PX + 1.5 * Math.log10(mark.things.length));
     const trouble = mark.things.find((t) => this.troubled.has(t));
     if (single && thing === this.selected) {
-      const target = this.robots.get(thing)?.motion.target;
-      if (target) {
-        const to = toScreen(target);
+      // The selected robot's way ahead: through the corners of its planned path, if any.
+      const motion = this.robots.get(thing)?.motion;
+      const ahead = motion ? motion.remaining(performance.now()) : [];
+      if (ahead.length) {
         context.strokeStyle = colour;
         context.lineWidth = 1.5;
         context.setLineDash([4, 3]);
         context.beginPath();
         context.moveTo(mark.x, mark.y);
-        context.lineTo(to.x, to.y);
+        for (const point of ahead) {
+          const to = toScreen(point);
+          context.lineTo(to.x, to.y);
+        }
         context.stroke();
         context.setLineDash([]);
       }

@@ -16,6 +16,7 @@ import { Panel } from "./panel.js";
 import { RobotsPanel } from "./robots.js";
 import { Talk } from "./talk.js";
 import { TasksView } from "./tasks-view.js";
+import { ZonesView } from "./zones-view.js";
 
 /** @import { AnnouncementMessage, CommandMessage, EventMessage, ExperimentStatus, FleetView, PageMessage, Reported, RobotChange, RobotView, RobotsMessage, SnapshotMessage } from "./contract.js" */
 /** @import { SayReply } from "./api.js" */
@@ -86,6 +87,10 @@ const alerts = new AlertsView({
 const tasks = new TasksView(
   { card: byId("tasks", HTMLElement), list: byId("task-list", HTMLElement), count: byId("task-count", HTMLElement) },
   { nameOf: (thing) => names[thing] || thing, zoneOf: (zone) => (zone.length <= 2 ? `zone ${zone}` : zoneText(zone)) },
+);
+const zones = new ZonesView(
+  { card: byId("zones", HTMLElement), list: byId("zone-switches", HTMLElement), count: byId("zones-count", HTMLElement) },
+  { onSwitch: (zone, closed) => post("/api/zone", { zone, closed }).catch((err) => panel.tell(reason(err), true)) },
 );
 new Talk({ button: byId("talk", HTMLButtonElement), level: byId("talk-level", HTMLElement), state: byId("talk-state", HTMLElement), interactions, metrics });
 
@@ -180,18 +185,21 @@ function reset(snapshot) {
     map.build(snapshot.fleet);
     robots.build(snapshot.fleet);
     panel.build(snapshot.fleet);
+    zones.build(snapshot.fleet);
   }
   conversation.build(snapshot.fleet, snapshot.conversation);
   for (const [thing, robot] of Object.entries(store.robots)) {
     /** @type {Reported} */
     const reported = robot.reported || {};
     const pose = robot.progress?.pose || reported.pose;
-    const driving = reported.status === "navigating" && reported.destination;
-    map.report(thing, pose, reported.destination, Boolean(driving));
+    const driving = reported.status === "navigating" && (reported.destination || reported.path);
+    map.report(thing, pose, reported.destination, Boolean(driving), reported.path);
     changed(thing);
   }
   onExperiment(snapshot.experiment);
   tasks.update(snapshot.tasks);
+  map.setClosed(snapshot.tasks?.closed || []);
+  zones.update(snapshot.tasks);
   alerts.reset(snapshot.alerts, first);
   if (store.selected) select(store.selected);
 }
@@ -216,12 +224,14 @@ function onChange(change, received) {
   if (!robot) return;
   applyChange(robot, change);
   const ended = change.last_event && DRIVE_ENDS.includes(change.last_event.event) ? change.last_event : null;
+  const path = robot.reported?.path;
   if (ended?.pose) map.report(change.thing, ended.pose, null, false);
-  if (change.progress) map.report(change.thing, change.progress.pose, change.progress.zone, true);
+  if (change.progress) map.report(change.thing, change.progress.pose, change.progress.zone, true, path);
   if (change.reported || change.removed) {
     const { status, destination, pose, zone } = robot.reported || {};
-    const driving = status === "navigating" && destination && zone !== destination;
-    if (!change.progress) map.report(change.thing, pose, destination, Boolean(driving));
+    // A robot leaving a closed zone drives with a path and no destination.
+    const driving = status === "navigating" && ((destination && zone !== destination) || path);
+    if (!change.progress) map.report(change.thing, pose, destination, Boolean(driving), path);
   }
   const marker = metrics && change.version !== undefined ? { thing: change.thing, version: change.version, received, station: change.last_seen } : null;
   changed(change.thing, marker);
@@ -280,6 +290,8 @@ const handlers = {
   },
   tasks(message) {
     tasks.update(message);
+    map.setClosed(message.closed || []);
+    zones.update(message);
   },
 };
 

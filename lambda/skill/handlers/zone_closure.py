@@ -1,0 +1,68 @@
+"""CloseZoneIntent and OpenZoneIntent: "close zone b", "open zone b" (docs/floors.md).
+
+The dispatcher keeps which zones are closed (`TaskDesk.set_zone`): no robot is sent into a
+closed zone, queued tasks for it wait, robots leave it and drive around its area. Anyone
+may close or open a zone today; when people have roles it is a supervisor's command.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ask_sdk_core.dispatch_components import AbstractRequestHandler
+from ask_sdk_core.utils import is_intent_name
+
+from skill import dialog, prompts, task_speech
+from skill.responses import answer
+from skill.task_desk import TaskRefused
+
+if TYPE_CHECKING:
+    from ask_sdk_core.handler_input import HandlerInput
+    from ask_sdk_model import Response
+
+    from skill.runtime import SkillRuntime
+    from skill.task_desk import TaskDesk
+
+
+class _ZoneHandler(AbstractRequestHandler):
+    """Close or open the zone named in the request."""
+
+    intent_name = ""
+    closes = True
+
+    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None) -> None:
+        self.runtime = runtime
+        self.desk = desk
+
+    def can_handle(self, handler_input: HandlerInput) -> bool:
+        return bool(is_intent_name(self.intent_name)(handler_input))
+
+    def handle(self, handler_input: HandlerInput) -> Response:
+        zone = dialog.zone(handler_input, self.runtime, "zone")
+        if zone.id is None:
+            return dialog.ask_zone(handler_input, self.runtime, zone)
+        if self.desk is None:
+            return answer(handler_input, prompts.NO_ZONE_DESK)
+        try:
+            change = self.desk.set_zone(zone.id, closed=self.closes)
+        except TaskRefused as err:
+            if err.status == 404:  # a stack without the dispatcher's zone routes
+                return answer(handler_input, prompts.NO_ZONE_DESK)
+            return answer(handler_input, prompts.DISPATCH_REFUSED.format(reason=str(err)))
+        return answer(
+            handler_input, task_speech.zone_change_report(self.runtime.vocabulary, change)
+        )
+
+
+class CloseZoneIntentHandler(_ZoneHandler):
+    """ "close zone b": no robot goes there until it opens."""
+
+    intent_name = "CloseZoneIntent"
+    closes = True
+
+
+class OpenZoneIntentHandler(_ZoneHandler):
+    """ "open zone b": robots may go there again; what waited for it goes."""
+
+    intent_name = "OpenZoneIntent"
+    closes = False
