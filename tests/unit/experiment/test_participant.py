@@ -260,8 +260,8 @@ def test_the_announce_participant_never_looks_and_acts_on_each_finished_task(
     assert decided
     heard = [e for e in entries if e.kind == Kind.INTERACTION_ENDED and e.data["text"] == HEAR_TEXT]
     assert [h.data["speech"] for h in heard] == [
-        "Placebot one has finished its task at loading zone.",
-        "Placebot two has finished its task at loading zone.",
+        "Placebot one has finished its task at the loading zone.",
+        "Placebot two has finished its task at the loading zone.",
     ]
     assert [h.data["seen"] for h in heard] == [["placebot1 was loaded"], ["placebot2 was loaded"]]
     assert all(h.data["counts"] is False for h in heard)
