@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
+from vahr.domain.people import MAX_ID_CHARS, valid_person_id
 from vahr.protocol import ProtocolError, topics
 from vahr.protocol.station_topics import ORIGIN_PATTERN, Heard
 
@@ -28,9 +29,17 @@ def serve_alexa(
     fleet_file: Path | None = None,
     log_level: str = "WARNING",
     locale: str = "en-US",
+    users_file: Path | None = None,
+    confirm: bool | None = None,
 ) -> AlexaSimulator:
     """Serve the Alexa simulator (and the skill, in-process) at `POST /vahr/say`, in
-    `locale`: its understanding data, and the locale of every request it sends."""
+    `locale`: its understanding data, and the locale of every request it sends. The skill
+    knows the people of `users_file` (None: everyone may do everything) and confirms
+    fleet-wide commands as `confirm` says (None: as the fleet file says, else when people
+    are known).
+
+    A say request may name the Alexa account speaking (`user`, `vahr say --user`) and the
+    voice recognised (`person`); each account has its own session."""
     # The NLU's libraries load here, not when `vahr.local` is imported.
     from vahr.assistant.commands_seen import CommandLog
     from vahr.assistant.envelope import Identity
@@ -57,6 +66,8 @@ def serve_alexa(
         skill_id=identity.skill_id,
         fleet_file=str(fleet_file) if fleet_file else None,
         log_level=log_level,
+        users_file=str(users_file) if users_file else None,
+        confirm=confirm,
     )
 
     def publish_turn(turn: Turn) -> None:
@@ -86,12 +97,24 @@ def serve_alexa(
             return 400, {"code": 400, "message": message}
         try:
             origin, heard = _speaker(request)
+            user, person = _account(request, "user"), _account(request, "person")
         except ProtocolError as err:
             return 400, {"code": 400, "message": str(err)}
-        return 200, simulator.say(utterance, origin=origin, heard=heard).to_json()
+        turn = simulator.say(utterance, origin=origin, heard=heard, user=user, person=person)
+        return 200, turn.to_json()
 
     dataplane.local_routes[("POST", "/vahr/say")] = say
     return simulator
+
+
+def _account(request: dict[str, Any], field: str) -> str | None:
+    """An Alexa userId or personId from a say request, or None when not given."""
+    value = request.get(field)
+    if value is None:
+        return None
+    if not isinstance(value, str) or not valid_person_id(value):
+        raise ProtocolError(field, f"an Alexa id is 1 to {MAX_ID_CHARS} printable characters")
+    return value
 
 
 def _speaker(request: dict[str, Any]) -> tuple[str, dict[str, Any] | None]:

@@ -11,6 +11,11 @@
 The data plane serves it (`TasksApi`) under `/vahr/tasks`: `POST` submits an order
 (answers the `Submission`), `GET` lists the tasks robots hold then the queue
 (`{"tasks": [...]}`), `DELETE /vahr/tasks/{id}` cancels one.
+
+Each order and cancel that reaches the API is recorded in the audit trail (channel `api`),
+unless its sender recorded it already (the skill does, with the person who asked: it says
+so in `RECORDED_BY_HEADER`); so is each queued task the dispatcher gives a robot by itself
+once one comes free (channel `dispatcher`).
 """
 
 from __future__ import annotations
@@ -34,12 +39,15 @@ from vahr.domain import Pose
 from vahr.local.task_store import SqliteTaskStore
 from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import encode, topics
+from vahr.protocol.audit import RECORDED_BY_HEADER, AuditEntry, Outcome, now
 from vahr.protocol.errors import from_validation_error
 from vahr.twin import identities
 
 if TYPE_CHECKING:
+    from collections.abc import Callable, Mapping
     from pathlib import Path
 
+    from vahr.dispatch import Task
     from vahr.domain import Fleet
     from vahr.plumbing.mqtt import MqttEndpoint
     from vahr.protocol import Command
@@ -51,6 +59,8 @@ TASKS_PATH = "/vahr/tasks"
 STOP_TIMEOUT_S = 5.0
 
 Answer = tuple[int, bytes, str | None]
+# Who acts when no person does: a program calling the tasks API, the dispatcher itself.
+API_CALLER = "api"
 
 
 def robot_state(entry: IndexedThing) -> RobotState:
@@ -110,12 +120,25 @@ class IndexCandidates:
 
 
 class TasksApi:
-    """`/vahr/tasks` on the data plane, in its typed-route form: (status, body, error type)."""
+    """`/vahr/tasks` on the data plane, in its typed-route form: (status, body, error type).
+    `record`, when given, takes the trail's entry for each order and cancel."""
 
-    def __init__(self, dispatcher: Dispatcher) -> None:
+    def __init__(
+        self, dispatcher: Dispatcher, record: Callable[[AuditEntry], object] | None = None
+    ) -> None:
         self.dispatcher = dispatcher
+        self._record = record
 
-    def respond(self, method: str, path: str, body: bytes) -> Answer:
+    def respond(
+        self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
+    ) -> Answer:
+        answer = self._respond(method, path, body)
+        recorded = any(name.lower() == RECORDED_BY_HEADER.lower() for name in headers or {})
+        if self._record is not None and method in ("POST", "DELETE") and not recorded:
+            self._record(_api_entry(method, path, body, answer))
+        return answer
+
+    def _respond(self, method: str, path: str, body: bytes) -> Answer:
         if path == TASKS_PATH:
             if method == "GET":
                 return _ok({"tasks": self.dispatcher.tasks()})
@@ -143,6 +166,65 @@ class TasksApi:
             return _error(400, str(err), error=err.code)
 
 
+def _api_entry(method: str, path: str, body: bytes, answer: Answer) -> AuditEntry:
+    """The trail's record of one order or cancel sent to the API by a program."""
+    status, payload, _ = answer
+    outcome: Outcome = "sent" if status == 200 else "failed"
+    reason = None
+    robots: list[str] = []
+    commands: list[str] = []
+    slots: dict[str, str | None] = {}
+    try:
+        answered = msgspec.json.decode(payload)
+    except msgspec.DecodeError:
+        answered = {}
+    if not isinstance(answered, dict):
+        answered = {}
+    if status != 200:
+        reason = str(answered.get("message", f"HTTP {status}"))[:500]
+    if method == "POST":
+        try:
+            order = msgspec.json.decode(body or b"{}")
+        except msgspec.DecodeError:
+            order = {}
+        if isinstance(order, dict):
+            slots = {str(k)[:255]: str(v)[:255] for k, v in order.items() if v is not None}
+        tasks = [*answered.get("assigned", []), *answered.get("queued", [])]
+        commands = [str(task.get("id")) for task in tasks if isinstance(task, dict)]
+        robots = [str(t["thing"]) for t in answered.get("assigned", []) if t.get("thing")]
+    else:
+        task = answered.get("task") or {}
+        commands = [path[len(TASKS_PATH) + 1 :][:255]]
+        robots = [str(task["thing"])] if task.get("thing") else []
+    return AuditEntry(
+        time=now(),
+        who=API_CALLER,
+        channel="api",
+        words=f"{method} {path}",
+        intent="submit" if method == "POST" else "cancel",
+        slots=slots,
+        robots=robots,
+        commands=commands,
+        outcome=outcome,
+        reason=reason,
+    )
+
+
+def _dispatcher_entry(task: Task) -> AuditEntry:
+    """The trail's record of a queued task the dispatcher gave a robot by itself."""
+    return AuditEntry(
+        time=now(),
+        who=identities.DISPATCHER,
+        channel="dispatcher",
+        intent=task.kind,
+        slots={"zone": task.zone},
+        robots=[task.thing] if task.thing else [],
+        commands=[task.id],
+        outcome="sent",
+        reason="a queued task given to a robot that came free",
+    )
+
+
 def _ok(body: object) -> Answer:
     return 200, msgspec.json.encode(body), None
 
@@ -164,15 +246,22 @@ class LocalDispatcher:
     worker thread that hands robots' updates to the core. A context manager."""
 
     def __init__(
-        self, *, fleet: Fleet, index: FleetIndex, endpoint: MqttEndpoint, state_dir: Path
+        self,
+        *,
+        fleet: Fleet,
+        index: FleetIndex,
+        endpoint: MqttEndpoint,
+        state_dir: Path,
+        record: Callable[[AuditEntry], object] | None = None,
     ) -> None:
         self.tasks = SqliteTaskStore.in_state_dir(state_dir)
+        self._record = record
         self.candidates = IndexCandidates(index, fleet)
         self._client = MqttClient(endpoint, client_id=identities.DISPATCHER)
         self.dispatcher = Dispatcher(
             fleet=fleet, store=self.tasks, candidates=self.candidates, publish=self._publish
         )
-        self.api = TasksApi(self.dispatcher)
+        self.api = TasksApi(self.dispatcher, record)
         self._updates: queue.SimpleQueue[str | None] = queue.SimpleQueue()
         self._worker: threading.Thread | None = None
 
@@ -193,9 +282,22 @@ class LocalDispatcher:
             if state is None:
                 continue
             try:
-                self.dispatcher.observe(state)
+                given = self.dispatcher.observe(state)
             except Exception:  # one failed hand-over must not stop the dispatcher
                 log.exception("dispatching after an update of %s failed", thing)
+                continue
+            if given is not None:
+                self._recorded([given])
+
+    def _recorded(self, tasks: list[Task]) -> None:
+        """Record tasks the dispatcher gave robots by itself (never stopping it)."""
+        if self._record is None:
+            return
+        for task in tasks:
+            try:
+                self._record(_dispatcher_entry(task))
+            except Exception:
+                log.exception("the audit trail did not take the dispatch of %s", task.id)
 
     def start(self) -> LocalDispatcher:
         self._client.subscribe(topics.ALL_SHADOW_DOCUMENTS, self._on_documents, retained=False)
@@ -204,8 +306,8 @@ class LocalDispatcher:
         self._worker.start()
         # What a previous run left: commands assigned but never acknowledged go out again
         # (same ids: a robot that had one runs it once), then queued tasks to free robots.
-        self.dispatcher.resume()
-        self.dispatcher.drain()
+        self._recorded(self.dispatcher.resume())
+        self._recorded(self.dispatcher.drain())
         return self
 
     def stop(self) -> None:

@@ -25,6 +25,7 @@ import msgspec
 
 from vahr.assistant import SimulatorAssistant
 from vahr.domain.fleet import SPOKEN_LOCALE
+from vahr.domain.people import confirmation_on
 from vahr.errors import VahrError
 from vahr.local.alexa_host import serve_alexa
 from vahr.local.announce_host import LocalAnnouncer
@@ -51,6 +52,7 @@ if TYPE_CHECKING:
 
     from vahr.assistant.simulator import AlexaSimulator
     from vahr.domain import Fleet
+    from vahr.domain.people import People
     from vahr.plumbing.client import Assistant
 
 log = logging.getLogger(__name__)
@@ -88,6 +90,13 @@ class SystemConfig:
     # The language people speak to the simulated Echo (`vahr up --locale`); the robots'
     # own spoken exchange with the assistant stays English (an English recognizer).
     locale: str = "en-US"
+    # Who may do what (`vahr up --users FILE`, `vahr.domain.people`): None, everyone may do
+    # everything. `people` is that file read; the station signs its operators in with it.
+    users_file: Path | None = None
+    people: People | None = None
+    # Whether fleet-wide commands are confirmed first; None: as the fleet file says, else
+    # whenever people are known. The paper's experiment sets False: one-turn commands.
+    confirm: bool | None = None
 
 
 class ServedStation(Protocol):
@@ -159,6 +168,14 @@ class LocalSystem:
         self._restarts: dict[str, deque[float]] = {}
 
     @property
+    def confirmation(self) -> bool:
+        """Whether the skill confirms fleet-wide commands first (as it decides it)."""
+        rules = self.fleet.confirmation_rules
+        return confirmation_on(
+            self.config.confirm, rules.enabled, self.config.users_file is not None
+        )
+
+    @property
     def voice_enabled(self) -> bool:
         return self.config.voice and shutil.which("espeak-ng") is not None
 
@@ -202,6 +219,8 @@ class LocalSystem:
                 fleet_file=fleet_file,
                 log_level=cfg.log_level,
                 locale=cfg.locale,
+                users_file=cfg.users_file,
+                confirm=cfg.confirm,
             )
             assert self.stack.dataplane is not None and self.stack.ca is not None
             self.stack.dataplane.local_routes[("GET", "/vahr/status")] = self._status
@@ -271,6 +290,7 @@ class LocalSystem:
             index=store.index,
             endpoint=self.stack.service_endpoint(identities.DISPATCHER),
             state_dir=self.config.state_dir,
+            record=self.stack.trail.append if self.stack.trail is not None else None,
         ).start()
         dataplane.typed_routes[TASKS_PATH] = self.dispatcher.api.respond
 
@@ -293,7 +313,7 @@ class LocalSystem:
         )
 
         def ask(request: str) -> str | None:
-            turn = room_echo.say(f"alexa {request}")
+            turn = room_echo.say(f"alexa {request}", origin="robot")
             # Each question is one-shot: the robot does not hold a conversation.
             room_echo.end_session()
             return turn.speech or None

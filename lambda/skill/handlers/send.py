@@ -1,4 +1,5 @@
-"""The step every robot-command handler ends with: send, wait for robots, speak the outcome."""
+"""The step every robot-command handler ends with: send, wait for robots, speak the outcome
+(a fleet-wide command is confirmed first, `skill.guard.confirm_first`)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ from typing import TYPE_CHECKING
 
 from skill import session, speech
 from skill.commands import publication
+from skill.guard import confirm_first
 from skill.responses import answer
 
 if TYPE_CHECKING:
@@ -23,6 +25,9 @@ def send_and_report(
     params: dict[str, object] | None = None,
 ) -> Response:
     """Publish `action` to one robot (or the fleet) and say what the robots answered."""
+    question = confirm_first(handler_input, runtime)
+    if question is not None:
+        return question
     item = publication(runtime.fleet, action, target, params)
     answers = runtime.robots.send([item])
     session.remember(handler_input, item)
