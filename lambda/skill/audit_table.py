@@ -25,7 +25,7 @@ import msgspec
 from botocore.config import Config
 from botocore.exceptions import BotoCoreError, ClientError
 
-from skill.trail import TrailUnavailable
+from skill.errors import TrailUnavailable
 from vahr.protocol.audit import TrailHead, chained, record_from_json
 
 if TYPE_CHECKING:
@@ -117,21 +117,30 @@ class AuditTable:
             raise TrailUnavailable(f"the audit table cannot be written: {err}") from err
         return True
 
-    def records(self) -> list[AuditRecord]:
-        """Every record, by number (an item that is no record raises ProtocolError)."""
+    def records(self, after: int = 0, limit: int | None = None) -> list[AuditRecord]:
+        """The records numbered above `after`, in order, at most `limit` (an item that is no
+        record raises ProtocolError)."""
         found: list[AuditRecord] = []
+        query: dict[str, Any] = {
+            "TableName": self.table_name,
+            "KeyConditionExpression": "trail = :records AND seq > :after",
+            "ExpressionAttributeValues": {":records": {"S": RECORDS}, ":after": {"N": str(after)}},
+            "ConsistentRead": True,
+        }
         try:
-            pages = self.client.get_paginator("query").paginate(
-                TableName=self.table_name,
-                KeyConditionExpression="trail = :records",
-                ExpressionAttributeValues={":records": {"S": RECORDS}},
-                ConsistentRead=True,
-            )
-            for page in pages:
+            for page in self.client.get_paginator("query").paginate(**query):
                 found += [_stored(item) for item in page.get("Items", [])]
+                if limit is not None and len(found) >= limit:
+                    return found[:limit]
         except (BotoCoreError, ClientError) as err:
             raise TrailUnavailable(f"the audit table cannot be read: {err}") from err
         return found
+
+    def snapshot(self, after: int, limit: int) -> tuple[list[AuditRecord], TrailHead | None]:
+        """Up to `limit` records above `after`, and the head read after them (so it is never
+        older than they are)."""
+        records = self.records(after, limit)
+        return records, self.head()
 
 
 def _stored(item: dict[str, Any]) -> AuditRecord:

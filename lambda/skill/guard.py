@@ -31,7 +31,8 @@ from ask_sdk_model import IntentRequest
 
 from skill import deeds, prompts
 from skill.access import INTENT_RULES, REQUEST_KINDS, classify
-from skill.people import PeopleUnavailable, speaker_id
+from skill.errors import PeopleUnavailable
+from skill.people import speaker_id
 from skill.responses import answer, confirm_intent
 from skill.slots import MATCH
 from skill.trail import append_or_log

@@ -10,14 +10,15 @@ recognised the voice (Alexa personalization), which is preferred, else the accou
 - neither: everyone may do everything, as a supervisor (`vahr.domain.people.OPEN`).
 
 `people_directory(config)` picks one. A directory that cannot be read raises
-`PeopleUnavailable`: the skill then sends nothing but a stop, which needs nobody's role.
+`skill.errors.PeopleUnavailable`: the skill then sends nothing but a stop, which needs
+nobody's role.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Protocol
 
-from skill.errors import ConfigError, GatewayError
+from skill.errors import ConfigError
 from vahr.domain.people import OPEN, load_people
 from vahr.protocol import ProtocolError
 
@@ -30,10 +31,6 @@ if TYPE_CHECKING:
 # An envelope that names nobody (hand-built, not Alexa's) is this person, with the default
 # role: never anyone's in particular.
 NOBODY = "unknown"
-
-
-class PeopleUnavailable(GatewayError):
-    """The directory of people could not be read (the table unreachable, access denied)."""
 
 
 class PeopleDirectory(Protocol):

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Protocol
 
 import msgspec
 
-from skill.errors import GatewayError
+from skill.errors import TrailUnavailable
 from skill.logs import log_event
 from vahr.protocol import ProtocolError
 from vahr.protocol.audit import record_from_json
@@ -30,10 +30,6 @@ if TYPE_CHECKING:
 
 AUDIT_PATH = "/vahr/audit"
 TIMEOUT_S = 2.0
-
-
-class TrailUnavailable(GatewayError):
-    """The trail could not take a record."""
 
 
 class Trail(Protocol):

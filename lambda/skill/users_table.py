@@ -16,7 +16,7 @@ import boto3
 from botocore.config import Config
 from botocore.exceptions import BotoCoreError, ClientError
 
-from skill.people import PeopleUnavailable
+from skill.errors import PeopleUnavailable
 from vahr.domain.people import EVERYONE_ELSE, ROLES, Person
 
 if TYPE_CHECKING:
@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     from vahr.domain.people import People, Role
 
 CACHE_S = 30.0
+WRITE_ATTEMPTS = 5
 # The skill answers within Alexa's 8 s; a table slower than this is unavailable.
 TIMEOUT_S = 2.0
 
@@ -80,10 +81,12 @@ def _role(item: dict[str, Any]) -> Role | None:
     return next((role for role in ROLES if role == value), None)
 
 
-def write_people(people: People, table_name: str, client: Any = None) -> int:
+def write_people(
+    people: People, table_name: str, client: Any = None, *, region: str | None = None
+) -> int:
     """Put every person of a users file, and everyone else's role, into the table; remove
     people no longer in the file. Returns how many people the table holds."""
-    client = client or boto3.client("dynamodb")
+    client = client or boto3.client("dynamodb", region_name=region)
     wanted = {person.id for person in people.users} | {EVERYONE_ELSE}
     try:
         stale: list[str] = []
@@ -110,9 +113,14 @@ def write_people(people: People, table_name: str, client: Any = None) -> int:
         ]
         for start in range(0, len(requests), 25):  # BatchWriteItem's limit
             pending = {table_name: requests[start : start + 25]}
-            while pending:
+            for attempt in range(WRITE_ATTEMPTS):
                 answer = client.batch_write_item(RequestItems=pending)
                 pending = answer.get("UnprocessedItems") or {}
+                if not pending:
+                    break
+                time.sleep(0.1 * 2**attempt)  # DynamoDB's advice for unprocessed items
+            if pending:
+                raise PeopleUnavailable(f"{table_name} kept refusing writes; try again")
     except (BotoCoreError, ClientError) as err:
         raise PeopleUnavailable(f"cannot write the users table {table_name}: {err}") from err
     return len(people.users)

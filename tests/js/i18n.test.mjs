@@ -7,7 +7,10 @@ import { test } from "node:test";
 import { chooseLocale, SUPPORTED } from "../../vahr/station/static/i18n.js";
 
 const LOCALES = new URL("../../vahr/station/locales/", import.meta.url);
-const PAGE = readFileSync(new URL("../../vahr/station/static/index.html", import.meta.url), "utf8");
+// The station's pages: the station itself, and the sign-in page of a station people sign in to.
+const PAGE = ["index.html", "signin.html"]
+  .map((page) => readFileSync(new URL(`../../vahr/station/static/${page}`, import.meta.url), "utf8"))
+  .join("\n");
 const words = (locale) => JSON.parse(readFileSync(new URL(`${locale}.json`, LOCALES), "utf8"));
 
 test("a German browser gets German, an Austrian one too, anything else English", () => {

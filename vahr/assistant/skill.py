@@ -23,6 +23,7 @@ def load_skill_handler(
     log_level: str = "WARNING",
     users_file: str | None = None,
     confirm: bool | None = None,
+    audit_table: str | None = None,
 ) -> SkillHandler:
     """`skill.app`'s handler built around the local data plane (the same handler function
     Lambda runs, given another configuration): the people of `users_file`, fleet-wide
@@ -44,6 +45,7 @@ def load_skill_handler(
         "log_level": log_level,
         "users_file": users_file,
         "confirm": confirm,
+        "audit_table": audit_table,
     }
     if ack_timeout_s is not None:
         settings["ack_timeout_s"] = ack_timeout_s

@@ -233,9 +233,15 @@ def _who(system: LocalSystem) -> str:
     if people is None:
         return f"anyone may do everything, as a supervisor; {asks} (--users FILE gives roles)"
     count = len(people.users)
+    signing_in = sum(person.token_sha256 is not None for person in people.users)
+    station = (
+        f"{signing_in} may sign in at the station"
+        if signing_in
+        else "nobody may sign in at the station (give people a token_sha256: vahr users token)"
+    )
     return (
         f"{count} {'person' if count == 1 else 'people'} from {system.config.users_file}, "
-        f"anyone else a {people.default_role}; {asks}; the station signs people in"
+        f"anyone else a {people.default_role}; {asks}; {station}"
     )
 
 

@@ -54,6 +54,7 @@ if TYPE_CHECKING:
     from vahr.domain import Fleet
     from vahr.domain.people import People
     from vahr.plumbing.client import Assistant
+    from vahr.twin.trail_store import SqliteTrail
 
 log = logging.getLogger(__name__)
 
@@ -120,6 +121,8 @@ class StartStation(Protocol):
         assistant: Assistant,
         read_shadow: Callable[[str], bytes | None],
         tasks_url: str | None = None,
+        people: People | None = None,
+        trail: SqliteTrail | None = None,
     ) -> ServedStation: ...
 
 
@@ -338,6 +341,8 @@ class LocalSystem:
             assistant=SimulatorAssistant(self.alexa),
             read_shadow=self._stored_shadow,
             tasks_url=self.stack.api_url + TASKS_PATH if self.dispatcher is not None else None,
+            people=self.config.people,
+            trail=self.stack.trail,
         )
         self.stack.dataplane.redirects["/vahr/dashboard"] = self.station.url
 

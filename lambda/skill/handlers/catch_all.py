@@ -10,10 +10,9 @@ from typing import TYPE_CHECKING
 from ask_sdk_core.dispatch_components import AbstractExceptionHandler
 
 from skill import prompts
-from skill.errors import GatewayError
+from skill.errors import GatewayError, PeopleUnavailable
 from skill.guard import record_failure
 from skill.logs import get_logger, log_event
-from skill.people import PeopleUnavailable
 from skill.responses import in_conversation
 
 if TYPE_CHECKING:

@@ -74,6 +74,8 @@ export class Panel {
     /** @type {HTMLButtonElement | null} */
     this.anyButton = null;
     this.ordersAllowed = true;
+    // Whether the person at the page may send robots at all (a viewer may not).
+    this.commandsAllowed = true;
     /** Per command id, what the status line says about it. @type {Map<string, string>} */
     this.pending = new Map();
     /** @type {FleetView | null} */
@@ -112,6 +114,7 @@ export class Panel {
     any.dataset.any = "true";
     any.setAttribute("aria-pressed", "false");
     any.addEventListener("click", () => this.chooseAny());
+    any.hidden = !this.commandsAllowed;
     this.robotsBox.appendChild(any);
     this.anyButton = any;
     if (fleet.robots.length > this.robotButtons.size) {
@@ -174,9 +177,18 @@ export class Panel {
     this.refresh();
   }
 
+  // A person whose role does not let them send robots: the panel selects and stops only.
+  /** @param {boolean} allowed */
+  allowCommands(allowed) {
+    this.commandsAllowed = allowed;
+    if (this.anyButton) this.anyButton.hidden = !allowed;
+    if (!allowed && this.anyRobot) this.chooseAny();
+    this.refresh();
+  }
+
   refresh() {
     for (const made of this.zoneButtons?.values() ?? []) {
-      made.disabled = !(this.selected || this.anyRobot) || !this.ordersAllowed;
+      made.disabled = !(this.selected || this.anyRobot) || !this.ordersAllowed || !this.commandsAllowed;
       const zone = made.dataset.zone;
       made.title = this.selected ? `Send ${this.names[this.selected]} to ${zone}` : this.anyRobot ? ANY.title(String(zone)) : `Zone ${zone}: select a robot first`;
     }
@@ -212,6 +224,7 @@ export class Panel {
 
   /** @param {string | null} thing @param {string} zone */
   navigate(thing, zone) {
+    if (!this.commandsAllowed) return;
     if (!thing && this.anyRobot) return this.ordersAllowed ? this.sendAny(zone) : undefined;
     if (!thing) {
       this.tell("Select a robot first: click it on the map, or press its number.", true);
@@ -294,7 +307,7 @@ export class Panel {
     }
     if (event.key === ANY.key) {
       event.preventDefault();
-      this.chooseAny();
+      if (this.commandsAllowed) this.chooseAny();
       return;
     }
     const robot = this.fleet?.robots.find((r) => r.key && r.key === event.key);

@@ -3,7 +3,7 @@
 // things happen; the page never polls), one store, and the views that draw it.
 
 import { AlertsView } from "./alerts-view.js";
-import { post, reason, replyVoice, setReplyVoice, speak } from "./api.js";
+import { get, post, reason, replyVoice, setReplyVoice, speak } from "./api.js";
 import { COMMANDS_LIMIT, DRIVE_ENDS, EXCHANGE_EVENTS } from "./contract.js";
 import { Conversation } from "./conversation.js";
 import { byId } from "./dom.js";
@@ -15,9 +15,10 @@ import { Panel } from "./panel.js";
 import { RobotsPanel } from "./robots.js";
 import { Talk } from "./talk.js";
 import { TasksView } from "./tasks-view.js";
+import { TrailView } from "./trail-view.js";
 
 /** @import { AnnouncementMessage, CommandMessage, EventMessage, ExperimentStatus, FleetView, PageMessage, Reported, RobotChange, RobotView, RobotsMessage, SnapshotMessage } from "./contract.js" */
-/** @import { SayReply } from "./api.js" */
+/** @import { Operator, SayReply } from "./api.js" */
 
 /**
  * What the page knows, kept from the station's messages.
@@ -86,7 +87,38 @@ const tasks = new TasksView(
   { card: byId("tasks", HTMLElement), list: byId("task-list", HTMLElement), count: byId("task-count", HTMLElement) },
   { nameOf: (thing) => names[thing] || thing, zoneOf: (zone) => (zone.length <= 2 ? `zone ${zone}` : zoneText(zone)) },
 );
+const trail = new TrailView(
+  { card: byId("trail", HTMLElement), list: byId("trail-list", HTMLElement), count: byId("trail-count", HTMLElement) },
+  (thing) => names[thing] || thing,
+);
 new Talk({ button: byId("talk", HTMLButtonElement), level: byId("talk-level", HTMLElement), state: byId("talk-state", HTMLElement), interactions, metrics });
+
+// Who works this page, and what their role lets them do: a viewer's page has no controls
+// that send robots (the station refuses them anyway); stopping stays, as it is anyone's.
+const ROLE_WORDS = {
+  /** @param {string} name */
+  viewer: (name) => `${name} is a viewer: you may watch the robots, ask the assistant and stop them; sending robots needs an operator.`,
+};
+/** @param {Operator} operator */
+function showOperator(operator) {
+  const commands = operator.may.includes("command");
+  panel.allowCommands(commands);
+  byId("zone-row", HTMLElement).hidden = !commands;
+  if (!commands) byId("map-hint", HTMLElement).textContent = "Click a robot to follow it.";
+  const note = byId("panel-role", HTMLElement);
+  note.hidden = commands;
+  if (!commands) note.textContent = ROLE_WORDS.viewer(operator.name || operator.id);
+  if (!operator.signed_in) return;
+  byId("operator", HTMLElement).hidden = false;
+  byId("operator-name", HTMLElement).textContent = `${operator.name || operator.id} · ${operator.role}`;
+}
+byId("sign-out", HTMLButtonElement).addEventListener("click", async () => {
+  await post("/api/signout", {}).catch(() => {});
+  location.replace("/");
+});
+/** @type {Promise<Operator>} */
+const me = get("/api/me");
+me.then(showOperator, (err) => panel.tell(reason(err), true));
 
 const voice = byId("reply-voice", HTMLSelectElement);
 voice.value = replyVoice();
@@ -98,9 +130,11 @@ function select(thing) {
   map.select(store.selected);
   robots.select(store.selected);
   panel.select(store.selected);
-  byId("map-hint", HTMLElement).textContent = store.selected
-    ? `${names[store.selected]} selected: click a zone (or press its key) to send it there.`
-    : "Click a robot, then a zone to send it there.";
+  byId("map-hint", HTMLElement).textContent = !panel.commandsAllowed
+    ? "Click a robot to follow it."
+    : store.selected
+      ? `${names[store.selected]} selected: click a zone (or press its key) to send it there.`
+      : "Click a robot, then a zone to send it there.";
 }
 
 // -- drawing changes, at most once a frame ---------------------------------------------
@@ -191,6 +225,7 @@ function reset(snapshot) {
   }
   onExperiment(snapshot.experiment);
   tasks.update(snapshot.tasks);
+  trail.update(snapshot.trail);
   alerts.reset(snapshot.alerts, first);
   if (store.selected) select(store.selected);
 }
@@ -279,6 +314,9 @@ const handlers = {
   },
   tasks(message) {
     tasks.update(message);
+  },
+  trail(message) {
+    trail.update(message);
   },
 };
 
