@@ -8,6 +8,7 @@
 | `VAHR_FLEET_FILE` | bundled fleet.yaml | the fleet definition (zones, groups, floor) |
 | `VAHR_CLOSED_TASK_DAYS` | 30 | how long a finished or cancelled task stays readable |
 | `VAHR_LOG_LEVEL` | INFO | DEBUG, INFO, WARNING or ERROR |
+| `VAHR_AUDIT_TABLE` | unset | the audit trail's table: tasks given by the dispatcher itself |
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ class DispatcherConfig(msgspec.Struct, frozen=True, kw_only=True):
     fleet_file: str | None = None
     closed_task_days: int = 30
     log_level: str = "INFO"
+    audit_table: str | None = None
 
     @classmethod
     def from_env(cls, environ: Mapping[str, str] | None = None) -> DispatcherConfig:
@@ -61,4 +63,5 @@ class DispatcherConfig(msgspec.Struct, frozen=True, kw_only=True):
             fleet_file=env.get("VAHR_FLEET_FILE", "").strip() or None,
             closed_task_days=days,
             log_level=level,
+            audit_table=env.get("VAHR_AUDIT_TABLE", "").strip() or None,
         )

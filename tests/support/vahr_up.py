@@ -94,10 +94,11 @@ def _first_line(process: subprocess.Popen[str], timeout_s: float) -> str:
         return ""
 
 
-def say(api: str, utterance: str) -> dict[str, Any]:
-    """`vahr say --json` against `api`: the turn it prints."""
+def say(api: str, utterance: str, *flags: str) -> dict[str, Any]:
+    """`vahr say --json` against `api` (with `flags`, such as `--user ID`): the turn it
+    prints."""
     result = subprocess.run(
-        [*VAHR, "say", "--json", "--api", api, utterance],
+        [*VAHR, "say", "--json", "--api", api, *flags, utterance],
         cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=30, check=True,
     )  # fmt: skip
     turn: dict[str, Any] = json.loads(result.stdout)

@@ -35,6 +35,7 @@ from vahr.dispatch import (
     Order,
     RobotState,
 )
+from vahr.dispatch.records import task_given
 from vahr.domain import Pose
 from vahr.local.task_store import SqliteTaskStore
 from vahr.plumbing.mqtt import MqttClient
@@ -210,21 +211,6 @@ def _api_entry(method: str, path: str, body: bytes, answer: Answer) -> AuditEntr
     )
 
 
-def _dispatcher_entry(task: Task) -> AuditEntry:
-    """The trail's record of a queued task the dispatcher gave a robot by itself."""
-    return AuditEntry(
-        time=now(),
-        who=identities.DISPATCHER,
-        channel="dispatcher",
-        intent=task.kind,
-        slots={"zone": task.zone},
-        robots=[task.thing] if task.thing else [],
-        commands=[task.id],
-        outcome="sent",
-        reason="a queued task given to a robot that came free",
-    )
-
-
 def _ok(body: object) -> Answer:
     return 200, msgspec.json.encode(body), None
 
@@ -295,7 +281,7 @@ class LocalDispatcher:
             return
         for task in tasks:
             try:
-                self._record(_dispatcher_entry(task))
+                self._record(task_given(task))
             except Exception:
                 log.exception("the audit trail did not take the dispatch of %s", task.id)
 

@@ -21,11 +21,14 @@ from __future__ import annotations
 
 import hashlib
 from datetime import UTC, datetime
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import msgspec
 
 from vahr.protocol.errors import from_validation_error
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 # How a command reached the robots. `alexa`: an Echo or `vahr say`; `station-voice`:
 # push-to-talk at the station; `station`: typed at the station (`station-weather`: its
@@ -235,3 +238,77 @@ def channel_of(origin: str) -> str:
 # recorded by its sender (the skill records its own, with the person), so the API does not
 # record it again.
 RECORDED_BY_HEADER = "X-Vahr-Recorded-By"
+
+
+# -- the trail's items in DynamoDB: the layout every writer and reader on AWS shares --------
+#
+# Key `trail` (S) and `seq` (N). The records are partition `records`, in `seq` order, each
+# item holding the record's JSON in `record`; item (`head`, 0) holds the last record's
+# number (`last`) and `hash`. A record is appended with one transaction of two conditional
+# puts (`appended_items`): the record, if its number is free, and the new head, if the head
+# is still the one the record was chained to. Writers that lose a race read the new head
+# and chain again (`append_chained`), so the chain never forks and nothing is overwritten.
+TRAIL_RECORDS = "records"
+TRAIL_HEAD = "head"
+HEAD_KEY: dict[str, Any] = {"trail": {"S": TRAIL_HEAD}, "seq": {"N": "0"}}
+APPEND_ATTEMPTS = 6
+
+
+def appended_items(record: AuditRecord, head: TrailHead | None) -> list[dict[str, Any]]:
+    """The two conditional puts (TransactItems, without the table's name) that append
+    `record` after `head`."""
+    stored = {
+        "trail": {"S": TRAIL_RECORDS},
+        "seq": {"N": str(record.seq)},
+        "record": {"S": msgspec.json.encode(record).decode()},
+    }
+    new_head = {**HEAD_KEY, "last": {"N": str(record.seq)}, "hash": {"S": record.hash}}
+    if head is None:
+        head_condition: dict[str, Any] = {"ConditionExpression": "attribute_not_exists(trail)"}
+    else:
+        head_condition = {
+            "ConditionExpression": "#last = :last AND #hash = :hash",
+            "ExpressionAttributeNames": {"#last": "last", "#hash": "hash"},
+            "ExpressionAttributeValues": {
+                ":last": {"N": str(head.seq)},
+                ":hash": {"S": head.hash},
+            },
+        }
+    return [
+        {"Put": {"Item": stored, "ConditionExpression": "attribute_not_exists(trail)"}},
+        {"Put": {"Item": new_head, **head_condition}},
+    ]
+
+
+def head_from_item(item: dict[str, Any] | None) -> TrailHead | None:
+    if item is None:
+        return None
+    return TrailHead(int(item["last"]["N"]), str(item["hash"]["S"]))
+
+
+def record_from_item(item: dict[str, Any]) -> AuditRecord:
+    """A records item as the record it holds; its key `seq` wins over the JSON's, so a
+    record moved to another number reads as altered."""
+    record = record_from_json(item["record"]["S"])
+    key = int(item["seq"]["N"])
+    return record if record.seq == key else msgspec.structs.replace(record, seq=key)
+
+
+def append_chained(
+    entry: AuditEntry,
+    read_head: Callable[[], TrailHead | None],
+    put: Callable[[AuditRecord, TrailHead | None], bool],
+    *,
+    attempts: int = APPEND_ATTEMPTS,
+    pause: Callable[[int], None] | None = None,
+) -> AuditRecord | None:
+    """Chain `entry` after the head `read_head` gives and `put` it (False: another writer
+    won the race); try again on the new head, up to `attempts` times. None when every
+    attempt lost (the trail stayed busy)."""
+    for attempt in range(attempts):
+        record = chained(entry, read_head())
+        if put(record, None if record.seq == 1 else TrailHead(record.seq - 1, record.prev)):
+            return record
+        if pause is not None:
+            pause(attempt)
+    return None

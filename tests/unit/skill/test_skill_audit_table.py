@@ -11,7 +11,8 @@ import boto3
 import pytest
 from skill_testkit import REGION
 
-from skill.audit_table import RECORDS, AuditTable
+from skill.audit_table import AuditTable
+from vahr.protocol.audit import TRAIL_RECORDS as RECORDS
 from vahr.protocol.audit import AuditEntry, verify
 
 TABLE = "vahr-audit"
@@ -75,18 +76,20 @@ def test_two_functions_appending_at_once_never_fork_the_chain(client: Any) -> No
     first, second = AuditTable(TABLE, client), AuditTable(TABLE, client)
     first.append(entry(1))
     real_head = second.head
+    reads = []
 
     def stale_once() -> Any:
         head = real_head()
-        second.head = real_head  # type: ignore[method-assign]
-        first.append(entry(2))  # the other function wins the race meanwhile
+        reads.append(head)
+        if len(reads) == 1:
+            first.append(entry(2))  # the other function wins the race meanwhile
         return head
 
     second.head = stale_once  # type: ignore[method-assign]
     # When the second appends on the head it read, its transaction loses and it chains again
     record = second.append(entry(3))
     # Then the trail has three records in one chain, none overwritten
-    assert record.seq == 3
+    assert record.seq == 3 and [head.seq for head in reads] == [1, 2]
     records = first.records()
     assert [r.commands for r in records] == [["c-1"], ["c-2"], ["c-3"]]
     assert verify(records, first.head()) == []
