@@ -30,7 +30,7 @@ from vahr.plumbing.ports import free_port  # noqa: E402
 from vahr.twin.stack import LocalStack, StackConfig  # noqa: E402
 
 TARGET_PER_S = 5000
-BEFORE = "about 700 acknowledgments per second (issue 17, measured through `bench/fanout.py`)"
+BEFORE = "about 700 acknowledgments per second (measured through `bench/fanout.py`)"
 
 
 def _report(thing: str, sequence: int) -> bytes:

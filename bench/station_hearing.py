@@ -1,9 +1,9 @@
 """How push-to-talk hears: spoken requests through the station's recognizer, its N best
-weighed by the simulator's NLU (`vahr.station.confidence`), on sets and voices kept apart.
+weighed by the simulator's NLU (`vahr.assistant.nbest`), on sets and voices kept apart.
 
 Tuning: every 12th utterance and out-of-domain sentence of the NLU's tuning set
 (`vahr/assistant/data/tuning-en-US.yaml`), spoken in turn by the TUNING voices. On it,
-and on it only, the three constants of `vahr.station.confidence` are chosen:
+and on it only, the constants of `vahr.assistant.nbest` are chosen:
 
 1. SHARPNESS by temperature scaling: the value of the grid that gives the labelled robot
    and zone the highest likelihood among the readings of the labelled intent;

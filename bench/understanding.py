@@ -182,7 +182,7 @@ NLU build at start-up, a fresh interpreter importing, building and answering onc
 | cached (exported model read, no scikit-learn) | {len(warm)} | {median(warm):.2f} s |
 
 `vahr up --no-voice`, spawn to the endpoints line and to the first answered turn ("where
-are the robots"); `before` is commit {args.before}, the literal-match simulator. The
+are the robots"); `before` is the literal-match simulator (`--before`). The
 classifier builds on a thread while the stack starts, so a cold cache delays the first
 turn, not the endpoints (budget: at most 1 s added to the start).
 

@@ -17,7 +17,8 @@ posterior of the least sure deciding word is still the confidence reported.
 A grammar of the listed answers used to be tried first, the language model only when the
 grammar recognized nothing; with the adapted model, on the tuning set, the grammar's
 confident matches of the wrong answer ("it's wet outside" as "it's sunny outside") cost
-more than it gained, so the language model hears alone (docs/voice.md has the figures).
+more than it gained, so the language model hears alone (docs/decisions/0002-robot-hearing.md
+has the figures).
 
 The interpreter reads cues, which say nothing of a word's sense ("a sunny personality"); so
 offline, the sense check (`sense.py`) reads the whole sentence and may veto: what it finds
@@ -51,7 +52,8 @@ log = logging.getLogger(__name__)
 # The minimum posterior, of 0, 0.01, 0.02, 0.05, 0.1, 0.2 and 0.3: 0, so with the adapted
 # model the check stands aside (every threshold cost more answers than it saved unrelated
 # speech); it stays a parameter for a voice heard less well. The commonest words the
-# recognizer also knows, of 0, 3,000 and 10,000: 3,000. docs/voice.md has the figures.
+# recognizer also knows, of 0, 3,000 and 10,000: 3,000. docs/decisions/0002-robot-hearing.md
+# has the figures.
 DEFAULT_MIN_POSTERIOR = 0.0
 BACKGROUND_WORDS = 3000
 

@@ -15,10 +15,11 @@ a sentence the cues make sunny or rainy is unknown when the classifier finds it 
 in (the words up to a question that follows them). Which answer it is stays the cues' to say,
 so the reason is always a cue.
 
-Chosen on the tuning set (docs/voice.md): scikit-learn's default regularization, and the
-threshold by the hearing's rule (the classifier's own decision, 0.5, until the eleventh
-round; 0.65 since the twelfth, of 0.4 to 0.8). The model is exported and cached like the
-NLU's, so a robot starts without importing scikit-learn once the cache is warm.
+Chosen on the tuning set (docs/history/voice-tuning.md): scikit-learn's default
+regularization, and the threshold by the hearing's rule (the classifier's own decision,
+0.5, until the eleventh round; 0.65 since the twelfth, of 0.4 to 0.8). The model is
+exported and cached like the NLU's, so a robot starts without importing scikit-learn once
+the cache is warm.
 """
 
 from __future__ import annotations

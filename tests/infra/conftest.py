@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import pytest
-from synthesis import SKILL_ID, Synthesized, synth_app
+from synthesis import Synthesized, synth_app
+from template_tools import SKILL_ID
 
 
 @pytest.fixture(scope="session")

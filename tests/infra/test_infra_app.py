@@ -12,8 +12,8 @@ import aws_cdk as cdk
 import pytest
 from aws_cdk import aws_iam as iam
 from aws_cdk.assertions import Template
-from synthesis import SKILL_ID, Synthesized, synth_app
-from template_tools import cdk_context, only, resources
+from synthesis import Synthesized, synth_app
+from template_tools import SKILL_ID, cdk_context, only, resources
 
 from infra.app import build_app
 from vahr.errors import VahrError

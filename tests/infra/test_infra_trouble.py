@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import pytest
-from conftest import Synthesized, synth_app
+from synthesis import Synthesized, synth_app
 from template_tools import ACCOUNT, PARTITION, REGION, grants, only, resolve, resources, role_grants
 
 from infra.constructs.alexa_skill import CREATION_STATEMENT

@@ -20,7 +20,7 @@ the fallback. Then:
   other readings lack the slot) the slot is left empty and the skill asks for it.
 
 The four constants are chosen on the tuning voices only (`bench/station_hearing.py`,
-docs/voice.md "Push-to-talk: asking when unsure").
+docs/push-to-talk.md).
 
 A second recognizer that errs differently (Whisper, beside pocketsphinx) is used by
 `agreement`: a request both transcripts read alike is acted on without weighing.
@@ -54,7 +54,7 @@ SHARPNESS = 1 / 200
 # count as wrong actions: a robot sent where nobody asked costs far more than a question),
 # ties to the lowest. The tuning voices are heard poorly, so the rule chose the highest
 # thresholds of the grid: push-to-talk acts rarely and wrongly more rarely still
-# (docs/voice.md, "Push-to-talk: hearing many voices").
+# (docs/push-to-talk.md).
 MIN_SLOT_CONFIDENCE = 0.9
 MIN_INTENT_CONFIDENCE = 0.9
 # The least lattice posterior of a word of the best transcript (`Recognition.confidence`)
@@ -183,7 +183,7 @@ def agreement(
     instead). Each is read by `reading` (the simulator's, in the dialog under way), else as
     a request. Two recognizers that err differently rarely make the same mistake: on the
     development voices, of the requests both heard alike none moved a robot other than
-    said (docs/voice.md)."""
+    said (docs/decisions/0003-push-to-talk-two-ears.md)."""
     read = reading or request_reader(model)
     first, second = read(heard), read(confirming)
     if first.intent == FALLBACK_INTENT or _moving(model, first) != _moving(model, second):

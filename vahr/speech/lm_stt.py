@@ -22,7 +22,7 @@ error.
 
 A phone-loop likelihood ratio, as `GrammarRecognizer` uses, was measured here too and
 dropped: with a back-off model, answers and unrelated speech scored alike (tuning set,
-docs/voice.md), and it doubled the time. Silence never reaches the decoder (energy
+docs/history/voice-tuning.md), and it doubled the time. Silence never reaches the decoder (energy
 detection first).
 
 Beside the best transcript the recognizer gives its N best (`Recognition.hypotheses`,

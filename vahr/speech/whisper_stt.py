@@ -35,7 +35,7 @@ SHA256_ENV = "VAHR_WHISPER_SHA256"
 # tiny.en's model.bin (Systran/faster-whisper-tiny.en).
 MODEL_SHA256 = "1a5afae06a4db91c975c9a9d78be5cc110ee4ea022ad57d55492e4550e936b2a"
 # Two threads: the station's machine may have no more, and a 3 s clip then takes about
-# half a second (docs/voice.md), in parallel with pocketsphinx.
+# half a second (docs/push-to-talk.md), after pocketsphinx.
 THREADS = 2
 # Beam search as Whisper's own decoding does it; greedy decoding misspelled names more.
 BEAM_SIZE = 5

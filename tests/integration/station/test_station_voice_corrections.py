@@ -50,7 +50,7 @@ def test_a_correction_by_push_to_talk_redirects_or_moves_nothing(up: Up) -> None
     assert "Placebot one is on its way to zone C" in sent["speech"], sent
     first = robots(up)["placebot1"]["last_command"]["id"]
     other_before = robots(up)["placebot2"].get("last_command")
-    # A short correction is often heard too unsurely to act on (docs/voice.md, push-to-talk):
+    # A short correction is often heard too unsurely to act on (docs/push-to-talk.md):
     # then the station says so and nothing moves; when it is acted on, it is the correction.
     corrected = say_at_station(up, "no zone a")
     if corrected["understood"]:

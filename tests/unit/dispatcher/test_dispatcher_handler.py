@@ -234,19 +234,19 @@ def test_cancel_stops_the_robot_and_frees_it(
 
 
 @pytest.mark.parametrize(
-    ("request_body", "status", "message"),
+    ("request_body", "status", "message", "error"),
     [
         ({"operation": "submit", "order": {"zone": "Z"}}, 400,
-         "there is no zone 'Z'; zones are LOADING, A, B, C, D"),
+         "there is no zone 'Z'; zones are LOADING, A, B, C, D", "unknown_zone"),
         ({"operation": "submit", "order": {"zone": "A", "count": 5}}, 400,
-         "the fleet has 2 robots; 5 cannot go"),
+         "the fleet has 2 robots; 5 cannot go", "too_many"),
         ({"operation": "submit", "order": {"zone": "A", "colour": "red"}}, 400,
-         "order.colour: is not a known field"),
-        ({"operation": "submit"}, 400, "order: is required but missing"),
-        ({"operation": "cancel", "task_id": "nope"}, 404, "no open task 'nope'"),
+         "order.colour: is not a known field", None),
+        ({"operation": "submit"}, 400, "order: is required but missing", None),
+        ({"operation": "cancel", "task_id": "nope"}, 404, "no open task 'nope'", None),
         ({"operation": "launch"}, 400,
-         "operation: 'launch' is not one of submit, tasks, pending, cancel"),
-        ({}, 400, "operation: 'None' is not one of submit, tasks, pending, cancel"),
+         "operation: 'launch' is not one of submit, tasks, pending, cancel", None),
+        ({}, 400, "operation: 'None' is not one of submit, tasks, pending, cancel", None),
     ],
 )  # fmt: skip
 def test_a_request_that_cannot_be_done_is_one_line_and_changes_nothing(
@@ -256,9 +256,12 @@ def test_a_request_that_cannot_be_done_is_one_line_and_changes_nothing(
     request_body: dict[str, Any],
     status: int,
     message: str,
+    error: str | None,
 ) -> None:
     answer = app.handle(request_body, dispatcher)
-    assert answer == {"status": status, "body": {"code": status, "message": message}}
+    # An order the dispatcher refused says why by its code, which the skill decides by.
+    refusal = {"code": status, "message": message} | ({"error": error} if error else {})
+    assert answer == {"status": status, "body": refusal}
     assert table.pending() == [] and table.active() == [] and len(published) == 0
 
 

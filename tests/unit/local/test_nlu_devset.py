@@ -74,7 +74,7 @@ def test_no_evaluation_sentence_is_trained_on(devset: LabelledSet) -> None:
 # it measures now, kept as floors and ceilings so that nothing gets worse. Issue 13's
 # targets (at least 95% right in domain and out-of-domain falling back, at most 1% wrong)
 # were met by the English rules (157 right, 1 wrong; 59 of 61 falling back); they are
-# missed now by one to two utterances each (docs/skill.md, "Development set"), since en-US
+# missed now by one to two utterances each (docs/history/nlu-tuning.md), since en-US
 # takes its slot roles from the tagger and the fleet's dispatch intents joined the model.
 # Since readings below a roles confidence of 0.5 are confirmed and listed values are read as
 # one by the classifier: 155 right, 2 wrong, 4 fallback, 4 asks (docs/skill.md).

@@ -57,7 +57,7 @@ def test_no_sentence_is_trained_or_tuned_on(roles_set: LabelledSet) -> None:
 
 
 def test_roles_stay_at_the_measured_figures(report: Report) -> None:
-    # Scored once with the tagger (docs/skill.md): 118 of 156 right, 16 wrong; out of
+    # Scored once with the tagger (docs/history/nlu-tuning.md): 118 of 156 right, 16 wrong; out of
     # domain 17 of 19 falling back. The English rules it replaced, on the same build: 116
     # right and 10 wrong. With the intents added since (fleet commands, task queue,
     # corrections), 16 of 19 out-of-domain sentences fall back. With readings below a roles
