@@ -61,9 +61,10 @@ def _summary(people: People, path: Path) -> str:
 
     counts = [f"{sum(p.role == role for p in people.users)} {role}" for role in reversed(ROLES)]
     signs_in = sum(p.token_sha256 is not None for p in people.users)
+    count = len(people.users)
     return (
-        f"{path}: {len(people.users)} people ({', '.join(counts)}); anyone else is a "
-        f"{people.default_role}; {signs_in} may sign in at the station"
+        f"{path}: {count} {'person' if count == 1 else 'people'} ({', '.join(counts)}); "
+        f"anyone else is a {people.default_role}; {signs_in} may sign in at the station"
     )
 
 

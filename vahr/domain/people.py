@@ -161,15 +161,49 @@ class People(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True)
 
     @classmethod
     def from_yaml(cls, text: str | bytes) -> People:
+        """The users file's text, checked; a fault is one `ProtocolError` naming the entry."""
         if not text or not str(text).strip():
             raise ProtocolError("users", "the file is empty; it needs users: (and default_role:)")
         try:
-            people = msgspec.yaml.decode(text, type=cls)
+            written = msgspec.yaml.decode(text, type=_UsersFile)
         except msgspec.ValidationError as err:
             raise from_validation_error(err) from err
         except msgspec.DecodeError as err:
             raise ProtocolError("users", f"is not valid YAML ({err})") from err
+        people = cls(
+            users=[
+                Person(
+                    id=entry.id,
+                    name=entry.name,
+                    role=_role(f"users.{index}.role", entry.role),
+                    token_sha256=entry.token_sha256,
+                )
+                for index, entry in enumerate(written.users)
+            ],
+            default_role=_role("default_role", written.default_role),
+        )
         return people.validate()
+
+
+class _Entry(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """One person as the file writes them (`role` checked by `_role`)."""
+
+    id: PersonId
+    name: PersonName
+    role: str
+    token_sha256: TokenHash | None = None
+
+
+class _UsersFile(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    users: list[_Entry] = []
+    default_role: str = "viewer"
+
+
+def _role(field: str, value: str) -> Role:
+    for role in ROLES:
+        if role == value:
+            return role
+    raise ProtocolError(field, f"{value!r} is not a role; roles are {', '.join(ROLES)}")
 
 
 # Everyone may do everything, as a supervisor: VAHR without a users file.
