@@ -137,7 +137,8 @@ def _verify(records: list[AuditRecord], head: TrailHead | None, *, as_json: bool
         print(f"The audit trail was altered: {len(faults)} fault(s) in {len(records)} records.")
         return 1
     ending = f"; its head is record {head.seq}, hash {head.hash}" if head else ""
-    print(f"The audit trail is intact: {len(records)} records{ending}.")
+    count = f"{len(records)} record{'' if len(records) == 1 else 's'}"
+    print(f"The audit trail is intact: {count}{ending}.")
     return 0
 
 
