@@ -54,11 +54,30 @@ users:
 )
 
 
+class Listening:
+    """An assistant that answers every request and keeps who asked (`user`) and from where."""
+
+    def __init__(self) -> None:
+        self.asked: list[tuple[str, str, str | None]] = []
+
+    def ask(
+        self,
+        utterance: str,
+        *,
+        origin: str = "say",
+        heard: dict[str, Any] | None = None,
+        user: str | None = None,
+    ) -> dict[str, Any]:
+        self.asked.append((utterance, origin, user))
+        return {"speech": "Placebot one is idle.", "intent": "StatusIntent", "commands": []}
+
+
 class Station:
     """A station with people and a trail, on a free port; what it published is kept."""
 
     def __init__(self, fleet: Fleet, state: Path) -> None:
         self.published: list[tuple[str, bytes]] = []
+        self.assistant = Listening()
         self.trail = SqliteTrail.in_state_dir(state)
         self.feed = Feed(fleet)
         desk = Desk(self.feed, self._publish)
@@ -66,7 +85,7 @@ class Station:
             feed=self.feed,
             controls=Controls(fleet, desk, self._publish, self.trail.append),
             desk=desk,
-            assistant=None,
+            assistant=self.assistant,
             push_to_talk=None,
             synthesize=None,
         )
@@ -189,6 +208,17 @@ def test_each_role_may_use_the_panel_as_it_allows_and_every_order_is_recorded(
     ]
     assert records[2].commands == [sent["id"]] and records[1].commands == [stopped["id"]]
     assert verify(records, station.trail.head()) == []
+
+
+def test_what_a_person_types_reaches_the_assistant_as_their_alexa_account(
+    station: Station,
+) -> None:
+    said = {"utterance": "where are the robots", "origin": "station"}
+    status, _, turn = call(station, "POST", "/api/say", said, cookie=TOKENS["viewer"])
+    assert status == 200 and turn["speech"] == "Placebot one is idle."
+    assert station.assistant.asked == [
+        ("where are the robots", "station", "amzn1.ask.account.VERA")
+    ]
 
 
 def sign_in(page: Any, station: Station, role: str) -> None:
