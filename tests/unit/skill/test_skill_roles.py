@@ -27,7 +27,6 @@ if TYPE_CHECKING:
 
     from skill_testkit import RobotDoubles
 
-Handler = "Callable[[dict[str, Any], Any], dict[str, Any]]"
 
 SUPERVISOR = "amzn1.ask.account.SUPERVISORSUSAN"
 OPERATOR = "amzn1.ask.account.OPERATOROTTO"
@@ -386,3 +385,29 @@ def test_users_file_people_are_listed_with_default_role() -> None:
     assert people.person(VIEWER) == Person(id=VIEWER, name="Vera", role="viewer")
     assert people.person(STRANGER) == Person(id=STRANGER, role="viewer")
     assert not people.person(STRANGER).known
+
+
+def test_vahr_users_import_loads_the_table_and_removes_who_left(
+    tables: tuple[AuditTable, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from vahr.cli import main
+
+    _, client = tables
+    people = tmp_path / "people.yaml"
+    people.write_text(USERS_YAML, encoding="utf-8")
+    assert main(["users", "import", str(people), "--table", USERS_TABLE, "--region", REGION]) == 0
+    assert capsys.readouterr().out == f"{USERS_TABLE}: 3 people, anyone else a viewer\n"
+    # Vera leaves the file, and everyone else becomes an operator
+    people.write_text(
+        USERS_YAML.replace("default_role: viewer", "default_role: operator").replace(
+            f"  - {{id: {VIEWER}, name: Vera, role: viewer}}\n", ""
+        ),
+        encoding="utf-8",
+    )
+    assert main(["users", "import", str(people), "--table", USERS_TABLE, "--region", REGION]) == 0
+    items = client.scan(TableName=USERS_TABLE)["Items"]
+    assert sorted((item["id"]["S"], item["role"]["S"]) for item in items) == [
+        ("*", "operator"),
+        (OPERATOR, "operator"),
+        (SUPERVISOR, "supervisor"),
+    ]
