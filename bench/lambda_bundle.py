@@ -114,7 +114,7 @@ def main() -> None:
         "/var/task), the bundle first on the path and the runtime's boto3 after it.\n\n"
         + "\n".join(rows)
         + f"\n\nPrecompiling saves about **{saved:.0f} ms** of every cold start; both "
-        "bundles are far below Lambda's 250 MB (unzipped) and the 15 MB this project allows "
+        "bundles are far below Lambda's 250 MB (unzipped) and the 16 MB this project allows "
         "itself. Lambda's own cold start (micro-VM, runtime) comes on top of these figures."
     )
     write_section("lambda_bundle", "Lambda bundle: size and cold import", body)

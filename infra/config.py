@@ -90,6 +90,11 @@ class InfraConfig:
     device_audit: bool = True
     # Where the alarms are mailed (an SNS subscription to confirm); none: subscribe later.
     alarm_email: str | None = None
+    # Who may do what (infra/constructs/people.py): the users table, which the skill reads;
+    # off, everyone may do everything. The audit table is always made; its deletion
+    # protection is on unless said otherwise.
+    people: bool = False
+    audit_table_deletion_protection: bool = True
 
     def skill_invocation(self) -> SkillInvocation:
         """Which Alexa skill may invoke the skill function: the one whose id is given, the
@@ -163,6 +168,10 @@ class InfraConfig:
             iot_logging=_flag(get, "iotLogging", default=True),
             device_audit=_flag(get, "deviceDefenderAudit", default=True),
             alarm_email=_text(get, "alarmEmail"),
+            people=_flag(get, "people"),
+            audit_table_deletion_protection=_flag(
+                get, "auditTableDeletionProtection", default=True
+            ),
         )
         config.skill_invocation()
         if config.alarm_email is not None and not _EMAIL.match(config.alarm_email):

@@ -89,6 +89,11 @@ class LabUsage:
     skill_seconds: float = 0.7
     skill_memory_gb: float = 0.5
     log_bytes_per_skill_request: int = 2_000
+    # The audit trail: each skill request is one record, appended with a strongly
+    # consistent read of the head (1 read unit) and one transaction of two puts under 1 KB
+    # (a transaction bills twice: 4 write units).
+    audit_reads_per_record: float = 1.0
+    audit_writes_per_record: float = 4.0
     # Per robot per lab day: CONNECT, retained presence (publish + retained), twelve
     # SUBSCRIBEs, and the last will on shutdown.
     session_messages_per_robot_day: int = 17
@@ -130,6 +135,7 @@ def estimate(usage: LabUsage, prices: Prices, *, lex: bool, skill: bool) -> list
         + sessions  # the experiment plan written to the experiment thing's shadow
     )
     gb_seconds = skill_requests * usage.skill_seconds * usage.skill_memory_gb
+    audit_units = skill_requests * (usage.audit_reads_per_record + usage.audit_writes_per_record)
     lines = [
         Line("IoT connectivity", connection_minutes, "connection-minutes",
              connection_minutes * prices.connection_minute),
@@ -143,6 +149,9 @@ def estimate(usage: LabUsage, prices: Prices, *, lex: bool, skill: bool) -> list
         Line("CloudWatch Logs", skill_requests * usage.log_bytes_per_skill_request / 1e9,
              "GB ingested",
              skill_requests * usage.log_bytes_per_skill_request / 1e9 * prices.log_ingestion_gb),
+        Line("DynamoDB (audit trail)", audit_units, "request units",
+             skill_requests * (usage.audit_reads_per_record * prices.dynamodb_read
+                               + usage.audit_writes_per_record * prices.dynamodb_write)),
     ]  # fmt: skip
     if lex:
         questions = sessions * usage.weather_questions_per_session

@@ -20,6 +20,14 @@ SUBCOMMANDS: Subcommands = {
         "vahr.commands.station",
         "serve the operator station page (map, panel, push-to-talk) for any deployment",
     ),
+    "audit": (
+        "vahr.commands.audit",
+        "print the audit trail of every command (who, channel, outcome) or verify it",
+    ),
+    "users": (
+        "vahr.commands.users",
+        "check a users file, load it into the users table on AWS, make a station token",
+    ),
     "fault": (
         "vahr.commands.fault",
         "inject a fault (stuck, fail, offline, clear) into a running simulated robot",

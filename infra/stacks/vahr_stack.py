@@ -18,6 +18,7 @@ from infra.constructs.iot_endpoint import IotEndpoint
 from infra.constructs.iot_fleet import IotFleet
 from infra.constructs.iot_logging import IotLogging
 from infra.constructs.operator_policy import OperatorPolicy
+from infra.constructs.people import PeopleTables
 from infra.constructs.presence_rule import PresenceRule
 from infra.constructs.robot_policy import RobotPolicy
 from infra.constructs.skill_function import SkillFunction
@@ -111,6 +112,19 @@ class VahrStack(cdk.Stack):
             data_endpoint=self.data_endpoint.address,
             code=code,
         )
+        # Who may do what, and the trail of what was done (infra/constructs/people.py).
+        self.people = PeopleTables(
+            self,
+            "People",
+            people=config.people,
+            audit_deletion_protection=config.audit_table_deletion_protection,
+        )
+        skill = self.skill_function.function
+        skill.add_environment("VAHR_AUDIT_TABLE", self.people.audit.table_name)
+        self.people.admit_trail_writer(self.skill_function.role)
+        if self.people.users is not None:
+            skill.add_environment("VAHR_USERS_TABLE", self.people.users.table_name)
+            self.people.admit_reader_of_people(self.skill_function.role)
         self.announcer = (
             Announcer(
                 self,
@@ -142,6 +156,11 @@ class VahrStack(cdk.Stack):
                 data_endpoint=self.data_endpoint.address,
             )
             self.dispatcher.admit_skill(self.skill_function.function, self.skill_function.role)
+            # What the dispatcher does by itself (a queued task given to a freed robot).
+            self.dispatcher.function.add_environment(
+                "VAHR_AUDIT_TABLE", self.people.audit.table_name
+            )
+            self.people.admit_trail_writer(self.dispatcher.role)
         self.credentials_endpoint = (
             IotEndpoint(
                 self,
@@ -301,6 +320,17 @@ class VahrStack(cdk.Stack):
             "IoT policy for the experiment recorder's certificate (client ids vahr-experiment-*)",
         )
         output("AlarmTopicArn", self.alarms.topic.topic_arn, "Subscribe here to hear of trouble")
+        output(
+            "AuditTableName",
+            self.people.audit.table_name,
+            "The audit trail of every command: vahr audit --table NAME [--verify]",
+        )
+        if self.people.users is not None:
+            output(
+                "UsersTableName",
+                self.people.users.table_name,
+                "Who may do what: vahr users import FILE --table NAME",
+            )
         if self.weather_bot is not None and self.credentials_endpoint is not None:
             output(
                 "CredentialsEndpoint",

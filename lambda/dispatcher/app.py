@@ -37,8 +37,10 @@ from dispatcher.requests import (
 )
 from dispatcher.robot_updates import robot_freed
 from dispatcher.task_table import TaskTable
+from dispatcher.trail_table import TrailTable
 from vahr.dispatch import Dispatcher, DispatchError
 from vahr.dispatch.grid_routes import DistancesError, floor_routes
+from vahr.dispatch.records import task_given
 from vahr.domain import load_fleet
 from vahr.protocol.errors import ProtocolError, from_validation_error
 
@@ -69,9 +71,16 @@ def runtime() -> Dispatcher:
     )
 
 
+@cache
+def trail() -> TrailTable | None:
+    """Where the dispatcher records what it does by itself (None: no audit table)."""
+    table = DispatcherConfig.from_env().audit_table
+    return TrailTable(table) if table else None
+
+
 def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
     try:
-        return handle(event, runtime())
+        return handle(event, runtime(), trail())
     except DispatcherError as err:
         log.error("dispatcher failed: %s", err)
         raise
@@ -80,13 +89,16 @@ def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
         raise DispatcherError(f"dispatcher failed: {type(err).__name__}: {err}") from err
 
 
-def handle(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, Any]:
+def handle(
+    event: dict[str, Any], dispatcher: Dispatcher, trail: TrailTable | None = None
+) -> dict[str, Any]:
     """One invocation: a robot's update (from the rule), the schedule's tick, or a skill's
-    request."""
+    request. What the dispatcher does by itself (a queued task given to a robot) goes to
+    `trail`; a skill's request is recorded by the skill, with who asked."""
     if is_robot_update(event):
-        return on_robot_update(event, dispatcher)
+        return on_robot_update(event, dispatcher, trail)
     if is_tick(event):
-        return on_tick(dispatcher)
+        return on_tick(dispatcher, trail)
     try:
         answer = on_request(_request(event), dispatcher)
     except BadRequest as err:
@@ -97,7 +109,9 @@ def handle(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, Any]:
     return msgspec.to_builtins(answer)  # type: ignore[no-any-return]
 
 
-def on_robot_update(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, Any]:
+def on_robot_update(
+    event: dict[str, Any], dispatcher: Dispatcher, trail: TrailTable | None = None
+) -> dict[str, Any]:
     """A robot's update the rule selected: it may have finished its task and be free."""
     try:
         update = msgspec.convert(event, RobotUpdate, strict=False)
@@ -112,10 +126,12 @@ def on_robot_update(event: dict[str, Any], dispatcher: Dispatcher) -> dict[str, 
     taken = robot_freed(dispatcher, state, now=datetime.now(UTC))
     if taken is not None:
         log.info("task %s (%s to %s) given to %s", taken.id, taken.kind, taken.zone, taken.thing)
+        if trail is not None:
+            trail.record(task_given(taken))
     return {"took": taken.id if taken is not None else None}
 
 
-def on_tick(dispatcher: Dispatcher) -> dict[str, Any]:
+def on_tick(dispatcher: Dispatcher, trail: TrailTable | None = None) -> dict[str, Any]:
     """Once a minute: queued tasks go to robots that are free now. A robot freed while its
     rule event was lost (dead-lettered, or the function failed) would otherwise wait for its
     next change; with nothing queued this is one read of the queue and nothing more. The
@@ -125,6 +141,8 @@ def on_tick(dispatcher: Dispatcher) -> dict[str, Any]:
     given = dispatcher.drain()
     for task in given:
         log.info("task %s (%s to %s) given to %s", task.id, task.kind, task.zone, task.thing)
+        if trail is not None:
+            trail.record(task_given(task))
     return {"given": [task.id for task in given]}
 
 

@@ -9,6 +9,7 @@
 | `VAHR_DISTANCES_FILE` | bundled fleet-distances.bin | a map fleet's zone distances (grid_routes) |
 | `VAHR_CLOSED_TASK_DAYS` | 30 | how long a finished or cancelled task stays readable |
 | `VAHR_LOG_LEVEL` | INFO | DEBUG, INFO, WARNING or ERROR |
+| `VAHR_AUDIT_TABLE` | unset | the audit trail's table: tasks given by the dispatcher itself |
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ class DispatcherConfig(msgspec.Struct, frozen=True, kw_only=True):
     distances_file: str = BUNDLED_FILE
     closed_task_days: int = 30
     log_level: str = "INFO"
+    audit_table: str | None = None
 
     @classmethod
     def from_env(cls, environ: Mapping[str, str] | None = None) -> DispatcherConfig:
@@ -65,4 +67,5 @@ class DispatcherConfig(msgspec.Struct, frozen=True, kw_only=True):
             distances_file=env.get("VAHR_DISTANCES_FILE", "").strip() or BUNDLED_FILE,
             closed_task_days=days,
             log_level=level,
+            audit_table=env.get("VAHR_AUDIT_TABLE", "").strip() or None,
         )

@@ -21,6 +21,7 @@ from ask_sdk_core.skill_builder import SkillBuilder
 from skill import logs, prompts
 from skill.catalog import use_locale
 from skill.config import SkillConfig
+from skill.guard import AccessInterceptor, RefusedRequestHandler, TrailInterceptor
 from skill.handlers.built_in import (
     CancelIntentHandler,
     FallbackIntentHandler,
@@ -78,6 +79,8 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
     """
     desk = task_desk(runtime.config)
     return [
+        # What the speaker's role does not allow is refused before anything else.
+        RefusedRequestHandler(),
         # A denied intent is answered before its own handler could act on it.
         DeniedIntentHandler(),
         # A command naming a robot asks the dispatcher (`desk`) whether its zone is closed.
@@ -120,8 +123,11 @@ def build_skill_builder(runtime: SkillRuntime) -> SkillBuilder:
     builder.add_global_request_interceptor(LocaleInterceptor())
     builder.add_global_request_interceptor(CorrelationIdInterceptor())
     builder.add_global_request_interceptor(RequestLogInterceptor())
+    # Who is speaking and what their role allows, before any handler (skill.guard).
+    builder.add_global_request_interceptor(AccessInterceptor(runtime))
     builder.add_global_response_interceptor(ResponseLogInterceptor())
-    builder.add_exception_handler(CatchAllExceptionHandler())
+    builder.add_global_response_interceptor(TrailInterceptor(runtime))
+    builder.add_exception_handler(CatchAllExceptionHandler(runtime))
     return builder
 
 

@@ -15,6 +15,10 @@ Every setting has a default, so the handler runs with only a region configured:
 | `VAHR_FLEET_FILE` | bundled fleet.yaml | the fleet definition |
 | `VAHR_LOG_LEVEL` | INFO | DEBUG, INFO, WARNING or ERROR |
 | `VAHR_DISPATCHER_FUNCTION` | unset | the fleet dispatcher function (the CDK stack sets it) |
+| `VAHR_USERS_TABLE` | unset | the DynamoDB table of people and their roles (the stack sets it) |
+| `VAHR_USERS_FILE` | unset | a users file instead (`vahr up --users`); neither: all may do all |
+| `VAHR_AUDIT_TABLE` | unset | the DynamoDB table of the audit trail (the stack sets it) |
+| `VAHR_CONFIRM` | unset | true or false: confirm fleet-wide commands first (else the fleet file) |
 """
 
 from __future__ import annotations
@@ -54,6 +58,19 @@ class SkillConfig(msgspec.Struct, frozen=True):
     dispatcher_function: str | None = None
     # The IoT control plane's URL for fleet indexing, when not boto3's default.
     control_endpoint: str | None = None
+    # Who may do what (skill.people): a DynamoDB table, or a users file; neither is open.
+    users_table: str | None = None
+    users_file: str | None = None
+    # Where every request's record goes (skill.trail): a DynamoDB table on AWS; the local
+    # data plane when `data_endpoint` is a local one.
+    audit_table: str | None = None
+    # Whether fleet-wide commands are confirmed first; None: as the fleet file says, else
+    # whenever people are known.
+    confirm: bool | None = None
+
+    @property
+    def people_known(self) -> bool:
+        return self.users_table is not None or self.users_file is not None
 
     @property
     def index_endpoint(self) -> str | None:
@@ -82,6 +99,14 @@ class SkillConfig(msgspec.Struct, frozen=True):
             log_level=_log_level(env.get("VAHR_LOG_LEVEL")),
             dispatcher_function=_blank_to_none(env.get("VAHR_DISPATCHER_FUNCTION")),
             control_endpoint=_blank_to_none(env.get("AWS_ENDPOINT_URL_IOT")),
+            users_table=_blank_to_none(env.get("VAHR_USERS_TABLE")),
+            users_file=_blank_to_none(env.get("VAHR_USERS_FILE")),
+            audit_table=_blank_to_none(env.get("VAHR_AUDIT_TABLE")),
+            confirm=(
+                None
+                if _blank_to_none(env.get("VAHR_CONFIRM")) is None
+                else _flag(env.get("VAHR_CONFIRM"), "VAHR_CONFIRM")
+            ),
         )
 
 

@@ -22,3 +22,11 @@ class MissingCredentials(GatewayError):
 
 class ShadowConflict(GatewayError):
     """A shadow update carried a version that is no longer current (HTTP 409)."""
+
+
+class PeopleUnavailable(GatewayError):
+    """The directory of people could not be read (the table unreachable, access denied)."""
+
+
+class TrailUnavailable(GatewayError):
+    """The audit trail could not take a record."""

@@ -265,6 +265,41 @@ QUEUE_ENTRY_WAITING = "{place}, {task}, waiting until {zone} opens"
 NO_ZONE_DESK = (
     "Closing a zone needs the fleet dispatcher, which is not running here, so nothing changed."
 )
+# Who may do what (skill.guard). A refusal says what the person may do, and that nothing
+# was sent: to someone the skill knows by name, or to someone it does not know.
+REFUSED_KNOWN = "Sorry, {name}: as {role} you may {may}. I sent nothing."
+REFUSED_UNKNOWN = "Sorry, I don't know who is speaking, so you may {may}. I sent nothing."
+ROLE_NAMES = {"viewer": "a viewer", "operator": "an operator", "supervisor": "a supervisor"}
+MAY = {
+    "viewer": "ask about the robots and stop them, but not send them",
+    "operator": (
+        "send robots and ask about them, but commands to the whole fleet or to many robots, "
+        "and service changes, need a supervisor"
+    ),
+    "supervisor": "do everything",
+}
+# A yes to a fleet-wide command from someone other than who asked for it.
+NOT_YOURS_TO_CONFIRM = "Only the person who asked for that can confirm it, so I sent nothing."
+PEOPLE_UNAVAILABLE = (
+    "Sorry, I could not check who is speaking just now, so I sent nothing. "
+    "To halt the robots, say emergency stop."
+)
+# Fleet-wide and disruptive commands are confirmed first, as Alexa's intent confirmation
+# asks; by intent, with the slots' names filled in. {robots} is a count or a group.
+CONFIRM_COMMAND = {
+    "NavigateIntent": "Send {robot} to {zone}, is that right?",
+    "DeliverIntent": "Have {robot} deliver packages to {zone}, is that right?",
+    "WeatherDeliveryIntent": "Have {robot} deliver by the weather, is that right?",
+    "FleetNavigateIntent": "Send {robots} to {zone}, is that right?",
+    "IdleRobotsIntent": "Send every idle robot to {zone}, is that right?",
+    "ZoneRobotsIntent": "Send the robots in {origin} to {zone}, is that right?",
+    "CorrectionIntent": "Send {robot} instead, is that right?",
+    "CloseZoneIntent": "Close {zone}, so that no robot goes there, is that right?",
+    "OpenZoneIntent": "Open {zone} again, is that right?",
+}
+CONFIRM_ANY = "That affects the whole fleet. Is that right?"
+ROBOTS_COUNTED = "{count} robots"
+EVERY_ROBOT = "all robots"
 
 # The word before the last of several choices ("zone a, zone b, or zone c"), and of several
 # robots listed ("heron, plover and curlew").

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ask_sdk_model import Slot, SlotConfirmationStatus
-from ask_sdk_model.dialog import ConfirmSlotDirective, ElicitSlotDirective
+from ask_sdk_model.dialog import ConfirmIntentDirective, ConfirmSlotDirective, ElicitSlotDirective
 
 from skill import prompts
 
@@ -137,5 +137,18 @@ def confirm_slot(
         handler_input.response_builder.speak(plain_text(question))
         .ask(plain_text(question))
         .add_directive(ConfirmSlotDirective(updated_intent=intent, slot_to_confirm=slot_name))
+        .response
+    )
+
+
+def confirm_intent(handler_input: HandlerInput, question: str) -> Response:
+    """Ask a yes-or-no question about the whole request (Dialog.ConfirmIntent); the answer
+    comes back as the same intent with confirmationStatus CONFIRMED or DENIED."""
+    request: IntentRequest = handler_input.request_envelope.request  # type: ignore[assignment]
+    assert request.intent is not None
+    return (
+        handler_input.response_builder.speak(plain_text(question))
+        .ask(plain_text(question))
+        .add_directive(ConfirmIntentDirective(updated_intent=request.intent))
         .response
     )

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
+from skill import deeds
 from skill.acknowledgment import MAX_WORKERS, await_acknowledgments
 from skill.errors import GatewayError
 from skill.logs import log_event
@@ -65,6 +66,7 @@ class Robots:
         started = self._clock()
         for item in publications:
             self.gateway.publish(item.topic, encode(item.command))
+            deeds.published(item)
             log_event(
                 "published",
                 topic=item.topic,

@@ -9,9 +9,12 @@ looked up in the fleet's names, so the same words work either way.
 
 from __future__ import annotations
 
+from functools import cache
 from typing import TYPE_CHECKING
 
 import msgspec
+
+from vahr.domain.text import normalize, number_in_words
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Collection
@@ -70,3 +73,18 @@ def read_slot(
         # Resolutions were present and none matched (ER_SUCCESS_NO_MATCH).
         return SlotReading(name, heard, None)
     return SlotReading(name, heard, lookup(heard))
+
+
+def spoken_number(heard: str | None) -> int | None:
+    """A count as said ("2", "two", "twelve"), or None when it is no number to 99."""
+    words = normalize(heard or "")
+    if words.isdigit():
+        return int(words)
+    return _spoken_numbers().get(words)
+
+
+@cache
+def _spoken_numbers() -> dict[str | None, int]:
+    """Numbers a person may say for a count, word -> value ("twelve" -> 12); built on first
+    use, as the number words are read from the locale's data."""
+    return {number_in_words(n): n for n in range(1, 100)}

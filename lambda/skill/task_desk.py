@@ -30,6 +30,7 @@ import msgspec
 
 from skill.errors import GatewayError, SkillError
 from vahr.dispatch import DispatchErrorCode, Order, Submission, Task, ZoneChange
+from vahr.protocol.audit import RECORDED_BY_HEADER
 
 if TYPE_CHECKING:
     from skill.config import SkillConfig
@@ -117,6 +118,8 @@ class HttpTaskDesk:
     def _call(self, method: str, url: str, body: bytes | None = None) -> tuple[int, bytes]:
         request = urllib.request.Request(url, data=body, method=method)  # noqa: S310 - http(s) only
         request.add_header("Content-Type", "application/json")
+        # The skill records its own requests in the trail, with who asked.
+        request.add_header(RECORDED_BY_HEADER, "skill")
         try:
             with urllib.request.urlopen(request, timeout=self.timeout_s) as response:  # noqa: S310
                 return response.status, response.read()

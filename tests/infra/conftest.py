@@ -15,5 +15,8 @@ def lean_app(tmp_path_factory: pytest.TempPathFactory) -> Synthesized:
 
 @pytest.fixture(scope="session")
 def full_app(tmp_path_factory: pytest.TempPathFactory) -> Synthesized:
-    """Every optional part: the Alexa skill and the Lex bot, with a known skill id."""
-    return synth_app(tmp_path_factory.mktemp("full"), skill="true", lex="true", skillId=SKILL_ID)
+    """Every optional part: the Alexa skill, the Lex bot and people's roles, with a known
+    skill id."""
+    return synth_app(
+        tmp_path_factory.mktemp("full"), skill="true", lex="true", people="true", skillId=SKILL_ID
+    )

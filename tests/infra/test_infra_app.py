@@ -35,7 +35,7 @@ def test_the_lean_app_has_the_core_and_no_optional_parts(lean_app: Synthesized) 
     assert not found & set(OPTIONAL_TYPES)
     assert set(lean_app.template["Outputs"]) == {
         "IotDataEndpoint", "SkillFunctionArn", "ThingNames", "ExperimentThing", "RobotPolicyName",
-        "StationPolicyName", "RecorderPolicyName", "AlarmTopicArn",
+        "StationPolicyName", "RecorderPolicyName", "AlarmTopicArn", "AuditTableName",
     }  # fmt: skip
     # What lets AWS see trouble is part of the core
     assert {"AWS::IoT::Logging", "AWS::IoT::AccountAuditConfiguration",
@@ -44,9 +44,9 @@ def test_the_lean_app_has_the_core_and_no_optional_parts(lean_app: Synthesized) 
 
 def test_the_full_app_adds_the_skill_the_bot_and_the_role_alias(full_app: Synthesized) -> None:
     assert set(OPTIONAL_TYPES) <= types(full_app)
-    assert {"RoleAlias", "CredentialsEndpoint", "BotId", "BotAliasId", "SkillId"} <= set(
-        full_app.template["Outputs"]
-    )
+    assert {
+        "RoleAlias", "CredentialsEndpoint", "BotId", "BotAliasId", "SkillId", "UsersTableName",
+    } <= set(full_app.template["Outputs"])  # fmt: skip
     # The robot policy gains the right to use the role alias
     policy = next(
         p["PolicyDocument"]

@@ -268,7 +268,9 @@ def test_the_lean_app_has_no_dispatcher(lean_app: Synthesized) -> None:
         "VAHR_DISPATCHER_FUNCTION"
         not in handlers["skill.app.lambda_handler"]["Environment"]["Variables"]
     )
-    assert not resources(lean_app.template, "AWS::DynamoDB::Table")
+    # No task table (the audit table is the only one)
+    tables = resources(lean_app.template, "AWS::DynamoDB::Table").values()
+    assert [table["KeySchema"][0]["AttributeName"] for table in tables] == ["trail"]
 
 
 def test_cfn_lint_passes_with_the_dispatcher(dispatch_app: Synthesized) -> None:

@@ -7,7 +7,10 @@ import { test } from "node:test";
 import { chooseLocale, SUPPORTED } from "../../vahr/station/static/i18n.js";
 
 const LOCALES = new URL("../../vahr/station/locales/", import.meta.url);
-const PAGE = readFileSync(new URL("../../vahr/station/static/index.html", import.meta.url), "utf8");
+// The station's pages: the station itself, and the sign-in page of a station people sign in to.
+const PAGE = ["index.html", "signin.html"]
+  .map((page) => readFileSync(new URL(`../../vahr/station/static/${page}`, import.meta.url), "utf8"))
+  .join("\n");
 const words = (locale) => JSON.parse(readFileSync(new URL(`${locale}.json`, LOCALES), "utf8"));
 
 test("a German browser gets German, an Austrian one too, anything else English", () => {
@@ -45,7 +48,7 @@ test("the English words are the page's own", () => {
 // What the scripts write (`t`, `tNodes`) and say to the assistant (`said`), by their English
 // wording: each in every other locale, with the same placeholders.
 const STATIC = new URL("../../vahr/station/static/", import.meta.url);
-const scripts = ["alerts-view", "conversation", "map", "panel", "robots", "station", "talk", "tasks", "tasks-view", "zones-view"]
+const scripts = ["alerts-view", "conversation", "map", "panel", "robots", "station", "talk", "tasks", "tasks-view", "trail-view", "zones-view"]
   .map((name) => readFileSync(new URL(`${name}.js`, STATIC), "utf8"));
 const used = (pattern) => new Set(scripts.flatMap((text) => [...text.matchAll(pattern)].map((m) => m[1])));
 const placeholders = (text) => [...text.matchAll(/\{(\w+)\}/g)].map((m) => m[1]).sort();

@@ -23,7 +23,12 @@ class RecordingAssistant:
         self.asked: list[tuple[str, str]] = []
 
     def ask(
-        self, utterance: str, *, origin: str, heard: dict[str, Any] | None = None
+        self,
+        utterance: str,
+        *,
+        origin: str,
+        heard: dict[str, Any] | None = None,
+        user: str | None = None,
     ) -> dict[str, Any]:
         self.asked.append((utterance, origin))
         return {"speech": "It is sunny.", "intent": "WeatherIntent", "commands": []}

@@ -103,8 +103,8 @@ def _first_line(process: subprocess.Popen[str], timeout_s: float) -> str:
 
 
 def say(api: str, utterance: str, *flags: str) -> dict[str, Any]:
-    """`vahr say --json` against `api` (with `flags`, such as `--locale de-DE`): the turn it
-    prints."""
+    """`vahr say --json` against `api` (with `flags`, such as `--locale de-DE` or `--user
+    ID`): the turn it prints."""
     result = subprocess.run(
         [*VAHR, "say", "--json", "--api", api, *flags, utterance],
         cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=60, check=True,

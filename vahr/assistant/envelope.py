@@ -23,6 +23,7 @@ from ask_sdk_model import (
     IntentConfirmationStatus,
     IntentRequest,
     LaunchRequest,
+    Person,
     RequestEnvelope,
     Session,
     SessionEndedReason,
@@ -145,10 +146,14 @@ def envelope(
     session_id: str,
     new: bool,
     attributes: dict[str, Any],
+    user_id: str | None = None,
+    person_id: str | None = None,
 ) -> dict[str, Any]:
-    """The whole request envelope as the JSON object a Lambda receives."""
+    """The whole request envelope as the JSON object a Lambda receives: from `user_id`'s
+    Alexa account (default: the identity's), and `person_id` when Alexa recognised the
+    speaker's voice (Alexa personalization: `context.System.person`)."""
     application = Application(application_id=identity.skill_id)
-    user = User(user_id=identity.user_id)
+    user = User(user_id=user_id or identity.user_id)
     built = RequestEnvelope(
         version="1.0",
         session=Session(
@@ -162,6 +167,7 @@ def envelope(
             system=SystemState(
                 application=application,
                 user=user,
+                person=Person(person_id=person_id) if person_id else None,
                 device=Device(
                     device_id=identity.device_id, supported_interfaces=SupportedInterfaces()
                 ),

@@ -26,6 +26,14 @@ Silence is answered by the device itself (nothing reaches the skill); a ramble l
 any request the model knows reaches it as AMAZON.FallbackIntent, so nothing moves. The
 skill's last command (`vahr.protocol.conversation`) outlives the session for the same
 origin for a short window, so a correction said just after a one-shot request works.
+
+Each Alexa account (`user`, the envelope's userId; the Echo's own by default) has a session
+of its own, as each person has their own Echo: one person's open question is never
+answered by another's words. `person` is the personId Alexa gives when it recognised the
+voice; people recognised on one account share its session, as on one Echo, and the skill
+itself tells their answers apart. The handler is called with a
+`vahr.protocol.audit.RequestSource` as its context: the channel (from the origin) and the
+words, which the skill's audit record keeps.
 """
 
 from __future__ import annotations
@@ -48,6 +56,7 @@ from vahr.assistant.deadline import TurnDeadline, TurnNotStarted
 from vahr.assistant.localized import invocation_patterns
 from vahr.assistant.nlu import Understanding, normalize_utterance
 from vahr.domain.invocation import FALLBACK_INTENT
+from vahr.protocol.audit import RequestSource, channel_of
 from vahr.protocol.conversation import CORRECTION_WINDOW_S, LAST_COMMAND_ATTRIBUTE, speaker
 
 if TYPE_CHECKING:
@@ -94,6 +103,8 @@ class Turn:
     # For speech: what the recognizer heard (transcript, confidence...), as it reported it.
     heard: dict[str, Any] | None = None
     at: datetime = field(default_factory=lambda: datetime.now(UTC))
+    # The Alexa account that spoke, when not the Echo's own.
+    user: str | None = None
 
     def to_json(self) -> dict[str, Any]:
         body = {
@@ -109,6 +120,8 @@ class Turn:
         }
         if self.heard is not None:
             body["heard"] = self.heard
+        if self.user is not None:
+            body["user"] = self.user
         return body
 
     def to_message(self) -> dict[str, Any]:
@@ -246,14 +259,18 @@ class AlexaSimulator:
         self.identity = identity or envelope.Identity()
         self._command_log = command_log or (lambda: [])
         self.on_turn = on_turn
-        self._session: _Session | None = None
+        # Alexa account (userId) -> its open session.
+        self._sessions: dict[str, _Session] = {}
         self._lock = threading.Lock()
         self._clock = clock
-        # speaker -> (when, the skill's last command) of that speaker's latest turn.
-        self._recent: dict[str, tuple[float, Any]] = {}
+        # (account, speaker) -> (when, the skill's last command) of their latest turn.
+        self._recent: dict[tuple[str, str], tuple[float, Any]] = {}
         self._origin = "say"
         # The deadline of the turn under way, when its asker said how long they wait.
         self._deadline: TurnDeadline | None = None
+        # Who speaks in the turn under way: the account, and the recognised person if any.
+        self._user = self.identity.user_id
+        self._person: str | None = None
         longest = max((len(text.split()) for text in model.training[0]), default=0)
         self._longest_words = RAMBLE_FACTOR * longest
         # The language spoken: the request's locale, and how the skill is addressed in it.
@@ -261,13 +278,37 @@ class AlexaSimulator:
         self._one_shot, self._open = invocation_patterns(model.invocation_name, locale)
 
     @property
+    def _session(self) -> _Session | None:
+        """The session of the account speaking now."""
+        return self._sessions.get(self._user)
+
+    @_session.setter
+    def _session(self, session: _Session | None) -> None:
+        if session is None:
+            self._sessions.pop(self._user, None)
+        else:
+            self._sessions[self._user] = session
+
+    def _account(self, user: str | None) -> str:
+        return user or self.identity.user_id
+
+    @property
     def session_open(self) -> bool:
-        return self._session is not None
+        return self.session_open_for(None)
+
+    def session_open_for(self, user: str | None) -> bool:
+        """Whether `user`'s account (the Echo's own for None) has a session open."""
+        return self._account(user) in self._sessions
 
     @property
     def pending(self) -> PendingDialog | None:
         """What the skill asked and waits for an answer to, in the open session."""
-        return self._session.pending if self._session else None
+        return self.pending_for(None)
+
+    def pending_for(self, user: str | None) -> PendingDialog | None:
+        """What the skill asked `user`'s account (the Echo's own for None) and waits for."""
+        session = self._sessions.get(self._account(user))
+        return session.pending if session else None
 
     def say(
         self,
@@ -277,17 +318,20 @@ class AlexaSimulator:
         heard: dict[str, Any] | None = None,
         understanding: Understanding | None = None,
         deadline: TurnDeadline | None = None,
+        user: str | None = None,
+        person: str | None = None,
     ) -> Turn:
         """Speak one utterance; returns the skill's answer and what the turn did.
 
         `origin` says who spoke and `heard` what a recognizer made of their speech; both
-        travel with the turn to `on_turn`. `understanding`, when given, is used instead of
-        understanding the words (a recognizer that weighed several hearings built it);
-        while a slot is elicited it is an answer when its intent is the pending one or
-        it names the slot alone (`pending` says which). With a `deadline`, a turn that
-        cannot start by its `start_by` (another turn held the simulator, the language
-        model was still being built) raises TurnNotStarted having done nothing, and
-        `may_publish` says whether its commands may still go out.
+        travel with the turn to `on_turn`. `user` is the Alexa account speaking (the Echo's
+        own by default) and `person` the recognised voice, if any. `understanding`, when
+        given, is used instead of understanding the words (a recognizer that weighed
+        several hearings built it); while a slot is elicited it is an answer when its
+        intent is the pending one or it names the slot alone (`pending` says which). With a
+        `deadline`, a turn that cannot start by its `start_by` (another turn held the
+        simulator, the language model was still being built) raises TurnNotStarted having
+        done nothing, and `may_publish` says whether its commands may still go out.
         """
         with self._lock:
             if deadline is not None and deadline.start_left() < 0:
@@ -296,12 +340,14 @@ class AlexaSimulator:
                     "to the robots"
                 )
             self._origin = origin
+            self._user, self._person = self._account(user), person
             self._deadline = deadline
             try:
                 turn = self._say(utterance, understanding)
             finally:
                 self._deadline = None
             turn.origin, turn.heard = origin, heard
+            turn.user = user
             self._announce(turn)
             return turn
 
@@ -312,7 +358,7 @@ class AlexaSimulator:
         deadline = self._deadline
         return deadline is None or deadline.may_publish()
 
-    def reading(self, utterance: str) -> Understanding:
+    def reading(self, utterance: str, user: str | None = None) -> Understanding:
         """What `utterance` would be understood as if said now, without saying it: while
         the skill asks for a slot, as the answer to that question (as `say` reads it); while
         it asks a yes-or-no question, a yes as the intent it confirms and a no as
@@ -321,18 +367,18 @@ class AlexaSimulator:
         "Placebot two instead?") is weighed as one, and readings split between yes and no
         are not sure of either."""
         with self._lock:
-            pending = self.pending
+            pending = self.pending_for(user)
         text = strip_invocation(self.model.invocation_name, utterance)
         if pending is not None and pending.directive == ELICIT and pending.slot is not None:
             return self._answer(text, pending.understanding, pending.slot)
-        return self.yes_or_no(text) or self.model.understand(text)
+        return self.yes_or_no(text, user) or self.model.understand(text)
 
-    def yes_or_no(self, utterance: str) -> Understanding | None:
+    def yes_or_no(self, utterance: str, user: str | None = None) -> Understanding | None:
         """`utterance` as the answer to the yes-or-no question under way: a yes as the
         intent it confirms, a no as AMAZON.NoIntent; None when no such question is asked or
         `utterance` is neither."""
         with self._lock:
-            pending = self.pending
+            pending = self.pending_for(user)
         if pending is None or pending.directive not in (CONFIRM_SLOT, CONFIRM_INTENT):
             return None
         status = confirmation_of(
@@ -342,9 +388,11 @@ class AlexaSimulator:
             return None
         return pending.understanding if status == "CONFIRMED" else Understanding("AMAZON.NoIntent")
 
-    def end_session(self) -> Turn | None:
-        """End an open session as the user walking away would (reason USER_INITIATED)."""
+    def end_session(self, user: str | None = None) -> Turn | None:
+        """End `user`'s open session (the Echo's own account's by default) as the user
+        walking away would (reason USER_INITIATED)."""
         with self._lock:
+            self._user, self._person = self._account(user), None
             if self._session is None:
                 return None
             turn = self._send("", envelope.session_ended_request(), None)
@@ -362,7 +410,7 @@ class AlexaSimulator:
     def _new_session(self) -> _Session:
         """A fresh session, holding the speaker's last command while it may be corrected."""
         session = _Session()
-        recent = self._recent.get(speaker(self._origin))
+        recent = self._recent.get((self._user, speaker(self._origin)))
         if recent is not None and self._clock() - recent[0] <= CORRECTION_WINDOW_S:
             session.attributes[LAST_COMMAND_ATTRIBUTE] = recent[1]
         return session
@@ -485,18 +533,21 @@ class AlexaSimulator:
             session_id=session.id,
             new=session.turns == 0,
             attributes=session.attributes,
+            user_id=self._user,
+            person_id=self._person,
         )
         event["request"]["locale"] = self.locale
         self._command_log()  # forget commands published outside this turn
+        source = RequestSource(channel_of(self._origin), utterance.strip() or None)
         started = time.perf_counter()
-        response = self.handler(event, None)
+        response = self.handler(event, source)
         latency_ms = (time.perf_counter() - started) * 1000
         commands = self._command_log()
         body = response.get("response", {})
         ended = request.object_type == "SessionEndedRequest" or body.get("shouldEndSession", True)
         attributes = response.get("sessionAttributes") or {}
         if LAST_COMMAND_ATTRIBUTE in attributes:
-            self._recent[speaker(self._origin)] = (
+            self._recent[(self._user, speaker(self._origin))] = (
                 self._clock(),
                 attributes[LAST_COMMAND_ATTRIBUTE],
             )
@@ -568,7 +619,12 @@ class SimulatorAssistant:
         self.simulator = simulator
 
     def ask(
-        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+        self,
+        utterance: str,
+        *,
+        origin: str = "say",
+        heard: dict[str, Any] | None = None,
+        user: str | None = None,
     ) -> dict[str, Any]:
-        turn = self.simulator.say(utterance, origin=origin, heard=heard)
+        turn = self.simulator.say(utterance, origin=origin, heard=heard, user=user)
         return {**turn.to_json(), "utterance": utterance}

@@ -21,9 +21,13 @@ def load_skill_handler(
     skill_id: str | None = None,
     fleet_file: str | None = None,
     log_level: str = "WARNING",
+    users_file: str | None = None,
+    confirm: bool | None = None,
+    audit_table: str | None = None,
 ) -> SkillHandler:
     """`skill.app`'s handler built around the local data plane (the same handler function
-    Lambda runs, given another configuration)."""
+    Lambda runs, given another configuration): the people of `users_file`, fleet-wide
+    commands confirmed as `confirm` says."""
     # The local data plane accepts any SigV4 signature, but boto3 will not sign without
     # credentials: give it dummy ones when the environment has none.
     if not (os.environ.get("AWS_ACCESS_KEY_ID") or os.environ.get("AWS_PROFILE")):
@@ -39,6 +43,9 @@ def load_skill_handler(
         "skill_id": skill_id,
         "fleet_file": fleet_file,
         "log_level": log_level,
+        "users_file": users_file,
+        "confirm": confirm,
+        "audit_table": audit_table,
     }
     if ack_timeout_s is not None:
         settings["ack_timeout_s"] = ack_timeout_s

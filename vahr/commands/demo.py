@@ -167,6 +167,8 @@ def run(args: argparse.Namespace) -> int:
             sim_speed_factor=args.sim_speed_factor,
             voice=not args.no_voice,
             log_level=args.log_level,
+            # The paper's one-turn commands: nothing is confirmed first.
+            confirm=False,
         )
         started = time.perf_counter()
         with LocalSystem(config, on_event=events.record) as system:

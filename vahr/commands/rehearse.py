@@ -172,6 +172,8 @@ def _on_own_stack(
             sim_speed_factor=args.speed_factor,
             voice=True,
             log_level=args.log_level,
+            # The paper's one-turn commands: nothing is confirmed first.
+            confirm=False,
         )
         with LocalSystem(config) as system:
             if not system.voice_enabled:

@@ -15,6 +15,16 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print the whole turn as JSON")
     parser.add_argument("--speak", action="store_true", help="also speak the reply (espeak-ng)")
     parser.add_argument(
+        "--user",
+        metavar="ID",
+        help="speak as this Alexa account (its userId, as in the users file of vahr up --users)",
+    )
+    parser.add_argument(
+        "--person",
+        metavar="ID",
+        help="speak as a voice Alexa recognised (a personId: preferred over --user for roles)",
+    )
+    parser.add_argument(
         "--locale",
         default="en-US",
         help="the language spoken: en-US (default) or de-DE; the system must run in it "
@@ -24,13 +34,22 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from vahr.assistant.localized import supported
+    from vahr.domain.people import MAX_ID_CHARS, valid_person_id
     from vahr.errors import VahrError
     from vahr.plumbing.client import default_api, say
 
     supported(args.locale)
     if not args.utterance.strip():
         raise VahrError("the utterance is empty")
-    turn = say(args.api or default_api(), args.utterance, args.locale)
+    for flag in ("user", "person"):
+        value = getattr(args, flag)
+        if value is not None and not valid_person_id(value):
+            raise VahrError(
+                f"--{flag} {value!r}: an Alexa id is 1 to {MAX_ID_CHARS} printable characters"
+            )
+    turn = say(
+        args.api or default_api(), args.utterance, args.locale, user=args.user, person=args.person
+    )
     if args.json:
         print(json.dumps(turn))
     else:

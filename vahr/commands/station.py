@@ -29,6 +29,7 @@ from vahr.commands.fleet_flag import add_fleet_flag, fleet_for
 if TYPE_CHECKING:
     import argparse
 
+    from vahr.domain.people import People
     from vahr.station.server import ServerTls
 
 DEFAULT_PORT = 8181
@@ -78,6 +79,19 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--state-dir", type=Path, default=Path(".state"), help="where the local CA is (--tls)"
     )
+    parser.add_argument(
+        "--users",
+        type=Path,
+        metavar="FILE",
+        help="the users file: each person signs in with their own token (token_sha256) and "
+        "may do what their role allows (the skill in this process knows them too)",
+    )
+    parser.add_argument(
+        "--audit-table",
+        metavar="NAME",
+        help="on AWS: the DynamoDB audit table the panel's orders are recorded in and the page "
+        "shows (a local stack's --api has its own trail)",
+    )
     parser.add_argument("--no-voice", action="store_true", help="no push-to-talk")
     parser.add_argument("--json", action="store_true", help="print the page's address as JSON")
     add_logging_flag(parser)
@@ -94,6 +108,8 @@ def run(args: argparse.Namespace) -> int:
         raise VahrError(f"--port {args.port}: not a usable port")
     if args.token is not None and len(args.token) < 16:
         raise VahrError("--token must be at least 16 characters")
+    if args.token is not None and args.users is not None:
+        raise VahrError("give --token (one for everyone) or --users (one each), not both")
     served_tls = _served_tls(args)
     public_origin = _public_origin(args.public_origin)
     tls = client_credentials(args)
@@ -103,6 +119,9 @@ def run(args: argparse.Namespace) -> int:
         fleet_file=args.fleet,
         tls=tls,
         api=args.api,
+        people=_people(args.users),
+        users_file=args.users,
+        audit_table=args.audit_table,
     )
     config = StationConfig(
         port=args.port,
@@ -148,6 +167,25 @@ def run(args: argparse.Namespace) -> int:
     if not args.json:
         print("vahr station: stopped", file=sys.stderr)
     return 0
+
+
+def _people(path: Path | None) -> People | None:
+    if path is None:
+        return None
+    from vahr.domain.people import load_people
+    from vahr.errors import VahrError
+    from vahr.protocol import ProtocolError
+
+    try:
+        people = load_people(path)
+    except ProtocolError as err:
+        raise VahrError(f"--users {path}: {err}") from err
+    if not any(person.token_sha256 for person in people.users):
+        raise VahrError(
+            f"--users {path}: nobody in it has a token_sha256, so nobody could sign in; "
+            "make one with vahr users token"
+        )
+    return people
 
 
 def _served_tls(args: argparse.Namespace) -> ServerTls | None:

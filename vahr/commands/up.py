@@ -17,6 +17,8 @@ if TYPE_CHECKING:
     import argparse
 
     from vahr.domain import Fleet
+    from vahr.domain.people import People
+    from vahr.local.system import LocalSystem
     from vahr.protocol import Event
 
 DEFAULT_API_PORT = 8180
@@ -88,6 +90,15 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--no-voice", action="store_true", help="no room assistant (robots cannot ask by voice)"
     )
     parser.add_argument(
+        "--users",
+        type=Path,
+        metavar="FILE",
+        help="who may do what: a YAML file of people (Alexa ids), their names and roles "
+        "(viewer, operator, supervisor) and default_role; fleet-wide commands are then "
+        "confirmed first and the station signs its operators in (default: anyone may do "
+        "everything, as today)",
+    )
+    parser.add_argument(
         "--locale",
         default="en-US",
         help="the language people speak to the simulated Echo: en-US (default) or de-DE "
@@ -137,6 +148,7 @@ def run(args: argparse.Namespace) -> int:
                 f"--swarm {args.swarm}: give 1 to {SWARM_MAX:,} robots (the most whose names"
                 " fit in one Alexa interaction model; see docs/large-fleets.md)"
             )
+    people = _people(args.users)
     config = SystemConfig(
         state_dir=args.state_dir.resolve(),
         mqtts_port=args.mqtts_port,
@@ -152,6 +164,8 @@ def run(args: argparse.Namespace) -> int:
         log_level=args.log_level,
         station_port=args.station_port or None,
         locale=args.locale,
+        users_file=args.users.resolve() if args.users is not None else None,
+        people=people,
     )
     stopping = threading.Event()
     # SIGTERM ends the run like Ctrl-C does; both just set the event the main thread waits on.
@@ -174,7 +188,7 @@ def run(args: argparse.Namespace) -> int:
         if args.json:
             _emit(json.dumps(endpoints))
         else:
-            _emit(_banner(endpoints, system.fleet, system.voice_enabled, args.locale))
+            _emit(_banner(endpoints, system.fleet, system.voice_enabled, args.locale, _who(system)))
         printer.release()
         while not stopping.wait(0.5):
             for line in system.supervise():
@@ -229,7 +243,46 @@ def example_command(fleet: Fleet, locale: str) -> str:
     return f'vahr say{flag} "{sentence}"'
 
 
-def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool, locale: str) -> str:
+def _people(path: Path | None) -> People | None:
+    """The users file, read and checked before anything starts (one line naming a fault)."""
+    if path is None:
+        return None
+    from vahr.domain.people import load_people
+    from vahr.errors import VahrError
+    from vahr.protocol import ProtocolError
+
+    try:
+        return load_people(path)
+    except ProtocolError as err:
+        raise VahrError(f"--users {path}: {err}") from err
+
+
+def _who(system: LocalSystem) -> str:
+    """The banner's line on who may do what."""
+    people, confirm = system.config.people, system.confirmation
+    asks = (
+        "fleet-wide commands are confirmed with a yes first"
+        if confirm
+        else "nothing is confirmed first"
+    )
+    if people is None:
+        return f"anyone may do everything, as a supervisor; {asks} (--users FILE gives roles)"
+    count = len(people.users)
+    signing_in = sum(person.token_sha256 is not None for person in people.users)
+    station = (
+        f"{signing_in} may sign in at the station"
+        if signing_in
+        else "nobody may sign in at the station (give people a token_sha256: vahr users token)"
+    )
+    return (
+        f"{count} {'person' if count == 1 else 'people'} from {system.config.users_file}, "
+        f"anyone else a {people.default_role}; {asks}; {station}"
+    )
+
+
+def _banner(
+    endpoints: dict[str, str | None], fleet: Fleet, voice: bool, locale: str, who: str
+) -> str:
     things = fleet.robot_things
     named = (
         ", ".join(things)
@@ -248,6 +301,7 @@ def _banner(endpoints: dict[str, str | None], fleet: Fleet, voice: bool, locale:
     lines += [
         f"  station     {endpoints['station'] or '(off)'}   (the operator station page)",
         f"  robots      {named} (sim backend{', room voice' if voice else ''})",
+        f"  people      {who}",
         f"  talk to it: {example_command(fleet, locale)}   (Ctrl-C stops everything)",
     ]
     return "\n".join(lines)

@@ -179,6 +179,16 @@ class Group(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     spoken_by_locale: dict[str, SpokenNames] | msgspec.UnsetType = msgspec.UNSET
 
 
+class Confirmation(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """When fleet-wide and disruptive commands are confirmed with a spoken yes first
+    (`vahr.domain.people`): `enabled` None means on whenever people are known (a users
+    file, or the users table on AWS); a command to more than `group_threshold` robots is
+    fleet-wide."""
+
+    enabled: bool | None = None
+    group_threshold: Annotated[int, msgspec.Meta(ge=1)] = 3
+
+
 class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
     """The whole fleet definition. Build it with `load_fleet` or `Fleet.from_yaml`."""
 
@@ -187,6 +197,13 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
     groups: list[Group] = []
     experiment_thing: str = "vahr-experiment"
     floor: Floor | None = None
+    # Left out of the fleet's JSON when the file gives none (`confirmation_rules`).
+    confirmation: Confirmation | msgspec.UnsetType = msgspec.UNSET
+
+    @property
+    def confirmation_rules(self) -> Confirmation:
+        """The file's confirmation settings, or the defaults."""
+        return self.confirmation if isinstance(self.confirmation, Confirmation) else Confirmation()
 
     def validate(self) -> Fleet:
         """Check the rules that span fields; return self. `from_yaml` calls this.

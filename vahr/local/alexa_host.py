@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import msgspec
 
 from vahr.assistant.deadline import TurnDeadline, TurnNotStarted
+from vahr.domain.people import MAX_ID_CHARS, valid_person_id
 from vahr.protocol import ProtocolError, topics
 from vahr.protocol.station_topics import ORIGIN_PATTERN, Heard
 from vahr.twin.dataplane import ApiError
@@ -42,10 +43,18 @@ def serve_alexa(
     log_level: str = "WARNING",
     locale: str = "en-US",
     readiness: Readiness | None = None,
+    users_file: Path | None = None,
+    confirm: bool | None = None,
 ) -> AlexaSimulator:
     """Serve the Alexa simulator (and the skill, in-process) at `POST /vahr/say`, in
     `locale`: its understanding data, and the locale of every request it sends. A say
-    request waits for `readiness` (every robot online, the language model built)."""
+    request waits for `readiness` (every robot online, the language model built). The
+    skill knows the people of `users_file` (None: everyone may do everything) and confirms
+    fleet-wide commands as `confirm` says (None: as the fleet file says, else when people
+    are known).
+
+    A say request may name the Alexa account speaking (`user`, `vahr say --user`) and the
+    voice recognised (`person`); each account has its own session."""
     # The NLU's libraries load here, not when `vahr.local` is imported.
     from vahr.assistant.commands_seen import CommandLog
     from vahr.assistant.envelope import Identity
@@ -72,6 +81,8 @@ def serve_alexa(
         skill_id=identity.skill_id,
         fleet_file=str(fleet_file) if fleet_file else None,
         log_level=log_level,
+        users_file=str(users_file) if users_file else None,
+        confirm=confirm,
     )
 
     def publish_turn(turn: Turn) -> None:
@@ -111,6 +122,7 @@ def serve_alexa(
         try:
             origin, heard = _speaker(request)
             deadline = _deadline(request)
+            user, person = _account(request, "user"), _account(request, "person")
         except ProtocolError as err:
             return 400, {"code": 400, "message": str(err)}
         if readiness is not None:
@@ -120,7 +132,9 @@ def serve_alexa(
                 message = f"vahr up is still starting (waiting for {what}); nothing was sent"
                 return 503, {"code": 503, "message": message}
         try:
-            turn = simulator.say(utterance, origin=origin, heard=heard, deadline=deadline)
+            turn = simulator.say(
+                utterance, origin=origin, heard=heard, deadline=deadline, user=user, person=person
+            )
         except TurnNotStarted as err:
             return 503, {"code": 503, "message": str(err)}
         return 200, turn.to_json()
@@ -142,6 +156,16 @@ def _deadline(request: dict[str, Any]) -> TurnDeadline | None:
 def _is_command(topic: str) -> bool:
     parsed = topics.parse_robot_topic(topic)
     return topic == topics.FLEET_CMD or (parsed is not None and parsed[1] == "cmd")
+
+
+def _account(request: dict[str, Any], field: str) -> str | None:
+    """An Alexa userId or personId from a say request, or None when not given."""
+    value = request.get(field)
+    if value is None:
+        return None
+    if not isinstance(value, str) or not valid_person_id(value):
+        raise ProtocolError(field, f"an Alexa id is 1 to {MAX_ID_CHARS} printable characters")
+    return value
 
 
 def _speaker(request: dict[str, Any]) -> tuple[str, dict[str, Any] | None]:

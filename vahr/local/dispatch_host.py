@@ -19,6 +19,11 @@ retained, on `vahr/fleet/zones` for the robots.
 On a map (`floor: {map: FILE}`), the cost of a robot is its planned path's length:
 `vahr.navigation`'s distance field from each zone, one search per zone and set of closed
 zones, cached.
+
+Each order, cancel and zone change that reaches the API is recorded in the audit trail
+(channel `api`), unless its sender recorded it already (the skill and the station do, with
+the person who asked: they say so in `RECORDED_BY_HEADER`); so is each queued task the
+dispatcher gives a robot by itself once one comes free (channel `dispatcher`).
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ from __future__ import annotations
 import logging
 import queue
 import threading
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import msgspec
 
@@ -38,16 +43,18 @@ from vahr.dispatch import (
     Order,
     RobotState,
 )
+from vahr.dispatch.records import task_given
 from vahr.domain import Pose
 from vahr.local.task_store import SqliteTaskStore
 from vahr.navigation import load_floor
 from vahr.plumbing.mqtt import MqttClient
 from vahr.protocol import encode, topics
+from vahr.protocol.audit import RECORDED_BY_HEADER, AuditEntry, Outcome, now
 from vahr.protocol.errors import from_validation_error
 from vahr.twin import identities
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Mapping
     from pathlib import Path
 
     from vahr.dispatch import Task
@@ -63,6 +70,8 @@ ZONES_PATH = "/vahr/zones"
 STOP_TIMEOUT_S = 5.0
 
 Answer = tuple[int, bytes, str | None]
+# Who acts when no person does: a program calling the tasks API, the dispatcher itself.
+API_CALLER = "api"
 
 
 def robot_state(entry: IndexedThing) -> RobotState:
@@ -122,12 +131,25 @@ class IndexCandidates:
 
 
 class TasksApi:
-    """`/vahr/tasks` on the data plane, in its typed-route form: (status, body, error type)."""
+    """`/vahr/tasks` on the data plane, in its typed-route form: (status, body, error type).
+    `record`, when given, takes the trail's entry for each order and cancel."""
 
-    def __init__(self, dispatcher: Dispatcher) -> None:
+    def __init__(
+        self, dispatcher: Dispatcher, record: Callable[[AuditEntry], object] | None = None
+    ) -> None:
         self.dispatcher = dispatcher
+        self._record = record
 
-    def respond(self, method: str, path: str, body: bytes) -> Answer:
+    def respond(
+        self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
+    ) -> Answer:
+        answer = self._respond(method, path, body)
+        recorded = any(name.lower() == RECORDED_BY_HEADER.lower() for name in headers or {})
+        if self._record is not None and method in ("POST", "DELETE") and not recorded:
+            self._record(_api_entry(method, path, body, answer))
+        return answer
+
+    def _respond(self, method: str, path: str, body: bytes) -> Answer:
         if path == TASKS_PATH:
             if method == "GET":
                 closed = self.dispatcher.closed_zones()
@@ -163,12 +185,25 @@ class ZoneRequest(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
 
 
 class ZonesApi:
-    """`/vahr/zones` on the data plane: the zones closed at run time."""
+    """`/vahr/zones` on the data plane: the zones closed at run time. `record`, when given,
+    takes the trail's entry for each change asked for."""
 
-    def __init__(self, dispatcher: Dispatcher) -> None:
+    def __init__(
+        self, dispatcher: Dispatcher, record: Callable[[AuditEntry], object] | None = None
+    ) -> None:
         self.dispatcher = dispatcher
+        self._record = record
 
-    def respond(self, method: str, path: str, body: bytes) -> Answer:
+    def respond(
+        self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
+    ) -> Answer:
+        answer = self._respond(method, path, body)
+        recorded = any(name.lower() == RECORDED_BY_HEADER.lower() for name in headers or {})
+        if self._record is not None and method == "POST" and not recorded:
+            self._record(_zone_entry(path, body, answer))
+        return answer
+
+    def _respond(self, method: str, path: str, body: bytes) -> Answer:
         if path == ZONES_PATH:
             if method == "GET":
                 return _ok({"closed": self.dispatcher.closed_zones()})
@@ -186,6 +221,70 @@ class ZonesApi:
             return _ok(self.dispatcher.set_zone(zone, closed=request.closed))
         except DispatchError as err:
             return _error(400, str(err), error=err.code)
+
+
+def _api_entry(method: str, path: str, body: bytes, answer: Answer) -> AuditEntry:
+    """The trail's record of one order or cancel sent to the API by a program."""
+    status, payload, _ = answer
+    outcome: Outcome = "sent" if status == 200 else "failed"
+    reason = None
+    robots: list[str] = []
+    commands: list[str] = []
+    slots: dict[str, str | None] = {}
+    answered = _json_object(payload)
+    if status != 200:
+        reason = str(answered.get("message", f"HTTP {status}"))[:500]
+    if method == "POST":
+        order = _json_object(body)
+        slots = {str(k)[:255]: str(v)[:255] for k, v in order.items() if v is not None}
+        tasks = [*answered.get("assigned", []), *answered.get("queued", [])]
+        commands = [str(task.get("id")) for task in tasks if isinstance(task, dict)]
+        robots = [str(t["thing"]) for t in answered.get("assigned", []) if t.get("thing")]
+    else:
+        task = answered.get("task") or {}
+        commands = [path[len(TASKS_PATH) + 1 :][:255]]
+        robots = [str(task["thing"])] if task.get("thing") else []
+    return AuditEntry(
+        time=now(),
+        who=API_CALLER,
+        channel="api",
+        words=f"{method} {path}",
+        intent="submit" if method == "POST" else "cancel",
+        slots=slots,
+        robots=robots,
+        commands=commands,
+        outcome=outcome,
+        reason=reason,
+    )
+
+
+def _zone_entry(path: str, body: bytes, answer: Answer) -> AuditEntry:
+    """The trail's record of one zone closed or opened through the API by a program."""
+    status, payload, _ = answer
+    answered = _json_object(payload)
+    closed = _json_object(body).get("closed")
+    given = [task for task in answered.get("given", []) if isinstance(task, dict)]
+    return AuditEntry(
+        time=now(),
+        who=API_CALLER,
+        channel="api",
+        words=f"POST {path}",
+        intent="close_zone" if closed is True else "open_zone" if closed is False else "zone",
+        slots={"zone": path[len(ZONES_PATH) + 1 :][:255]},
+        robots=[str(task["thing"]) for task in given if task.get("thing")],
+        commands=[str(task.get("id")) for task in given],
+        outcome="sent" if status == 200 else "failed",
+        reason=None if status == 200 else str(answered.get("message", f"HTTP {status}"))[:500],
+    )
+
+
+def _json_object(data: bytes) -> dict[str, Any]:
+    """`data` as a JSON object, or an empty one when it is not one (a record never fails)."""
+    try:
+        value = msgspec.json.decode(data or b"{}")
+    except msgspec.DecodeError:
+        return {}
+    return value if isinstance(value, dict) else {}
 
 
 def _ok(body: object) -> Answer:
@@ -216,9 +315,11 @@ class LocalDispatcher:
         endpoint: MqttEndpoint,
         state_dir: Path,
         on_given_up: Callable[[Task], None] | None = None,
+        record: Callable[[AuditEntry], object] | None = None,
     ) -> None:
         """`on_given_up`: told each task given up because its robot was sent elsewhere."""
         self.tasks = SqliteTaskStore.in_state_dir(state_dir)
+        self._record = record
         self.candidates = IndexCandidates(index, fleet)
         self._client = MqttClient(endpoint, client_id=identities.DISPATCHER)
         floor = load_floor(fleet)
@@ -231,8 +332,8 @@ class LocalDispatcher:
             routes=floor.routes if floor is not None else None,
             publish_closures=self._publish_closures,
         )
-        self.api = TasksApi(self.dispatcher)
-        self.zones_api = ZonesApi(self.dispatcher)
+        self.api = TasksApi(self.dispatcher, record)
+        self.zones_api = ZonesApi(self.dispatcher, record)
         self._updates: queue.SimpleQueue[str | None] = queue.SimpleQueue()
         self._worker: threading.Thread | None = None
 
@@ -257,9 +358,22 @@ class LocalDispatcher:
             if state is None:
                 continue
             try:
-                self.dispatcher.observe(state)
+                given = self.dispatcher.observe(state)
             except Exception:  # one failed hand-over must not stop the dispatcher
                 log.exception("dispatching after an update of %s failed", thing)
+                continue
+            if given is not None:
+                self._recorded([given])
+
+    def _recorded(self, tasks: list[Task]) -> None:
+        """Record tasks the dispatcher gave robots by itself (never stopping it)."""
+        if self._record is None:
+            return
+        for task in tasks:
+            try:
+                self._record(task_given(task))
+            except Exception:
+                log.exception("the audit trail did not take the dispatch of %s", task.id)
 
     def start(self) -> LocalDispatcher:
         self._client.subscribe(topics.ALL_SHADOW_DOCUMENTS, self._on_documents, retained=False)
@@ -270,8 +384,8 @@ class LocalDispatcher:
         # assigned but never acknowledged go out again (same ids: a robot that had one runs
         # it once), then queued tasks to free robots.
         self.dispatcher.announce_closures()
-        self.dispatcher.resume()
-        self.dispatcher.drain()
+        self._recorded(self.dispatcher.resume())
+        self._recorded(self.dispatcher.drain())
         return self
 
     def stop(self) -> None:

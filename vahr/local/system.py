@@ -26,6 +26,7 @@ import msgspec
 from vahr.announce import TaskCancelled
 from vahr.assistant import SimulatorAssistant
 from vahr.domain.fleet import SPOKEN_LOCALE
+from vahr.domain.people import confirmation_on
 from vahr.errors import VahrError
 from vahr.local.alexa_host import serve_alexa
 from vahr.local.announce_host import LocalAnnouncer
@@ -56,7 +57,9 @@ if TYPE_CHECKING:
     from vahr.assistant.simulator import AlexaSimulator
     from vahr.dispatch import Task
     from vahr.domain import Fleet
+    from vahr.domain.people import People
     from vahr.plumbing.client import Assistant
+    from vahr.twin.trail_store import SqliteTrail
 
 log = logging.getLogger(__name__)
 
@@ -100,6 +103,13 @@ class SystemConfig:
     # The language people speak to the simulated Echo (`vahr up --locale`); the robots'
     # own spoken exchange with the assistant stays English (an English recognizer).
     locale: str = "en-US"
+    # Who may do what (`vahr up --users FILE`, `vahr.domain.people`): None, everyone may do
+    # everything. `people` is that file read; the station signs its operators in with it.
+    users_file: Path | None = None
+    people: People | None = None
+    # Whether fleet-wide commands are confirmed first; None: as the fleet file says, else
+    # whenever people are known. The paper's experiment sets False: one-turn commands.
+    confirm: bool | None = None
 
 
 class ServedStation(Protocol):
@@ -124,6 +134,8 @@ class StartStation(Protocol):
         read_shadow: Callable[[str], bytes | None],
         tasks_url: str | None = None,
         locale: str = "en-US",
+        people: People | None = None,
+        trail: SqliteTrail | None = None,
     ) -> ServedStation: ...
 
 
@@ -178,6 +190,14 @@ class LocalSystem:
         self._room_model: InteractionModel | None = None
 
     @property
+    def confirmation(self) -> bool:
+        """Whether the skill confirms fleet-wide commands first (as it decides it)."""
+        rules = self.fleet.confirmation_rules
+        return confirmation_on(
+            self.config.confirm, rules.enabled, self.config.users_file is not None
+        )
+
+    @property
     def voice_enabled(self) -> bool:
         return self.config.voice and shutil.which("espeak-ng") is not None
 
@@ -222,6 +242,8 @@ class LocalSystem:
                 log_level=cfg.log_level,
                 locale=cfg.locale,
                 readiness=self.readiness,
+                users_file=cfg.users_file,
+                confirm=cfg.confirm,
             )
             assert self.stack.dataplane is not None and self.stack.ca is not None
             self.stack.dataplane.local_routes[("GET", "/vahr/status")] = self._status
@@ -301,6 +323,7 @@ class LocalSystem:
             endpoint=self.stack.service_endpoint(identities.DISPATCHER),
             state_dir=self.config.state_dir,
             on_given_up=given_up,
+            record=self.stack.trail.append if self.stack.trail is not None else None,
         ).start()
         dataplane.typed_routes[TASKS_PATH] = self.dispatcher.api.respond
         dataplane.typed_routes[ZONES_PATH] = self.dispatcher.zones_api.respond
@@ -325,7 +348,7 @@ class LocalSystem:
         )
 
         def ask(request: str) -> str | None:
-            turn = room_echo.say(f"alexa {request}")
+            turn = room_echo.say(f"alexa {request}", origin="robot")
             # Each question is one-shot: the robot does not hold a conversation.
             room_echo.end_session()
             return turn.speech or None
@@ -351,6 +374,8 @@ class LocalSystem:
             read_shadow=self._stored_shadow,
             tasks_url=self.stack.api_url + TASKS_PATH if self.dispatcher is not None else None,
             locale=self.config.locale,
+            people=self.config.people,
+            trail=self.stack.trail,
         )
         self.stack.dataplane.redirects["/vahr/dashboard"] = self.station.url
 

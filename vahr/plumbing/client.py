@@ -88,13 +88,23 @@ def call(
         raise VahrError(f"{api}{path} did not answer with JSON") from err
 
 
-def say(api: str, utterance: str, locale: str | None = None) -> dict[str, Any]:
+def say(
+    api: str,
+    utterance: str,
+    locale: str | None = None,
+    *,
+    user: str | None = None,
+    person: str | None = None,
+) -> dict[str, Any]:
     """The turn's JSON, with `latency_ms` measured here: utterance in to reply out.
-    `locale` is the language spoken; the system refuses one it was not started in."""
+    `locale` is the language spoken; the system refuses one it was not started in. `user`
+    speaks as that Alexa account (its userId), `person` as a voice Alexa recognised (its
+    personId)."""
     started = time.perf_counter()
     body: dict[str, Any] = {"utterance": utterance, "timeout_s": SAY_TIMEOUT_S}
-    if locale is not None:
-        body["locale"] = locale
+    for key, value in (("locale", locale), ("user", user), ("person", person)):
+        if value is not None:
+            body[key] = value
     turn = _say_call(api, body, SAY_TIMEOUT_S)
     turn["skill_ms"] = turn.get("latency_ms")
     turn["latency_ms"] = round((time.perf_counter() - started) * 1000, 1)
@@ -116,10 +126,16 @@ def _say_call(api: str, body: dict[str, Any], timeout_s: float) -> dict[str, Any
 
 class Assistant(Protocol):
     def ask(
-        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+        self,
+        utterance: str,
+        *,
+        origin: str = "say",
+        heard: dict[str, Any] | None = None,
+        user: str | None = None,
     ) -> Turn:
         """Say `utterance` to the assistant; `origin` names who spoke, `heard` what the
-        recognizer made of it. Raises VahrError when the assistant cannot be reached."""
+        recognizer made of it, `user` the Alexa account (userId) speaking, when not the
+        assistant's own. Raises VahrError when the assistant cannot be reached."""
         ...
 
 
@@ -131,7 +147,12 @@ class HttpAssistant:
         self.timeout_s = timeout_s
 
     def ask(
-        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+        self,
+        utterance: str,
+        *,
+        origin: str = "say",
+        heard: dict[str, Any] | None = None,
+        user: str | None = None,
     ) -> Turn:
         body: dict[str, Any] = {
             "utterance": utterance,
@@ -140,24 +161,33 @@ class HttpAssistant:
         }
         if heard is not None:
             body["heard"] = heard
+        if user is not None:
+            body["user"] = user
         turn = _say_call(self.api_url, body, self.timeout_s)
         return _with_utterance(turn, utterance, f"{self.api_url}{SAY_PATH}")
 
 
 class SayCommandAssistant:
     """`vahr say --json` against the local stack's API (`origin` and `heard` are not passed
-    on: the command speaks as "say")."""
+    on: the command speaks as "say"; `user` is, as `--user`)."""
 
     def __init__(self, api_url: str | None, timeout_s: float = SAY_TIMEOUT_S + 10.0) -> None:
         self.api_url = api_url
         self.timeout_s = timeout_s
 
     def ask(
-        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+        self,
+        utterance: str,
+        *,
+        origin: str = "say",
+        heard: dict[str, Any] | None = None,
+        user: str | None = None,
     ) -> Turn:
         argv = [sys.executable, "-m", "vahr.cli", "say", utterance, "--json"]
         if self.api_url:
             argv += ["--api", self.api_url]
+        if user is not None:
+            argv += ["--user", user]
         try:
             done = subprocess.run(
                 argv, capture_output=True, text=True, timeout=self.timeout_s, check=False

@@ -15,6 +15,13 @@ Routes (all JSON unless said otherwise; errors are `{"error": "one line"}`):
 | `POST /api/acknowledge` `{"id"}` | an alert acknowledged: `{"acknowledged": [ids]}` |
 | `POST /api/zone` `{"zone", "closed"}` | a zone closed or opened: the dispatcher's `ZoneChange` |
 | `GET /api/map.png` | the map, when the fleet's floor is one (`floor_picture.py`) |
+| `GET /api/me` | who works this page: `{"id", "name", "role", "may": [kinds], "signed_in"}` |
+
+Every request is someone's (`vahr.domain.people.Person`): the person signed in, or, where
+nobody signs in, anyone as a supervisor (`controls.ANYONE`). The panel's orders (a zone
+closed or opened among them) are checked against their role and recorded with them; what
+they type or say goes to the assistant as their Alexa account, so the skill decides and
+records it the same way.
 
 Each JSON body is decoded by msgspec into its route's request type (`json_routes`); an
 empty body is `{}`, unknown fields are ignored, and an error names the field. The page
@@ -31,16 +38,19 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import msgspec
 
+from vahr.domain.people import ACTION_KINDS, may
 from vahr.errors import VahrError
 from vahr.experiment.procedures import ProcedureViolation
 from vahr.protocol import ProtocolError
 from vahr.protocol.errors import from_validation_error
 from vahr.speech.errors import SpeechError
+from vahr.station.controls import ANYONE
 from vahr.station.errors import RequestError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from vahr.domain.people import Person
     from vahr.plumbing.client import Assistant
     from vahr.station.controls import Controls
     from vahr.station.desk import Desk
@@ -110,10 +120,11 @@ ParticipantRequest = dict[str, Any]
 
 @dataclass(frozen=True)
 class JsonRoute:
-    """A POST of JSON: the type its body is decoded into, and what answers it."""
+    """A POST of JSON: the type its body is decoded into, and what answers it (given the
+    person who sent it)."""
 
     shape: Any
-    answer: Callable[[Any], Reply]
+    answer: Callable[[Any, Person], Reply]
 
 
 @dataclass(frozen=True)
@@ -164,13 +175,14 @@ class StationApp:
             "/api/zone": JsonRoute(ZoneRequest, self.zone),
         }
 
-    def handle_json(self, method: str, path: str, body: bytes) -> Reply:
-        """A JSON route: the body decoded into the route's request type, then answered."""
+    def handle_json(self, method: str, path: str, body: bytes, operator: Person = ANYONE) -> Reply:
+        """A JSON route: the body decoded into the route's request type, then answered for
+        `operator`."""
         route = self.json_routes.get(path) if method == "POST" else None
         if route is None:
             return error_reply(404, f"nothing to {method} at {path}")
         try:
-            return route.answer(_decode(body, route.shape))
+            return route.answer(_decode(body, route.shape), operator)
         except RequestError as err:
             return error_reply(err.status, err.message)
         except ProcedureViolation as err:
@@ -185,23 +197,35 @@ class StationApp:
 
     # -- routes -------------------------------------------------------------------------
 
-    def command(self, request: CommandRequest) -> Reply:
+    def me(self, operator: Person) -> Reply:
+        """Who works this page and what they may do (the page hides what they may not)."""
+        return json_reply(
+            {
+                "id": operator.id,
+                "name": operator.name,
+                "role": operator.role,
+                "may": [kind for kind in ACTION_KINDS if may(operator.role, kind)],
+                "signed_in": operator.known,
+            }
+        )
+
+    def command(self, request: CommandRequest, operator: Person) -> Reply:
         if request.action == "navigate":
             if request.zone is None:
                 raise RequestError(400, "zone: a string is required")
-            command_id = self.controls.navigate(request.robot, request.zone)
+            command_id = self.controls.navigate(request.robot, request.zone, operator)
         elif request.action == "stop":
-            command_id = self.controls.stop(request.robot)
+            command_id = self.controls.stop(request.robot, operator)
         else:
             raise RequestError(
                 400, f"action: {request.action!r} is not one the panel sends (navigate or stop)"
             )
         return json_reply({"id": command_id})
 
-    def stop_all(self, request: StopRequest) -> Reply:
-        return json_reply({"id": self.controls.stop(None)})
+    def stop_all(self, request: StopRequest, operator: Person) -> Reply:
+        return json_reply({"id": self.controls.stop(None, operator)})
 
-    def say(self, request: SayRequest) -> Reply:
+    def say(self, request: SayRequest, operator: Person) -> Reply:
         utterance = request.utterance.strip()
         if not utterance:
             raise RequestError(400, "utterance: say something (it is empty)")
@@ -209,9 +233,11 @@ class StationApp:
             raise RequestError(400, f"origin: one of {', '.join(sorted(SAY_ORIGINS))}")
         if self.assistant is None:
             raise RequestError(503, "no assistant is connected to this station")
-        return json_reply(self.assistant.ask(utterance, origin=request.origin))
+        return json_reply(
+            self.assistant.ask(utterance, origin=request.origin, user=account(operator))
+        )
 
-    def speech(self, request: SpeechRequest) -> Reply:
+    def speech(self, request: SpeechRequest, operator: Person) -> Reply:
         text = request.text.strip()
         if not text:
             raise RequestError(400, "text: nothing to say (it is empty)")
@@ -222,35 +248,44 @@ class StationApp:
         except SpeechError as err:
             raise RequestError(503, str(err)) from err
 
-    def interaction(self, request: ParticipantRequest) -> Reply:
+    def interaction(self, request: ParticipantRequest, operator: Person) -> Reply:
         return self._participant("interaction", request)
 
-    def puzzle(self, request: ParticipantRequest) -> Reply:
+    def puzzle(self, request: ParticipantRequest, operator: Person) -> Reply:
         return self._participant("puzzle", request)
 
     def _participant(self, kind: str, request: ParticipantRequest) -> Reply:
         logged = self.desk.forward(kind, request)
         return json_reply({"logged": logged}, 202 if logged else 200)
 
-    def acknowledge(self, request: AcknowledgeRequest) -> Reply:
+    def acknowledge(self, request: AcknowledgeRequest, operator: Person) -> Reply:
         """An alert acknowledged on a page: no page shows it from now on."""
         return json_reply({"acknowledged": self.feed.acknowledge(request.id)})
 
-    def zone(self, request: ZoneRequest) -> Reply:
-        """Close or open a zone at the dispatcher (no robot is sent into a closed one)."""
+    def zone(self, request: ZoneRequest, operator: Person) -> Reply:
+        """Close or open a zone at the dispatcher (no robot is sent into a closed one): a
+        change to the whole fleet's service, so a supervisor's, and recorded."""
         if request.zone not in self.feed.fleet.zone_ids:
             zones = ", ".join(self.feed.fleet.zone_ids)
             raise RequestError(400, f"zone: {request.zone!r} is not a zone; zones are {zones}")
         if self.zones is None:
             raise RequestError(503, "closing a zone needs the fleet dispatcher, which is not here")
-        return json_reply(self.zones.set(request.zone, closed=request.closed))
+        switch = self.zones
+        change = self.controls.change_zone(
+            request.zone,
+            request.closed,
+            operator,
+            lambda: switch.set(request.zone, closed=request.closed),
+        )
+        return json_reply(change)
 
-    def voice(self, wav: bytes) -> Reply:
-        """Push-to-talk: a WAV clip in, what was heard and answered out."""
+    def voice(self, wav: bytes, operator: Person = ANYONE) -> Reply:
+        """Push-to-talk: a WAV clip in, what was heard and answered out (spoken as the
+        operator's Alexa account)."""
         if self.push_to_talk is None:
             return error_reply(503, "push-to-talk needs an assistant and a recognizer")
         try:
-            return json_reply(self.push_to_talk.handle(wav))
+            return json_reply(self.push_to_talk.handle(wav, user=account(operator)))
         except RequestError as err:
             return error_reply(err.status, err.message)
         except (SpeechError, VahrError) as err:
@@ -258,6 +293,12 @@ class StationApp:
         except Exception:
             log.exception("push-to-talk failed")
             return error_reply(500, "push-to-talk failed; see the station's log")
+
+
+def account(operator: Person) -> str | None:
+    """The Alexa account the operator speaks to the assistant as: their own when they signed
+    in, else the assistant's own (everyone at an open station is one speaker, as before)."""
+    return operator.id if operator.known else None
 
 
 def _decode(body: bytes, shape: Any) -> Any:

@@ -8,6 +8,9 @@ start-up; it subscribes the feed, reads every robot's shadow once, and serves th
   (`vahr.station.deployment.on_local_system`): the simulator in-process, shadows read from
   the store;
 - `vahr station` builds one against any deployment (`vahr.station.deployment`).
+
+Given `people`, each person signs in and the panel's orders are checked against their role;
+given a `trail`, every order is recorded in it and the pages show its latest records.
 """
 
 from __future__ import annotations
@@ -25,14 +28,17 @@ from vahr.station.desk import Desk
 from vahr.station.feed import Feed
 from vahr.station.server import ServerTls, StationServer
 from vahr.station.task_queue import TaskPoller, ZoneSwitch
+from vahr.station.trail_feed import TrailPoller
 
 if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
     from vahr.domain import Fleet
+    from vahr.domain.people import People
     from vahr.plumbing.client import Assistant
     from vahr.plumbing.mqtt import MqttClient
+    from vahr.station.trail_feed import StationTrail
     from vahr.station.voice import PushToTalk
 
 log = logging.getLogger(__name__)
@@ -73,6 +79,8 @@ class Station:
         read_shadow: Callable[[str], bytes | None] | None = None,
         turns: bool = True,
         feed: Feed | None = None,
+        people: People | None = None,
+        trail: StationTrail | None = None,
     ) -> None:
         self.config = config
         self.fleet = fleet
@@ -81,7 +89,8 @@ class Station:
         self._read_shadow = read_shadow
         self._turns = turns
         self.desk = Desk(self.feed, self._publish)
-        self.controls = Controls(fleet, self.desk, self._publish)
+        record = trail.append if trail is not None else None
+        self.controls = Controls(fleet, self.desk, self._publish, record)
         self.push_to_talk = self._push_to_talk(assistant) if config.voice and assistant else None
         self.tasks = TaskPoller(config.tasks_url, self.feed) if config.tasks_url else None
         self.app = StationApp(
@@ -101,7 +110,9 @@ class Station:
             tls=config.tls,
             public_origin=config.public_origin,
             locale=config.locale,
+            people=people,
         )
+        self.trail = TrailPoller(trail, self.feed) if trail is not None else None
 
     def _publish(self, topic: str, payload: bytes) -> None:
         self.link.publish(topic, payload, qos=1)
@@ -138,6 +149,8 @@ class Station:
             self.server.start()
             if self.tasks is not None:
                 self.tasks.start()
+            if self.trail is not None:
+                self.trail.start()
         except BaseException:
             self.stop()
             raise
@@ -146,6 +159,8 @@ class Station:
     def stop(self) -> None:
         if self.tasks is not None:
             self.tasks.stop()
+        if self.trail is not None:
+            self.trail.stop()
         self.server.stop()
 
     def __enter__(self) -> Station:

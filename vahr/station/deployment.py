@@ -36,14 +36,17 @@ from vahr.protocol.broker import parse_broker_url
 from vahr.protocol.identities import STATION_CLIENT_PREFIX
 from vahr.station.assembly import Station, StationConfig
 from vahr.station.feed import Feed
+from vahr.station.trail_feed import HttpTrail
 
 if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
     from vahr.domain import Fleet
+    from vahr.domain.people import People
     from vahr.plumbing.client import Assistant
     from vahr.protocol.broker import ClientCredentials
+    from vahr.station.trail_feed import StationTrail
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +63,11 @@ class Deployment:
     tls: ClientCredentials | None = None
     api: str | None = None
     ack_timeout_s: float | None = None
+    # Who may do what (`vahr station --users`): people sign in; None, anyone may do all.
+    people: People | None = None
+    users_file: Path | None = None
+    # The audit trail on AWS (`vahr station --audit-table`); a local stack's is its own.
+    audit_table: str | None = None
 
 
 def is_local_stack(api: str) -> bool:
@@ -90,13 +98,19 @@ def build_station(config: StationConfig, deployment: Deployment) -> Station:
     api = deployment.api
     local = api is not None and is_local_stack(api)
     assistant: Assistant | None = None
+    trail: StationTrail | None = None
     if api is not None and local:
         assistant = HttpAssistant(api)
+        trail = HttpTrail(api)
         if config.tasks_url is None:
             # The local stack's dispatcher serves the fleet's task queue beside its data plane.
             config = dataclasses.replace(config, tasks_url=f"{api.rstrip('/')}/vahr/tasks")
     elif api is not None:
         assistant = _simulator_for(api, config.model_file, deployment, feed, link)
+    if deployment.audit_table is not None:
+        from skill.audit_table import AuditTable
+
+        trail = AuditTable(deployment.audit_table)
     link.connect()
     try:
         return Station(
@@ -107,6 +121,8 @@ def build_station(config: StationConfig, deployment: Deployment) -> Station:
             read_shadow=_shadow_reader(api) if api is not None else None,
             turns=local,
             feed=feed,
+            people=deployment.people,
+            trail=trail,
         )
     except BaseException:
         link.stop()
@@ -122,16 +138,21 @@ def on_local_system(
     read_shadow: Callable[[str], bytes | None],
     tasks_url: str | None = None,
     locale: str = "en-US",
+    people: People | None = None,
+    trail: StationTrail | None = None,
 ) -> Station:
     """`vahr up`'s station, started: on the stack's broker, the simulator in-process, shadows
     read from the store, every turn seen on the broker, the task queue from `tasks_url`, its
-    words and names in the stack's `locale`."""
+    words and names in the stack's `locale`, `people` signing in, and the stack's audit
+    trail."""
     return Station(
         StationConfig(port=port, tasks_url=tasks_url, locale=locale),
         fleet,
         link=link,
         assistant=assistant,
         read_shadow=read_shadow,
+        people=people,
+        trail=trail,
     ).start()
 
 
@@ -166,6 +187,8 @@ def _simulator_for(
         ack_timeout_s=deployment.ack_timeout_s,
         fleet_file=fleet_file,
         skill_id=identity.skill_id,
+        users_file=str(deployment.users_file) if deployment.users_file else None,
+        audit_table=deployment.audit_table,
     )
     simulator = AlexaSimulator(
         model,

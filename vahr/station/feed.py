@@ -26,7 +26,9 @@ the typedefs of `static/contract.js`:
 - `alert_acknowledged`: someone acknowledged an alert on a page (`acknowledge`): the
   announcement and any other still open about the same robot and trouble;
 - `tasks`: the fleet's task queue and who took which task, when it changed (`set_tasks`,
-  fed by `vahr.station.task_queue.TaskPoller` from the dispatcher's `GET {api}/vahr/tasks`).
+  fed by `vahr.station.task_queue.TaskPoller` from the dispatcher's `GET {api}/vahr/tasks`);
+- `trail`: the audit trail's latest records, when new ones came (`add_records`, fed by
+  `vahr.station.trail_feed.TrailPoller`).
 
 Acknowledgments are the station's, not one page's: every page stops showing the alert, and
 a page that reloads does not raise it again.
@@ -86,6 +88,7 @@ from vahr.station.page_messages import (
     RobotView,
     SnapshotMessage,
     TasksMessage,
+    TrailMessage,
     TurnMessage,
     ZoneEntry,
     encode_page_message,
@@ -95,6 +98,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
 
     from vahr.domain import Fleet
+    from vahr.protocol.audit import AuditRecord
 
 log = logging.getLogger(__name__)
 
@@ -104,6 +108,8 @@ SUBSCRIBER_LIMIT = 20_000
 CONVERSATION_LIMIT = 400
 # Commands whose acknowledgments are followed; older ones are forgotten.
 COMMANDS_LIMIT = 1_000
+# The audit trail's records a page shows: the latest ones (`vahr audit` prints them all).
+TRAIL_SHOWN = 30
 # Alerts kept until acknowledged; past this many the oldest is let go (the rate limit tells
 # at most a few a minute, so this is hours of nobody looking).
 ALERTS_LIMIT = 100
@@ -287,6 +293,7 @@ class Feed:
         self._alerts: OrderedDict[str, AnnouncementMessage] = OrderedDict()
         self._announced: OrderedDict[str, None] = OrderedDict()
         self._tasks: TasksMessage | None = None
+        self._trail: deque[AuditRecord] | None = None
         self.closed = False
 
     # -- pages ----------------------------------------------------------------------------
@@ -331,6 +338,7 @@ class Feed:
             alerts=list(self._alerts.values()),
             server_time=self._clock(),
             tasks=self._tasks,
+            trail=TrailMessage(records=list(self._trail)) if self._trail is not None else None,
         )
 
     def close(self) -> None:
@@ -348,6 +356,20 @@ class Feed:
                 return
             self._tasks = tasks
             self._broadcast(tasks, "tasks")
+
+    def add_records(self, records: list[AuditRecord]) -> None:
+        """Records of the audit trail just read (oldest first): the pages are sent the
+        latest `TRAIL_SHOWN` when any is new (an empty list says the trail is there)."""
+        with self._lock:
+            first = self._trail is None
+            if self._trail is None:
+                self._trail = deque(maxlen=TRAIL_SHOWN)
+            last = self._trail[-1].seq if self._trail else 0
+            new = [record for record in records if record.seq > last]
+            if not new and not first:
+                return
+            self._trail.extend(new)
+            self._broadcast(TrailMessage(records=list(self._trail)), "trail")
 
     def _broadcast_change(self, change: RobotChange) -> None:
         """Send a robot's change to every page (merged with one not taken yet); call with

@@ -16,6 +16,7 @@ import msgspec
 from vahr.dispatch import Task  # noqa: TC001
 from vahr.domain.fleet import Floor, Point, Pose  # noqa: TC001
 from vahr.protocol.announcements import Announcement
+from vahr.protocol.audit import AuditRecord  # noqa: TC001
 from vahr.protocol.messages import Event, EventKind
 from vahr.protocol.station_topics import AssistantTurn, ExperimentStatus  # noqa: TC001
 
@@ -133,11 +134,19 @@ class TasksMessage(msgspec.Struct, frozen=True, kw_only=True, tag="tasks", tag_f
     closed: list[str] = []
 
 
+class TrailMessage(msgspec.Struct, frozen=True, kw_only=True, tag="trail", tag_field="type"):
+    """The latest records of the audit trail (`vahr.protocol.audit`, oldest first), sent
+    when new ones came: who did what, through which channel, and what came of it."""
+
+    records: list[AuditRecord]
+
+
 class SnapshotMessage(msgspec.Struct, kw_only=True, tag="snapshot", tag_field="type"):
     """What a page starts from: the fleet, every robot, the conversation so far, the
     commands seen with their acknowledgments, the session, the announcements nobody has
     acknowledged yet (oldest first), the station's clock (ms since the epoch) for the
-    page to correct its own, and the fleet's task queue when the station has read it."""
+    page to correct its own, the fleet's task queue when the station has read it, and the
+    audit trail's latest records when the station reads one."""
 
     fleet: FleetView
     robots: dict[str, RobotView]
@@ -147,6 +156,7 @@ class SnapshotMessage(msgspec.Struct, kw_only=True, tag="snapshot", tag_field="t
     alerts: list[AnnouncementMessage]
     server_time: float
     tasks: TasksMessage | None = None
+    trail: TrailMessage | None = None
 
 
 class RobotChange(msgspec.Struct, kw_only=True, omit_defaults=True):
@@ -254,6 +264,7 @@ PageMessage = (
     | AnnouncementMessage
     | AlertAcknowledgedMessage
     | TasksMessage
+    | TrailMessage
 )
 
 _page_encoder = msgspec.json.Encoder()

@@ -4,7 +4,16 @@ It binds 127.0.0.1 unless told otherwise. Bound elsewhere (a tablet on the lab n
 requires a token, printed at start-up in the station's URL: the first page load carries it
 as `?token=`, which sets a cookie for the page's later requests (HttpOnly, SameSite=Strict,
 `Secure` when the page is HTTPS, expiring after `COOKIE_HOURS`) and is redirected to the
-same page without it, so the token stays in neither the address bar nor the history. Off
+same page without it, so the token stays in neither the address bar nor the history.
+
+Given the people of a users file (`vahr up --users`, `vahr station --users`), each person
+signs in with a token of their own, on loopback too: the file keeps only its SHA-256
+(`token_sha256`), `vahr users token` makes one. A page opened without it is the sign-in
+page (`static/signin.html`), which posts the token to `POST /api/signin` for the same
+cookie; `?token=` in the address works as before, and `POST /api/signout` ends it. Every
+request then is that person's: the panel's orders are checked against their role and
+recorded with them, and what they type or say reaches the assistant as their Alexa account
+(`StationApp`). Off
 loopback the page should be HTTPS (browsers give a plain-HTTP page elsewhere no
 microphone, and the token would cross the network in the clear): the station serves TLS
 itself (`ServerTls`: a certificate from the local CA, or one the user gives), or stands
@@ -42,12 +51,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, urlencode, urlsplit
 
+import msgspec
+
 from vahr.plumbing.http_server import QuietHandler, QuietServer, ServerThread
 from vahr.plumbing.ports import LOOPBACK
 from vahr.station.app import Reply, error_reply, json_reply
+from vahr.station.controls import ANYONE
 from vahr.station.floor_picture import MAP_PATH
 
 if TYPE_CHECKING:
+    from vahr.domain.people import People, Person
     from vahr.station.app import StationApp
 
 log = logging.getLogger(__name__)
@@ -94,6 +107,25 @@ SECURITY_HEADERS = {
     "Cache-Control": "no-store",
 }
 LOOPBACK_NAMES = ("127.0.0.1", "localhost", "[::1]")
+# What anyone may reach before signing in, where people sign in: the sign-in page and
+# its files (the page's code is no secret), and the sign-in itself.
+BEFORE_SIGN_IN = frozenset(
+    {
+        ("GET", "/"),
+        ("GET", "/index.html"),
+        ("GET", "/favicon.ico"),
+        ("GET", "/api/health"),
+        ("POST", "/api/signin"),
+    }
+)
+NOT_SIGNED_IN = "sign in first: open the station's page and give your token"
+TOKEN_MAX_CHARS = 200
+
+
+class SignIn(msgspec.Struct, frozen=True):
+    """`POST /api/signin`: a person's station token."""
+
+    token: str
 
 
 def is_loopback(host: str) -> bool:
@@ -140,7 +172,8 @@ class _Handler(QuietHandler):
         self._send(error_reply(status, message), {"Connection": "close"})
 
     def _checked(self) -> tuple[str, dict[str, str]] | None:
-        """The path and query of an acceptable request, or None once refused."""
+        """The path and query of an acceptable request, or None once refused; `operator`
+        is then who sent it (None before signing in, on what anyone may reach)."""
         station = self.server.station
         host = self.headers.get("Host", "")
         if not station.host_allowed(host):
@@ -148,9 +181,18 @@ class _Handler(QuietHandler):
             return None
         url = urlsplit(self.path)
         query = {k: v[-1] for k, v in parse_qs(url.query).items()}
-        if station.token is not None and not self._authorized(query):
-            self.refuse(401, "this station needs its token: open the URL it printed")
-            return None
+        self.operator = self._operator(query)
+        if self.operator is None:
+            before = (self.command if self.command != "HEAD" else "GET", url.path)
+            open_to_all = station.people is not None and (
+                before in BEFORE_SIGN_IN or url.path.startswith(STATIC_PATH)
+            )
+            if not open_to_all:
+                if station.people is not None:
+                    self.refuse(401, NOT_SIGNED_IN)
+                else:
+                    self.refuse(401, "this station needs its token: open the URL it printed")
+                return None
         origin = self.headers.get("Origin")
         if (
             self.command == "POST"
@@ -161,9 +203,8 @@ class _Handler(QuietHandler):
             return None
         return url.path, query
 
-    def _authorized(self, query: dict[str, str]) -> bool:
-        token = self.server.station.token
-        assert token is not None
+    def _offered(self, query: dict[str, str]) -> list[str]:
+        """The tokens the request carries: in the address, a bearer header, the cookie."""
         offered = [query.get("token", "")]
         header = self.headers.get("Authorization", "")
         if header.startswith("Bearer "):
@@ -174,7 +215,23 @@ class _Handler(QuietHandler):
                 offered.append(cookie[COOKIE].value)
         except CookieError:
             pass
-        return any(hmac.compare_digest(token.encode(), o.encode()) for o in offered if o)
+        return [token for token in offered if token and len(token) <= TOKEN_MAX_CHARS]
+
+    def _operator(self, query: dict[str, str]) -> Person | None:
+        """Who sends the request: the person whose token it carries (people sign in), anyone
+        as a supervisor (the station's one token, or no token on loopback), or None."""
+        station = self.server.station
+        if station.people is not None:
+            for token in self._offered(query):
+                person = station.people.signed_in(token)
+                if person is not None:
+                    return person
+            return None
+        if station.token is None:
+            return ANYONE
+        expected = station.token.encode()
+        offered = self._offered(query)
+        return ANYONE if any(hmac.compare_digest(expected, o.encode()) for o in offered) else None
 
     def _body(self, limit: int) -> bytes | None:
         if "chunked" in self.headers.get("Transfer-Encoding", "").lower():
@@ -201,6 +258,8 @@ class _Handler(QuietHandler):
     def do_POST(self) -> None:  # noqa: N802
         self._route("POST")
 
+    operator: Person | None = None
+
     def _route(self, method: str) -> None:
         checked = self._checked()
         if checked is None:
@@ -216,22 +275,58 @@ class _Handler(QuietHandler):
 
     def _page(self, path: str, query: dict[str, str]) -> None:
         station = self.server.station
-        if station.token is not None and query.get("token"):
+        if station.signs_in and query.get("token"):
             # The page's own later requests (the stream, the API) carry the cookie, and the
-            # page is opened again without the token in its address.
+            # page is opened again without the token in its address (a token that opens
+            # nothing sets no cookie: the sign-in page shows).
             rest = urlencode({k: v for k, v in query.items() if k != "token"})
-            self._send(
-                Reply(303, b"", "text/plain; charset=utf-8"),
-                {"Set-Cookie": station.cookie(), "Location": path + (f"?{rest}" if rest else "")},
-            )
+            headers = {"Location": path + (f"?{rest}" if rest else "")}
+            if self.operator is not None:
+                headers["Set-Cookie"] = station.cookie(query["token"])
+            self._send(Reply(303, b"", "text/plain; charset=utf-8"), headers)
             return
-        page = station.file("index.html")
+        # Nobody signed in: the sign-in page, in the same language.
+        page = station.file("index.html" if self.operator is not None else "signin.html")
         # The page shows itself in the language people speak to the assistant unless its
         # reader chose another (static/i18n.js reads `data-locale`).
         body = page.body.replace(
             b'<html lang="en">', f'<html lang="en" data-locale="{station.locale}">'.encode(), 1
         )
         self._send(Reply(page.status, body, page.content_type))
+
+    def _me(self, path: str, query: dict[str, str]) -> None:
+        assert self.operator is not None
+        self._send(self.server.station.app.me(self.operator))
+
+    def _sign_in(self, path: str, query: dict[str, str]) -> None:
+        station = self.server.station
+        if self._kind() != "application/json":
+            self.refuse(415, "send application/json")
+            return
+        body = self._body(MAX_JSON_BYTES)
+        if body is None:
+            return
+        try:
+            token = msgspec.json.decode(body or b"{}", type=SignIn).token.strip()
+        except (msgspec.ValidationError, msgspec.DecodeError):
+            self.refuse(400, "token: a string is required")
+            return
+        person = station.people.signed_in(token) if station.people and token else None
+        if person is None:
+            log.warning("station: a sign-in with a token that opens no account")
+            self._send(error_reply(401, "That token opens no account at this station."))
+            return
+        log.info("station: %s signed in as %s", person.shown, person.role)
+        self._send(
+            json_reply({"name": person.name, "role": person.role}),
+            {"Set-Cookie": station.cookie(token)},
+        )
+
+    def _sign_out(self, path: str, query: dict[str, str]) -> None:
+        # The body is read (and ignored), so the connection's next request starts clean.
+        if self._body(MAX_JSON_BYTES) is None:
+            return
+        self._send(json_reply({"signed_out": True}), {"Set-Cookie": self.server.station.cookie("")})
 
     def _favicon(self, path: str, query: dict[str, str]) -> None:
         self._send(self.server.station.file("favicon.svg"))
@@ -258,7 +353,8 @@ class _Handler(QuietHandler):
             return
         body = self._body(MAX_JSON_BYTES)
         if body is not None:
-            self._send(self.server.station.app.handle_json("POST", path, body))
+            assert self.operator is not None
+            self._send(self.server.station.app.handle_json("POST", path, body, self.operator))
 
     def _voice(self, path: str, query: dict[str, str]) -> None:
         if self._kind() not in ("audio/wav", "audio/x-wav", "audio/wave"):
@@ -266,7 +362,8 @@ class _Handler(QuietHandler):
             return
         body = self._body(MAX_AUDIO_BYTES)
         if body is not None:
-            self._send(self.server.station.app.voice(body))
+            assert self.operator is not None
+            self._send(self.server.station.app.voice(body, self.operator))
 
     def _kind(self) -> str:
         return self.headers.get("Content-Type", "").split(";")[0].strip().lower()
@@ -331,8 +428,11 @@ class StationServer:
         public_origin: str | None = None,
         idle_timeout_s: float = IDLE_TIMEOUT_S,
         locale: str = "en-US",
+        people: People | None = None,
     ) -> None:
         self.app = app
+        # Given, each person signs in with a token of their own (on loopback too).
+        self.people = people
         self.host = host
         self.tls = tls
         self.locale = locale
@@ -343,7 +443,10 @@ class StationServer:
         # Off the loopback interface, or behind a proxy, the station is reachable by others:
         # a token guards it.
         reachable = not is_loopback(host) or self.public_origin is not None
-        self.token = token or (secrets.token_urlsafe(18) if reachable else None)
+        if people is not None:
+            self.token = None
+        else:
+            self.token = token or (secrets.token_urlsafe(18) if reachable else None)
         pages = [*STATIC.iterdir(), *LOCALES.iterdir()]
         self._files = {p.name: p for p in pages if p.suffix in CONTENT_TYPES}
         self._streams = 0
@@ -358,7 +461,10 @@ class StationServer:
             ("GET", MAP_PATH): _Handler._map,
             ("GET", "/api/snapshot"): _Handler._snapshot,
             ("GET", "/api/stream"): _Handler._stream,
+            ("GET", "/api/me"): _Handler._me,
             ("POST", "/api/voice"): _Handler._voice,
+            ("POST", "/api/signin"): _Handler._sign_in,
+            ("POST", "/api/signout"): _Handler._sign_out,
             # The JSON API, each route with its body's type (`StationApp.json_routes`).
             **{("POST", path): _Handler._json for path in app.json_routes},
         }
@@ -379,6 +485,11 @@ class StationServer:
     @property
     def scheme(self) -> str:
         return "https" if self.tls is not None else "http"
+
+    @property
+    def signs_in(self) -> bool:
+        """Whether a page must carry a token: each person's own, or the station's one."""
+        return self.people is not None or self.token is not None
 
     @property
     def secure(self) -> bool:
@@ -403,14 +514,14 @@ class StationServer:
             self.public_origin is not None and origin == self.public_origin
         )
 
-    def cookie(self) -> str:
-        """The token's cookie: the page's later requests carry it, and only they."""
-        assert self.token is not None
+    def cookie(self, token: str | None = None) -> str:
+        """The cookie of `token` (the station's own by default; "" ends it): the page's
+        later requests carry it, and only they."""
+        value = self.token if token is None else token
+        assert value is not None
         secure = "; Secure" if self.secure else ""
-        return (
-            f"{COOKIE}={self.token}; Path=/; Max-Age={COOKIE_HOURS * 3600}; HttpOnly; "
-            f"SameSite=Strict{secure}"
-        )
+        age = COOKIE_HOURS * 3600 if value else 0
+        return f"{COOKIE}={value}; Path=/; Max-Age={age}; HttpOnly; SameSite=Strict{secure}"
 
     def route(self, method: str, path: str) -> Answer | None:
         """What answers `method` on `path`, or None (nothing is there)."""
@@ -420,7 +531,7 @@ class StationServer:
         return answer
 
     def host_allowed(self, host: str) -> bool:
-        if self.token is not None:
+        if not is_loopback(self.host) or self.public_origin is not None:
             return True  # reachable by any name on the network; the token decides
         return host in {f"{name}:{self.port}" for name in LOOPBACK_NAMES}
 

@@ -23,6 +23,7 @@ from urllib.parse import quote
 import msgspec
 
 from vahr.dispatch import Task  # noqa: TC001 (msgspec reads it at run time)
+from vahr.protocol.audit import RECORDED_BY_HEADER
 from vahr.station.errors import RequestError
 from vahr.station.page_messages import TasksMessage
 
@@ -117,7 +118,8 @@ class ZoneSwitch:
             f"{self.url}/{quote(zone, safe='')}",
             data=msgspec.json.encode({"closed": closed}),
             method="POST",
-            headers={"Content-Type": "application/json"},
+            # The station records the change in the trail with its operator (controls.py).
+            headers={"Content-Type": "application/json", RECORDED_BY_HEADER: "station"},
         )
         try:
             with urllib.request.urlopen(request, timeout=TIMEOUT_S) as answer:  # noqa: S310

@@ -186,10 +186,9 @@ class PushToTalk:
             return self._second
 
     def _listen_twice(self, audio: Audio) -> tuple[Recognition, str | None]:
-        """The first recognizer's recognition, and the second ear's transcript when it can
-        matter: only a best transcript that reads as a request can be agreed with, so
-        silence, noise and talk of other things never wait for Whisper (which spends
-        seconds writing nothing for them)."""
+        """The first recognizer's recognition, and the second ear's transcript whenever the
+        first took the clip for speech: silence and noise never wait for Whisper (which
+        spends seconds writing nothing for them)."""
         recognition = self.recognizer().recognize(audio)
         second = self.second_ear()
         if second is None or not recognition.accepted or not recognition.text:
@@ -203,11 +202,12 @@ class PushToTalk:
             log.exception("push-to-talk: the second recognizer failed on a clip")
             return recognition, None
 
-    def _reader(self) -> Callable[[str], Understanding]:
-        """How the weighing reads words: in the dialog under way (the simulator in this
+    def _reader(self, user: str | None = None) -> Callable[[str], Understanding]:
+        """How the weighing reads words: in `user`'s dialog under way (the simulator in this
         process), else as a request."""
         if isinstance(self.assistant, SimulatorAssistant):
-            return self.assistant.simulator.reading
+            simulator = self.assistant.simulator
+            return lambda words: simulator.reading(words, user)
         return request_reader(self.model())
 
     def model(self) -> InteractionModel:
@@ -220,22 +220,25 @@ class PushToTalk:
                 self._model = InteractionModel.load()
             return self._model
 
-    def weigh(self, recognition: Recognition, second: str | None = None) -> Weighed:
+    def weigh(
+        self, recognition: Recognition, second: str | None = None, user: str | None = None
+    ) -> Weighed:
         """The understanding of a recognition's N best (its transcript alone without); with
         the simulator in this process each reading is read in the dialog under way, so an
         answer to the skill's question ("zone b" to "Zone B or zone D?") is weighed as one.
         A second ear's transcript (`second`) read alike to the best transcript is acted on
         as heard (`agreement`); a robot or zone it heard otherwise is asked about
-        (`disputed`)."""
+        (`disputed`). `user` is the Alexa account speaking (the dialog under way is
+        theirs)."""
         simulator = (
             self.assistant.simulator if isinstance(self.assistant, SimulatorAssistant) else None
         )
-        model, read = self.model(), self._reader()
+        model, read = self.model(), self._reader(user)
         if second:
             both = agreement(model, second, recognition.text, read)
             if both is not None:
                 return both
-        answer = simulator.yes_or_no(recognition.text) if simulator else None
+        answer = simulator.yes_or_no(recognition.text, user) if simulator else None
         if answer is not None and recognition.confidence >= Weighing().min_word_posterior:
             # A yes or a no to the skill's yes-or-no question, which said back all it
             # would do: taken from the best transcript, as the N best of one short word
@@ -251,7 +254,9 @@ class PushToTalk:
                 return stop
         return replace(weighed, understanding=disputed(model, weighed.understanding, read(second)))
 
-    def handle(self, wav: bytes) -> dict[str, Any]:
+    def handle(self, wav: bytes, user: str | None = None) -> dict[str, Any]:
+        """Hear a clip and, when it is understood, say it to the assistant as `user`'s
+        Alexa account (the assistant's own when None)."""
         audio = read_clip(wav)
         started = time.perf_counter()
         recognition, second = self._listen_twice(audio)
@@ -272,38 +277,40 @@ class PushToTalk:
             "turn": None,
         }
         if not recognition.accepted or not recognition.text:
-            return self._not_caught(result)
-        weighed = self.weigh(recognition, second)
+            return self._not_caught(result, user)
+        weighed = self.weigh(recognition, second, user)
         heard["weighed"] = weighed.to_json()
         understanding = weighed.understanding
         if understanding.intent == FALLBACK_INTENT:
-            return self._not_caught(result)
+            return self._not_caught(result, user)
         heard["accepted"] = True
-        turn = self._ask(weighed.words or recognition.text, heard, weighed)
+        turn = self._ask(weighed.words or recognition.text, heard, weighed, user)
         result["turn"] = turn
         if turn.get("intent") not in (None, FALLBACK_INTENT):
             result.update(understood=True, speech=turn.get("speech") or "")
         return result
 
-    def _not_caught(self, result: dict[str, Any]) -> dict[str, Any]:
+    def _not_caught(self, result: dict[str, Any], user: str | None = None) -> dict[str, Any]:
         """`result` (SORRY); while the skill waits for an answer, with its reprompt after,
         as an Echo says it when it did not catch the answer ("Zone B or zone D? You can
         also say bravo or delta."): the question is still open."""
         if isinstance(self.assistant, SimulatorAssistant):
-            pending = self.assistant.simulator.pending
+            pending = self.assistant.simulator.pending_for(user)
             if pending is not None and pending.reprompt:
                 result["speech"] = f"{SORRY} {pending.reprompt}"
         return result
 
-    def _ask(self, text: str, heard: dict[str, Any], weighed: Weighed) -> dict[str, Any]:
+    def _ask(
+        self, text: str, heard: dict[str, Any], weighed: Weighed, user: str | None = None
+    ) -> dict[str, Any]:
         if isinstance(self.assistant, SimulatorAssistant):
             # The weighed understanding already reads an answer against the question.
             turn = self.assistant.simulator.say(
-                text, origin=ORIGIN, heard=heard, understanding=weighed.understanding
+                text, origin=ORIGIN, heard=heard, understanding=weighed.understanding, user=user
             )
             return {**turn.to_json(), "utterance": text}
         intent = weighed.understanding.intent
         question = ask_back(weighed, self.model().intent_slots.get(intent, {}))
         if question is not None:
             return {"speech": question, "intent": intent, "commands": [], "utterance": text}
-        return self.assistant.ask(text, origin=ORIGIN, heard=heard)
+        return self.assistant.ask(text, origin=ORIGIN, heard=heard, user=user)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
@@ -33,8 +34,6 @@ from vahr.twin.fleet_index_api import FleetIndexApi
 from vahr.twin.shadow_store import MAX_REQUEST_BYTES, ShadowError
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
-
     from vahr.twin.meter import Meter
     from vahr.twin.shadow_service import ShadowService
 
@@ -57,6 +56,9 @@ MAX_PUBLISH_BYTES = 128 * 1024  # AWS IoT's message size limit
 LIST_PAGE_MAX = 100
 
 Json = dict[str, Any]
+# A route that answers (status, body, AWS error type) itself, given the method, the path,
+# the body and the request's headers.
+TypedRoute = Callable[[str, str, bytes, Mapping[str, str]], tuple[int, bytes, str | None]]
 
 
 class ApiError(Exception):
@@ -94,16 +96,22 @@ class DataPlane:
         self.awaiting: Callable[[], list[str]] | None = None
         # Path prefixes whose routes answer (status, body, AWS error type) themselves: the
         # IoT control plane's fleet-indexing calls (boto3's `iot` client), whose error
-        # names the status alone does not tell.
-        self.typed_routes: dict[str, Callable[[str, str, bytes], tuple[int, bytes, str | None]]]
+        # names the status alone does not tell. Each is given the request's headers too.
+        self.typed_routes: dict[str, TypedRoute]
         self.typed_routes = {"/indices": FleetIndexApi(shadows.store.index).respond}
 
-    def respond(self, method: str, raw_path: str, body: bytes) -> tuple[int, bytes, str | None]:
+    def respond(
+        self,
+        method: str,
+        raw_path: str,
+        body: bytes,
+        headers: Mapping[str, str] | None = None,
+    ) -> tuple[int, bytes, str | None]:
         """`handle`, and the typed routes: (status, body, error type or None)."""
         path = urlsplit(raw_path).path
         for prefix, route in self.typed_routes.items():
             if path == prefix or path.startswith(prefix + "/"):
-                return route(method, path, body)
+                return route(method, path, body, headers or {})
         status, payload = self.handle(method, raw_path, body)
         return status, payload, None
 
@@ -114,7 +122,7 @@ class DataPlane:
         parts = [unquote(p) for p in url.path.split("/") if p]
         try:
             if parts[:1] == ["vahr"]:
-                return self._local(method, "/" + "/".join(parts), body)
+                return self._local(method, "/" + "/".join(parts), body, query)
             if len(parts) >= 2 and parts[0] == "topics":
                 return self._publish_request(method, "/".join(parts[1:]), query, body)
             if len(parts) == 3 and parts[0] == "things" and parts[2] == "shadow":
@@ -205,7 +213,9 @@ class DataPlane:
 
     # -- the local stack's own routes --------------------------------------------------
 
-    def _local(self, method: str, path: str, body: bytes) -> tuple[int, bytes]:
+    def _local(
+        self, method: str, path: str, body: bytes, query: dict[str, str] | None = None
+    ) -> tuple[int, bytes]:
         if (method, path) == ("GET", "/vahr/health"):
             awaiting = self.awaiting() if self.awaiting is not None else []
             if awaiting:
@@ -227,6 +237,9 @@ class DataPlane:
             raise ApiError(400, "Invalid JSON") from None
         if not isinstance(request, dict):
             raise ApiError(400, "the request body must be a JSON object")
+        if method == "GET" and query:
+            # A read's parameters are its query's (`GET /vahr/audit?after=10`).
+            request = {**query, **request}
         status, response = route(request)
         return status, _encode(response)
 
@@ -281,7 +294,9 @@ class _Handler(QuietHandler):
             self.end_headers()
             return
         try:
-            answer = self.server.dataplane.respond(self.command, self.path, body)
+            answer = self.server.dataplane.respond(
+                self.command, self.path, body, dict(self.headers.items())
+            )
             status, payload, error_type = answer
         except Exception:  # the server must answer even when a bug bites
             log.exception("data plane request %s %s failed", self.command, self.path)

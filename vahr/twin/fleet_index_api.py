@@ -19,12 +19,15 @@ field it does not keep is `InvalidAggregationException`; another index name is
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import msgspec
 
 from vahr.twin.fleet_index import AggregationError, FleetIndex, IndexedThing
 from vahr.twin.fleet_query import QueryError
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
 
 INDEX_NAME = "AWS_Things"
 # AWS: "This maximum number cannot exceed 100" (SearchIndex maxResults).
@@ -105,8 +108,11 @@ class FleetIndexApi:
     def __init__(self, index: FleetIndex) -> None:
         self.index = index
 
-    def respond(self, method: str, path: str, body: bytes) -> Answer:
-        """(status, JSON body, AWS error type or None) for a request under /indices."""
+    def respond(
+        self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
+    ) -> Answer:
+        """(status, JSON body, AWS error type or None) for a request under /indices (its
+        headers say nothing these calls need)."""
         try:
             return 200, msgspec.json.encode(self._route(method, path, body)), None
         except _RequestError as err:

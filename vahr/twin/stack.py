@@ -1,4 +1,5 @@
-"""The local stack without robots: broker, shadow service and data plane, started in order.
+"""The local stack without robots: broker, shadow service, data plane and audit trail,
+started in order.
 
 `LocalStack` is what `vahr up`, `vahr demo`, the tests and the benchmarks share: it makes
 (or reuses) the local CA, writes the ACL, starts mosquitto with an mTLS listener (and, when
@@ -23,6 +24,7 @@ from vahr.twin.meter import Meter
 from vahr.twin.recovery import StateLock, recover
 from vahr.twin.shadow_service import ShadowService
 from vahr.twin.shadow_store import ShadowStore
+from vahr.twin.trail_store import AUDIT_PATH, SqliteTrail, TrailApi
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -61,6 +63,8 @@ class LocalStack:
         self.store: ShadowStore | None = None
         self.shadows: ShadowService | None = None
         self.dataplane: DataPlane | None = None
+        # The audit trail (the twin of the DynamoDB audit table), served at /vahr/audit.
+        self.trail: SqliteTrail | None = None
         self._service_client: MqttClient | None = None
         self._server: DataPlaneServer | None = None
         self._claim = StateLock(config.state_dir)
@@ -158,6 +162,10 @@ class LocalStack:
 
             self.dataplane = DataPlane(self.shadows, publish, self.meter)
             self.dataplane.awaiting = self._awaiting
+            self.trail = SqliteTrail.in_state_dir(cfg.state_dir)
+            trail_api = TrailApi(self.trail)
+            self.dataplane.local_routes[("POST", AUDIT_PATH)] = trail_api.append
+            self.dataplane.local_routes[("GET", AUDIT_PATH)] = trail_api.page
             self._server = DataPlaneServer(
                 self.dataplane, cfg.api_port, hosts=cfg.api_hosts
             ).start()
@@ -186,6 +194,9 @@ class LocalStack:
         if self.store is not None:
             self.store.close()
             self.store = None
+        if self.trail is not None:
+            self.trail.close()
+            self.trail = None
         if self.broker is not None:
             self.broker.stop()
             self.broker = None

@@ -10,7 +10,8 @@ from typing import TYPE_CHECKING
 from ask_sdk_core.dispatch_components import AbstractExceptionHandler
 
 from skill import prompts
-from skill.errors import GatewayError
+from skill.errors import GatewayError, PeopleUnavailable
+from skill.guard import record_failure
 from skill.logs import get_logger, log_event
 from skill.responses import in_conversation
 
@@ -18,16 +19,24 @@ if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
     from ask_sdk_model import Response
 
+    from skill.runtime import SkillRuntime
+
 
 def speech_for(exception: Exception) -> str:
     """The sentence for a failure: the one place errors are mapped to speech."""
+    if isinstance(exception, PeopleUnavailable):
+        return prompts.PEOPLE_UNAVAILABLE
     if isinstance(exception, GatewayError):
         return prompts.GATEWAY_ERROR
     return prompts.GENERIC_ERROR
 
 
 class CatchAllExceptionHandler(AbstractExceptionHandler):
-    """Any exception a handler raises (or no handler at all) ends in valid speech."""
+    """Any exception a handler raises (or no handler at all) ends in valid speech, and the
+    request's record in the trail says it failed."""
+
+    def __init__(self, runtime: SkillRuntime | None = None) -> None:
+        self.runtime = runtime
 
     def can_handle(self, handler_input: HandlerInput, exception: Exception) -> bool:
         return True
@@ -40,6 +49,8 @@ class CatchAllExceptionHandler(AbstractExceptionHandler):
             error=str(exception),
         )
         get_logger().debug("traceback", exc_info=exception)
+        if self.runtime is not None:
+            record_failure(handler_input, self.runtime, f"{type(exception).__name__}: {exception}")
         speech = speech_for(exception)
         builder = handler_input.response_builder.speak(speech)
         if in_conversation(handler_input):

@@ -17,6 +17,7 @@ from ask_sdk_core.utils import is_intent_name
 
 from skill import dialog, prompts, session, speech
 from skill.commands import publication
+from skill.guard import confirm_first
 from skill.handlers.send import closed_reply
 from skill.responses import answer, confirm_slot
 from skill.vocabulary import FLEET, capitalise
@@ -106,6 +107,9 @@ class CorrectionIntentHandler(AbstractRequestHandler):
         refused = closed_reply(self.runtime, self.desk, [zone])
         if refused is not None:
             return answer(handler_input, refused)
+        question = confirm_first(handler_input, self.runtime)
+        if question is not None:
+            return question
         params: dict[str, object] | None = {"zone": zone} if zone is not None else None
         items: list[Publication] = []
         if target != last.robot:

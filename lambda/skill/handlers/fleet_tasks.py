@@ -10,22 +10,22 @@ desk and speak `skill.task_speech`'s sentence; the dispatcher picks the robots.
 
 from __future__ import annotations
 
-from functools import cache
 from typing import TYPE_CHECKING
 
 from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_intent_name
 
-from skill import dialog, prompts, task_speech
+from skill import deeds, dialog, prompts, task_speech
 from skill.catalog import current_locale
+from skill.guard import confirm_first
 from skill.responses import answer
-from skill.slots import read_slot
+from skill.slots import read_slot, spoken_number
 from skill.task_desk import TaskRefused
 from skill.vocabulary import capitalise, join_choices
 from vahr.dispatch import Order
 from vahr.domain import FLEET_GROUP
 from vahr.domain.fleet import spoken_in
-from vahr.domain.text import normalize, number_in_words
+from vahr.domain.text import normalize
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
@@ -53,6 +53,9 @@ class _FleetHandler(AbstractRequestHandler):
         robot may go (no free robot in the zone, none idle)."""
         if self.desk is None:
             return answer(handler_input, prompts.NO_DISPATCHER)
+        question = confirm_first(handler_input, self.runtime)
+        if question is not None:
+            return question
         try:
             submission = self.desk.submit(order)
         except TaskRefused as err:
@@ -60,10 +63,12 @@ class _FleetHandler(AbstractRequestHandler):
                 return answer(handler_input, prompts.NO_DISPATCHER)
             if err.error == "none_free":
                 return answer(handler_input, when_none)
+            deeds.failed(f"the dispatcher refused: {err}")
             if err.error == "zone_closed":
                 zone = self.runtime.vocabulary.zone(order.zone)
                 return answer(handler_input, capitalise(prompts.ZONE_CLOSED.format(zone=zone)))
             return answer(handler_input, prompts.DISPATCH_REFUSED.format(reason=str(err)))
+        deeds.submitted(submission)
         speech = task_speech.submission_report(self.runtime.vocabulary, order, submission)
         return answer(handler_input, speech)
 
@@ -158,7 +163,7 @@ class FleetNavigateIntentHandler(_FleetHandler):
         )
         if reading.missing:
             return (None if group is not None else 1), ""
-        count = int(reading.id) if reading.id is not None else _number_or_none(reading.heard)
+        count = int(reading.id) if reading.id is not None else spoken_number(reading.heard)
         if count is None:
             return 1, ""
         if count > members:
@@ -246,6 +251,8 @@ class CancelTaskIntentHandler(_FleetHandler):
             return answer(
                 handler_input, prompts.NOTHING_TO_CANCEL.format(zone=vocabulary.zone(zone.id))
             )
+        for task, _ in cancelled:
+            deeds.cancelled_task(task)
         return answer(handler_input, task_speech.cancel_report(vocabulary, cancelled))
 
 
@@ -255,19 +262,5 @@ def _intent(handler_input: HandlerInput):  # type: ignore[no-untyped-def]
 
 
 def _number(heard: str) -> str | None:
-    value = _number_or_none(heard)
+    value = spoken_number(heard)
     return str(value) if value is not None else None
-
-
-def _number_or_none(heard: str | None) -> int | None:
-    words = normalize(heard or "")
-    if words.isdigit():
-        return int(words)
-    return _spoken_numbers().get(words)
-
-
-@cache
-def _spoken_numbers() -> dict[str | None, int]:
-    """Numbers a person may say for a count, word -> value ("twelve" -> 12); built on first
-    use, as the number words are read from the locale's data."""
-    return {number_in_words(n): n for n in range(1, 100)}

@@ -1,4 +1,5 @@
-"""The step every robot-command handler ends with: send, wait for robots, speak the outcome."""
+"""The step every robot-command handler ends with: send, wait for robots, speak the outcome
+(a fleet-wide command is confirmed first, `skill.guard.confirm_first`)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ from typing import TYPE_CHECKING
 
 from skill import prompts, session, speech
 from skill.commands import publication
+from skill.guard import confirm_first
 from skill.responses import answer
 from skill.vocabulary import capitalise
 from skill.zone_guard import closed_zone
@@ -28,11 +30,15 @@ def send_and_report(
     desk: TaskDesk | None = None,
 ) -> Response:
     """Publish `action` to one robot (or the fleet) and say what the robots answered; a
-    command into a zone the dispatcher (`desk`) says is closed is not sent."""
+    command into a zone the dispatcher (`desk`) says is closed is not sent, and a
+    fleet-wide one is confirmed by its asker first."""
     zone = (params or {}).get("zone")
     refused = closed_reply(runtime, desk, [zone if isinstance(zone, str) else None])
     if refused is not None:
         return answer(handler_input, refused)
+    question = confirm_first(handler_input, runtime)
+    if question is not None:
+        return question
     item = publication(runtime.fleet, action, target, params)
     answers = runtime.robots.send([item])
     session.remember(handler_input, item)

@@ -1,8 +1,9 @@
 """CloseZoneIntent and OpenZoneIntent: "close zone b", "open zone b" (docs/floors.md).
 
 The dispatcher keeps which zones are closed (`TaskDesk.set_zone`): no robot is sent into a
-closed zone, queued tasks for it wait, robots leave it and drive around its area. Anyone
-may close or open a zone today; when people have roles it is a supervisor's command.
+closed zone, queued tasks for it wait, robots leave it and drive around its area. Closing
+and opening change the service of the whole fleet: a supervisor's commands (`skill.access`),
+confirmed by their asker first (`skill.guard.confirm_first`) and recorded in the trail.
 """
 
 from __future__ import annotations
@@ -12,7 +13,8 @@ from typing import TYPE_CHECKING
 from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_intent_name
 
-from skill import dialog, prompts, task_speech
+from skill import deeds, dialog, prompts, task_speech
+from skill.guard import confirm_first
 from skill.responses import answer
 from skill.task_desk import TaskRefused
 
@@ -43,12 +45,17 @@ class _ZoneHandler(AbstractRequestHandler):
             return dialog.ask_zone(handler_input, self.runtime, zone)
         if self.desk is None:
             return answer(handler_input, prompts.NO_ZONE_DESK)
+        question = confirm_first(handler_input, self.runtime)
+        if question is not None:
+            return question
         try:
             change = self.desk.set_zone(zone.id, closed=self.closes)
         except TaskRefused as err:
+            deeds.failed(f"the dispatcher refused: {err}")
             if err.status == 404:  # a stack without the dispatcher's zone routes
                 return answer(handler_input, prompts.NO_ZONE_DESK)
             return answer(handler_input, prompts.DISPATCH_REFUSED.format(reason=str(err)))
+        deeds.zone_changed(change)
         return answer(
             handler_input, task_speech.zone_change_report(self.runtime.vocabulary, change)
         )

@@ -22,6 +22,8 @@ from dispatcher.config import DispatcherConfig
 from dispatcher.errors import ConfigError, DispatcherError
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
+from dispatcher.trail_table import TrailTable
+from skill.audit_table import AuditTable
 from tests.support.dispatch_meter import REGION, AtomicCalls, load_event
 from vahr.dispatch import Dispatcher, Task, timestamp
 from vahr.domain import load_fleet
@@ -36,6 +38,7 @@ if TYPE_CHECKING:
 
 
 LONG_AGO = datetime(2026, 11, 26, 22, 0, tzinfo=UTC)
+AUDIT_TABLE = "vahr-audit"
 
 
 class Index:
@@ -142,7 +145,7 @@ def test_with_every_robot_taken_the_task_is_queued_and_its_place_said(
 
 
 def test_a_robot_that_finishes_its_task_takes_the_next_in_line(
-    table: TaskTable, index: Index, published: list[tuple[str, dict[str, Any]]]
+    table: TaskTable, index: Index, published: list[tuple[str, dict[str, Any]]], dynamodb: Any
 ) -> None:
     # Given placebot1 alone, holding task T (the fixture's id), and a delivery queued
     rule_event = load_event("iot_rule_robot_freed")
@@ -155,7 +158,8 @@ def test_a_robot_that_finishes_its_task_takes_the_next_in_line(
     queued = submit(dispatcher, kind="deliver", zone="D")["body"]["queued"][0]
     # When the rule reports placebot1 idle with T done
     index.report("placebot1", **rule_event["reported"])
-    answer = app.handle(rule_event, dispatcher)
+    trail = audit_trail(dynamodb)
+    answer = app.handle(rule_event, dispatcher, trail)
     # Then T is done and placebot1 took the delivery
     assert answer == {"took": queued["id"]}
     done = table.get(task_id)
@@ -165,6 +169,27 @@ def test_a_robot_that_finishes_its_task_takes_the_next_in_line(
         topics.robot_cmd("placebot1"), queued["id"], "deliver",
     )  # fmt: skip
     assert app.handle({"operation": "pending"}, dispatcher)["body"]["tasks"] == []
+    # And the audit trail records the dispatcher's own act: the task, the robot, the channel
+    [record] = AuditTable(AUDIT_TABLE, dynamodb).records()
+    assert (record.who, record.channel, record.outcome) == ("dispatcher", "dispatcher", "sent")
+    assert (record.robots, record.commands) == (["placebot1"], [queued["id"]])
+
+
+def audit_trail(dynamodb: Any) -> TrailTable:
+    """The audit table the stack makes (keys as infra/constructs/people.py), in moto."""
+    dynamodb.create_table(
+        TableName=AUDIT_TABLE,
+        KeySchema=[
+            {"AttributeName": "trail", "KeyType": "HASH"},
+            {"AttributeName": "seq", "KeyType": "RANGE"},
+        ],
+        AttributeDefinitions=[
+            {"AttributeName": "trail", "AttributeType": "S"},
+            {"AttributeName": "seq", "AttributeType": "N"},
+        ],
+        BillingMode="PAY_PER_REQUEST",
+    )
+    return TrailTable(AUDIT_TABLE, dynamodb)
 
 
 def test_a_task_lost_to_a_command_by_name_is_closed_after_the_grace(

@@ -44,7 +44,12 @@ class ScriptedAssistant:
         self.weather = weather
 
     def ask(
-        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+        self,
+        utterance: str,
+        *,
+        origin: str = "say",
+        heard: dict[str, Any] | None = None,
+        user: str | None = None,
     ) -> dict[str, Any]:
         self.heard.append(utterance)
         if "what is the weather" in utterance:
@@ -130,7 +135,12 @@ class UnreachableAssistant:
         self.heard: list[str] = []
 
     def ask(
-        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+        self,
+        utterance: str,
+        *,
+        origin: str = "say",
+        heard: dict[str, Any] | None = None,
+        user: str | None = None,
     ) -> dict[str, Any]:
         self.heard.append(utterance)
         raise VahrError("nothing answers at http://127.0.0.1:1 (refused)")

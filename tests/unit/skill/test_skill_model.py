@@ -11,15 +11,18 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 import pytest
+from ask_sdk_core.attributes_manager import AttributesManager
 from ask_sdk_core.serialize import DefaultSerializer
 from skill_testkit import speech
 
 from skill.app import request_handlers
 from skill.config import SkillConfig
+from skill.guard import ACCESS, Access
 from skill.runtime import SkillRuntime
 from skill.vocabulary import FLEET
 from tests.conftest import EVENTS_DIR, load_event
 from vahr.domain import Fleet
+from vahr.domain.people import Person
 from vahr.protocol import ProtocolError
 from vahr.skill_model import FLEET_ROBOT_ID, ModelError, build_files, build_interaction_model
 from vahr.skill_model.__main__ import main as skill_model_main
@@ -235,6 +238,20 @@ def test_every_model_intent_has_exactly_one_handler_and_every_handler_an_intent(
     )
     claimed = [h for h in handlers if h.can_handle(HandlerInput(request_envelope=envelope))]
     assert type(claimed[0]).__name__ == "DeniedIntentHandler"
+    used.add(type(claimed[0]))
+    # A request the speaker's role does not allow is refused before any other handler.
+    envelope = serializer.deserialize(
+        json.dumps(load_event("alexa_navigate")), "ask_sdk_model.RequestEnvelope"
+    )
+    refused = HandlerInput(
+        request_envelope=envelope, attributes_manager=AttributesManager(envelope)
+    )
+    viewer = Person(id="amzn1.ask.account.V", name="Vera", role="viewer")
+    refused.attributes_manager.request_attributes[ACCESS] = Access(
+        person=viewer, kind="command", allowed=False
+    )
+    claimed = [h for h in handlers if h.can_handle(refused)]
+    assert type(claimed[0]).__name__ == "RefusedRequestHandler"
     used.add(type(claimed[0]))
     assert {type(handler) for handler in handlers} == used
 

@@ -52,7 +52,12 @@ class Assistant:
         self.asked: list[tuple[str, str, dict[str, Any] | None]] = []
 
     def ask(
-        self, utterance: str, *, origin: str = "say", heard: dict[str, Any] | None = None
+        self,
+        utterance: str,
+        *,
+        origin: str = "say",
+        heard: dict[str, Any] | None = None,
+        user: str | None = None,
     ) -> dict[str, Any]:
         self.asked.append((utterance, origin, heard))
         return {

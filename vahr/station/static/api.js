@@ -23,6 +23,17 @@
 
 /** The id of a command the station sent (`/api/command`, `/api/stop`). @typedef {{id: string}} CommandReply */
 
+/**
+ * Who works the page (`/api/me`): their Alexa id, name and role, the kinds of action the
+ * role allows, and whether they signed in (else everyone may do everything here).
+ * @typedef {object} Operator
+ * @property {string} id
+ * @property {string | null} name
+ * @property {string} role
+ * @property {string[]} may
+ * @property {boolean} signed_in
+ */
+
 export class ApiError extends Error {}
 
 /** What went wrong, in words (an ApiError's message says it). @param {unknown} err */
@@ -46,6 +57,22 @@ export async function post(path, body) {
       headers: { "Content-Type": "application/json" },
       body: JSON.stringify(body ?? {}),
     });
+  } catch (err) {
+    throw new ApiError("The station does not answer; is it still running?");
+  }
+  return answer(response);
+}
+
+/**
+ * GET `path` from the station; resolves with its JSON answer, rejects with an ApiError.
+ * @template [T=unknown]
+ * @param {string} path
+ * @returns {Promise<T>}
+ */
+export async function get(path) {
+  let response;
+  try {
+    response = await fetch(path);
   } catch (err) {
     throw new ApiError("The station does not answer; is it still running?");
   }

@@ -49,6 +49,26 @@
  */
 
 /**
+ * An entry in the trail: its number, the hash of the one before, and its own.
+ * @typedef {object} AuditRecord
+ * @property {string} time
+ * @property {string} who
+ * @property {string|null} name
+ * @property {string|null} role
+ * @property {string} channel
+ * @property {string|null} words
+ * @property {string|null} intent
+ * @property {Record<string, string|null>} slots
+ * @property {Array<string>} robots
+ * @property {Array<string>} commands
+ * @property {"answered"|"asked"|"cancelled"|"confirmed"|"failed"|"refused"|"sent"|"unsent"} outcome
+ * @property {string|null} reason
+ * @property {number} seq
+ * @property {string} prev
+ * @property {string} hash
+ */
+
+/**
  * A robot's battery as its backend reads it: charge in percent and whether it charges.
  * @typedef {object} Battery
  * @property {number} percent
@@ -384,8 +404,9 @@
 /**
  * What a page starts from: the fleet, every robot, the conversation so far, the commands seen
  * with their acknowledgments, the session, the announcements nobody has acknowledged yet
- * (oldest first), the station's clock (ms since the epoch) for the page to correct its own, and
- * the fleet's task queue when the station has read it.
+ * (oldest first), the station's clock (ms since the epoch) for the page to correct its own, the
+ * fleet's task queue when the station has read it, and the audit trail's latest records when
+ * the station reads one.
  * @typedef {object} SnapshotMessage
  * @property {"snapshot"} type
  * @property {FleetView} fleet
@@ -396,6 +417,7 @@
  * @property {Array<AnnouncementMessage>} alerts
  * @property {number} server_time
  * @property {TasksMessage|null} tasks
+ * @property {TrailMessage|null} trail
  */
 
 /**
@@ -435,6 +457,14 @@
  */
 
 /**
+ * The latest records of the audit trail (`vahr.protocol.audit`, oldest first), sent when new
+ * ones came: who did what, through which channel, and what came of it.
+ * @typedef {object} TrailMessage
+ * @property {"trail"} type
+ * @property {Array<AuditRecord>} records
+ */
+
+/**
  * One exchange with the assistant, with the robots it concerns.
  * @typedef {object} TurnMessage
  * @property {"turn"} type
@@ -465,7 +495,7 @@
  * @property {Array<Point>|null} area
  */
 
-/** @typedef {SnapshotMessage|RobotsMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage|AnnouncementMessage|AlertAcknowledgedMessage|TasksMessage} PageMessage */
+/** @typedef {SnapshotMessage|RobotsMessage|EventMessage|CommandMessage|AckMessage|TurnMessage|ExperimentMessage|AnnouncementMessage|AlertAcknowledgedMessage|TasksMessage|TrailMessage} PageMessage */
 
 /** @typedef {TurnMessage|CommandMessage|EventMessage|AnnouncementMessage} ConversationEntry */
 

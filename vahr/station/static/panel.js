@@ -119,6 +119,8 @@ export class Panel {
     /** @type {HTMLButtonElement | null} */
     this.anyButton = null;
     this.ordersAllowed = true;
+    // Whether the person at the page may send robots at all (a viewer may not).
+    this.commandsAllowed = true;
     /** Per command id, what the status line says about it. @type {Map<string, string>} */
     this.pending = new Map();
     /** @type {FleetView | null} */
@@ -157,6 +159,7 @@ export class Panel {
     any.dataset.any = "true";
     any.setAttribute("aria-pressed", "false");
     any.addEventListener("click", () => this.chooseAny());
+    any.hidden = !this.commandsAllowed;
     this.robotsBox.appendChild(any);
     this.anyButton = any;
     if (fleet.robots.length > this.robotButtons.size) {
@@ -222,9 +225,18 @@ export class Panel {
     this.refresh();
   }
 
+  // A person whose role does not let them send robots: the panel selects and stops only.
+  /** @param {boolean} allowed */
+  allowCommands(allowed) {
+    this.commandsAllowed = allowed;
+    if (this.anyButton) this.anyButton.hidden = !allowed;
+    if (!allowed && this.anyRobot) this.chooseAny();
+    this.refresh();
+  }
+
   refresh() {
     for (const made of this.zoneButtons?.values() ?? []) {
-      made.disabled = !(this.selected || this.anyRobot) || !this.ordersAllowed;
+      made.disabled = !(this.selected || this.anyRobot) || !this.ordersAllowed || !this.commandsAllowed;
       const zone = made.dataset.zone;
       const name = zoneText(zone ?? "");
       made.title = this.selected ? t("Send {robot} to {zone}", { robot: this.names[this.selected], zone: name }) : this.anyRobot ? ANY.title(name) : t("{zone}: select a robot first", { zone: name });
@@ -261,6 +273,7 @@ export class Panel {
 
   /** @param {string | null} thing @param {string} zone */
   navigate(thing, zone) {
+    if (!this.commandsAllowed) return;
     if (!thing && this.anyRobot) return this.ordersAllowed ? this.sendAny(zone) : undefined;
     if (!thing) {
       this.tell(t("Select a robot first: click it on the map, or press its number."), true);
@@ -343,7 +356,7 @@ export class Panel {
     }
     if (event.key === ANY.key) {
       event.preventDefault();
-      this.chooseAny();
+      if (this.commandsAllowed) this.chooseAny();
       return;
     }
     const robot = this.fleet?.robots.find((r) => r.key && r.key === event.key);

@@ -3,7 +3,7 @@
 // things happen; the page never polls), one store, and the views that draw it.
 
 import { AlertsView } from "./alerts-view.js";
-import { post, reason, replyVoice, setReplyVoice, speak } from "./api.js";
+import { get, post, reason, replyVoice, setReplyVoice, speak } from "./api.js";
 import { COMMANDS_LIMIT, DRIVE_ENDS, EXCHANGE_EVENTS } from "./contract.js";
 import { Conversation } from "./conversation.js";
 import { byId } from "./dom.js";
@@ -17,9 +17,10 @@ import { RobotsPanel } from "./robots.js";
 import { Talk } from "./talk.js";
 import { TasksView } from "./tasks-view.js";
 import { ZonesView } from "./zones-view.js";
+import { TrailView } from "./trail-view.js";
 
 /** @import { AnnouncementMessage, CommandMessage, EventMessage, ExperimentStatus, FleetView, PageMessage, Reported, RobotChange, RobotView, RobotsMessage, SnapshotMessage } from "./contract.js" */
-/** @import { SayReply } from "./api.js" */
+/** @import { Operator, SayReply } from "./api.js" */
 
 /**
  * What the page knows, kept from the station's messages.
@@ -92,7 +93,40 @@ const zones = new ZonesView(
   { card: byId("zones", HTMLElement), list: byId("zone-switches", HTMLElement), count: byId("zones-count", HTMLElement) },
   { onSwitch: (zone, closed) => post("/api/zone", { zone, closed }).catch((err) => panel.tell(reason(err), true)) },
 );
+const trail = new TrailView(
+  { card: byId("trail", HTMLElement), list: byId("trail-list", HTMLElement), count: byId("trail-count", HTMLElement) },
+  (thing) => names[thing] || thing,
+);
 new Talk({ button: byId("talk", HTMLButtonElement), level: byId("talk-level", HTMLElement), state: byId("talk-state", HTMLElement), interactions, metrics });
+
+// Who works this page, and what their role lets them do: a viewer's page has no controls
+// that send robots (the station refuses them anyway); stopping stays, as it is anyone's.
+const ROLE_WORDS = {
+  /** @param {string} name */
+  viewer: (name) => t("{name} is a viewer: you may watch the robots, ask the assistant and stop them; sending robots needs an operator.", { name }),
+};
+/** @param {Operator} operator */
+function showOperator(operator) {
+  const commands = operator.may.includes("command");
+  panel.allowCommands(commands);
+  byId("zone-row", HTMLElement).hidden = !commands;
+  if (!commands) byId("map-hint", HTMLElement).textContent = t("Click a robot to follow it.");
+  // Closing and opening zones changes the whole fleet's service: a supervisor's.
+  zones.allow(operator.may.includes("fleet"));
+  const note = byId("panel-role", HTMLElement);
+  note.hidden = commands;
+  if (!commands) note.textContent = ROLE_WORDS.viewer(operator.name || operator.id);
+  if (!operator.signed_in) return;
+  byId("operator", HTMLElement).hidden = false;
+  byId("operator-name", HTMLElement).textContent = `${operator.name || operator.id} · ${t(operator.role)}`;
+}
+byId("sign-out", HTMLButtonElement).addEventListener("click", async () => {
+  await post("/api/signout", {}).catch(() => {});
+  location.replace("/");
+});
+/** @type {Promise<Operator>} */
+const me = get("/api/me");
+me.then(showOperator, (err) => panel.tell(reason(err), true));
 
 const voice = byId("reply-voice", HTMLSelectElement);
 voice.value = replyVoice();
@@ -104,9 +138,11 @@ function select(thing) {
   map.select(store.selected);
   robots.select(store.selected);
   panel.select(store.selected);
-  byId("map-hint", HTMLElement).textContent = store.selected
-    ? t("{robot} selected: click a zone (or press its key) to send it there.", { robot: names[store.selected] })
-    : t("Click a robot, then a zone to send it there.");
+  byId("map-hint", HTMLElement).textContent = !panel.commandsAllowed
+    ? t("Click a robot to follow it.")
+    : store.selected
+      ? t("{robot} selected: click a zone (or press its key) to send it there.", { robot: names[store.selected] })
+      : t("Click a robot, then a zone to send it there.");
 }
 
 // -- drawing changes, at most once a frame ---------------------------------------------
@@ -200,6 +236,7 @@ function reset(snapshot) {
   tasks.update(snapshot.tasks);
   map.setClosed(snapshot.tasks?.closed || []);
   zones.update(snapshot.tasks);
+  trail.update(snapshot.trail);
   alerts.reset(snapshot.alerts, first);
   if (store.selected) select(store.selected);
 }
@@ -292,6 +329,9 @@ const handlers = {
     tasks.update(message);
     map.setClosed(message.closed || []);
     zones.update(message);
+  },
+  trail(message) {
+    trail.update(message);
   },
 };
 

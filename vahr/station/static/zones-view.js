@@ -30,6 +30,15 @@ export class ZonesView {
     this.switches = new Map();
     /** @type {Set<string>} */
     this.closed = new Set();
+    // Whether the person working the page may close zones (a supervisor); else no card.
+    this.allowed = true;
+    this.available = false;
+  }
+
+  /** @param {boolean} allowed */
+  allow(allowed) {
+    this.allowed = allowed;
+    this.card.hidden = !(this.available && this.allowed);
   }
 
   /** @param {FleetView} fleet */
@@ -51,7 +60,8 @@ export class ZonesView {
 
   /** @param {TasksMessage | null | undefined} message */
   update(message) {
-    this.card.hidden = !message?.available;
+    this.available = Boolean(message?.available);
+    this.card.hidden = !(this.available && this.allowed);
     this.closed = new Set(message?.closed || []);
     this.show();
   }
