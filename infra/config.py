@@ -90,7 +90,7 @@ class InfraConfig:
     device_audit: bool = True
     # Where the alarms are mailed (an SNS subscription to confirm); none: subscribe later.
     alarm_email: str | None = None
-    # Who may do what (infra/constructs/people.py): the users table, which the skill reads;
+    # Who may do what (infra/constructs/people_tables.py): the users table, which the skill reads;
     # off, everyone may do everything. The audit table is always made; its deletion
     # protection is on unless said otherwise.
     people: bool = False

@@ -18,7 +18,7 @@ from infra.constructs.iot_endpoint import IotEndpoint
 from infra.constructs.iot_fleet import IotFleet
 from infra.constructs.iot_logging import IotLogging
 from infra.constructs.operator_policy import OperatorPolicy
-from infra.constructs.people import PeopleTables
+from infra.constructs.people_tables import PeopleTables
 from infra.constructs.presence_rule import PresenceRule
 from infra.constructs.robot_policy import RobotPolicy
 from infra.constructs.skill_function import SkillFunction
@@ -112,7 +112,7 @@ class VahrStack(cdk.Stack):
             data_endpoint=self.data_endpoint.address,
             code=code,
         )
-        # Who may do what, and the trail of what was done (infra/constructs/people.py).
+        # Who may do what, and the trail of what was done (infra/constructs/people_tables.py).
         self.people = PeopleTables(
             self,
             "People",

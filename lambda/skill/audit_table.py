@@ -3,7 +3,7 @@
 The items and the append (one transaction of two conditional puts, tried again on a lost
 race, so concurrent functions never fork the chain) are `vahr.protocol.audit`'s, shared
 with the dispatcher function; this module makes the calls. The skill's role may only put
-items and read the head (infra/constructs/people.py): nothing of the skill updates or
+items and read the head (infra/constructs/people_tables.py): nothing of the skill updates or
 deletes. `vahr audit --table` reads the records and the head and verifies them
 (`vahr.protocol.audit.verify`). Point-in-time recovery keeps 35 days of the table's past.
 """

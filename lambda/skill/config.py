@@ -58,7 +58,7 @@ class SkillConfig(msgspec.Struct, frozen=True):
     dispatcher_function: str | None = None
     # The IoT control plane's URL for fleet indexing, when not boto3's default.
     control_endpoint: str | None = None
-    # Who may do what (skill.people): a DynamoDB table, or a users file; neither is open.
+    # Who may do what (skill.speakers): a DynamoDB table, or a users file; neither is open.
     users_table: str | None = None
     users_file: str | None = None
     # Where every request's record goes (skill.trail): a DynamoDB table on AWS; the local

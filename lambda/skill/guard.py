@@ -2,7 +2,7 @@
 confirmation of fleet-wide commands, and the request's record in the audit trail.
 
 - `AccessInterceptor` (a request interceptor) classifies the request from its intent and
-  slots (`skill.access.classify`), looks the speaker up (`skill.people`) and decides
+  slots (`skill.access.classify`), looks the speaker up (`skill.speakers`) and decides
   whether their role allows it (`vahr.domain.people.may`). A stop needs nobody's role and
   a question anybody's, so only commands wait for the directory.
 - `RefusedRequestHandler`, first of the handlers, answers a request the role does not
@@ -32,9 +32,9 @@ from ask_sdk_model import IntentRequest
 from skill import deeds, prompts
 from skill.access import INTENT_RULES, REQUEST_KINDS, classify
 from skill.errors import PeopleUnavailable
-from skill.people import speaker_id
 from skill.responses import answer, confirm_intent
 from skill.slots import MATCH
+from skill.speakers import speaker_id
 from skill.trail import append_or_log
 from skill.vocabulary import capitalise
 from vahr.domain import FLEET_GROUP

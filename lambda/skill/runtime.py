@@ -10,8 +10,8 @@ import msgspec
 
 from skill import fleet_source
 from skill.fleet_acknowledgment import FleetAcknowledgments
-from skill.people import people_directory
 from skill.robots import Robots
+from skill.speakers import people_directory
 from skill.trail import audit_trail
 from skill.vocabulary import Vocabulary
 from vahr.domain.people import confirmation_on
@@ -19,7 +19,7 @@ from vahr.domain.people import confirmation_on
 if TYPE_CHECKING:
     from skill.config import SkillConfig
     from skill.gateway import RobotGateway
-    from skill.people import PeopleDirectory
+    from skill.speakers import PeopleDirectory
     from skill.trail import Trail
     from vahr.domain import Fleet
 

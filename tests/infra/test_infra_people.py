@@ -11,7 +11,7 @@ from aws_cdk.assertions import Template
 from template_tools import bare_stack, resources, role_grants
 
 from infra.config import InfraConfig
-from infra.constructs.people import PeopleTables
+from infra.constructs.people_tables import PeopleTables
 from infra.constructs.skill_function import SkillFunction
 
 if TYPE_CHECKING:

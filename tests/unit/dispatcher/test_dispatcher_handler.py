@@ -176,7 +176,7 @@ def test_a_robot_that_finishes_its_task_takes_the_next_in_line(
 
 
 def audit_trail(dynamodb: Any) -> TrailTable:
-    """The audit table the stack makes (keys as infra/constructs/people.py), in moto."""
+    """The audit table the stack makes (keys as infra/constructs/people_tables.py), in moto."""
     dynamodb.create_table(
         TableName=AUDIT_TABLE,
         KeySchema=[

@@ -73,7 +73,7 @@ def directive(response: dict[str, Any]) -> str | None:
 
 @pytest.fixture
 def tables(aws: None) -> tuple[AuditTable, Any]:
-    """The audit and users tables the stack makes (keys as infra/constructs/people.py)."""
+    """The audit and users tables the stack makes (keys as infra/constructs/people_tables.py)."""
     client = boto3.client("dynamodb", region_name=REGION)
     client.create_table(
         TableName=AUDIT_TABLE,
