@@ -31,7 +31,7 @@ AREAS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     )),
     ("hearing", "Hearing people", (
         "hearing", "hearing_voices", "voice_roundtrip", "station_hearing",
-        "station_hearing_reply", "station_answers", "wrong_actions",
+        "station_hearing_reply", "station_answers", "wrong_actions", "wrong_stops",
     )),
     ("station", "The operator station", (
         "station", "station_map", "station-memory", "announcement", "say_latency",
