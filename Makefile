@@ -33,6 +33,9 @@ ROS2_TESTS := tests/integration/agent
 # than pip.
 UV_VERSION := 0.13.9
 UV := $(BIN)/uv pip install -q
+# Byte code is written and reused: the suite starts hundreds of Python processes (robots,
+# stacks, browsers' servers), and each would compile the sources again without it.
+unexport PYTHONDONTWRITEBYTECODE
 export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
 export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 
