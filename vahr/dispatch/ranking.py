@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Protocol
 import msgspec
 
 from vahr.domain.fleet import Pose
+from vahr.protocol.shadow import Battery
 
 if TYPE_CHECKING:
     from vahr.dispatch.tasks import Task
@@ -45,6 +46,8 @@ class RobotState(msgspec.Struct, frozen=True, kw_only=True):
     pose: Pose | None = None
     last_command_id: str | None = None
     last_result: str | None = None
+    battery: Battery | None = None
+    in_service: bool = True
 
     @property
     def available(self) -> bool:
