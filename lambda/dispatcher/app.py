@@ -1,7 +1,10 @@
 """The dispatcher's Lambda handler. Thin: parse the event, run the core, answer.
 
 Three callers (see `dispatcher.requests`): the skill, synchronously, the topic rule on the
-robots' shadow documents, and an EventBridge schedule once a minute. Errors are mapped
+robots' shadow documents, and an EventBridge schedule once a minute. A task the fleet
+loses (its robot sent elsewhere by name, gone offline, or never acknowledging it) is told
+to the announcer function (`announcer_channel`), never closed without a word. Errors are
+mapped
 here and nowhere else: a request that cannot be carried out (a bad order, an unknown
 task) is answered with its one line, and the skill speaks it; an AWS failure raises, so a
 rule's event is retried by Lambda and then kept in the dead-letter queue, and the skill
@@ -13,14 +16,16 @@ from __future__ import annotations
 import logging
 from datetime import UTC, datetime
 from functools import cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import msgspec
 
+from dispatcher.announcer_channel import AnnouncerChannel
 from dispatcher.command_channel import CommandChannel
 from dispatcher.config import DispatcherConfig
 from dispatcher.errors import BadRequest, ConfigError, DispatcherError
 from dispatcher.fleet_search import FleetSearch, robot_state
+from dispatcher.reoffer import watch_assigned
 from dispatcher.requests import (
     OPERATIONS,
     Answer,
@@ -44,6 +49,11 @@ from vahr.dispatch.records import task_given
 from vahr.domain import load_fleet
 from vahr.protocol.errors import ProtocolError, from_validation_error
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from vahr.protocol.lost_tasks import LostTask
+
 log = logging.getLogger("dispatcher")
 
 
@@ -61,10 +71,11 @@ def runtime() -> Dispatcher:
     except DistancesError as err:
         raise ConfigError(f"the fleet's map: {err}") from err
     channel = CommandChannel(config.iot_data_endpoint)
+    table = TaskTable(config.table, closed_task_days=config.closed_task_days)
     return Dispatcher(
         fleet=fleet,
-        store=TaskTable(config.table, closed_task_days=config.closed_task_days),
-        candidates=FleetSearch(index_name=config.index_name),
+        store=table,
+        candidates=FleetSearch(index_name=config.index_name, holding=table.holders),
         publish=channel,
         routes=lambda closed: routes,
         publish_closures=channel.closures,
@@ -78,9 +89,24 @@ def trail() -> TrailTable | None:
     return TrailTable(table) if table else None
 
 
+@cache
+def announcer() -> Callable[[LostTask], None]:
+    """Where lost tasks are told: the announcer function, or only the log without one."""
+    function = DispatcherConfig.from_env().announcer_function
+    return AnnouncerChannel(function) if function else _logged_only
+
+
+def _logged_only(lost: LostTask) -> None:
+    log.warning(
+        "task %s lost (%s) is not announced: no announcer function (VAHR_ANNOUNCER_FUNCTION)",
+        lost.task,
+        lost.why,
+    )
+
+
 def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
     try:
-        return handle(event, runtime(), trail())
+        return handle(event, runtime(), trail(), announcer())
     except DispatcherError as err:
         log.error("dispatcher failed: %s", err)
         raise
@@ -90,15 +116,19 @@ def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
 
 
 def handle(
-    event: dict[str, Any], dispatcher: Dispatcher, trail: TrailTable | None = None
+    event: dict[str, Any],
+    dispatcher: Dispatcher,
+    trail: TrailTable | None = None,
+    tell: Callable[[LostTask], None] = _logged_only,
 ) -> dict[str, Any]:
     """One invocation: a robot's update (from the rule), the schedule's tick, or a skill's
     request. What the dispatcher does by itself (a queued task given to a robot) goes to
-    `trail`; a skill's request is recorded by the skill, with who asked."""
+    `trail`, and a task it loses to `tell`; a skill's request is recorded by the skill,
+    with who asked."""
     if is_robot_update(event):
-        return on_robot_update(event, dispatcher, trail)
+        return on_robot_update(event, dispatcher, trail, tell)
     if is_tick(event):
-        return on_tick(dispatcher, trail)
+        return on_tick(dispatcher, trail, tell)
     try:
         answer = on_request(_request(event), dispatcher)
     except BadRequest as err:
@@ -110,7 +140,10 @@ def handle(
 
 
 def on_robot_update(
-    event: dict[str, Any], dispatcher: Dispatcher, trail: TrailTable | None = None
+    event: dict[str, Any],
+    dispatcher: Dispatcher,
+    trail: TrailTable | None = None,
+    tell: Callable[[LostTask], None] = _logged_only,
 ) -> dict[str, Any]:
     """A robot's update the rule selected: it may have finished its task and be free."""
     try:
@@ -123,7 +156,7 @@ def on_robot_update(
     if state is None or update.thing not in dispatcher.fleet.robot_things:
         log.warning("ignoring an update of %s, which is not a robot of the fleet", update.thing)
         return {"took": None}
-    taken = robot_freed(dispatcher, state, now=datetime.now(UTC))
+    taken = robot_freed(dispatcher, state, now=datetime.now(UTC), tell=tell)
     if taken is not None:
         log.info("task %s (%s to %s) given to %s", taken.id, taken.kind, taken.zone, taken.thing)
         if trail is not None:
@@ -131,25 +164,53 @@ def on_robot_update(
     return {"took": taken.id if taken is not None else None}
 
 
-def on_tick(dispatcher: Dispatcher, trail: TrailTable | None = None) -> dict[str, Any]:
-    """Once a minute: queued tasks go to robots that are free now. A robot freed while its
-    rule event was lost (dead-lettered, or the function failed) would otherwise wait for its
-    next change; with nothing queued this is one read of the queue and nothing more. The
-    closed zones are told again (retained), so two changes published out of order by two
-    invocations agree with the table within a minute."""
+def on_tick(
+    dispatcher: Dispatcher,
+    trail: TrailTable | None = None,
+    tell: Callable[[LostTask], None] = _logged_only,
+) -> dict[str, Any]:
+    """Once a minute: assigned tasks whose robot never acknowledged them are offered again
+    or, when they cannot be carried out any more, told as lost (`reoffer`); then queued
+    tasks go to robots that are free now. A robot freed while its rule event was lost
+    (dead-lettered, or the function failed) would otherwise wait for its next change; with
+    no open task this is one read of the open tasks and nothing more. The closed zones are
+    told again (retained), so two changes published out of order by two invocations agree
+    with the table within a minute."""
     dispatcher.announce_closures()
-    given = dispatcher.drain()
+    table, search = dispatcher.store, dispatcher.candidates
+    assert isinstance(table, TaskTable) and isinstance(search, FleetSearch)
+    watch = watch_assigned(dispatcher, table, search, now=datetime.now(UTC), tell=tell)
+    given = list(watch.given)
+    if watch.queued:
+        # A task only some robots may take (a group's member) may wait for a robot that
+        # the first page of idle robots does not hold.
+        if any(task.robots for task in watch.queued):
+            with search.every_robot():
+                given += dispatcher.drain()
+        else:
+            given += dispatcher.drain()
     for task in given:
         log.info("task %s (%s to %s) given to %s", task.id, task.kind, task.zone, task.thing)
         if trail is not None:
             trail.record(task_given(task))
-    return {"given": [task.id for task in given]}
+    return {
+        "given": [task.id for task in given],
+        "offered_again": watch.offered_again,
+        "acknowledged": watch.acknowledged,
+        "closed": watch.closed,
+        "lost": [lost.task for lost in watch.lost],
+    }
 
 
 def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
     if isinstance(request, Submit):
+        order, search = request.order, dispatcher.candidates
         try:
-            return Answer(200, dispatcher.submit(request.order))
+            if (order.idle or order.group is not None) and isinstance(search, FleetSearch):
+                # "Every idle robot" needs them all; a group's members may be on any page.
+                with search.every_robot():
+                    return Answer(200, dispatcher.submit(order))
+            return Answer(200, dispatcher.submit(order))
         except DispatchError as err:
             raise BadRequest(str(err), error=err.code) from err
     if isinstance(request, ListTasks):

@@ -153,13 +153,16 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
         submit_meter, freed_meter = CallMeter(), CallMeter()
 
         def dispatcher(meter: CallMeter) -> Dispatcher:
+            # Built as the function's runtime builds it (dispatcher.app.runtime).
+            table = TaskTable(
+                TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION))
+            )
             return Dispatcher(
                 fleet=fleet,
-                store=TaskTable(
-                    TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION))
-                ),
+                store=table,
                 candidates=FleetSearch(
-                    client=meter.watch(boto3.client("iot", endpoint_url=server.url))
+                    client=meter.watch(boto3.client("iot", endpoint_url=server.url)),
+                    holding=table.holders,
                 ),
                 publish=CommandChannel(
                     client=meter.watch(boto3.client("iot-data", region_name=REGION))
