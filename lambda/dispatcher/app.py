@@ -179,7 +179,7 @@ def on_tick(
     dispatcher.announce_closures()
     table, search = dispatcher.store, dispatcher.candidates
     assert isinstance(table, TaskTable) and isinstance(search, FleetSearch)
-    watch = watch_assigned(dispatcher, table, search, now=datetime.now(UTC), tell=tell)
+    watch = watch_assigned(dispatcher, table, search, now=dispatcher.clock(), tell=tell)
     given = list(watch.given)
     if watch.queued:
         # A task only some robots may take (a group's member) may wait for a robot that
