@@ -16,13 +16,14 @@ import json
 import threading
 from collections import Counter
 from dataclasses import dataclass, field
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from typing import Any
 
 import boto3
 
 from dispatcher import app
+from dispatcher.announcer_channel import AnnouncerChannel
 from dispatcher.command_channel import CommandChannel
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
@@ -202,4 +203,52 @@ def measure_zone_change() -> CallMeter:
     )
     answer = app.handle({"operation": "zone", "zone": "B", "closed": True}, core)
     assert answer["body"]["changed"] is True, answer
+    return meter
+
+
+# The announcer function the dispatcher tells of lost tasks (infra: its `function_name`).
+ANNOUNCER = "vahr-announcer"
+
+
+def measure_lost_task() -> CallMeter:
+    """A trip to zone A given to placebot2, whose command never reaches it: the schedule
+    sends it again, then placebot2 goes offline and the next tick tells the announcer the
+    task is lost. Call it inside `mock_aws(config={"lambda": {"use_docker": False}})`."""
+    store = ShadowStore(None)
+    shadows = ShadowService(store, publish=lambda _topic, _payload: None)
+    server = DataPlaneServer(DataPlane(shadows, publish=lambda *_: None, meter=Meter()), 0)
+
+    def report(**reported: object) -> None:
+        body = {"state": {"reported": {"status": "idle", "zone": "A", **reported}}}
+        store.update("placebot2", None, json.dumps(body).encode())
+
+    report(connected=True)
+    _create_table(boto3.client("dynamodb", region_name=REGION))
+    meter = CallMeter()
+    now = [datetime.now(UTC)]
+    tick = load_event("eventbridge_schedule")
+    with server:
+        table = TaskTable(TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION)))
+        core = Dispatcher(
+            fleet=load_fleet(),
+            store=table,
+            candidates=FleetSearch(
+                client=meter.watch(boto3.client("iot", endpoint_url=server.url)),
+                holding=table.holders,
+            ),
+            publish=CommandChannel(
+                client=meter.watch(boto3.client("iot-data", region_name=REGION))
+            ),
+            clock=lambda: now[0],
+        )
+        tell = AnnouncerChannel(
+            ANNOUNCER, client=meter.watch(boto3.client("lambda", region_name=REGION))
+        )
+        answer = app.handle({"operation": "submit", "order": {"zone": "A"}}, core, None, tell)
+        [task] = answer["body"]["assigned"]
+        now[0] += timedelta(minutes=1)
+        assert app.handle(tick, core, None, tell)["offered_again"] == [task["id"]]
+        report(connected=False)
+        now[0] += timedelta(minutes=1)
+        assert app.handle(tick, core, None, tell)["lost"] == [task["id"]]
     return meter
