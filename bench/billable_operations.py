@@ -298,10 +298,10 @@ request units it bills were counted. Load average {load} when it ran.
 Per dispatched task. Both designs share the measured table units, two Lambda requests (the
 skill's submit, the robot-freed event), the command (3 messages) and the dispatcher rule
 ({usage.shadow_updates} shadow updates of the robot matched by its topic filter, one
-action). Fleet indexing adds its queries (one per 100 candidates) and an index update per
-shadow update ({usage.shadow_updates}); reading shadows adds two shadow operations (a 1-2 KB
-document) per robot instead. Every robot is a candidate here (all idle), the most the index
-can return.
+action). Fleet indexing adds its queries (one page of idle robots, as long as it holds a
+free one; `bench/fleet_search.py`) and an index update per shadow update
+({usage.shadow_updates}); reading shadows adds two shadow operations (a 1-2 KB document)
+per robot instead. Every robot is idle here.
 
 {table_head(TASK_COLUMNS)}
 {chr(10).join(task_rows)}
@@ -320,7 +320,7 @@ indexing from aws.amazon.com/iot-device-management/pricing: USD 0.05 per 10,000 
 USD 2.25 per million 1 KB index updates). At 10 robots the two designs cost about the same
 per task (the index's updates weigh as much as ten shadow reads); from a few hundred robots
 on, reading every shadow costs more per task and per question, and its latency grows with
-the fleet (one GetThingShadow per robot) where the index's grows by a page per 100 robots.
+the fleet (one GetThingShadow per robot) where the index's stays one page.
 """
     write_section(
         "billable_operations_fleet",
