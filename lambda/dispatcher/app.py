@@ -14,6 +14,7 @@ hears that the dispatcher failed.
 from __future__ import annotations
 
 import logging
+from contextlib import AbstractContextManager, nullcontext
 from datetime import UTC, datetime
 from functools import cache
 from typing import TYPE_CHECKING, Any
@@ -43,7 +44,7 @@ from dispatcher.requests import (
 from dispatcher.robot_updates import robot_freed
 from dispatcher.task_table import TaskTable
 from dispatcher.trail_table import TrailTable
-from vahr.dispatch import Dispatcher, DispatchError
+from vahr.dispatch import Dispatcher, DispatchError, Task
 from vahr.dispatch.grid_routes import DistancesError, floor_routes
 from vahr.dispatch.records import task_given
 from vahr.domain import load_fleet
@@ -182,12 +183,7 @@ def on_tick(
     watch = watch_assigned(dispatcher, table, search, now=dispatcher.clock(), tell=tell)
     given = list(watch.given)
     if watch.queued:
-        # A task only some robots may take (a group's member) may wait for a robot that
-        # the first page of idle robots does not hold.
-        if any(task.robots for task in watch.queued):
-            with search.every_robot():
-                given += dispatcher.drain()
-        else:
+        with _searching(dispatcher, every=_restricted(watch.queued)):
             given += dispatcher.drain()
     for task in given:
         log.info("task %s (%s to %s) given to %s", task.id, task.kind, task.zone, task.thing)
@@ -204,13 +200,13 @@ def on_tick(
 
 def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
     if isinstance(request, Submit):
-        order, search = request.order, dispatcher.candidates
+        order = request.order
+        # "Every idle robot" needs them all; a group's members and the robots in a zone may
+        # be on any page of idle robots.
+        every = order.idle or order.group is not None or order.origin is not None
         try:
-            if (order.idle or order.group is not None) and isinstance(search, FleetSearch):
-                # "Every idle robot" needs them all; a group's members may be on any page.
-                with search.every_robot():
-                    return Answer(200, dispatcher.submit(order))
-            return Answer(200, dispatcher.submit(order))
+            with _searching(dispatcher, every=every):
+                return Answer(200, dispatcher.submit(order))
         except DispatchError as err:
             raise BadRequest(str(err), error=err.code) from err
     if isinstance(request, ListTasks):
@@ -221,7 +217,11 @@ def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
         return Answer(200, {"closed": dispatcher.closed_zones()})
     if isinstance(request, SetZone):
         try:
-            return Answer(200, dispatcher.set_zone(request.zone, closed=request.closed))
+            # Opened, the queued tasks that waited for it go: read every page if one of them
+            # is only some robots' to take.
+            every = not request.closed and _restricted(dispatcher.pending())
+            with _searching(dispatcher, every=every):
+                return Answer(200, dispatcher.set_zone(request.zone, closed=request.closed))
         except DispatchError as err:
             raise BadRequest(str(err), error=err.code) from err
     assert isinstance(request, Cancel)
@@ -229,6 +229,20 @@ def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
     if cancelled is None:
         raise BadRequest(f"no open task {request.task_id!r}", status=404)
     return Answer(200, {"task": cancelled})
+
+
+def _restricted(tasks: list[Task]) -> bool:
+    """Whether a task among these is only some robots' (a group's member, a robot in a
+    zone): such a robot may be on any page of idle robots."""
+    return any(task.robots for task in tasks)
+
+
+def _searching(dispatcher: Dispatcher, *, every: bool) -> AbstractContextManager[None]:
+    """Within it, the fleet search reads every page (`every`) or asks for idle robots first."""
+    search = dispatcher.candidates
+    if every and isinstance(search, FleetSearch):
+        return search.every_robot()
+    return nullcontext()
 
 
 def _request(event: dict[str, Any]) -> SkillRequest:
