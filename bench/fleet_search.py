@@ -7,9 +7,9 @@ HTTP on 127.0.0.1), and counts the SearchIndex calls of each submit. "Every page
 search as it was: every connected idle or busy robot, page after page (`FleetSearch`'s
 `every_robot`, which orders for every idle robot still use); "idle first" is the search
 a task uses now. Medians of `--repeats` submits (each cancelled after, so the fleet stays
-free), one JSON line at the end; `--write` puts the section into docs/benchmarks.md.
+free), its section written into docs/benchmarks.md and one JSON line at the end.
 
-    .venv/bin/python bench/fleet_search.py [--robots 10000] [--repeats 5] [--write]
+    .venv/bin/python bench/fleet_search.py [--robots 10000] [--repeats 5]
 """
 
 from __future__ import annotations
@@ -117,7 +117,6 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robots", type=int, default=10_000)
     parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--write", action="store_true", help="write docs/benchmarks.md")
     args = parser.parse_args()
     for name in ("AWS_ACCESS_KEY_ID", "AWS_SECRET_ACCESS_KEY"):
         os.environ.setdefault(name, "bench")
@@ -143,17 +142,18 @@ SearchIndex calls and wall time of one submit ("deliver a package to zone C") th
 dispatcher function's handler among {args.robots:,} connected robots, the task table in
 moto's DynamoDB and the fleet index answering boto3's `iot` client over HTTP on 127.0.0.1
 with AWS's 100-thing pages; medians of {args.repeats} submits. "Every page": every idle or
-busy robot, page after page, as a submit searched before (still the search of "every idle
-robot" and of a group's orders); "idle first": the connected idle robots first, reading
-on only while no robot found is free, then the busy ones. Load average {load} when it ran.
+busy robot, page after page, as a submit searched before (still the search of orders for
+every idle robot, a group's members or the robots in a zone); "idle first": the connected
+idle robots first, reading on only while no robot found is free, then the busy ones.
+Load average {load} when it ran.
 
 {HEAD}
 {chr(10).join(rows)}
 
 A busy robot is sent only when no idle one is free, so with none idle the idle search finds
 nothing (one call) and the first page of busy robots answers (one more). The times are the
-local index's; on AWS each SearchIndex call is a round trip to the IoT control plane (tens
-of milliseconds), so the calls saved are the time saved. What it costs: one index query per
+local index's; on AWS each SearchIndex call is a round trip to the IoT control plane, one
+after the other, so the calls saved are the time saved. What it costs: one index query per
 task whatever the fleet's size (`infra/cost_estimate.py`, "Billable AWS operations per
 dispatched task").
 """
