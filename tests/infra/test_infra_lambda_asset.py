@@ -159,7 +159,7 @@ def test_the_dispatcher_loads_from_the_same_bundle_and_answers_in_one_line(
         "status": 400,
         "body": {
             "code": 400,
-            "message": "operation: 'launch' is not one of submit, tasks, pending, cancel",
+            "message": "operation: 'launch' is not one of submit, tasks, pending, cancel, zones, zone",
         },
     }
     assert seen["loaded"] == ["vahr.dispatch"]
