@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Protocol
 import msgspec
 
 from vahr.domain.fleet import Pose
-from vahr.protocol.shadow import Battery
+from vahr.protocol.shadow import Battery  # noqa: TC001 - msgspec reads it at run time
 
 if TYPE_CHECKING:
     from vahr.dispatch.tasks import Task
