@@ -22,7 +22,9 @@ from typing import TYPE_CHECKING, Protocol
 import msgspec
 
 from vahr.domain.fleet import Pose
-from vahr.protocol.shadow import Battery  # noqa: TC001 - msgspec reads it at run time
+
+# At run time: msgspec reads RobotState's annotations when it decodes one.
+from vahr.protocol.shadow import Battery  # noqa: TC001
 
 if TYPE_CHECKING:
     from vahr.dispatch.tasks import Task
@@ -46,7 +48,9 @@ class RobotState(msgspec.Struct, frozen=True, kw_only=True):
     pose: Pose | None = None
     last_command_id: str | None = None
     last_result: str | None = None
+    # The battery as the robot reports it (None: it reports none, and is not planned by it).
     battery: Battery | None = None
+    # False while a person has taken the robot out of service: it takes no task.
     in_service: bool = True
 
     @property
