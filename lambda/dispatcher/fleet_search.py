@@ -153,13 +153,16 @@ class FleetSearch:
         index_name: str = "AWS_Things",
         client: Any = None,
         holding: Callable[[], Iterable[str]] | None = None,
+        usable: Callable[[RobotState], bool] | None = None,
     ) -> None:
-        """`holding` names the robots holding a task now (the task table's claims): a page
-        of idle robots that all hold one is read past. Without it, every robot found
-        counts as free."""
+        """`holding` names the robots holding a task now (the task table's claims) and
+        `usable` says whether the dispatcher would give a robot a task at all (a rule on
+        its battery, say): a page of idle robots none of which holds no task and is usable
+        is read past. Without them, every robot found counts as free."""
         self._index = index_name
         self._client = client or boto3.client("iot", config=CLIENT_CONFIG)
         self._holding = holding
+        self._usable = usable
         self._every_robot = False
 
     @contextmanager
@@ -184,7 +187,11 @@ class FleetSearch:
             for page in self._pages(status_query(statuses)):
                 found = self._found(page)
                 robots.extend(found)
-                if any(robot.thing not in holding for robot in found):
+                usable = self._usable
+                if any(
+                    robot.thing not in holding and (usable is None or usable(robot))
+                    for robot in found
+                ):
                     return robots
         return robots
 

@@ -27,6 +27,8 @@ from vahr.twin.shadow_store import ShadowStore
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
+    from vahr.dispatch import RobotState
+
 
 @pytest.fixture
 def fleet_index(aws_credentials: None) -> Iterator[tuple[ShadowStore, Any]]:
@@ -162,3 +164,24 @@ def test_many_robots_states_are_read_in_few_searches_within_the_query_limit(
     assert len(states) == 120 and "rover120" not in states
     assert states["rover007"].last_command_id == "task7" and not states["rover007"].connected
     assert len(queries) == 3 and all(len(query) <= 1000 for query in queries)
+
+
+def test_a_page_of_robots_the_dispatcher_would_not_use_is_read_past(
+    fleet_index: tuple[ShadowStore, Any],
+) -> None:
+    store, iot = fleet_index
+    # Given 100 idle robots almost empty, then 20 charged ones on the second page
+    for n in range(120):
+        report(store, f"rover{n:03}", status="idle", connected=True,
+               battery={"percent": 5 if n < 100 else 90, "charging": False})  # fmt: skip
+    queries = searches(iot)
+
+    def charged(robot: RobotState) -> bool:
+        return robot.battery is None or robot.battery.percent >= 20
+
+    found = FleetSearch(client=iot, usable=charged).available()
+    # Then the second page is read too, and the charged robots are among those found
+    assert len(queries) == 2
+    assert {robot.thing for robot in found if charged(robot)} == {
+        f"rover{n:03}" for n in range(100, 120)
+    }
