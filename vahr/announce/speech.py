@@ -24,7 +24,7 @@ WORDS: dict[str, str] = {
     "cancelled": "{robot} was given another command, so {task}{to_zone} is cancelled.",
     # A task lost for another reason (`vahr.protocol.lost_tasks.LostWhy`): `cancelled_<why>`.
     "cancelled_offline": "{robot} went offline before it started {task}{to_zone}; it is cancelled.",
-    "cancelled_unacknowledged": "{robot} never acknowledged {task}{to_zone}, so it is cancelled.",
+    "cancelled_unacknowledged": "{robot} is not doing {task}{to_zone}, so it is cancelled.",
     "done": "{robot} has finished its task{where}.",
     "on_its_way": " on its way to {zone}",
     "at": " at {zone}",
