@@ -51,8 +51,9 @@ TIMEOUT = cdk.Duration.seconds(30)
 MEMORY_MB = 512
 # The fleet index the skill may ask for counts and searches (issue 35's status summary).
 SKILL_INDEX_ACTIONS = ("iot:SearchIndex", "iot:GetBucketsAggregation", "iot:GetStatistics")
-# How often the schedule has the function give queued tasks to robots free now, in case a
-# robot's rule event was lost. With nothing queued a tick is one read of the queue.
+# How often the schedule has the function offer again the commands robots never acknowledged
+# and give queued tasks to robots free now, in case a robot's rule event was lost. With no
+# open task a tick is one read of the open tasks (and the closed zones told again).
 TICK = cdk.Duration.minutes(1)
 
 
