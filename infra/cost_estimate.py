@@ -278,6 +278,13 @@ class DispatchUsage:
     # and a GetItem (4).
     table_reads: float = 9.0
     table_writes: float = 11.0
+    # The schedule's look at the task once its robot has it (lambda/dispatcher/reoffer.py):
+    # the acknowledgment marked on the task's item (an UpdateItem, 1 write) and the robot
+    # found in the index (one SearchIndex query, shared by the up to about 40 tasks of one
+    # minute: one per task at most). The tick's own reads are the tick's
+    # (`announcer_ticks_cost`, the same schedule).
+    ack_writes: float = 1.0
+    ack_searches: float = 1.0
     # The robot's shadow updates while it does one task (LabUsage: a delivery sends 9).
     # Each is a rule triggered (the rule's topic filter matches every classic shadow's
     # documents; counted whether or not WHERE selects it) and an index update (a robot's
@@ -300,16 +307,18 @@ def dispatch_billable(
     reading every robot's shadow."""
     common = {
         "dynamodb_reads": usage.table_reads,
-        "dynamodb_writes": usage.table_writes,
+        "dynamodb_writes": usage.table_writes + usage.ack_writes,
         "lambda_requests": 2.0,  # the skill's submit, the robot-freed event
         "rules_triggered": float(usage.shadow_updates),
         "rule_actions": 1.0,
         "messages": float(usage.command_messages),
     }
     if not index:
-        return Billable(shadow_operations=robots * usage.shadow_units_per_read, **common)
+        # The candidates, and the schedule's look at the task's robot, by shadow reads.
+        reads = (robots + usage.ack_searches) * usage.shadow_units_per_read
+        return Billable(shadow_operations=reads, **common)
     return Billable(
-        index_queries=float(usage.search_pages),
+        index_queries=float(usage.search_pages) + usage.ack_searches,
         index_updates=float(usage.shadow_updates),
         **common,
     )

@@ -107,10 +107,13 @@ class CallMeter:
 
 @dataclass(frozen=True)
 class DispatchMeasure:
-    """The calls and units of one task: its submit and the event that closed it."""
+    """The calls and units of one task: its submit, the schedule's look at it once its
+    robot had it (the tick's own reads of the open tasks and the closed zones, and the
+    closures told, are the tick's whatever the tasks), and the event that closed it."""
 
     robots: int
     submit: CallMeter
+    tick: CallMeter
     freed: CallMeter
     assigned_to: str
 
@@ -150,8 +153,9 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
         store.update(thing, None, json.dumps({"state": {"reported": reported}}).encode())
     dynamodb = boto3.client("dynamodb", region_name=REGION)
     _create_table(dynamodb)
+    now = [datetime.now(UTC)]
     with server:
-        submit_meter, freed_meter = CallMeter(), CallMeter()
+        submit_meter, tick_meter, freed_meter = CallMeter(), CallMeter(), CallMeter()
 
         def dispatcher(meter: CallMeter) -> Dispatcher:
             # Built as the function's runtime builds it (dispatcher.app.runtime).
@@ -168,7 +172,7 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
                 publish=CommandChannel(
                     client=meter.watch(boto3.client("iot-data", region_name=REGION))
                 ),
-                clock=lambda: datetime.now(UTC),
+                clock=lambda: now[0],
             )
 
         answer = app.handle(
@@ -176,6 +180,16 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
             dispatcher(submit_meter),
         )
         [task] = answer["body"]["assigned"]
+        # The robot took it; a minute later the schedule sees that, once.
+        accepted = {
+            "status": "navigating",
+            "connected": True,
+            "last_command": {"id": task["id"], "action": "deliver", "result": "accepted"},
+        }
+        store.update(task["thing"], None, json.dumps({"state": {"reported": accepted}}).encode())
+        now[0] += timedelta(minutes=1)
+        tick = app.handle(load_event("eventbridge_schedule"), dispatcher(tick_meter))
+        assert tick["acknowledged"] == [task["id"]], tick
         done = {
             "status": "idle",
             "zone": "C",
@@ -183,7 +197,7 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
             "last_command": {"id": task["id"], "action": "deliver", "result": "done"},
         }
         app.handle({"thing": task["thing"], "reported": done}, dispatcher(freed_meter))
-    return DispatchMeasure(robots, submit_meter, freed_meter, task["thing"])
+    return DispatchMeasure(robots, submit_meter, tick_meter, freed_meter, task["thing"])
 
 
 def measure_zone_change() -> CallMeter:

@@ -25,9 +25,12 @@ def test_a_task_costs_the_modelled_table_units_and_one_search_page_whatever_the_
     assert measured.submit.calls["SearchIndex"] == 1
     assert measured.freed.calls["SearchIndex"] == 0
     assert "GetThingShadow" not in measured.submit.calls + measured.freed.calls
+    # The schedule saw the robot with it once: one search, the acknowledgment marked
+    assert measured.tick.calls["SearchIndex"] == usage.ack_searches
+    assert measured.tick.calls["UpdateItem"] == 1 and measured.tick.writes == usage.ack_writes
     # One command published, to the robot that took the task
     assert measured.submit.calls["Publish"] == 1 and measured.freed.calls["Publish"] == 0
-    assert dispatch_billable(robots, index=True).index_queries == 1
+    assert dispatch_billable(robots, index=True).index_queries == 1 + usage.ack_searches
 
 
 def test_the_index_is_cheaper_than_reading_every_shadow_from_a_few_hundred_robots() -> None:

@@ -241,9 +241,7 @@ def test_a_task_never_acknowledged_is_announced_once_offered_too_often(
     ended = table.get(task["id"])
     assert ended is not None and (ended.status, ended.outcome) == ("cancelled", "cancelled")
     assert table.active() == []
-    assert spoken(wire) == [
-        "Placebot one is not doing its delivery to zone C, so it is cancelled."
-    ]
+    assert spoken(wire) == ["Placebot one is not doing its delivery to zone C, so it is cancelled."]
     [invocation] = announcer.invocations
     assert invocation["lost_task"] | {"at": None} == {
         "task": task["id"], "thing": "placebot1", "kind": "deliver", "zone": "C",
