@@ -39,7 +39,8 @@ from dispatcher import app  # noqa: E402
 from dispatcher.command_channel import CommandChannel  # noqa: E402
 from dispatcher.fleet_search import FleetSearch  # noqa: E402
 from dispatcher.task_table import TaskTable  # noqa: E402
-from tests.support.dispatch_meter import REGION, TABLE, _create_table  # noqa: E402
+from tests.support.dispatch_meter import REGION, TABLE  # noqa: E402
+from tests.support.dynamodb_tables import create_task_table  # noqa: E402
 from vahr.dispatch import Dispatcher  # noqa: E402
 from vahr.domain import load_fleet  # noqa: E402
 from vahr.twin.dataplane import DataPlane, DataPlaneServer  # noqa: E402
@@ -87,7 +88,7 @@ def submits(store: ShadowStore, *, every_page: bool, repeats: int) -> tuple[list
     times: list[float] = []
     with mock_aws(), server:
         dynamodb = boto3.client("dynamodb", region_name=REGION)
-        _create_table(dynamodb)
+        create_task_table(dynamodb, TABLE)
         table = TaskTable(TABLE, client=dynamodb)
         iot = boto3.client("iot", endpoint_url=server.url)
         counted: Counter[str] = Counter()
@@ -153,15 +154,13 @@ Load average {load} when it ran.
 A busy robot is sent only when no idle one is free, so with none idle the idle search finds
 nothing (one call) and the first page of busy robots answers (one more). The times are the
 local index's; on AWS each SearchIndex call is a round trip to the IoT control plane, one
-after the other, so the calls saved are the time saved. What it costs: one index query per
-task whatever the fleet's size (`infra/cost_estimate.py`, "Billable AWS operations per
-dispatched task").
+after the other, so the calls saved are the time saved. In the index's bill a submit is one
+query whatever the fleet's size (the section "Billable AWS operations per dispatched task
+and per status question, by fleet size").
 """
     print(json.dumps({"robots": args.robots, **figures, "load": load}))
-    if args.write:
-        write_section(
-            "fleet_search", f"Fleet dispatch on AWS: a submit among {args.robots:,} robots", body
-        )
+    title = f"Fleet dispatch on AWS: a submit among {args.robots:,} robots"
+    write_section("fleet_search", title, body)
     return 0
 
 

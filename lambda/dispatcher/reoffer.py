@@ -101,14 +101,17 @@ def watch_assigned(
         elif offer.offers >= MAX_REOFFERS:
             why = "unacknowledged"
         if why is None:
+            # Counted first, on the version read: a task cancelled or finished meanwhile is
+            # not sent again (its robot may have been told to stop).
+            if not table.offered(task, at=timestamp(now)):
+                continue
             try:
                 dispatcher.publish(task.thing, Dispatcher.command_for(task))
             except PublishError as err:
                 log.warning("task %s not sent again (next minute): %s", task.id, err)
                 continue
-            if table.offered(task, at=timestamp(now)):
-                log.info("task %s sent again to %s (%d)", task.id, task.thing, offer.offers + 1)
-                offered.append(task.id)
+            log.info("task %s sent again to %s (%d)", task.id, task.thing, offer.offers + 1)
+            offered.append(task.id)
             continue
         ended = table.finish(task.id, outcome="cancelled")
         if ended is None:

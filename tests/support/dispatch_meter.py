@@ -28,6 +28,7 @@ from dispatcher.command_channel import CommandChannel
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
 from infra.cost_estimate import dynamodb_units
+from tests.support.dynamodb_tables import create_task_table
 from vahr.dispatch import Dispatcher
 from vahr.domain import load_fleet
 from vahr.twin.dataplane import DataPlane, DataPlaneServer
@@ -237,7 +238,7 @@ def measure_lost_task() -> CallMeter:
         store.update("placebot2", None, json.dumps(body).encode())
 
     report(connected=True)
-    _create_table(boto3.client("dynamodb", region_name=REGION))
+    create_task_table(boto3.client("dynamodb", region_name=REGION), TABLE)
     meter = CallMeter()
     now = [datetime.now(UTC)]
     tick = load_event("eventbridge_schedule")
