@@ -157,8 +157,8 @@ class FleetSearch:
     ) -> None:
         """`holding` names the robots holding a task now (the task table's claims) and
         `usable` says whether the dispatcher would give a robot a task at all (a rule on
-        its battery, say): a page of idle robots none of which holds no task and is usable
-        is read past. Without them, every robot found counts as free."""
+        its battery, say): a page whose idle robots all hold a task or are not usable is
+        read past. Without them, every robot found counts as free."""
         self._index = index_name
         self._client = client or boto3.client("iot", config=CLIENT_CONFIG)
         self._holding = holding
