@@ -46,7 +46,7 @@ AREAS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     )),
     ("aws", "AWS: cold starts and cost", (
         "skill_cold_start", "lambda_bundle", "billable_operations",
-        "billable_operations_fleet", "audit_trail",
+        "billable_operations_fleet", "fleet_search", "audit_trail",
     )),
     ("reliability", "Reliability", ("dataplane_load", "fuzz", "soak")),
     ("experiment", "The experiment", ("experiment_log", "rehearsal")),

@@ -23,6 +23,9 @@ import msgspec
 
 from vahr.domain.fleet import Pose
 
+# At run time: msgspec reads RobotState's annotations when it decodes one.
+from vahr.protocol.shadow import Battery  # noqa: TC001
+
 if TYPE_CHECKING:
     from vahr.dispatch.tasks import Task
     from vahr.domain.fleet import Fleet, Zone
@@ -45,6 +48,10 @@ class RobotState(msgspec.Struct, frozen=True, kw_only=True):
     pose: Pose | None = None
     last_command_id: str | None = None
     last_result: str | None = None
+    # The battery as the robot reports it (None: it reports none, and is not planned by it).
+    battery: Battery | None = None
+    # False while a person has taken the robot out of service: it takes no task.
+    in_service: bool = True
 
     @property
     def available(self) -> bool:
