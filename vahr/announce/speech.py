@@ -23,6 +23,7 @@ WORDS: dict[str, str] = {
     "waiting": "A task{for_robot} has waited {waited} in the queue.",
     "cancelled": "{robot} was given another command, so {task}{to_zone} is cancelled.",
     "done": "{robot} has finished its task{where}.",
+    "battery_low": "{robot} is low on battery and is going to charge.",
     "on_its_way": " on its way to {zone}",
     "at": " at {zone}",
     "for_robot": " for {robot}",
@@ -37,7 +38,8 @@ WORDS: dict[str, str] = {
     "task": "its task",
 }
 PROMPTS: dict[AnnouncementKind, str] = {
-    kind: WORDS[kind] for kind in ("stuck", "failed", "offline", "waiting", "cancelled", "done")
+    kind: WORDS[kind]
+    for kind in ("stuck", "failed", "offline", "waiting", "cancelled", "done", "battery_low")
 }
 NO_REASON = WORDS["no_reason"]
 

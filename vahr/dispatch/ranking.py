@@ -23,7 +23,11 @@ import msgspec
 
 from vahr.domain.fleet import Pose
 
+# At run time: msgspec reads RobotState's annotations when it decodes one.
+from vahr.protocol.shadow import Battery  # noqa: TC001
+
 if TYPE_CHECKING:
+    from vahr.dispatch.energy import EnergyRule
     from vahr.dispatch.tasks import Task
     from vahr.domain.fleet import Fleet, Zone
 
@@ -45,11 +49,20 @@ class RobotState(msgspec.Struct, frozen=True, kw_only=True):
     pose: Pose | None = None
     last_command_id: str | None = None
     last_result: str | None = None
+    # The battery as the robot reports it (None: it reports none, and is not planned by it).
+    battery: Battery | None = None
+    # False while a person has taken the robot out of service: it takes no task.
+    in_service: bool = True
 
     @property
     def available(self) -> bool:
-        """Connected and idle or busy; a stuck, failed or offline robot takes no task."""
-        return self.connected and (self.status in IDLE_STATUSES or self.status in BUSY_STATUSES)
+        """Connected, in service, and idle or busy; a stuck, failed or offline robot, or one
+        out of service, takes no task."""
+        return (
+            self.connected
+            and self.in_service
+            and (self.status in IDLE_STATUSES or self.status in BUSY_STATUSES)
+        )
 
     @property
     def idle(self) -> bool:
@@ -136,10 +149,13 @@ def rank(
     *,
     limit: int | None = None,
     routes: Routes = STRAIGHT,
+    energy: EnergyRule | None = None,
 ) -> list[RobotState]:
     """The robots allowed to take `task`, best first: idle before busy, then by cost, then
     by thing name. With `limit`, only the best `limit` (a partial sort: 10,000 robots are
-    ranked without sorting them all). A robot no path leads from is left out.
+    ranked without sorting them all). A robot no path leads from is left out, and so, with
+    `energy`, is one whose battery cannot do the task and still reach a charger with its
+    reserve left (`vahr.dispatch.energy`).
 
     The cost is `task_cost`, computed here with the pickup and drop looked up once: the
     leg from the pickup to the drop is the same for every robot, and the first leg is one
@@ -171,6 +187,9 @@ def rank(
         for robot, cost in zip(candidates, costs, strict=True)
         if cost != inf
     ]
+    if energy is not None:
+        after = energy.after(task)
+        keyed = [entry for entry in keyed if energy.can_do(entry[3], entry[1], after)]
     # Tuples compare field by field and thing names are unique, so the states themselves
     # are never compared.
     if limit is None:

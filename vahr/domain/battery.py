@@ -60,6 +60,8 @@ class BatteryPlan(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     types: dict[str, BatteryType] = {}
     # Seconds of arm work in a delivery (loading and unloading), counted as working time.
     arm_time_s: Annotated[float, msgspec.Meta(ge=0, le=3600)] = ARM_TIME_S
+    # The speed the dispatcher assumes to count the time a drive works (the simulator's).
+    drive_speed_mps: Annotated[float, msgspec.Meta(gt=0, le=20)] = 0.5
 
     def rates(self, robot_type: str) -> BatteryType:
         """The rates of robots of `robot_type` (the defaults for a type not listed)."""
