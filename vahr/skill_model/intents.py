@@ -669,7 +669,8 @@ BATTERY = IntentSpec(
         "[<ask>] (which|what) (robots|bots|ones) (are|have) (below|under|less than) {percent} "
         "percent (of battery|of charge|left)",
         "(are|is) (any|some) (robots|bots|of the robots) (below|under) {percent} percent",
-        "[<ask>] (which|what) (robots|bots|ones) (are|run) (low on|short of) (battery|charge|power)",
+        "[<ask>] (which|what) (robots|bots|ones) (are|run) (low on|short of) (battery|charge|"
+        "power)",
         "[<ask>] (which|what) (robots|bots|ones) need (to charge|charging|a charge)",
         "[<ask>] (how much battery|how much charge|what charge) do {robot} have",
         "[<ask>] (what are|tell me) the battery levels [of the robots|of the fleet]",
