@@ -422,4 +422,5 @@ def reference_id(subject: str, kind: str, opened_at: float) -> str:
     """A stable id for one fault: the same fault told twice (a retry) has the same id, so
     Alexa's Proactive Events API refuses the duplicate (409) instead of notifying twice."""
     digest = hashlib.sha256(f"{subject}\0{kind}\0{opened_at:.6f}".encode()).hexdigest()
-    return f"vahr~{kind}~{digest[:32]}"
+    # Alexa's referenceId takes letters, digits and '~' only: `battery_low` is `batterylow`.
+    return f"vahr~{kind.replace('_', '')}~{digest[:32]}"

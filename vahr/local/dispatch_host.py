@@ -10,7 +10,8 @@
 
 The data plane serves it (`TasksApi`) under `/vahr/tasks`: `POST` submits an order
 (answers the `Submission`), `GET` lists the tasks robots hold then the queue
-(`{"tasks": [...], "closed": [zone ids]}`), `DELETE /vahr/tasks/{id}` cancels one; and
+(`{"tasks": [...], "closed": [zone ids], "out_of_service": [things]}`), `DELETE
+/vahr/tasks/{id}` cancels one; and
 under `/vahr/zones` (`ZonesApi`): `GET` answers `{"closed": [zone ids]}`, `POST
 /vahr/zones/{zone}` with `{"closed": true|false}` closes or opens one (answers the
 `ZoneChange`). Closures live in the same SQLite file, and every change is published,
@@ -157,13 +158,18 @@ class IndexCandidates:
 
 class TasksApi:
     """`/vahr/tasks` on the data plane, in its typed-route form: (status, body, error type).
-    `record`, when given, takes the trail's entry for each order and cancel."""
+    `record`, when given, takes the trail's entry for each order and cancel;
+    `out_of_service` says which robots are out of service, for the list."""
 
     def __init__(
-        self, dispatcher: Dispatcher, record: Callable[[AuditEntry], object] | None = None
+        self,
+        dispatcher: Dispatcher,
+        record: Callable[[AuditEntry], object] | None = None,
+        out_of_service: Callable[[], list[str]] | None = None,
     ) -> None:
         self.dispatcher = dispatcher
         self._record = record
+        self._out_of_service = out_of_service
 
     def respond(
         self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
@@ -178,7 +184,9 @@ class TasksApi:
         if path == TASKS_PATH:
             if method == "GET":
                 closed = self.dispatcher.closed_zones()
-                return _ok({"tasks": self.dispatcher.tasks(), "closed": closed})
+                out = self._out_of_service() if self._out_of_service is not None else []
+                body = {"tasks": self.dispatcher.tasks(), "closed": closed, "out_of_service": out}
+                return _ok(body)
             if method == "POST":
                 return self._submit(body)
             return _error(405, f"{method} is not allowed on {TASKS_PATH}")
@@ -440,7 +448,7 @@ class LocalDispatcher:
             routes=floor.routes if floor is not None else None,
             publish_closures=self._publish_closures,
         )
-        self.api = TasksApi(self.dispatcher, record)
+        self.api = TasksApi(self.dispatcher, record, self.tasks.out_of_service)
         self.zones_api = ZonesApi(self.dispatcher, record)
         self.robots_api = RobotsApi(self, record)
         self._updates: queue.SimpleQueue[str | None] = queue.SimpleQueue()
