@@ -316,9 +316,9 @@ class Dispatcher:
         energy = self._energy()
         if energy is not None and energy.wants_charge(state) and state.idle:
             return self.charge(state.thing, state=state)
-        return self.robot_freed(state.thing)
+        return self.robot_freed(state.thing, state)
 
-    def robot_freed(self, thing: str) -> Task | None:
+    def robot_freed(self, thing: str, state: RobotState | None = None) -> Task | None:
         """Give `thing` the first queued task it may take (first come, first served): not
         one into a closed zone, nor, on a map, one it has no path to. When another
         dispatcher got there first, the next one; None when nothing is left."""
@@ -326,18 +326,26 @@ class Dispatcher:
         if not pending:
             return None
         closed = self._closed()
-        state = None
         on_map = self.fleet.floor is not None and self.fleet.floor.map is not None
         energy = self._energy(closed)
-        if energy is not None or on_map:
-            state = self.candidates.state(thing)
-            if state is not None and not state.in_service:
-                return None
+        # Its state as reported (passed by `observe`): a robot out of service takes nothing.
+        state = state or self.candidates.state(thing)
+        if state is not None and not state.in_service:
+            return None
         for task in pending:
             if not task.allows(thing) or self._blocked(task, closed):
                 continue
-            if state is not None and not rank(
-                self.fleet, task, [state], limit=1, routes=self.routes_for(closed), energy=energy
+            if (
+                state is not None
+                and (on_map or energy is not None)
+                and not rank(
+                    self.fleet,
+                    task,
+                    [state],
+                    limit=1,
+                    routes=self.routes_for(closed),
+                    energy=energy,
+                )
             ):
                 continue
             taken = self._assign(task, thing)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import heapq
 import math
 from collections.abc import Callable, Iterable
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import msgspec
 
@@ -27,7 +27,6 @@ from vahr.domain.fleet import Pose
 from vahr.protocol.shadow import Battery  # noqa: TC001
 
 if TYPE_CHECKING:
-    from vahr.dispatch.energy import EnergyRule
     from vahr.dispatch.tasks import Task
     from vahr.domain.fleet import Fleet, Zone
 
@@ -116,6 +115,18 @@ class StraightRoutes:
 STRAIGHT = StraightRoutes()
 
 
+class EnergyCheck(Protocol):
+    """Whether a robot's battery can do a task (`vahr.dispatch.energy.EnergyRule`)."""
+
+    def after(self, task: Task) -> object:
+        """What the task costs beyond the robot's way to it (the same for every robot)."""
+        ...
+
+    def can_do(self, robot: RobotState, metres: float, after: Any) -> bool:
+        """Whether `robot`, `metres` from the task's end by its way there, may take it."""
+        ...
+
+
 def task_cost(fleet: Fleet, pose: Pose, task: Task, routes: Routes = STRAIGHT) -> float:
     """Metres a robot at `pose` drives to do `task`: to the pickup (if any), then to the
     drop zone (math.inf when no path leads there). A robot already in the drop zone of a
@@ -149,7 +160,7 @@ def rank(
     *,
     limit: int | None = None,
     routes: Routes = STRAIGHT,
-    energy: EnergyRule | None = None,
+    energy: EnergyCheck | None = None,
 ) -> list[RobotState]:
     """The robots allowed to take `task`, best first: idle before busy, then by cost, then
     by thing name. With `limit`, only the best `limit` (a partial sort: 10,000 robots are

@@ -645,8 +645,9 @@ OPEN_ZONE = IntentSpec(
 # Batteries and service (docs/dispatch.md): the charge of a robot or of the fleet, a robot
 # sent to charge now, and robots taken out of service and put back.
 PERCENT = SlotSpec("percent", PERCENT_TYPE)
-# Fewer samples than the others: the model's samples are bounded in all (generator.py).
-BATTERY_SAMPLES = 100
+# Fewer samples than the others: the model's samples are bounded in all (generator.py), and
+# so are the sentences the station hears with a thousand robots' names (vahr.station).
+BATTERY_SAMPLES = 60
 
 BATTERY = IntentSpec(
     name="BatteryIntent",
@@ -737,8 +738,10 @@ BACK_IN_SERVICE = IntentSpec(
         "pool) <end>",
         "<ask> (put|bring|take|set) {group} back (in|into|to) (service|operation|rotation|the "
         "pool) <end>",
-        "<ask> (return|restore) {robot} to (service|operation|the pool) <end>",
-        "<ask> (return|restore) {group} to (service|operation|the pool) <end>",
+        # Not "return X to ...": a robot returns to a zone ("placebot two return to the
+        # loading zone" is a navigation).
+        "<ask> restore {robot} to (service|operation) <end>",
+        "<ask> restore {group} to (service|operation) <end>",
         "{robot} is (back in service|back in operation|repaired|fixed|working again) [now]",
         "{group} are (back in service|back in operation|repaired|fixed|working again) [now]",
         "<ask> (mark|set) {robot} (as in service|as back in service|as working)",
