@@ -21,10 +21,10 @@ from tests.conftest import load_event
 from tests.support.fleets import SIX_ROBOTS
 from vahr.dispatch import (
     Dispatcher,
-    ServiceChange,
     DispatchError,
     Order,
     RobotState,
+    ServiceChange,
     Submission,
     Task,
     ZoneChange,
