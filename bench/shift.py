@@ -100,12 +100,23 @@ def shift_fleet(robots: int) -> Fleet:
     return fleet.validate()
 
 
+SHIFT_START = datetime(2026, 11, 30, 6, 0, tzinfo=UTC)
+
+
 @dataclass
-class Clock:
-    now: float = 0.0
+class ShiftClock:
+    """The simulator's clock, moved by the shift one step at a time."""
+
+    seconds: float = 0.0
 
     def monotonic(self) -> float:
-        return self.now
+        return self.seconds
+
+    def now(self) -> datetime:
+        return SHIFT_START + timedelta(seconds=self.seconds)
+
+    async def sleep(self, seconds: float) -> None:
+        raise NotImplementedError("the shift steps its clock itself")
 
 
 @dataclass
@@ -140,7 +151,7 @@ class Shift:
 
     def __init__(self, fleet: Fleet, starts: list[float], *, respect: bool, store: Path) -> None:
         self.fleet = fleet
-        self.clock = Clock()
+        self.clock = ShiftClock()
         self.changed: set[str] = set()
         self.died: set[str] = set()
         self.bots: dict[str, Bot] = {}
@@ -149,29 +160,34 @@ class Shift:
             for robot, percent in zip(fleet.robots, starts, strict=True)
         }
         self.store = SqliteTaskStore(store)
-        began = datetime(2026, 11, 30, 6, 0, tzinfo=UTC)
         self.dispatcher = Dispatcher(
             fleet=fleet,
             store=self.store,
             candidates=self,
             publish=self._publish,
-            clock=lambda: began + timedelta(seconds=self.clock.now),
+            clock=self.clock.now,
             respect_battery=respect,
         )
         self.lowest = min(starts)
 
     def _battery(self, robot: Robot, percent: float) -> SimBattery:
-        bot_pose = robot.start
+        thing, start = robot.thing, robot.start
+
+        def pose() -> Pose:
+            bot = self.bots.get(thing)
+            return bot.pose if bot is not None else start
+
+        def changed(reading: Battery) -> None:
+            self.changed.add(thing)
+
         battery = SimBattery(
             clock=self.clock,
-            pose=lambda thing=robot.thing: (
-                self.bots[thing].pose if thing in self.bots else bot_pose
-            ),
-            rates=self.fleet.battery_rates(robot.thing),
+            pose=pose,
+            rates=self.fleet.battery_rates(thing),
             chargers=self.fleet.chargers,
             percent=percent,
         )
-        battery.watch(lambda reading, thing=robot.thing: self.changed.add(thing))
+        battery.watch(changed)
         return battery
 
     # -- the Candidates port ----------------------------------------------------------
@@ -210,7 +226,7 @@ class Shift:
         self.changed.add(thing)
 
     def step(self, dt: float) -> None:
-        self.clock.now += dt
+        self.clock.seconds += dt
         for bot in self.bots.values():
             if bot.dead or not bot.legs:
                 bot.battery.settle()
@@ -267,7 +283,7 @@ def run(
         began = time.perf_counter()
         due = 0
         for _ in range(int(SHIFT_H * 3600)):
-            while due < deliveries and arrivals[due] <= shift.clock.now:
+            while due < deliveries and arrivals[due] <= shift.clock.seconds:
                 shift.dispatcher.submit(Order(kind="deliver", zone=zones[due]))
                 due += 1
             shift.step(1.0)

@@ -185,8 +185,8 @@ class TasksApi:
             if method == "GET":
                 closed = self.dispatcher.closed_zones()
                 out = self._out_of_service() if self._out_of_service is not None else []
-                body = {"tasks": self.dispatcher.tasks(), "closed": closed, "out_of_service": out}
-                return _ok(body)
+                tasks = self.dispatcher.tasks()
+                return _ok({"tasks": tasks, "closed": closed, "out_of_service": out})
             if method == "POST":
                 return self._submit(body)
             return _error(405, f"{method} is not allowed on {TASKS_PATH}")
