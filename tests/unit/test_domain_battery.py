@@ -100,3 +100,20 @@ def test_vahr_fault_battery_refuses_a_charge_that_is_not_one_before_sending(
     err = capsys.readouterr().err.strip()
     assert code != 0
     assert words in err and "\n" not in err
+
+
+def test_a_charger_no_robot_can_reach_is_one_line() -> None:
+    text = """
+battery: {}
+floor: {width: 10, height: 6}
+robots:
+  - {thing: r1, spoken: [r one], start: {x: 1, y: 1}}
+zones:
+  - {id: LOADING, spoken: [loading], pose: {x: 2, y: 2}}
+  - {id: DOCK, spoken: [dock], pose: {x: 14, y: 2}, charger: true}
+"""
+    with pytest.raises(ProtocolError) as caught:
+        Fleet.from_yaml(text)
+    assert str(caught.value) == (
+        "zones.1.pose: (14, 2) is outside the floor (x 0 to 10, y 0 to 6), so no robot can reach it"
+    )
