@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from skill import prompts
-from skill.task_speech import and_list, task_name
+from skill.task_speech import and_list, spoken_number, task_name
 from skill.vocabulary import capitalise
 
 if TYPE_CHECKING:
@@ -48,7 +48,9 @@ def below(vocabulary: Vocabulary, percent: int, reads: Sequence[ShadowRead]) -> 
     low.sort()
     entries = [_entry(vocabulary, thing, level, charging) for level, thing, charging in low]
     wording = prompts.BATTERY_BELOW[min(len(low), 2)]
-    return wording.format(count=len(low), percent=percent, robots=and_list(entries))
+    return capitalise(
+        wording.format(count=spoken_number(len(low)), percent=percent, robots=and_list(entries))
+    )
 
 
 def every_battery(vocabulary: Vocabulary, reads: Sequence[ShadowRead]) -> str:
@@ -105,7 +107,7 @@ def service_report(vocabulary: Vocabulary, changes: Sequence[ServiceChange]) -> 
                 )
         if change.waiting and len(changes) == 1:
             waits = prompts.SERVICE_WAITING[min(len(change.waiting), 2)]
-            sentences.append(waits.format(count=len(change.waiting)))
+            sentences.append(capitalise(waits.format(count=spoken_number(len(change.waiting)))))
         for task in change.given:
             sentences.append(prompts.SERVICE_GIVEN.format(task=task_name(vocabulary, task)))
     return " ".join(sentences)
