@@ -39,7 +39,7 @@ AREAS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     )),
     ("fleet", "The fleet", (
         "fanout", "shadow_throughput", "fleet_index", "dispatch", "floor_planning",
-        "status_summary", "swarm_startup", "swarm_drive",
+        "status_summary", "swarm_startup", "swarm_drive", "shift",
     )),
     ("robots", "Robots and the wire", (
         "protocol_import", "agent_footprint", "nav2_goal_latency",

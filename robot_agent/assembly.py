@@ -56,7 +56,12 @@ def build_backend(config: AgentConfig, fleet: Fleet, clock: ScaledClock) -> Navi
             ) from err
         return Nav2Backend(config.nav2, start=fleet.robot(thing).start)
     return SimBackend(
-        start=fleet.robot(thing).start, clock=clock, settings=config.sim, floor=robot_floor(fleet)
+        start=fleet.robot(thing).start,
+        clock=clock,
+        settings=config.sim,
+        floor=robot_floor(fleet),
+        battery=fleet.battery_rates(thing),
+        chargers=fleet.chargers,
     )
 
 

@@ -61,6 +61,11 @@ class DevFaults:
             backend.inject_failure("an injected fault")
         elif request.fault == "clear":
             backend.clear_faults()
+        elif request.fault == "battery":
+            if request.percent is None:
+                self._answer(request.id, "battery: a percent from 0 to 100 is needed")
+                return
+            backend.set_battery(request.percent)
         elif self._away is None or self._away.done():
             # Answer first: the answer cannot be sent once the connection is dropped.
             self._answer(request.id)

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 from robot_agent.agent import RobotAgent
 from robot_agent.assembly import robot_floor
 from robot_agent.backends.sim import SimBackend
+from robot_agent.backends.sim_battery import BatteryTicker
 from robot_agent.backends.sim_ticker import SimTicker
 from robot_agent.clock import ScaledClock
 from robot_agent.config import ExecutorSettings, MqttSettings, SimSettings
@@ -85,6 +86,8 @@ class Swarm:
         self._sim = sim or SimSettings()
         # One timer steps every robot's drive: one per robot cost more than the motion.
         self.ticker = SimTicker(clock=self.clock, tick_s=self._sim.tick_s)
+        # And one settles every robot's battery while it stands.
+        self.battery_ticker = BatteryTicker(clock=self.clock)
         self._settings = settings or ExecutorSettings()
         self._state_dir = state_dir
         self._client_id = client_id or f"vahr-swarm-{uuid.uuid4().hex[:8]}"
@@ -129,6 +132,9 @@ class Swarm:
                 settings=self._sim,
                 ticker=self.ticker,
                 floor=floor,
+                battery=self.fleet.battery_rates(thing),
+                chargers=self.fleet.chargers,
+                battery_ticker=self.battery_ticker,
             )
             agent = _LoggedAgent(
                 self._on_event,
@@ -145,6 +151,7 @@ class Swarm:
                 decode=decode,
             )
             agent.attach()
+            backend.watch_battery(agent.executor.report_battery)
             if self._sim.accept_faults:
                 DevFaults(thing=thing, link=link, backend=backend).attach()
             self.agents[thing] = agent

@@ -22,6 +22,7 @@ from skill import logs, prompts
 from skill.catalog import use_locale
 from skill.config import SkillConfig
 from skill.guard import AccessInterceptor, RefusedRequestHandler, TrailInterceptor
+from skill.handlers.battery import BatteryIntentHandler, ChargeIntentHandler
 from skill.handlers.built_in import (
     CancelIntentHandler,
     FallbackIntentHandler,
@@ -46,6 +47,7 @@ from skill.handlers.fleet_tasks import (
 )
 from skill.handlers.navigate import NavigateIntentHandler
 from skill.handlers.sequential_delivery import SequentialDeliveryIntentHandler
+from skill.handlers.service import BackInServiceIntentHandler, OutOfServiceIntentHandler
 from skill.handlers.status import ProblemRobotsIntentHandler, StatusIntentHandler
 from skill.handlers.weather_delivery import WeatherDeliveryIntentHandler
 from skill.handlers.weather_question import WeatherIntentHandler
@@ -87,7 +89,7 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
         NavigateIntentHandler(runtime, desk),
         # A delivery naming no robot goes to the fleet; one naming a robot, as before.
         FleetDeliverHandler(runtime, desk, named=DeliverIntentHandler(runtime, desk)),
-        WeatherDeliveryIntentHandler(runtime),
+        WeatherDeliveryIntentHandler(runtime, desk),
         SequentialDeliveryIntentHandler(runtime, desk),
         StatusIntentHandler(runtime),
         ProblemRobotsIntentHandler(runtime),
@@ -100,6 +102,10 @@ def request_handlers(runtime: SkillRuntime) -> list[AbstractRequestHandler]:
         CancelTaskIntentHandler(runtime, desk),
         CloseZoneIntentHandler(runtime, desk),
         OpenZoneIntentHandler(runtime, desk),
+        BatteryIntentHandler(runtime),
+        ChargeIntentHandler(runtime, desk),
+        OutOfServiceIntentHandler(runtime, desk),
+        BackInServiceIntentHandler(runtime, desk),
         CorrectionIntentHandler(runtime, desk),
         UndoIntentHandler(runtime),
         LaunchRequestHandler(runtime),

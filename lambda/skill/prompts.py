@@ -193,8 +193,16 @@ WEATHER_HAS_NO_ZONE = (
 INTENT_DENIED = "Okay, I sent nothing. Please say it again."
 
 # Fleet dispatch (skill.handlers.fleet_tasks, skill.task_speech): tasks without a robot's name.
-TASK_NAMES = {"navigate": "the trip to {zone}", "deliver": "the delivery to {zone}"}
-TASK_NAMES_PLURAL = {"navigate": "trips to {zone}", "deliver": "deliveries to {zone}"}
+TASK_NAMES = {
+    "navigate": "the trip to {zone}",
+    "deliver": "the delivery to {zone}",
+    "charge": "charging at {zone}",
+}
+TASK_NAMES_PLURAL = {
+    "navigate": "trips to {zone}",
+    "deliver": "deliveries to {zone}",
+    "charge": "charges at {zone}",
+}
 DISPATCHED = {
     "navigate": "{robot} is on its way to {zone}.",
     "deliver": "{robot} is on its way to pick up a package for {zone}.",
@@ -264,6 +272,58 @@ ZONE_GIVEN = {
 QUEUE_ENTRY_WAITING = "{place}, {task}, waiting until {zone} opens"
 NO_ZONE_DESK = (
     "Closing a zone needs the fleet dispatcher, which is not running here, so nothing changed."
+)
+# Batteries: "how much battery does rover one have", "which robots are below 30 percent",
+# "send rover one to charge".
+BATTERY_LEVEL = "{robot} has {percent} percent battery."
+BATTERY_CHARGING = "{robot} has {percent} percent battery and is charging."
+BATTERY_UNKNOWN = "{robot} does not report its battery."
+BATTERY_OFFLINE = "{robot} is offline; it last reported {percent} percent battery."
+BATTERY_ENTRY = "{robot} {percent} percent"
+BATTERY_ENTRY_CHARGING = "{robot} {percent} percent, charging"
+BATTERY_BELOW_NONE = "No robot is below {percent} percent."
+BATTERY_BELOW = {
+    1: "One robot is below {percent} percent: {robots}.",
+    2: "{count} robots are below {percent} percent: {robots}.",
+}
+BATTERY_FLEET = "The batteries: {robots}."
+BATTERY_TOO_MANY = (
+    "The fleet has {count} robots, too many to read every battery aloud; the station shows "
+    "each robot's charge."
+)
+CHARGE_SENT = "{robot} is on its way to {zone} to charge."
+NO_CHARGER = "Every charger is taken or closed now, so {robot} stays where it is."
+# Out of service: "take rover one out of service", "put rover one back in service".
+OUT_OF_SERVICE_REFUSED = {
+    1: "{robots} is out of service, so I sent nothing.",
+    2: "{robots} are out of service, so I sent nothing.",
+}
+NOW_OUT_OF_SERVICE = {
+    1: "{robots} is out of service now and gets no tasks.",
+    2: "{robots} are out of service now and get no tasks.",
+}
+ALREADY_OUT_OF_SERVICE = {
+    1: "{robots} was already out of service.",
+    2: "{robots} were already out of service.",
+}
+NOW_IN_SERVICE = {
+    1: "{robots} is back in service.",
+    2: "{robots} are back in service.",
+}
+ALREADY_IN_SERVICE = {
+    1: "{robots} was not out of service.",
+    2: "{robots} were not out of service.",
+}
+SERVICE_REASSIGNED = "{task} went to {robot} instead."
+SERVICE_REQUEUED = "{task} waits in the queue for another robot."
+SERVICE_WAITING = {
+    1: "One task only it may do waits for it.",
+    2: "{count} tasks only it may do wait for it.",
+}
+SERVICE_GIVEN = "It took {task}."
+NO_SERVICE_DESK = (
+    "Taking a robot out of service needs the fleet dispatcher, which is not running here, "
+    "so nothing changed."
 )
 # Who may do what (skill.guard). A refusal says what the person may do, and that nothing
 # was sent: to someone the skill knows by name, or to someone it does not know.

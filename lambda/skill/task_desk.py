@@ -8,7 +8,8 @@ reads the tasks, cancels one, and reads, closes and opens zones:
   `DELETE {data_endpoint}/vahr/tasks/{id}`, `GET {data_endpoint}/vahr/zones` and `POST
   {data_endpoint}/vahr/zones/{zone}` (urllib; `vahr up`);
 - `LambdaTaskDesk`: the dispatcher function on AWS, invoked synchronously with
-  `{"operation": "submit"|"tasks"|"cancel"|"zones"|"zone", ...}` and answering `{"status",
+  `{"operation": "submit"|"tasks"|"cancel"|"zones"|"zone"|"service"|"set_service"|"charge",
+  ...}` and answering `{"status",
   "body"}`, the same status and body as the local routes (lambda/dispatcher/requests.py).
 
 `task_desk(config)` picks one: the function when `VAHR_DISPATCHER_FUNCTION` is set (the CDK
@@ -29,7 +30,7 @@ from urllib.parse import quote
 import msgspec
 
 from skill.errors import GatewayError, SkillError
-from vahr.dispatch import DispatchErrorCode, Order, Submission, Task, ZoneChange
+from vahr.dispatch import DispatchErrorCode, Order, ServiceChange, Submission, Task, ZoneChange
 from vahr.protocol.audit import RECORDED_BY_HEADER
 
 if TYPE_CHECKING:
@@ -39,6 +40,8 @@ if TYPE_CHECKING:
 DESK_TIMEOUT_S = 4.0
 TASKS_PATH = "/vahr/tasks"
 ZONES_PATH = "/vahr/zones"
+SERVICE_PATH = "/vahr/service"
+CHARGE_PATH = "/vahr/charge"
 
 
 class TaskRefused(SkillError):
@@ -74,6 +77,19 @@ class TaskDesk(Protocol):
         """Close or open a zone; TaskRefused for a zone the fleet does not have."""
         ...
 
+    def out_of_service(self) -> list[str]:
+        """The robots taken out of service now."""
+        ...
+
+    def set_service(self, thing: str, *, in_service: bool) -> ServiceChange:
+        """Take a robot out of service or put it back; TaskRefused for an unknown robot."""
+        ...
+
+    def charge(self, thing: str) -> Task:
+        """Send a robot to the nearest free charger now; TaskRefused (`no_charger`,
+        `out_of_service`, ...) when it cannot go."""
+        ...
+
 
 class _TaskList(msgspec.Struct):
     tasks: list[Task]
@@ -85,6 +101,10 @@ class _Closed(msgspec.Struct):
 
 class _Cancelled(msgspec.Struct):
     task: Task
+
+
+class _OutOfService(msgspec.Struct):
+    out_of_service: list[str]
 
 
 class _Refusal(msgspec.Struct):
@@ -113,6 +133,8 @@ class HttpTaskDesk:
     def __init__(self, endpoint: str, *, timeout_s: float = DESK_TIMEOUT_S) -> None:
         self.url = endpoint.rstrip("/") + TASKS_PATH
         self.zones_url = endpoint.rstrip("/") + ZONES_PATH
+        self.service_url = endpoint.rstrip("/") + SERVICE_PATH
+        self.charge_url = endpoint.rstrip("/") + CHARGE_PATH
         self.timeout_s = timeout_s
 
     def _call(self, method: str, url: str, body: bytes | None = None) -> tuple[int, bytes]:
@@ -152,6 +174,19 @@ class HttpTaskDesk:
         url = f"{self.zones_url}/{quote(zone, safe='')}"
         status, body = self._call("POST", url, msgspec.json.encode({"closed": closed}))
         return _read(status, body, ZoneChange)  # type: ignore[no-any-return]
+
+    def out_of_service(self) -> list[str]:
+        status, body = self._call("GET", self.service_url)
+        return _read(status, body, _OutOfService).out_of_service  # type: ignore[no-any-return]
+
+    def set_service(self, thing: str, *, in_service: bool) -> ServiceChange:
+        url = f"{self.service_url}/{quote(thing, safe='')}"
+        status, body = self._call("POST", url, msgspec.json.encode({"in_service": in_service}))
+        return _read(status, body, ServiceChange)  # type: ignore[no-any-return]
+
+    def charge(self, thing: str) -> Task:
+        status, body = self._call("POST", f"{self.charge_url}/{quote(thing, safe='')}", b"{}")
+        return _read(status, body, _Cancelled).task  # type: ignore[no-any-return]
 
 
 class LambdaTaskDesk:
@@ -211,6 +246,19 @@ class LambdaTaskDesk:
     def set_zone(self, zone: str, *, closed: bool) -> ZoneChange:
         status, body = self._invoke({"operation": "zone", "zone": zone, "closed": closed})
         return _read(status, body, ZoneChange)  # type: ignore[no-any-return]
+
+    def out_of_service(self) -> list[str]:
+        status, body = self._invoke({"operation": "service"})
+        return _read(status, body, _OutOfService).out_of_service  # type: ignore[no-any-return]
+
+    def set_service(self, thing: str, *, in_service: bool) -> ServiceChange:
+        request = {"operation": "set_service", "thing": thing, "in_service": in_service}
+        status, body = self._invoke(request)
+        return _read(status, body, ServiceChange)  # type: ignore[no-any-return]
+
+    def charge(self, thing: str) -> Task:
+        status, body = self._invoke({"operation": "charge", "thing": thing})
+        return _read(status, body, _Cancelled).task  # type: ignore[no-any-return]
 
 
 def task_desk(config: SkillConfig) -> TaskDesk | None:

@@ -20,16 +20,20 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from robot_agent.backends.port import NavigationFailed, Progress
+from robot_agent.backends.sim_battery import BatteryTicker, SimBattery
 from robot_agent.backends.sim_ticker import SimTicker
 from robot_agent.config import SimSettings
 from vahr.domain import Pose
+from vahr.domain.battery import NO_DRAIN
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from robot_agent.clock import Clock
     from vahr.domain import Zone
+    from vahr.domain.battery import BatteryType
     from vahr.navigation import FleetFloor
+    from vahr.protocol import Battery
 
 # A robot leaving a closed zone's circle on a drawn floor stops this far outside it.
 LEAVE_MARGIN_M = 0.3
@@ -69,11 +73,16 @@ class SimBackend:
         settings: SimSettings | None = None,
         ticker: SimTicker | None = None,
         floor: FleetFloor | None = None,
+        battery: BatteryType | None = None,
+        chargers: tuple[Zone, ...] = (),
+        battery_ticker: BatteryTicker | None = None,
     ) -> None:
         """`ticker` steps this robot's drives; robots sharing one event loop (a swarm)
         should share one. Without it, the robot has a ticker of its own. `floor` is the
         fleet's map (`vahr.navigation.load_floor`), shared by a swarm's robots; without
-        it the robot drives straight."""
+        it the robot drives straight. `battery` is how its battery drains and charges (the
+        fleet's rates for its type; without it, it never drains) at the `chargers`;
+        `battery_ticker` settles it while it stands (shared like `ticker`)."""
         self.settings = settings or SimSettings()
         self._clock = clock
         self._ticker = ticker or SimTicker(clock=clock, tick_s=self.settings.tick_s)
@@ -84,6 +93,19 @@ class SimBackend:
         self.floor = floor
         self.closed: frozenset[str] = frozenset()
         self._drive: _Drive | None = None
+        self.battery = SimBattery(
+            clock=clock, pose=lambda: self._pose, rates=battery or NO_DRAIN, chargers=chargers
+        )
+        self._battery_ticker = battery_ticker or BatteryTicker(clock=clock)
+
+    def watch_battery(self, on_battery: Callable[[Battery], None]) -> None:
+        """Report the battery now and whenever its whole percent or charging changes."""
+        self.battery.watch(on_battery)
+        self._battery_ticker.add(self.battery)
+
+    def set_battery(self, percent: float) -> None:
+        """Set the charge (a fault injected for tests and demos)."""
+        self.battery.set_percent(percent)
 
     @property
     def pose(self) -> Pose:
@@ -127,6 +149,9 @@ class SimBackend:
         return None if found is None else Way(found.points, found.length)
 
     async def go_to(self, zone: Zone, on_progress: Callable[[Progress], None]) -> None:
+        self.battery.settle()
+        if self.battery.empty:
+            raise NavigationFailed(f"goal to {zone.id} aborted: the battery is empty")
         stuck = self._faults.stuck_next or zone.id in self._faults.stuck_zones
         failure = self._faults.fail_next or (
             "the planner found no path" if zone.id in self._faults.fail_zones else None
@@ -135,7 +160,11 @@ class SimBackend:
         route = self._route_to(zone.pose, zone.id)
         if route is None:
             raise NavigationFailed(f"goal to {zone.id} aborted: no path to it on the map")
-        await self._drive_route(route, zone.pose, zone.id, on_progress, stuck, failure)
+        self.battery.set_working(True)
+        try:
+            await self._drive_route(route, zone.pose, zone.id, on_progress, stuck, failure)
+        finally:
+            self.battery.set_working(False)
 
     async def leave(self, zone: Zone, on_progress: Callable[[Progress], None]) -> None:
         """Drive out of `zone` (its area, or its arrival circle) to the nearest place a
@@ -163,7 +192,11 @@ class SimBackend:
             route = Way(found.points, found.length)
             end = route.points[-1]
             goal = Pose(end[0], end[1], _heading(route.points, here.theta))
-        await self._drive_route(route, goal, None, on_progress, False, None)
+        self.battery.set_working(True)
+        try:
+            await self._drive_route(route, goal, None, on_progress, False, None)
+        finally:
+            self.battery.set_working(False)
 
     async def _drive_route(
         self,
@@ -215,7 +248,11 @@ class SimBackend:
         delay = (
             self.settings.loader_delay_s if zone.arm == "loader" else self.settings.unloader_delay_s
         )
-        await self._clock.sleep(delay)
+        self.battery.set_working(True)
+        try:
+            await self._clock.sleep(delay)
+        finally:
+            self.battery.set_working(False)
 
     async def halt(self) -> None:
         # The simulator stops at once when the driving task is cancelled (its drive leaves
@@ -223,7 +260,7 @@ class SimBackend:
         await asyncio.sleep(0)
 
     async def close(self) -> None:
-        return None
+        self._battery_ticker.discard(self.battery)
 
 
 class _Drive:
@@ -311,6 +348,9 @@ class _Drive:
         travelled = min(self.total, self.travelled + speed * elapsed)
         if self.stuck or self.failure:
             travelled = min(travelled, self.halt_at)
+        battery = backend.battery
+        travelled = min(travelled, self.travelled + battery.range_m)
+        battery.drove(travelled - self.travelled)
         self.travelled = travelled
         starts, points = self.starts, self.points
         while self.leg < len(points) - 2 and travelled > starts[self.leg + 1]:
@@ -323,6 +363,12 @@ class _Drive:
         path, self.new_path = self.new_path, None
         eta = (self.total - travelled) / speed
         self.on_progress(Progress(self._fraction(), backend._pose, now, path=path, eta_s=eta))
+        if battery.empty:
+            # The robot stops where its charge ran out, as a real one does.
+            where = self.zone_id or "out of the zone"
+            empty = NavigationFailed(f"goal to {where} aborted: the battery is empty")
+            self.ended.set_exception(empty)
+            return True
         if travelled >= self.total:
             self.ended.set_result(None)
             return True

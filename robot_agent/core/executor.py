@@ -198,7 +198,12 @@ class Executor:
             self.peers.record(event.thing, event.at)
 
     def report_battery(self, battery: Battery) -> None:
-        """Record the battery as the backend read it; the shadow hears of it when it changes."""
+        """Record the battery as the backend read it; the shadow hears of it when it changes.
+        Before the robot is connected it is only recorded: the whole state goes out on
+        connecting (a swarm of thousands would otherwise send one update each twice)."""
+        if not self.state.connected:
+            self.state = msgspec.structs.replace(self.state, battery=battery)
+            return
         self._update(battery=battery)
 
     def close_zones(self, closed: frozenset[str]) -> None:

@@ -10,6 +10,8 @@ FLEETS_DIR = Path(__file__).resolve().parents[1] / "fleets"
 SIX_ROBOTS = FLEETS_DIR / "six_robots.yaml"
 # Four robots in a small hospital, with places named as staff say them and German names.
 HOSPITAL = FLEETS_DIR / "hospital.yaml"
+# Three rovers and one charger: batteries, charging and robots out of service.
+THREE_ROVERS = FLEETS_DIR / "three_rovers.yaml"
 
 # tests/fleets/bad/NAME.yaml -> the error, naming the entry and the reason.
 BAD_FLEETS = {
@@ -36,6 +38,10 @@ BAD_FLEETS = {
         "expected ',' or ']' at line 3, column 1)"
     ),
     "empty": "is empty; a fleet needs robots: and zones:",
+    "battery_without_charger": (
+        "zones: no zone has charger: true, but batteries drain (battery:); add a charging "
+        "zone, or set the drain rates of battery.types to 0"
+    ),
 }
 
 

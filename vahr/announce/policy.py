@@ -20,7 +20,9 @@ memory. The rules:
   in the log and counted in `PolicyState.dropped`;
 - a finished task (`done`, off by default) is told once, like a fault that never clears,
   and so is a task the fleet gave up because its robot was sent elsewhere by name
-  (`cancelled`, from the dispatcher's `TaskCancelled`): no task leaves without a word.
+  (`cancelled`, from the dispatcher's `TaskCancelled`): no task leaves without a word;
+- a robot the dispatcher sends to charge because it is low (`LowBattery`) is told once
+  (`battery_low`).
 
 There is no fleet task queue yet. `Queued` and `Dispatched` are the signals one will
 send (a task id, the robot it is for if any, when it was queued); `tick` tells the tasks
@@ -120,9 +122,18 @@ class TaskCancelled:
     why: str = "preempted"
 
 
-Signal = Opened | Cleared | Finished | Queued | Dispatched | TaskCancelled
+@dataclass(frozen=True)
+class LowBattery:
+    """The dispatcher sent `thing`, low on charge, to the charger `zone` by itself."""
+
+    thing: str
+    at: datetime
+    zone: str | None = None
+
+
+Signal = Opened | Cleared | Finished | Queued | Dispatched | TaskCancelled | LowBattery
 # Kinds told once and forgotten (nothing clears them: they are news, not a state).
-_ONE_SHOT: frozenset[AnnouncementKind] = frozenset({"done", "cancelled"})
+_ONE_SHOT: frozenset[AnnouncementKind] = frozenset({"done", "cancelled", "battery_low"})
 
 
 def signals_from_event(event: Event) -> list[Signal]:
@@ -269,6 +280,18 @@ class AnnouncePolicy:
                     )
                 )
             self.state.queued = [t for t in self.state.queued if t.task != signal.task]
+        elif isinstance(signal, LowBattery):
+            if "battery_low" in self.settings.kinds:
+                self.state.finished.append(
+                    Fault(
+                        subject=signal.thing,
+                        kind="battery_low",
+                        thing=signal.thing,
+                        opened_at=signal.at.timestamp(),
+                        seen_at=self._clock().timestamp(),
+                        zone=signal.zone,
+                    )
+                )
         elif isinstance(signal, Queued):
             if not any(t.task == signal.task for t in self.state.queued):
                 self.state.queued.append(
@@ -406,4 +429,5 @@ def reference_id(subject: str, kind: str, opened_at: float) -> str:
     """A stable id for one fault: the same fault told twice (a retry) has the same id, so
     Alexa's Proactive Events API refuses the duplicate (409) instead of notifying twice."""
     digest = hashlib.sha256(f"{subject}\0{kind}\0{opened_at:.6f}".encode()).hexdigest()
-    return f"vahr~{kind}~{digest[:32]}"
+    # Alexa's referenceId takes letters, digits and '~' only: `battery_low` is `batterylow`.
+    return f"vahr~{kind.replace('_', '')}~{digest[:32]}"

@@ -30,7 +30,15 @@ def _default_priorities() -> dict[AnnouncementKind, int]:
     # Stuck and offline first (a robot that needs a hand or has vanished), then a failed
     # task or one the fleet gave up (its robot was sent elsewhere by name), then a task kept
     # waiting, and a finished task last.
-    return {"stuck": 3, "offline": 3, "failed": 2, "cancelled": 2, "waiting": 1, "done": 0}
+    return {
+        "stuck": 3,
+        "offline": 3,
+        "failed": 2,
+        "cancelled": 2,
+        "battery_low": 2,
+        "waiting": 1,
+        "done": 0,
+    }
 
 
 class AnnounceSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
@@ -39,7 +47,14 @@ class AnnounceSettings(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown
     # The kinds worth telling; `done` is off by default (the person asked for the task and
     # the skill already confirmed it).
     kinds: list[AnnouncementKind] = msgspec.field(
-        default_factory=lambda: ["stuck", "failed", "offline", "waiting", "cancelled"]
+        default_factory=lambda: [
+            "stuck",
+            "failed",
+            "offline",
+            "waiting",
+            "cancelled",
+            "battery_low",
+        ]
     )
     priorities: dict[AnnouncementKind, Priority] = msgspec.field(
         default_factory=_default_priorities

@@ -26,6 +26,7 @@ WORDS: dict[str, str] = {
     "cancelled_offline": "{robot} went offline before it started {task}{to_zone}; it is cancelled.",
     "cancelled_unacknowledged": "{robot} is not doing {task}{to_zone}, so it is cancelled.",
     "done": "{robot} has finished its task{where}.",
+    "battery_low": "{robot} is low on battery and is going to charge.",
     "on_its_way": " on its way to {zone}",
     "at": " at {zone}",
     "for_robot": " for {robot}",
@@ -40,7 +41,8 @@ WORDS: dict[str, str] = {
     "task": "its task",
 }
 PROMPTS: dict[AnnouncementKind, str] = {
-    kind: WORDS[kind] for kind in ("stuck", "failed", "offline", "waiting", "cancelled", "done")
+    kind: WORDS[kind]
+    for kind in ("stuck", "failed", "offline", "waiting", "cancelled", "done", "battery_low")
 }
 NO_REASON = WORDS["no_reason"]
 

@@ -8,6 +8,8 @@ Lambda (lambda/dispatcher) run the same core.
   path lengths it ranks by (`Routes`, `DistanceField`; `STRAIGHT` on a drawn floor);
 - `dispatcher`: the `Dispatcher` and the ports it reaches the world through (`TaskStore`,
   `Candidates`, `Publish`, `PublishClosures`), and what closing a zone did (`ZoneChange`);
+- `energy`: whether a robot's battery can do a task and reach a charger after it
+  (`EnergyRule`), and when a robot should charge;
 - `grid_routes`: path lengths on a map read from the distances `vahr.navigation` wrote
   (the dispatcher Lambda's, which carries no numpy).
 
@@ -22,6 +24,7 @@ from vahr.dispatch.dispatcher import (
     Publish,
     PublishClosures,
     RoutesFor,
+    ServiceChange,
     TaskStore,
     ZoneChange,
 )
@@ -75,6 +78,7 @@ __all__ = [
     "RobotState",
     "Routes",
     "RoutesFor",
+    "ServiceChange",
     "StraightLine",
     "StraightRoutes",
     "Submission",

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Protocol
 
 import msgspec
 
+from vahr.dispatch.energy import EnergyRule
 from vahr.dispatch.ranking import (
     BUSY_STATUSES,
     IDLE_STATUSES,
@@ -24,6 +25,7 @@ from vahr.dispatch.ranking import (
     RobotState,
     Routes,
     rank,
+    robot_pose,
 )
 from vahr.dispatch.tasks import (
     FINAL_RESULTS,
@@ -40,7 +42,7 @@ from vahr.domain.fleet import FLEET_GROUP
 from vahr.protocol.messages import Command, ZoneClosures, new_command
 
 if TYPE_CHECKING:
-    from vahr.domain.fleet import Fleet
+    from vahr.domain.fleet import Fleet, Zone
 
 
 class TaskStore(Protocol):
@@ -139,6 +141,20 @@ class ZoneChange(msgspec.Struct, frozen=True, kw_only=True):
     given: list[Task] = []
 
 
+class ServiceChange(msgspec.Struct, frozen=True, kw_only=True):
+    """What taking a robot out of service (or putting it back) did: `changed` is False
+    when it already was so; `reassigned` the task it held, back in the queue (and given to
+    another robot when one may take it: `thing` then names that robot); `waiting` the queued
+    tasks only it may take, which wait for it; `given` the task it took once back."""
+
+    thing: str
+    in_service: bool
+    changed: bool
+    reassigned: list[Task] = []
+    waiting: list[Task] = []
+    given: list[Task] = []
+
+
 class Dispatcher:
     """Gives tasks to robots through the three ports; holds no state of its own.
 
@@ -159,14 +175,21 @@ class Dispatcher:
         routes: RoutesFor | None = None,
         publish_closures: PublishClosures | None = None,
         on_given_up: Callable[[Task], None] | None = None,
+        on_charging: Callable[[Task], None] | None = None,
+        respect_battery: bool = True,
     ) -> None:
         """`routes` gives the path lengths on the floor for a set of closed zones (default:
         straight lines, a drawn floor); `publish_closures` tells the robots which zones are
         closed after every change; `on_given_up` is told each task the fleet gives up without
         being asked (its robot was sent elsewhere by name), so that it is announced: no task
-        leaves the fleet's hands without a word."""
+        leaves the fleet's hands without a word; `on_charging` each robot the dispatcher
+        sends to charge by itself (it is low), so that it is announced too.
+        `respect_battery=False` ignores the batteries (what a fleet without the energy rule
+        would do; the shift benchmark compares the two)."""
         self.fleet = fleet
         self.on_given_up = on_given_up
+        self.on_charging = on_charging
+        self.respect_battery = respect_battery
         self.store = store
         self.candidates = candidates
         self.publish = publish
@@ -265,7 +288,10 @@ class Dispatcher:
         """A robot reported its state: if that ends its task, record how, and if it is
         free, give it the first queued task it may take. Returns the task it took."""
         held = self._held_by(state.thing)
-        if held is not None:
+        if held is not None and held.kind == "charge":
+            if not self._charge_over(held, state):
+                return None
+        elif held is not None:
             if state.last_command_id == held.id:
                 self._acknowledged.add(held.id)
                 if state.last_result not in FINAL_RESULTS:
@@ -287,9 +313,12 @@ class Dispatcher:
             self._acknowledged.discard(held.id)
         if not state.available:
             return None
-        return self.robot_freed(state.thing)
+        energy = self._energy()
+        if energy is not None and energy.wants_charge(state) and state.idle:
+            return self.charge(state.thing, state=state)
+        return self.robot_freed(state.thing, state)
 
-    def robot_freed(self, thing: str) -> Task | None:
+    def robot_freed(self, thing: str, state: RobotState | None = None) -> Task | None:
         """Give `thing` the first queued task it may take (first come, first served): not
         one into a closed zone, nor, on a map, one it has no path to. When another
         dispatcher got there first, the next one; None when nothing is left."""
@@ -297,17 +326,28 @@ class Dispatcher:
         if not pending:
             return None
         closed = self._closed()
-        state = None
         on_map = self.fleet.floor is not None and self.fleet.floor.map is not None
+        energy = self._energy(closed)
+        # Its state as reported (passed by `observe`): a robot out of service takes nothing.
+        state = state or self.candidates.state(thing)
+        if state is not None and not state.in_service:
+            return None
         for task in pending:
             if not task.allows(thing) or self._blocked(task, closed):
                 continue
-            if on_map:
-                state = state or self.candidates.state(thing)
-                if state is not None and not rank(
-                    self.fleet, task, [state], limit=1, routes=self.routes_for(closed)
-                ):
-                    continue
+            if (
+                state is not None
+                and (on_map or energy is not None)
+                and not rank(
+                    self.fleet,
+                    task,
+                    [state],
+                    limit=1,
+                    routes=self.routes_for(closed),
+                    energy=energy,
+                )
+            ):
+                continue
             taken = self._assign(task, thing)
             if taken is not None:
                 return taken
@@ -354,7 +394,158 @@ class Dispatcher:
     @staticmethod
     def command_for(task: Task) -> Command:
         """The command that carries out `task`; its id is the task's."""
-        return new_command(task.kind, {"zone": task.zone}, source=SOURCE, command_id=task.id)
+        # A robot goes to charge by driving to the charger; it charges standing there.
+        action = "navigate" if task.kind == "charge" else task.kind
+        return new_command(action, {"zone": task.zone}, source=SOURCE, command_id=task.id)
+
+    # --- batteries ----------------------------------------------------------------------
+
+    def charge(
+        self, thing: str, *, state: RobotState | None = None, asked: bool = False
+    ) -> Task | None:
+        """Send `thing` to the nearest free charger, holding it (a `charge` task) until the
+        robot is charged. By itself (`asked` False: the robot is low and idle) it is
+        announced (`on_charging`) and None means no charger is free now (the robot asks
+        again with its next report); asked ("send X to charge"), a task it holds goes back
+        to the queue first, and DispatchError says why it cannot go."""
+        if thing not in self.fleet.robot_things:
+            raise DispatchError("unknown_robot", f"there is no robot {thing!r}")
+        state = state or self.candidates.state(thing)
+        if state is None or not state.connected:
+            if asked:
+                raise DispatchError("none_free", f"{thing} is offline")
+            return None
+        if not state.in_service:
+            if asked:
+                raise DispatchError("out_of_service", f"{thing} is out of service")
+            return None
+        held = self._held_by(thing)
+        if held is not None and held.kind == "charge":
+            return held if asked else None
+        closed = self._closed()
+        chargers = self._free_chargers(thing, closed)
+        if not chargers:
+            if asked:
+                raise DispatchError("no_charger", "every charger is taken or closed now")
+            return None
+        routes = self.routes_for(closed)
+        here = robot_pose(self.fleet, state)
+        chargers.sort(key=lambda zone: (routes.field(zone).distance(here.x, here.y), zone.id))
+        if held is not None:
+            if not asked:
+                return None
+            self.store.release(held.id)
+            self._acknowledged.discard(held.id)
+        for charger in chargers:
+            task = self._hold_charger(thing, charger.id)
+            if task is None:
+                continue
+            if not asked and self.on_charging is not None:
+                self.on_charging(task)
+            if held is not None:
+                self.drain()
+            return task
+        if held is not None:
+            self.drain()
+        if asked:
+            raise DispatchError("no_charger", "every charger is taken or closed now")
+        return None
+
+    def _free_chargers(self, thing: str, closed: frozenset[str]) -> list[Zone]:
+        """The chargers no other robot holds (a `charge` task) or stands at, not closed."""
+        held = {task.zone for task in self.store.active() if task.kind == "charge"}
+        held |= {task.zone for task in self.store.pending() if task.kind == "charge"}
+        free = []
+        for zone in self.fleet.chargers:
+            if zone.id in closed or zone.id in held:
+                continue
+            others = self.candidates.available(zone=zone.id)
+            if any(robot.thing != thing for robot in others):
+                continue
+            free.append(zone)
+        return free
+
+    def _hold_charger(self, thing: str, charger: str) -> Task | None:
+        """Take `charger` for `thing`: the charge task is stored, then the earliest open
+        charge task for that charger keeps it and a later one gives way (so two
+        dispatchers racing for one charger agree whoever wrote first), then it is
+        assigned and its command sent. None when the charger went to another robot or
+        `thing` could not take it."""
+        now = self.clock()
+        task = Task(
+            id=uuid.uuid4().hex,
+            request=uuid.uuid4().hex,
+            kind="charge",
+            zone=charger,
+            robots=[thing],
+            created_at=timestamp(now),
+        )
+        self.store.add(task)
+        rivals = [
+            other
+            for other in self.store.active() + self.store.pending()
+            if other.kind == "charge" and other.zone == charger and other.id != task.id
+        ]
+        if any(other.order_key < task.order_key for other in rivals):
+            self.store.cancel(task.id)
+            return None
+        taken = self._assign(task, thing)
+        if taken is None:
+            self.store.cancel(task.id)
+        return taken
+
+    def _charge_over(self, held: Task, state: RobotState) -> bool:
+        """Whether the robot's charge task `held` is over (recorded so), after `state`:
+        charged at the charger, failed on the way, or the robot sent elsewhere."""
+        if state.last_command_id == held.id:
+            self._acknowledged.add(held.id)
+            if state.last_result not in FINAL_RESULTS:
+                return False
+            if state.last_result == "done":
+                energy = EnergyRule(self.fleet, STRAIGHT)
+                if not energy.charged(state):
+                    return False
+            self.store.finish(held.id, outcome=state.last_result)  # type: ignore[arg-type]
+        elif held.id in self._acknowledged:
+            # Sent elsewhere by name while going to charge or charging: the charger is free.
+            self.store.finish(held.id, outcome="preempted")
+        else:
+            return False
+        self._acknowledged.discard(held.id)
+        return True
+
+    # --- service ------------------------------------------------------------------------
+
+    def withdrawn(self, thing: str) -> ServiceChange:
+        """`thing` was just taken out of service (the host records it, and its candidates
+        say so from now on): the task it holds goes back to the queue, in its place, and to
+        another robot that may take it, and the robot is told to stop; queued tasks only it
+        may take wait for it."""
+        reassigned: list[Task] = []
+        held = self._held_by(thing)
+        if held is not None:
+            self._acknowledged.discard(held.id)
+            if held.kind == "charge":
+                self.store.finish(held.id, outcome="cancelled")
+            else:
+                released = self.store.release(held.id)
+                if released is not None:
+                    reassigned.append(released)
+            self.publish(thing, new_command("stop", source=SOURCE))
+            given = {task.id: task for task in self.drain()}
+            reassigned = [given.get(task.id, task) for task in reassigned]
+        waiting = [task for task in self.store.pending() if task.robots == [thing]]
+        return ServiceChange(
+            thing=thing, in_service=False, changed=True, reassigned=reassigned, waiting=waiting
+        )
+
+    def reinstated(self, thing: str) -> ServiceChange:
+        """`thing` is back in service (the host records it): it takes the first queued
+        task it may, now."""
+        given = self.robot_freed(thing)
+        return ServiceChange(
+            thing=thing, in_service=True, changed=True, given=[given] if given else []
+        )
 
     # --- inside -------------------------------------------------------------------------
 
@@ -434,7 +625,10 @@ class Dispatcher:
         return [
             robot
             for robot in robots
-            if robot.connected and robot.status in takes and robot.thing not in holding
+            if robot.connected
+            and robot.in_service
+            and robot.status in takes
+            and robot.thing not in holding
         ]
 
     def _closed(self) -> frozenset[str]:
@@ -450,7 +644,8 @@ class Dispatcher:
         race is lost; None when no free robot may take it."""
         closed = self._closed() if closed is None else closed
         free = self._free()
-        for robot in rank(self.fleet, task, free, routes=self.routes_for(closed)):
+        energy = self._energy(closed)
+        for robot in rank(self.fleet, task, free, routes=self.routes_for(closed), energy=energy):
             taken = self._assign(task, robot.thing)
             if taken is not None:
                 return taken
@@ -469,6 +664,13 @@ class Dispatcher:
             self.store.release(taken.id)
             return None
         return taken
+
+    def _energy(self, closed: frozenset[str] | None = None) -> EnergyRule | None:
+        """The energy rule on the floor as it is now; None when batteries do not count."""
+        if not self.respect_battery or not self.fleet.batteries_drain:
+            return None
+        closed = self._closed() if closed is None else closed
+        return EnergyRule(self.fleet, self.routes_for(closed))
 
     def _held_by(self, thing: str) -> Task | None:
         for task in self.store.active():

@@ -17,7 +17,7 @@ from __future__ import annotations
 import heapq
 import math
 from collections.abc import Callable, Iterable
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import msgspec
 
@@ -55,8 +55,13 @@ class RobotState(msgspec.Struct, frozen=True, kw_only=True):
 
     @property
     def available(self) -> bool:
-        """Connected and idle or busy; a stuck, failed or offline robot takes no task."""
-        return self.connected and (self.status in IDLE_STATUSES or self.status in BUSY_STATUSES)
+        """Connected, in service, and idle or busy; a stuck, failed or offline robot, or one
+        out of service, takes no task."""
+        return (
+            self.connected
+            and self.in_service
+            and (self.status in IDLE_STATUSES or self.status in BUSY_STATUSES)
+        )
 
     @property
     def idle(self) -> bool:
@@ -110,6 +115,18 @@ class StraightRoutes:
 STRAIGHT = StraightRoutes()
 
 
+class EnergyCheck(Protocol):
+    """Whether a robot's battery can do a task (`vahr.dispatch.energy.EnergyRule`)."""
+
+    def after(self, task: Task) -> object:
+        """What the task costs beyond the robot's way to it (the same for every robot)."""
+        ...
+
+    def can_do(self, robot: RobotState, metres: float, after: Any) -> bool:
+        """Whether `robot`, `metres` from the task's end by its way there, may take it."""
+        ...
+
+
 def task_cost(fleet: Fleet, pose: Pose, task: Task, routes: Routes = STRAIGHT) -> float:
     """Metres a robot at `pose` drives to do `task`: to the pickup (if any), then to the
     drop zone (math.inf when no path leads there). A robot already in the drop zone of a
@@ -143,10 +160,13 @@ def rank(
     *,
     limit: int | None = None,
     routes: Routes = STRAIGHT,
+    energy: EnergyCheck | None = None,
 ) -> list[RobotState]:
     """The robots allowed to take `task`, best first: idle before busy, then by cost, then
     by thing name. With `limit`, only the best `limit` (a partial sort: 10,000 robots are
-    ranked without sorting them all). A robot no path leads from is left out.
+    ranked without sorting them all). A robot no path leads from is left out, and so, with
+    `energy`, is one whose battery cannot do the task and still reach a charger with its
+    reserve left (`vahr.dispatch.energy`).
 
     The cost is `task_cost`, computed here with the pickup and drop looked up once: the
     leg from the pickup to the drop is the same for every robot, and the first leg is one
@@ -178,6 +198,9 @@ def rank(
         for robot, cost in zip(candidates, costs, strict=True)
         if cost != inf
     ]
+    if energy is not None:
+        after = energy.after(task)
+        keyed = [entry for entry in keyed if energy.can_do(entry[3], entry[1], after)]
     # Tuples compare field by field and thing names are unique, so the states themselves
     # are never compared.
     if limit is None:

@@ -21,7 +21,9 @@ DISPATCHER = "dispatcher"
 
 
 def task_given(task: Task) -> AuditEntry:
-    """The record of `task` given to its robot by the dispatcher itself."""
+    """The record of `task` given to its robot by the dispatcher itself (a robot low on
+    charge sent to a charger is one too)."""
+    charge = task.kind == "charge"
     return AuditEntry(
         time=now(),
         who=DISPATCHER,
@@ -31,5 +33,7 @@ def task_given(task: Task) -> AuditEntry:
         robots=[task.thing] if task.thing else [],
         commands=[task.id],
         outcome="sent",
-        reason="a queued task given to a robot that came free",
+        reason="low on battery: sent to the nearest free charger"
+        if charge
+        else "a queued task given to a robot that came free",
     )

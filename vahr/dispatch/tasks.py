@@ -9,7 +9,9 @@ from typing import Literal
 
 import msgspec
 
-TaskKind = Literal["navigate", "deliver"]
+# `charge`: the dispatcher sends a robot to a charger; the task is held, and the charger
+# with it, until the robot is charged (`vahr.dispatch.energy`).
+TaskKind = Literal["navigate", "deliver", "charge"]
 TaskStatus = Literal["queued", "assigned", "done", "cancelled"]
 # What a finished task ended as: the robot's result for its command, or why it ended early.
 Outcome = Literal["done", "failed", "cancelled", "rejected", "preempted"]
@@ -24,7 +26,15 @@ SOURCE = "dispatcher"
 
 # Why an order cannot be carried out as asked; callers decide on these, never on the text.
 DispatchErrorCode = Literal[
-    "unknown_zone", "unknown_group", "bad_count", "too_many", "none_free", "zone_closed"
+    "unknown_zone",
+    "unknown_group",
+    "bad_count",
+    "too_many",
+    "none_free",
+    "zone_closed",
+    "unknown_robot",
+    "out_of_service",
+    "no_charger",
 ]
 
 
@@ -126,7 +136,7 @@ class Order(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=Tru
     - `idle`: every idle robot now goes; nothing is queued: "every idle robot to zone C".
     """
 
-    kind: TaskKind = "navigate"
+    kind: Literal["navigate", "deliver"] = "navigate"
     zone: str
     count: int | None = None
     group: str | None = None

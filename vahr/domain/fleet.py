@@ -19,6 +19,7 @@ from typing import Annotated, Literal
 
 import msgspec
 
+from vahr.domain.battery import DEFAULT_TYPE, NO_DRAIN, BatteryPlan, BatteryType
 from vahr.domain.text import normalize
 from vahr.protocol.errors import ProtocolError, from_validation_error
 from vahr.protocol.identities import check_robot_thing
@@ -152,6 +153,15 @@ class Robot(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     # Names in other languages than en-US's `spoken`, by locale ("de-DE": [...]); left out
     # of the fleet's JSON when the file gives none.
     spoken_by_locale: dict[str, SpokenNames] | msgspec.UnsetType = msgspec.UNSET
+    # The robot's type, for its battery's rates (`battery.types` in the fleet file); left
+    # out of the fleet's JSON when the file gives none (`robot_type`).
+    type: Annotated[str, msgspec.Meta(min_length=1, max_length=64)] | msgspec.UnsetType = (
+        msgspec.UNSET
+    )
+
+    @property
+    def robot_type(self) -> str:
+        return self.type if isinstance(self.type, str) else DEFAULT_TYPE
 
 
 class Zone(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -199,6 +209,35 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
     floor: Floor | None = None
     # Left out of the fleet's JSON when the file gives none (`confirmation_rules`).
     confirmation: Confirmation | msgspec.UnsetType = msgspec.UNSET
+    # Left out of the fleet's JSON when the file gives none: batteries then never drain.
+    battery: BatteryPlan | msgspec.UnsetType = msgspec.UNSET
+
+    @property
+    def battery_plan(self) -> BatteryPlan:
+        """The file's battery rules, or the defaults (`vahr.domain.battery`)."""
+        return self.battery if isinstance(self.battery, BatteryPlan) else _DEFAULT_PLAN
+
+    @property
+    def batteries_drain(self) -> bool:
+        """Whether any robot's battery drains (the file has a `battery:` section that says
+        so): only then are robots sent to charge."""
+        return any(self.battery_rates(thing).drains for thing in self.robot_things)
+
+    @cached_property
+    def _types(self) -> dict[str, str]:
+        return {robot.thing: robot.robot_type for robot in self.robots}
+
+    def battery_rates(self, thing: str) -> BatteryType:
+        """How `thing`'s battery drains and charges; never draining without a `battery:`
+        section."""
+        if not isinstance(self.battery, BatteryPlan):
+            return NO_DRAIN
+        return self.battery.rates(self._types.get(thing, DEFAULT_TYPE))
+
+    @cached_property
+    def chargers(self) -> tuple[Zone, ...]:
+        """The zones with `charger: true`, in file order."""
+        return tuple(zone for zone in self.zones if zone.charger)
 
     @property
     def confirmation_rules(self) -> Confirmation:
@@ -231,6 +270,7 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
         for index, group in enumerate(self.groups):
             self._check_members(f"groups.{index}.robots", group.robots)
         self._check_spoken_names()
+        self._check_battery()
         _check_reachable(self)
         if self.floor is not None:
             with_arms = {zone.id for zone in self.zones if zone.arm is not None}
@@ -240,6 +280,38 @@ class Fleet(msgspec.Struct, frozen=True, forbid_unknown_fields=True, dict=True):
                         "floor.arms", f"{zone_id!r} is not a zone with an arm (arm: in zones)"
                     )
         return self
+
+    def _check_battery(self) -> None:
+        """The battery rules hold together, every robot's type is one the section lists
+        (when it lists any), and batteries that drain have somewhere to charge."""
+        if not isinstance(self.battery, BatteryPlan):
+            return
+        plan = self.battery
+        if plan.reserve >= plan.charge_below:
+            raise ProtocolError(
+                "battery.reserve",
+                f"{plan.reserve:g} must be below battery.charge_below ({plan.charge_below:g}): "
+                "a robot goes to charge before it reaches its reserve",
+            )
+        if plan.charged <= plan.charge_below:
+            raise ProtocolError(
+                "battery.charged",
+                f"{plan.charged:g} must be above battery.charge_below ({plan.charge_below:g})",
+            )
+        if plan.types:
+            for index, robot in enumerate(self.robots):
+                if robot.robot_type not in plan.types:
+                    raise ProtocolError(
+                        f"robots.{index}.type",
+                        f"{robot.robot_type!r} is not a type of battery.types "
+                        f"({', '.join(sorted(plan.types))})",
+                    )
+        if not self.chargers and self.batteries_drain:
+            raise ProtocolError(
+                "zones",
+                "no zone has charger: true, but batteries drain (battery:); add a charging "
+                "zone, or set the drain rates of battery.types to 0",
+            )
 
     def _check_members(self, field: str, members: list[str]) -> None:
         _require_unique([(f"{field}.{i}", member) for i, member in enumerate(members)])
@@ -438,6 +510,8 @@ def _require_unique(entries: list[tuple[str, str]]) -> None:
             raise ProtocolError(field, f"{value!r} is used twice (also {first[value]})")
         first[value] = field
 
+
+_DEFAULT_PLAN = BatteryPlan()
 
 # An error lists at most this many robots of the fleet.
 LISTED_MAX = 8

@@ -10,7 +10,8 @@
 
 The data plane serves it (`TasksApi`) under `/vahr/tasks`: `POST` submits an order
 (answers the `Submission`), `GET` lists the tasks robots hold then the queue
-(`{"tasks": [...], "closed": [zone ids]}`), `DELETE /vahr/tasks/{id}` cancels one; and
+(`{"tasks": [...], "closed": [zone ids], "out_of_service": [things]}`), `DELETE
+/vahr/tasks/{id}` cancels one; and
 under `/vahr/zones` (`ZonesApi`): `GET` answers `{"closed": [zone ids]}`, `POST
 /vahr/zones/{zone}` with `{"closed": true|false}` closes or opens one (answers the
 `ZoneChange`). Closures live in the same SQLite file, and every change is published,
@@ -43,18 +44,20 @@ from vahr.dispatch import (
     Order,
     RobotState,
 )
+from vahr.dispatch.dispatcher import ServiceChange
 from vahr.dispatch.records import task_given
+from vahr.dispatch.tasks import timestamp
 from vahr.domain import Pose
 from vahr.local.task_store import SqliteTaskStore
 from vahr.navigation import load_floor
 from vahr.plumbing.mqtt import MqttClient
-from vahr.protocol import encode, topics
+from vahr.protocol import Battery, encode, topics, utc_now
 from vahr.protocol.audit import RECORDED_BY_HEADER, AuditEntry, Outcome, now
 from vahr.protocol.errors import from_validation_error
 from vahr.twin import identities
 
 if TYPE_CHECKING:
-    from collections.abc import Callable, Mapping
+    from collections.abc import Callable, Iterable, Mapping
     from pathlib import Path
 
     from vahr.dispatch import Task
@@ -67,6 +70,8 @@ log = logging.getLogger(__name__)
 
 TASKS_PATH = "/vahr/tasks"
 ZONES_PATH = "/vahr/zones"
+SERVICE_PATH = "/vahr/service"
+CHARGE_PATH = "/vahr/charge"
 STOP_TIMEOUT_S = 5.0
 
 Answer = tuple[int, bytes, str | None]
@@ -74,7 +79,7 @@ Answer = tuple[int, bytes, str | None]
 API_CALLER = "api"
 
 
-def robot_state(entry: IndexedThing) -> RobotState:
+def robot_state(entry: IndexedThing, *, in_service: bool = True) -> RobotState:
     """A fleet index entry as the dispatcher reads it."""
     pose = entry.pose
     return RobotState(
@@ -85,7 +90,19 @@ def robot_state(entry: IndexedThing) -> RobotState:
         pose=Pose(pose.x, pose.y, pose.theta) if pose is not None else None,
         last_command_id=entry.command_id,
         last_result=entry.command_result,
+        battery=reported_battery(entry.reported.get("battery")),
+        in_service=in_service,
     )
+
+
+def reported_battery(value: object) -> Battery | None:
+    """`reported.battery` as the robot wrote it; None when it wrote none or not one."""
+    if not isinstance(value, dict):
+        return None
+    percent, charging = value.get("percent"), value.get("charging", False)
+    if isinstance(percent, bool) or not isinstance(percent, int | float) or not 0 <= percent <= 100:
+        return None
+    return Battery(percent=round(percent), charging=charging is True)
 
 
 class IndexCandidates:
@@ -95,16 +112,22 @@ class IndexCandidates:
     def __init__(self, index: FleetIndex, fleet: Fleet) -> None:
         self.index = index
         self.robots = frozenset(fleet.robot_things)
+        # The robots out of service (`set_out_of_service`; the store keeps them).
+        self.out_of_service: frozenset[str] = frozenset()
         # Each robot's state as last read, with the index entry it was read from: entries
         # are replaced, never changed, on every update, so an unchanged robot costs one
         # identity check instead of a new state (most of the time at 10,000 robots).
         self._read: dict[str, tuple[IndexedThing, RobotState]] = {}
 
+    def set_out_of_service(self, things: Iterable[str]) -> None:
+        self.out_of_service = frozenset(things)
+        self._read.clear()
+
     def _state(self, entry: IndexedThing) -> RobotState:
         read = self._read.get(entry.thing)
         if read is not None and read[0] is entry:
             return read[1]
-        state = robot_state(entry)
+        state = robot_state(entry, in_service=entry.thing not in self.out_of_service)
         self._read[entry.thing] = (entry, state)
         return state
 
@@ -116,9 +139,12 @@ class IndexCandidates:
             for status in sorted(IDLE_STATUSES | BUSY_STATUSES):
                 entries += self.index.with_status(status)
         robots, takes, read = self.robots, IDLE_STATUSES | BUSY_STATUSES, self._read
+        out = self.out_of_service
         states = []
         for entry in entries:
             if not (entry.connected and entry.status in takes and entry.thing in robots):
+                continue
+            if out and entry.thing in out:
                 continue
             known = read.get(entry.thing)
             fresh = known is not None and known[0] is entry
@@ -132,13 +158,18 @@ class IndexCandidates:
 
 class TasksApi:
     """`/vahr/tasks` on the data plane, in its typed-route form: (status, body, error type).
-    `record`, when given, takes the trail's entry for each order and cancel."""
+    `record`, when given, takes the trail's entry for each order and cancel;
+    `out_of_service` says which robots are out of service, for the list."""
 
     def __init__(
-        self, dispatcher: Dispatcher, record: Callable[[AuditEntry], object] | None = None
+        self,
+        dispatcher: Dispatcher,
+        record: Callable[[AuditEntry], object] | None = None,
+        out_of_service: Callable[[], list[str]] | None = None,
     ) -> None:
         self.dispatcher = dispatcher
         self._record = record
+        self._out_of_service = out_of_service
 
     def respond(
         self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
@@ -153,7 +184,9 @@ class TasksApi:
         if path == TASKS_PATH:
             if method == "GET":
                 closed = self.dispatcher.closed_zones()
-                return _ok({"tasks": self.dispatcher.tasks(), "closed": closed})
+                out = self._out_of_service() if self._out_of_service is not None else []
+                tasks = self.dispatcher.tasks()
+                return _ok({"tasks": tasks, "closed": closed, "out_of_service": out})
             if method == "POST":
                 return self._submit(body)
             return _error(405, f"{method} is not allowed on {TASKS_PATH}")
@@ -226,6 +259,84 @@ class ZonesApi:
 def _recorded_by_sender(headers: Mapping[str, str] | None) -> bool:
     """Whether the request's sender recorded it in the trail itself (with its person)."""
     return any(name.lower() == RECORDED_BY_HEADER.lower() for name in headers or {})
+
+
+class ServiceRequest(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
+    """The body of `POST /vahr/service/{thing}`."""
+
+    in_service: bool
+
+
+class RobotsApi:
+    """`/vahr/service` and `/vahr/charge` on the data plane: robots out of service and back
+    (`GET /vahr/service` answers `{"out_of_service": [things]}`, `POST /vahr/service/{thing}`
+    with `{"in_service": true|false}` answers the `ServiceChange`) and a robot sent to charge
+    now (`POST /vahr/charge/{thing}` answers `{"task": Task}`). `record`, when given, takes
+    the trail's entry for each change asked for by a program."""
+
+    def __init__(
+        self, host: LocalDispatcher, record: Callable[[AuditEntry], object] | None = None
+    ) -> None:
+        self.host = host
+        self._record = record
+
+    def respond(
+        self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
+    ) -> Answer:
+        answer = self._respond(method, path, body)
+        recorded = _recorded_by_sender(headers)
+        if self._record is not None and method == "POST" and not recorded:
+            self._record(_robot_entry(path, body, answer))
+        return answer
+
+    def _respond(self, method: str, path: str, body: bytes) -> Answer:
+        if path == SERVICE_PATH:
+            if method == "GET":
+                return _ok({"out_of_service": self.host.tasks.out_of_service()})
+            return _error(405, f"{method} is not allowed on {SERVICE_PATH}")
+        base = SERVICE_PATH if path.startswith(SERVICE_PATH + "/") else CHARGE_PATH
+        thing = path[len(base) + 1 :]
+        if "/" in thing or not thing:
+            return _error(404, f"No route for {method} {path}")
+        if method != "POST":
+            return _error(405, f"{method} is not allowed on {path}; POST")
+        if thing not in self.host.candidates.robots:
+            return _error(404, f"{thing[:40]} is not a robot of the fleet", error="unknown_robot")
+        if base == CHARGE_PATH:
+            try:
+                task = self.host.dispatcher.charge(thing, asked=True)
+            except DispatchError as err:
+                return _error(400, str(err), error=err.code)
+            return _ok({"task": task})
+        try:
+            request = msgspec.json.decode(body or b"{}", type=ServiceRequest)
+        except (msgspec.ValidationError, msgspec.DecodeError) as err:
+            return _error(400, str(from_validation_error(err)))
+        return _ok(self.host.set_in_service(thing, request.in_service))
+
+
+def _robot_entry(path: str, body: bytes, answer: Answer) -> AuditEntry:
+    """The trail's record of a robot taken out of service, put back or sent to charge
+    through the API by a program."""
+    status, payload, _ = answer
+    answered = _json_object(payload)
+    charge = path.startswith(CHARGE_PATH + "/")
+    thing = path.rsplit("/", 1)[-1][:255]
+    in_service = _json_object(body).get("in_service")
+    intent = "charge" if charge else "back_in_service" if in_service else "out_of_service"
+    task = answered.get("task") if charge else None
+    return AuditEntry(
+        time=now(),
+        who=API_CALLER,
+        channel="api",
+        words=f"POST {path}",
+        intent=intent,
+        slots={"robot": thing},
+        robots=[thing] if status == 200 else [],
+        commands=[str(task.get("id"))] if isinstance(task, dict) else [],
+        outcome="sent" if status == 200 else "failed",
+        reason=None if status == 200 else str(answered.get("message", f"HTTP {status}"))[:500],
+    )
 
 
 def _api_entry(method: str, path: str, body: bytes, answer: Answer) -> AuditEntry:
@@ -320,12 +431,16 @@ class LocalDispatcher:
         endpoint: MqttEndpoint,
         state_dir: Path,
         on_given_up: Callable[[Task], None] | None = None,
+        on_charging: Callable[[Task], None] | None = None,
         record: Callable[[AuditEntry], object] | None = None,
     ) -> None:
-        """`on_given_up`: told each task given up because its robot was sent elsewhere."""
+        """`on_given_up`: told each task given up because its robot was sent elsewhere;
+        `on_charging`: told each robot the dispatcher sends to charge by itself."""
         self.tasks = SqliteTaskStore.in_state_dir(state_dir)
         self._record = record
         self.candidates = IndexCandidates(index, fleet)
+        self.candidates.set_out_of_service(self.tasks.out_of_service())
+        self._service_lock = threading.Lock()
         self._client = MqttClient(endpoint, client_id=identities.DISPATCHER)
         floor = load_floor(fleet)
         self.dispatcher = Dispatcher(
@@ -334,13 +449,37 @@ class LocalDispatcher:
             candidates=self.candidates,
             publish=self._publish,
             on_given_up=on_given_up,
+            on_charging=on_charging,
             routes=floor.routes if floor is not None else None,
             publish_closures=self._publish_closures,
         )
-        self.api = TasksApi(self.dispatcher, record)
+        self.api = TasksApi(self.dispatcher, record, self.tasks.out_of_service)
         self.zones_api = ZonesApi(self.dispatcher, record)
+        self.robots_api = RobotsApi(self, record)
         self._updates: queue.SimpleQueue[str | None] = queue.SimpleQueue()
         self._worker: threading.Thread | None = None
+
+    def set_in_service(self, thing: str, in_service: bool) -> ServiceChange:
+        """Take `thing` out of service, or put it back: recorded in the store, then the
+        dispatcher reads it so (`RobotState.in_service`) and acts on it."""
+        with self._service_lock:
+            changed = self.tasks.set_in_service(thing, in_service, at=timestamp(utc_now()))
+            self.candidates.set_out_of_service(self.tasks.out_of_service())
+        if not changed:
+            waiting = [t for t in self.dispatcher.pending() if t.robots == [thing]]
+            return ServiceChange(
+                thing=thing,
+                in_service=in_service,
+                changed=False,
+                waiting=[] if in_service else waiting,
+            )
+        if in_service:
+            change = self.dispatcher.reinstated(thing)
+            self._recorded(change.given)
+            return change
+        change = self.dispatcher.withdrawn(thing)
+        self._recorded([task for task in change.reassigned if task.thing is not None])
+        return change
 
     def _publish(self, thing: str, command: Command) -> None:
         # Waits for the broker's PUBACK and raises when none comes: the task keeps its place.

@@ -38,9 +38,10 @@ STOP_TIMEOUT_S = 8.0
 # process measured 34.5 MB at 100 robots, 47.7 MB at 1,000 and 92 MB at 5,000 (11 to 15 kB
 # a robot; bench/swarm_startup.py, docs/large-fleets.md). What binds is Alexa's limit of
 # 1,000,000 characters on an interaction model, whose ROBOT slot type names every robot:
-# 4,514 rovers fit today (911,437 characters at 4,000), and the intents' samples grow as
-# the skill learns phrasings (5,000 fitted before "the robot" requests came), so the bound
-# keeps a tenth in hand; a test checks the model of this many fits.
+# about 4,250 rovers fit today (955,909 characters at 4,000, 172 more a robot), and the
+# intents' samples grow as the skill learns phrasings (5,000 fitted before "the robot"
+# requests came, 4,514 before the battery and service intents), so the bound keeps some in
+# hand; a test checks the model of this many fits.
 SWARM_MAX = 4_000
 # The swarm's floor: robots parked on a grid of this spacing, clear of the zones.
 SWARM_SPACING_M = 2.0

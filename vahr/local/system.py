@@ -23,14 +23,20 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import msgspec
 
-from vahr.announce import TaskCancelled
+from vahr.announce import LowBattery, TaskCancelled
 from vahr.assistant import SimulatorAssistant
 from vahr.domain.fleet import SPOKEN_LOCALE
 from vahr.domain.people import confirmation_on
 from vahr.errors import VahrError
 from vahr.local.alexa_host import serve_alexa
 from vahr.local.announce_host import LocalAnnouncer
-from vahr.local.dispatch_host import TASKS_PATH, ZONES_PATH, LocalDispatcher
+from vahr.local.dispatch_host import (
+    CHARGE_PATH,
+    SERVICE_PATH,
+    TASKS_PATH,
+    ZONES_PATH,
+    LocalDispatcher,
+)
 from vahr.local.readiness import Readiness
 from vahr.local.robots import (
     ProgressRate,
@@ -317,16 +323,24 @@ class LocalSystem:
                     [TaskCancelled(task.id, task.thing, task.kind, task.zone, utc_now())]
                 )
 
+        def charging(task: Task) -> None:
+            # A robot the dispatcher sends to charge by itself is told: it leaves its work.
+            if announcer is not None and task.thing is not None:
+                announcer.observe([LowBattery(task.thing, utc_now(), zone=task.zone)])
+
         self.dispatcher = LocalDispatcher(
             fleet=self.fleet,
             index=store.index,
             endpoint=self.stack.service_endpoint(identities.DISPATCHER),
             state_dir=self.config.state_dir,
             on_given_up=given_up,
+            on_charging=charging,
             record=self.stack.trail.append if self.stack.trail is not None else None,
         ).start()
         dataplane.typed_routes[TASKS_PATH] = self.dispatcher.api.respond
         dataplane.typed_routes[ZONES_PATH] = self.dispatcher.zones_api.respond
+        dataplane.typed_routes[SERVICE_PATH] = self.dispatcher.robots_api.respond
+        dataplane.typed_routes[CHARGE_PATH] = self.dispatcher.robots_api.respond
 
     def _start_room(self) -> None:
         """The assistant robots talk to: a second simulated Echo on the same skill."""

@@ -2,10 +2,11 @@
 
 One row per task, in `tasks.sqlite3` in the state directory, so the queue and who holds
 which task survive a restart of `vahr up`; the zones closed at run time are rows of their
-own table in the same file. Every conditional change is one SQL statement
-(an UPDATE whose WHERE is the condition) inside one `BEGIN IMMEDIATE` transaction, so two
-dispatchers, in threads or in processes sharing the file, cannot give one task to two
-robots or two tasks to one robot: the loser's UPDATE changes no row and it gets None.
+own table in the same file, and so are the robots taken out of service. Every conditional
+change is one SQL statement (an UPDATE whose WHERE is the condition) inside one
+`BEGIN IMMEDIATE` transaction, so two dispatchers, in threads or in processes sharing the
+file, cannot give one task to two robots or two tasks to one robot: the loser's UPDATE
+changes no row and it gets None.
 """
 
 from __future__ import annotations
@@ -42,6 +43,10 @@ CREATE UNIQUE INDEX IF NOT EXISTS one_task_per_robot ON tasks (thing) WHERE stat
 CREATE TABLE IF NOT EXISTS closed_zones (
     zone TEXT PRIMARY KEY,
     closed_at TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS out_of_service (
+    thing TEXT PRIMARY KEY,
+    since TEXT NOT NULL
 );
 """
 
@@ -160,6 +165,26 @@ class SqliteTaskStore:
     def closed_zones(self) -> list[str]:
         with self._lock:
             rows = self._db.execute("SELECT zone FROM closed_zones ORDER BY zone").fetchall()
+        return [row[0] for row in rows]
+
+    # --- robots out of service (the local host's; the dispatcher reads `in_service`) ----
+
+    def set_in_service(self, thing: str, in_service: bool, *, at: str) -> bool:
+        """Record `thing` in service or out of it (since `at`); False when it already was."""
+        with self._transaction() as db:
+            if in_service:
+                return (
+                    db.execute("DELETE FROM out_of_service WHERE thing = ?", (thing,)).rowcount == 1
+                )
+            cursor = db.execute(
+                "INSERT OR IGNORE INTO out_of_service (thing, since) VALUES (?, ?)", (thing, at)
+            )
+            return cursor.rowcount == 1
+
+    def out_of_service(self) -> list[str]:
+        """The robots out of service now, sorted."""
+        with self._lock:
+            rows = self._db.execute("SELECT thing FROM out_of_service ORDER BY thing").fetchall()
         return [row[0] for row in rows]
 
     def _with_status(self, status: str) -> list[Task]:

@@ -16,7 +16,10 @@ from vahr.protocol.decoding import LazyDecoder
 from vahr.protocol.errors import from_validation_error
 from vahr.protocol.messages import Timestamp, check_payload
 
-AnnouncementKind = Literal["stuck", "failed", "offline", "waiting", "cancelled", "done"]
+# `battery_low`: a robot low on charge is going to a charger by itself.
+AnnouncementKind = Literal[
+    "stuck", "failed", "offline", "waiting", "cancelled", "done", "battery_low"
+]
 ANNOUNCEMENT_KINDS: tuple[AnnouncementKind, ...] = (
     "stuck",
     "failed",
@@ -24,6 +27,7 @@ ANNOUNCEMENT_KINDS: tuple[AnnouncementKind, ...] = (
     "waiting",
     "cancelled",
     "done",
+    "battery_low",
 )
 # Alexa's referenceId allows letters, digits and '~', 1 to 100 characters.
 ReferenceId = Annotated[str, msgspec.Meta(pattern=r"^[A-Za-z0-9~]{1,100}$")]

@@ -16,8 +16,9 @@ from vahr.protocol.decoding import LazyDecoder
 from vahr.protocol.errors import from_validation_error
 from vahr.protocol.messages import CommandId, Timestamp, check_payload
 
-FaultKind = Literal["stuck", "fail", "offline", "clear"]
-FAULT_KINDS: tuple[FaultKind, ...] = ("stuck", "fail", "offline", "clear")
+FaultKind = Literal["stuck", "fail", "offline", "clear", "battery"]
+FAULT_KINDS: tuple[FaultKind, ...] = ("stuck", "fail", "offline", "clear", "battery")
+Percent = Annotated[float, msgspec.Meta(ge=0, le=100)]
 # How long an `offline` robot stays away before it reconnects by itself (wall seconds).
 DEFAULT_OFFLINE_S = 30.0
 
@@ -26,12 +27,14 @@ class FaultRequest(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fie
     """`stuck`: the robot stops where it is on its current (or next) way and never
     arrives; `fail`: its current (or next) goal aborts; `offline`: it drops its connection
     without saying goodbye (its last will says offline) for `offline_s`, then comes back;
-    `clear`: faults not yet applied are forgotten."""
+    `clear`: faults not yet applied are forgotten; `battery`: the battery's charge is
+    set to `percent`."""
 
     id: CommandId
     fault: FaultKind
     at: Timestamp
     offline_s: Annotated[float, msgspec.Meta(gt=0, le=3600)] = DEFAULT_OFFLINE_S
+    percent: Percent | None = None
 
 
 class FaultAnswer(msgspec.Struct, frozen=True, kw_only=True):

@@ -27,6 +27,7 @@ from vahr.skill_model.intents import (
     CUSTOM_INTENTS,
     GROUP_TYPE,
     LOCALE,
+    PERCENT_TYPE,
     ROBOT_TYPE,
     ZONE_TYPE,
     IntentSpec,
@@ -114,7 +115,13 @@ def build_interaction_model(
     whole fleet) is left out, with every slot and sample that needs it: Alexa refuses a
     custom type without values.
     """
-    types = [robot_type(fleet), zone_type(fleet), group_type(fleet), count_type()]
+    types = [
+        robot_type(fleet),
+        zone_type(fleet),
+        group_type(fleet),
+        count_type(),
+        percent_type(),
+    ]
     present = [slot_type for slot_type in types if slot_type["values"]]
     intents = for_types(intents, {slot_type["name"] for slot_type in present})
     check_samples(intents)
@@ -224,6 +231,13 @@ def count_type() -> dict[str, Any]:
     has), spelled out ("two", id "2"); "a robot" and "one robot" are words of the samples."""
     values = [_value(str(n), [spell_numbers(str(n))]) for n in range(2, MAX_COUNT + 1)]
     return {"name": COUNT_TYPE, "values": values}
+
+
+def percent_type() -> dict[str, Any]:
+    """PERCENT: a battery's charge, five to a hundred in steps of five, spelled out
+    ("thirty", id "30"), as people say a threshold."""
+    values = [_value(str(n), [spell_numbers(str(n))]) for n in range(5, 101, 5)]
+    return {"name": PERCENT_TYPE, "values": values}
 
 
 def for_types(intents: tuple[IntentSpec, ...], types: set[str]) -> tuple[IntentSpec, ...]:
@@ -376,7 +390,7 @@ def build_locale_model(fleet: Fleet, locale: str) -> dict[str, Any]:
     language = model["interactionModel"]["languageModel"]
     language["invocationName"] = load_language(locale).invocation_name
     for slot_type in language["types"]:
-        if slot_type["name"] != COUNT_TYPE_NAME:
+        if slot_type["name"] not in (COUNT_TYPE_NAME, PERCENT_TYPE):
             continue
         for value in slot_type["values"]:
             number = int(value["id"])

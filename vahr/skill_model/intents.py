@@ -25,6 +25,8 @@ ZONE_TYPE = "ZONE"
 # The fleet's groups other than the whole fleet, and how many robots (fleet dispatch).
 GROUP_TYPE = "GROUP"
 COUNT_TYPE = "COUNT"
+# A battery's charge in percent ("which robots are below thirty percent").
+PERCENT_TYPE = "PERCENT"
 # How many expanded samples an intent keeps at most: enough variety for Alexa (and the
 # simulator's classifier) to generalize, far inside the model's size limits (generator.py).
 MAX_SAMPLES_PER_INTENT = 240
@@ -34,6 +36,7 @@ ROBOT_ANSWERS = ("{slot}", "use {slot}", "with {slot}", "i mean {slot}", "i want
 ZONE_ANSWERS = ("{slot}", "to {slot}", "go to {slot}", "deliver it to {slot}", "i mean {slot}")
 GROUP_ANSWERS = ("{slot}", "i mean {slot}")
 COUNT_ANSWERS = ("{slot}", "{slot} robots")
+PERCENT_ANSWERS = ("{slot}", "{slot} percent")
 
 
 @dataclass(frozen=True)
@@ -45,9 +48,12 @@ class SlotSpec:
 
     @property
     def answers(self) -> list[str]:
-        template = {ROBOT_TYPE: ROBOT_ANSWERS, GROUP_TYPE: GROUP_ANSWERS}.get(
-            self.type, COUNT_ANSWERS if self.type == COUNT_TYPE else ZONE_ANSWERS
-        )
+        template = {
+            ROBOT_TYPE: ROBOT_ANSWERS,
+            GROUP_TYPE: GROUP_ANSWERS,
+            COUNT_TYPE: COUNT_ANSWERS,
+            PERCENT_TYPE: PERCENT_ANSWERS,
+        }.get(self.type, ZONE_ANSWERS)
         return [answer.replace("{slot}", "{" + self.name + "}") for answer in template]
 
 
@@ -636,6 +642,113 @@ OPEN_ZONE = IntentSpec(
     ),
 )
 
+# Batteries and service (docs/dispatch.md): the charge of a robot or of the fleet, a robot
+# sent to charge now, and robots taken out of service and put back.
+PERCENT = SlotSpec("percent", PERCENT_TYPE)
+# Fewer samples than the others: the model's samples are bounded in all (generator.py), and
+# so are the sentences the station hears with a thousand robots' names (vahr.station).
+BATTERY_SAMPLES = 60
+
+BATTERY = IntentSpec(
+    name="BatteryIntent",
+    max_samples=BATTERY_SAMPLES,
+    slots=(ROBOT, PERCENT),
+    essentials=(
+        "how much battery does {robot} have",
+        "which robots are below {percent} percent",
+        "which robots are low on battery",
+        "what is the battery of {robot}",
+    ),
+    templates=(
+        "[<ask>] how much (battery|charge|power|juice) (does|has) {robot} (have|got|left) [left]",
+        "[<ask>] (what is|what's|tell me) the (battery|charge|battery level|charge level) of "
+        "{robot} [now|right now]",
+        "[<ask>] how (charged|full) is {robot} [now|right now]",
+        "[<ask>] (is|does) {robot} (low on battery|need to charge|need charging|running low)",
+        "[<ask>] (which|what) (robots|bots|ones) (are|have) (below|under|less than|lower than) "
+        "{percent} percent [battery|charge]",
+        "[<ask>] (which|what) (robots|bots|ones) (are|have) (below|under|less than) {percent} "
+        "percent (of battery|of charge|left)",
+        "(are|is) (any|some) (robots|bots|of the robots) (below|under) {percent} percent",
+        "[<ask>] (which|what) (robots|bots|ones) (are|run) (low on|short of) (battery|charge|"
+        "power)",
+        "[<ask>] (which|what) (robots|bots|ones) need (to charge|charging|a charge)",
+        "[<ask>] (how much battery|how much charge|what charge) do {robot} have",
+        "[<ask>] (what are|tell me) the battery levels [of the robots|of the fleet]",
+    ),
+)
+
+CHARGE = IntentSpec(
+    name="ChargeIntent",
+    max_samples=BATTERY_SAMPLES,
+    slots=(ROBOT,),
+    commands_robots=True,
+    essentials=(
+        "send {robot} to charge",
+        "charge {robot}",
+        "{robot} go charge",
+    ),
+    templates=(
+        "<ask> (send|take|bring|get) {robot} (to charge|to recharge|charging|to get charged|to "
+        "its charger|to a charger|to the nearest charger) [now|right now] <end>",
+        "<ask> (charge|recharge|plug in|dock) {robot} [now|right now] <end>",
+        "{robot} (go|should go|must go|needs to go) (charge|recharge|and charge|charging|to a "
+        "charger|to charge) [now|right now]",
+        "{robot} (needs|has) to (charge|recharge|be charged) [now|right now]",
+        "<ask> (have|let|make) {robot} (charge|recharge|go charge|go and charge|dock) [now|right "
+        "now]",
+        "<ask> (put|set) {robot} (on charge|on the charger|on a charger) [now|right now]",
+    ),
+)
+
+OUT_OF_SERVICE = IntentSpec(
+    name="OutOfServiceIntent",
+    max_samples=BATTERY_SAMPLES,
+    slots=(ROBOT, GROUP),
+    essentials=(
+        "take {robot} out of service",
+        "take {group} out of service",
+        "put {robot} out of service",
+    ),
+    templates=(
+        "<ask> (take|put|pull|set) {robot} out of (service|operation|rotation|the pool) "
+        "[for maintenance|for repairs|for now] <end>",
+        "<ask> (take|put|pull|set) {group} out of (service|operation|rotation|the pool) "
+        "[for maintenance|for repairs|for now] <end>",
+        "{robot} is (out of service|out of order|down for maintenance|in maintenance) [now]",
+        "{group} are (out of service|out of order|down for maintenance|in maintenance) [now]",
+        "<ask> (mark|set) {robot} (as out of service|as out of order|as in maintenance)",
+        "<ask> (mark|set) {group} (as out of service|as out of order|as in maintenance)",
+        "<ask> (stop giving|don't give|give no) (tasks|jobs|work) to {robot} [for now]",
+        "<ask> (retire|withdraw|bench) {robot} [for maintenance|for now]",
+    ),
+)
+
+BACK_IN_SERVICE = IntentSpec(
+    name="BackInServiceIntent",
+    max_samples=BATTERY_SAMPLES,
+    slots=(ROBOT, GROUP),
+    essentials=(
+        "put {robot} back in service",
+        "put {group} back in service",
+        "{robot} is back in service",
+    ),
+    templates=(
+        "<ask> (put|bring|take|set) {robot} back (in|into|to) (service|operation|rotation|the "
+        "pool) <end>",
+        "<ask> (put|bring|take|set) {group} back (in|into|to) (service|operation|rotation|the "
+        "pool) <end>",
+        # Not "return X to ...": a robot returns to a zone ("placebot two return to the
+        # loading zone" is a navigation).
+        "<ask> restore {robot} to (service|operation) <end>",
+        "<ask> restore {group} to (service|operation) <end>",
+        "{robot} is (back in service|back in operation|repaired|fixed|working again) [now]",
+        "{group} are (back in service|back in operation|repaired|fixed|working again) [now]",
+        "<ask> (mark|set) {robot} (as in service|as back in service|as working)",
+        "<ask> (give|start giving) (tasks|jobs|work) to {robot} again",
+    ),
+)
+
 
 CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     NAVIGATE,
@@ -655,6 +768,10 @@ CUSTOM_INTENTS: tuple[IntentSpec, ...] = (
     CANCEL_TASK,
     CLOSE_ZONE,
     OPEN_ZONE,
+    BATTERY,
+    CHARGE,
+    OUT_OF_SERVICE,
+    BACK_IN_SERVICE,
 )
 
 BUILT_IN_INTENTS: tuple[str, ...] = (

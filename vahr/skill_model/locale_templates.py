@@ -112,8 +112,8 @@ def locale_intents(
                 essentials=tuple(words.essentials),
                 templates=tuple(inline_rules(t, data.rules) for t in words.templates),
                 # The locale's own templates, with the usual cap (an English intent's larger
-                # cap is for English templates added later).
-                max_samples=MAX_SAMPLES_PER_INTENT,
+                # cap is for English templates added later) or the English one when smaller.
+                max_samples=min(intent.max_samples, MAX_SAMPLES_PER_INTENT),
             )
         )
     return tuple(intents)

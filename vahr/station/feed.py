@@ -233,6 +233,7 @@ def fleet_view(
             )
             for index, robot in enumerate(fleet.robots)
         ],
+        charge_below=fleet.battery_plan.charge_below,
         zones=[
             ZoneEntry(
                 id=zone.id,

@@ -93,6 +93,8 @@ class FleetView(msgspec.Struct, frozen=True, kw_only=True):
     floor: Floor
     experiment_thing: str
     map: FloorMap | None = None
+    # Under this charge (percent) a robot is low: the fleet's `battery.charge_below`.
+    charge_below: float = 20.0
 
 
 class RobotView(msgspec.Struct, kw_only=True):
@@ -126,12 +128,13 @@ class CommandParams(msgspec.Struct, frozen=True, omit_defaults=True):
 class TasksMessage(msgspec.Struct, frozen=True, kw_only=True, tag="tasks", tag_field="type"):
     """The fleet's task queue, sent when it changed: every task the dispatcher lists
     (`GET {api}/vahr/tasks`, `vahr.dispatch.Task`: what is to be done where, its
-    state, the robot that took it), in its order, and the zones closed now; `available` is
-    False when the deployment has no dispatcher to ask."""
+    state, the robot that took it), in its order, the zones closed now and the robots out of
+    service; `available` is False when the deployment has no dispatcher to ask."""
 
     tasks: list[Task]
     available: bool
     closed: list[str] = []
+    out_of_service: list[str] = []
 
 
 class TrailMessage(msgspec.Struct, frozen=True, kw_only=True, tag="trail", tag_field="type"):

@@ -1,14 +1,15 @@
 """The fleet's task queue for the station: read from the dispatcher and relayed to the pages;
 and the station's switch that closes and opens zones there.
 
-The dispatcher serves the queue at `GET {api}/vahr/tasks` (`{"tasks": [...], "closed":
-[zone ids]}`) and closes a zone at `POST {api}/vahr/zones/{zone}` (`ZoneSwitch`). A
-`TaskPoller` reads it every `EVERY_S` on its own thread and hands it to the feed, which
-sends it to the pages only when it changed (`Feed.set_tasks`): the page never polls, and
-however many pages are open the dispatcher is asked once a period. A deployment without a
-dispatcher (a 404) shows the queue as not available; an unreachable or unreadable answer
-leaves the last queue shown, and is logged as a warning the first time only (a busy data
-plane that answers late now and then would otherwise fill the station's log).
+The dispatcher serves the queue at `GET {api}/vahr/tasks` (`{"tasks": [...], "closed": [zone
+ids], "out_of_service": [things]}`) and closes a zone at `POST {api}/vahr/zones/{zone}`
+(`ZoneSwitch`). A `TaskPoller` reads it every `EVERY_S` on its own thread and hands it to
+the feed, which sends it to the pages only when it changed (`Feed.set_tasks`): the page
+never polls, and however many pages are open the dispatcher is asked once a period. A
+deployment without a dispatcher (a 404) shows the queue as not available; an unreachable or
+unreadable answer leaves the last queue shown, and is logged as a warning the first time
+only (a busy data plane that answers late now and then would otherwise fill the station's
+log).
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ TASKS_SHOWN = 200
 class _Tasks(msgspec.Struct):
     tasks: list[Task]
     closed: list[str] = []
+    out_of_service: list[str] = []
 
 
 _decoder = msgspec.json.Decoder(_Tasks)
@@ -58,7 +60,12 @@ def read_tasks(url: str, timeout_s: float = TIMEOUT_S) -> TasksMessage:
             return TasksMessage(tasks=[], available=False)
         raise
     answer = _decoder.decode(body)
-    return TasksMessage(tasks=answer.tasks[:TASKS_SHOWN], available=True, closed=answer.closed)
+    return TasksMessage(
+        tasks=answer.tasks[:TASKS_SHOWN],
+        available=True,
+        closed=answer.closed,
+        out_of_service=answer.out_of_service,
+    )
 
 
 class TaskPoller(Poller):

@@ -1,8 +1,10 @@
 """`POST /vahr/fault`: inject a fault into a running simulated robot (development only).
 
-The request `{"thing": ..., "fault": "stuck"|"fail"|"offline"|"clear", "offline_s": ...}`
+The request `{"thing": ..., "fault": "stuck"|"fail"|"offline"|"clear"|"battery", "offline_s": ...,
+"percent": ...}`
 is checked against the fleet, published to the robot on its development fault topic
-(`vahr.protocol.fault_request`), and answered with what the robot said, within `timeout_s`. The
+(`vahr.protocol.fault_request`), and answered with what the robot said, within `timeout_s`. A
+`battery` fault carries `percent` (0 to 100), the charge to set. The
 answer is 200 `{"thing", "fault", "backend"}`, or an error whose message is one line:
 404 for a robot not in the fleet, 409 for a robot that is not simulated, 504 for one that
 did not answer (offline, or started without `sim.accept_faults`).
@@ -54,21 +56,36 @@ class FaultInjector:
             return _error(400, f"fault: {fault!s:.40} is not one of {', '.join(FAULT_KINDS)}")
         if not isinstance(offline_s, int | float) or not 0 < offline_s <= 3600:
             return _error(400, "offline_s: must be a number of seconds in (0, 3600]")
+        percent = request.get("percent")
+        if fault == "battery":
+            if isinstance(percent, bool) or not isinstance(percent, int | float):
+                return _error(400, "percent: a battery fault needs a percent from 0 to 100")
+            if not 0 <= percent <= 100:
+                return _error(400, f"percent: {percent:g} is not a charge; give 0 to 100")
+        elif percent is not None:
+            return _error(400, f"percent: only a battery fault takes one, not {fault}")
         try:
-            answer = self.inject(thing, fault, float(offline_s))
+            answer = self.inject(thing, fault, float(offline_s), percent)
         except VahrError as err:
             return _error(504, str(err))
         if not answer.ok:
             return _error(409, f"{thing}: {answer.reason or 'refused'}")
         return 200, {"thing": thing, "fault": fault, "backend": answer.backend}
 
-    def inject(self, thing: str, fault: str, offline_s: float = DEFAULT_OFFLINE_S) -> FaultAnswer:
+    def inject(
+        self,
+        thing: str,
+        fault: str,
+        offline_s: float = DEFAULT_OFFLINE_S,
+        percent: float | None = None,
+    ) -> FaultAnswer:
         """Publish the request and wait for the robot's answer; VahrError if none comes."""
         request = FaultRequest(
             id=uuid.uuid4().hex,
             fault=fault,  # type: ignore[arg-type]
             at=utc_now(),
             offline_s=offline_s,
+            percent=percent,
         )
         done: tuple[threading.Event, list[FaultAnswer]] = (threading.Event(), [])
         with self._lock:

@@ -5,11 +5,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from skill import prompts, session, speech
+from skill import battery_speech, deeds, prompts, session, speech
 from skill.commands import publication
 from skill.guard import confirm_first
 from skill.responses import answer
-from skill.vocabulary import capitalise
+from skill.service_guard import out_of_service
+from skill.vocabulary import FLEET, capitalise
 from skill.zone_guard import closed_zone
 
 if TYPE_CHECKING:
@@ -30,8 +31,12 @@ def send_and_report(
     desk: TaskDesk | None = None,
 ) -> Response:
     """Publish `action` to one robot (or the fleet) and say what the robots answered; a
-    command into a zone the dispatcher (`desk`) says is closed is not sent, and a
-    fleet-wide one is confirmed by its asker first."""
+    command into a zone the dispatcher (`desk`) says is closed, or to a robot it says is
+    out of service (any command but a stop), is not sent, and a fleet-wide one is
+    confirmed by its asker first."""
+    refusal = service_reply(runtime, desk, action, [target])
+    if refusal is not None:
+        return answer(handler_input, refusal)
     zone = (params or {}).get("zone")
     refused = closed_reply(runtime, desk, [zone if isinstance(zone, str) else None])
     if refused is not None:
@@ -43,6 +48,25 @@ def send_and_report(
     answers = runtime.robots.send([item])
     session.remember(handler_input, item)
     return answer(handler_input, speech.command_report(runtime.vocabulary, item, answers))
+
+
+def service_reply(
+    runtime: SkillRuntime, desk: TaskDesk | None, action: str, targets: list[str]
+) -> str | None:
+    """What to say instead of sending `action` to `targets` (things, or the fleet) when
+    some of them are out of service; None for a stop, which always goes out."""
+    if action == "stop":
+        return None
+    things = [
+        thing
+        for target in targets
+        for thing in (runtime.fleet.robot_things if target == FLEET else (target,))
+    ]
+    out = out_of_service(desk, things)
+    if not out:
+        return None
+    deeds.failed("out of service: " + ", ".join(out))
+    return battery_speech.refused(runtime.vocabulary, out)
 
 
 def closed_reply(

@@ -9,7 +9,7 @@ from ask_sdk_core.utils import is_intent_name
 
 from skill import dialog, prompts, speech
 from skill.commands import sequential
-from skill.handlers.send import closed_reply
+from skill.handlers.send import closed_reply, service_reply
 from skill.responses import answer
 from skill.vocabulary import FLEET, capitalise
 
@@ -71,7 +71,9 @@ class SequentialDeliveryIntentHandler(AbstractRequestHandler):
         if dialog.delivery_zone_problem(second_zone):
             return self._ask_zone(handler_input, second_zone, second_id)
         assert first_zone.id is not None and second_zone.id is not None
-        refused = closed_reply(runtime, self.desk, [first_zone.id, second_zone.id])
+        refused = service_reply(
+            runtime, self.desk, "sequential_delivery", [first.id, second_id]
+        ) or closed_reply(runtime, self.desk, [first_zone.id, second_zone.id])
         if refused is not None:
             return answer(handler_input, refused)
         items = sequential(runtime.fleet, first.id, first_zone.id, second_id, second_zone.id)

@@ -17,6 +17,7 @@ if TYPE_CHECKING:
     from ask_sdk_model import Response
 
     from skill.runtime import SkillRuntime
+    from skill.task_desk import TaskDesk
     from vahr.protocol.shadow import Weather
 
 # The zones a person may say with the request ("deliver to zone a if it's sunny and zone c
@@ -27,8 +28,9 @@ RULE_SLOTS: dict[Weather, str] = {"sunny": "sunnyZone", "rainy": "rainyZone"}
 class WeatherDeliveryIntentHandler(AbstractRequestHandler):
     """Have a robot ask for the weather, then deliver to A if sunny or C if rainy."""
 
-    def __init__(self, runtime: SkillRuntime) -> None:
+    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None = None) -> None:
         self.runtime = runtime
+        self.desk = desk
 
     def can_handle(self, handler_input: HandlerInput) -> bool:
         return bool(is_intent_name("WeatherDeliveryIntent")(handler_input))
@@ -45,7 +47,9 @@ class WeatherDeliveryIntentHandler(AbstractRequestHandler):
         robot = dialog.robot(handler_input, self.runtime, "robot")
         if robot.id is None:
             return dialog.ask_robot(handler_input, self.runtime, robot)
-        return send_and_report(handler_input, self.runtime, "weather_delivery", robot.id)
+        return send_and_report(
+            handler_input, self.runtime, "weather_delivery", robot.id, desk=self.desk
+        )
 
     def _rule_as_robots_follow(self, handler_input: HandlerInput) -> bool:
         """Whether every zone said for a weather is the one robots deliver to in it."""

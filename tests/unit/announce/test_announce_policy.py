@@ -25,6 +25,7 @@ from vahr.announce import (
 )
 from vahr.announce.speech import Names
 from vahr.protocol import ProtocolError, decode_event, decode_presence
+from vahr.protocol.announcements import decode_announcement
 
 if TYPE_CHECKING:
     from vahr.domain import Fleet
@@ -360,6 +361,24 @@ def test_a_task_given_up_for_a_command_by_name_is_told_once_with_its_place(fleet
     )
     clock.advance(120)
     assert p.tick() == []
+
+
+def test_a_robot_sent_to_charge_by_itself_is_told_once_in_both_languages(fleet: Fleet) -> None:
+    from vahr.announce import LowBattery
+
+    clock = Clock()
+    p = policy(fleet, clock)
+    [told] = p.observe([LowBattery("placebot1", T0, zone="A")])
+    assert (told.kind, told.thing) == ("battery_low", "placebot1")
+    assert told.speech == "Placebot one is low on battery and is going to charge."
+    # Its id is one Alexa's Proactive Events API takes (letters, digits and '~').
+    assert told.id.startswith("vahr~batterylow~")
+    decode_announcement(msgspec.json.encode(told))
+    clock.advance(120)
+    assert p.tick() == []
+    german = AnnouncePolicy(settings_from({}), Names.of(fleet, "de-DE"), Clock())
+    [gesagt] = german.observe([LowBattery("placebot1", T0)])
+    assert gesagt.speech == "Placebot eins hat wenig Akku und fährt zum Laden."
 
 
 def test_announcements_are_said_in_the_stacks_language() -> None:

@@ -24,6 +24,7 @@ from vahr.dispatch import (
     DispatchError,
     Order,
     RobotState,
+    ServiceChange,
     Submission,
     Task,
     ZoneChange,
@@ -65,6 +66,7 @@ class CoreDesk:
 
     def __init__(self, dispatcher: Dispatcher) -> None:
         self.dispatcher = dispatcher
+        self.out: set[str] = set()
 
     def submit(self, order: Order) -> Submission:
         try:
@@ -86,6 +88,26 @@ class CoreDesk:
             return self.dispatcher.set_zone(zone, closed=closed)
         except DispatchError as err:
             raise TaskRefused(400, str(err), err.code) from err
+
+    def out_of_service(self) -> list[str]:
+        return sorted(self.out)
+
+    def set_service(self, thing: str, *, in_service: bool) -> ServiceChange:
+        changed = (thing in self.out) == in_service
+        self.out.discard(thing) if in_service else self.out.add(thing)
+        if not changed:
+            return ServiceChange(thing=thing, in_service=in_service, changed=False)
+        if in_service:
+            return self.dispatcher.reinstated(thing)
+        return self.dispatcher.withdrawn(thing)
+
+    def charge(self, thing: str) -> Task:
+        try:
+            task = self.dispatcher.charge(thing, asked=True)
+        except DispatchError as err:
+            raise TaskRefused(400, str(err), err.code) from err
+        assert task is not None
+        return task
 
 
 @pytest.fixture
@@ -372,6 +394,39 @@ def test_closing_a_zone_is_said_in_german(
         "ist gesperrt. Bis sie wieder offen ist, schicke ich keinen Roboter dorthin."
     )
     assert desk.closed_zones() == ["OVEN"]
+
+
+def test_a_robot_out_of_service_is_not_sent_by_name_and_back_in_service_it_is(
+    skill: Callable[[dict[str, Any]], dict[str, Any]],
+    sent: list[tuple[str, Command]],
+    desk: CoreDesk,
+) -> None:
+    # When the heron is taken out of service by voice
+    out = intent("OutOfServiceIntent", robot=("heron", "heron"))
+    assert said(skill, out) == "Heron is out of service now and gets no tasks."
+    assert desk.out_of_service() == ["heron"]
+    assert said(skill, out) == "Heron was already out of service."
+    # Then a command naming it is not sent, and says why; a stop still is
+    by_name = intent("NavigateIntent", robot=("heron", "heron"), zone=("the oven", "OVEN"))
+    assert said(skill, by_name) == "Heron is out of service, so I sent nothing."
+    charge = intent("ChargeIntent", robot=("heron", "heron"))
+    assert said(skill, charge) == "Heron is out of service, so I sent nothing."
+    assert sent == []
+    # Back in service, it takes commands again
+    back = intent("BackInServiceIntent", robot=("heron", "heron"))
+    assert said(skill, back) == "Heron is back in service."
+    assert desk.out_of_service() == []
+    assert said(skill, by_name) != "Heron is out of service, so I sent nothing."
+
+
+def test_taking_a_group_out_of_service_names_its_members_in_german(
+    skill: Callable[[dict[str, Any]], dict[str, Any]], desk: CoreDesk
+) -> None:
+    event = intent("OutOfServiceIntent", group=("die watvögel", "waders"))
+    event["request"]["locale"] = "de-DE"
+    spoken = said(skill, event)
+    assert spoken.endswith("sind jetzt außer Betrieb und bekommen keine Aufträge."), spoken
+    assert desk.out_of_service() == ["curlew", "dunlin", "plover"]
 
 
 def test_with_confirmation_on_a_zone_is_closed_only_after_its_askers_yes(

@@ -18,7 +18,7 @@ import { typing } from "./talk.js";
 
 const SHOWN = 2; // alerts drawn at once; the rest wait behind a count
 /** What happened, in a word or two, per kind of announcement. @type {Record<AnnouncementMessage["kind"], string>} */
-const TROUBLES = { stuck: t("stuck"), failed: t("task failed"), offline: t("offline"), waiting: t("task waiting"), cancelled: t("task cancelled"), done: t("task done") };
+const TROUBLES = { stuck: t("stuck"), failed: t("task failed"), offline: t("offline"), waiting: t("task waiting"), cancelled: t("task cancelled"), done: t("task done"), battery_low: t("battery low") };
 // A key pressed on one of these does what the element does, not the page's shortcut.
 const CONTROLS = "button, a[href], input, select, textarea, summary, [contenteditable], [role=button]";
 

@@ -40,7 +40,7 @@
  * @property {string} id
  * @property {string} time
  * @property {string|null} thing
- * @property {"cancelled"|"done"|"failed"|"offline"|"stuck"|"waiting"} kind
+ * @property {"battery_low"|"cancelled"|"done"|"failed"|"offline"|"stuck"|"waiting"} kind
  * @property {number} priority
  * @property {string} speech
  * @property {string|null} reason
@@ -203,6 +203,7 @@
  * @property {Floor} floor
  * @property {string} experiment_thing
  * @property {FloorMap|null} map
+ * @property {number} charge_below
  */
 
 /**
@@ -431,7 +432,7 @@
  * @typedef {object} Task
  * @property {string} id
  * @property {string} request
- * @property {"deliver"|"navigate"} kind
+ * @property {"charge"|"deliver"|"navigate"} kind
  * @property {string} zone
  * @property {string|null} pickup
  * @property {string|null} group
@@ -447,13 +448,14 @@
 /**
  * The fleet's task queue, sent when it changed: every task the dispatcher lists (`GET
  * {api}/vahr/tasks`, `vahr.dispatch.Task`: what is to be done where, its state, the robot that
- * took it), in its order, and the zones closed now; `available` is False when the deployment
- * has no dispatcher to ask.
+ * took it), in its order, the zones closed now and the robots out of service; `available` is
+ * False when the deployment has no dispatcher to ask.
  * @typedef {object} TasksMessage
  * @property {"tasks"} type
  * @property {Array<Task>} tasks
  * @property {boolean} available
  * @property {Array<string>} closed
+ * @property {Array<string>} out_of_service
  */
 
 /**

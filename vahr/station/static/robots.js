@@ -61,6 +61,8 @@ const STATUSES = ["idle", "navigating", "loading", "unloading", "waiting", "stop
  * @property {HTMLSpanElement} status
  * @property {HTMLSpanElement} zone
  * @property {HTMLSpanElement} cargo
+ * @property {HTMLSpanElement} battery
+ * @property {HTMLSpanElement} service
  * @property {string | null} thing the robot it shows
  */
 
@@ -86,6 +88,8 @@ function put(target, key, value) {
  * @property {HTMLSpanElement} status
  * @property {HTMLElement} zone
  * @property {HTMLSpanElement} cargo
+ * @property {HTMLSpanElement} battery
+ * @property {HTMLSpanElement} service
  * @property {HTMLDivElement} task
  * @property {HTMLSpanElement} taskWhat
  * @property {HTMLSpanElement} bar
@@ -122,6 +126,10 @@ export class RobotsPanel {
     this.bound = new Map();
     /** @type {string | null} */
     this.selected = null;
+    /** The robots out of service. @type {Set<string>} */
+    this.outOfService = new Set();
+    /** Under this charge a robot is low (the fleet's). */
+    this.chargeBelow = 20;
     /** @type {ReturnType<typeof setTimeout> | null} */
     this.refilter = null;
     search.none.textContent = WORDS.none;
@@ -160,6 +168,17 @@ export class RobotsPanel {
     }
   }
 
+  /** The robots taken out of service (the dispatcher's list). @param {string[]} things */
+  setOutOfService(things) {
+    this.outOfService = new Set(things);
+    for (const [thing, parts] of this.rows) {
+      const out = this.outOfService.has(thing);
+      parts.row.classList.toggle("out-of-service", out);
+      parts.service.hidden = !out;
+    }
+    for (const line of this.bound.values()) this.fillLine(line);
+  }
+
   // The robots with an open alert: their rows are marked until it is acknowledged.
   /** @param {Map<string, string>} troubled */
   setTroubled(troubled) {
@@ -172,6 +191,7 @@ export class RobotsPanel {
 
   /** @param {FleetView} fleet */
   build(fleet) {
+    this.chargeBelow = fleet.charge_below ?? 20;
     this.list.replaceChildren();
     this.list.classList.toggle("many", fleet.robots.length > ROWS_SIZED_BY_CONTENT);
     this.rows.clear();
@@ -204,7 +224,11 @@ export class RobotsPanel {
       const zoneFact = node("span", "", t("zone") + " ");
       zoneFact.appendChild(zone);
       const cargo = node("span");
-      facts.append(status, zoneFact, cargo);
+      const battery = node("span", "battery");
+      battery.hidden = true;
+      const service = node("span", "service-tag", t("out of service"));
+      service.hidden = !this.outOfService.has(robot.thing);
+      facts.append(status, zoneFact, cargo, battery, service);
       const task = node("div", "task");
       const taskWhat = node("span", "task-what");
       const bar = node("span", "progress");
@@ -221,7 +245,8 @@ export class RobotsPanel {
       details.addEventListener("toggle", () => { if (details.open) raw.textContent = JSON.stringify(parts.reported, null, 2); });
       row.append(badge, node("span", "name", robot.name), presence, facts, task, last, details);
       this.list.appendChild(row);
-      const parts = { row, badge, presence, presenceText, status, zone, cargo, task, taskWhat, bar, fill, percent, source, last, details, raw, reported: {} };
+      row.classList.toggle("out-of-service", this.outOfService.has(robot.thing));
+      const parts = { row, badge, presence, presenceText, status, zone, cargo, battery, service, task, taskWhat, bar, fill, percent, source, last, details, raw, reported: {} };
       this.rows.set(robot.thing, parts);
     });
     this.find();
@@ -236,10 +261,11 @@ export class RobotsPanel {
     pick.type = "button";
     const dot = node("span", "line-dot"), name = node("span", "name"), status = node("span", "status-text");
     const zone = node("span", "line-zone"), cargo = node("span", "cargo-tag");
-    pick.append(dot, name, status, zone, cargo);
+    const battery = node("span", "battery"), service = node("span", "service-tag", t("out of service"));
+    pick.append(dot, name, status, zone, cargo, battery, service);
     row.appendChild(pick);
     /** @type {Line} */
-    const line = { row, pick, dot, name, status, zone, cargo, thing: null };
+    const line = { row, pick, dot, name, status, zone, cargo, battery, service, thing: null };
     pick.addEventListener("click", () => { if (line.thing) this.onSelect(line.thing); });
     lineOf.set(row, line);
     return row;
@@ -277,6 +303,21 @@ export class RobotsPanel {
     put(line.zone, "textContent", reported.zone ? zoneText(reported.zone) : "");
     line.cargo.hidden = !reported.cargo;
     if (reported.cargo) put(line.cargo, "textContent", t("package"));
+    this.showBattery(line.battery, reported.battery);
+    const out = this.outOfService.has(line.thing);
+    line.service.hidden = !out;
+    line.row.classList.toggle("out-of-service", out);
+  }
+
+  /** A robot's charge, and whether it charges; red under the fleet's threshold.
+   * @param {HTMLElement} element @param {Reported["battery"]} battery */
+  showBattery(element, battery) {
+    element.hidden = !battery;
+    if (!battery) return;
+    const words = battery.charging ? t("battery {percent}%, charging", { percent: battery.percent }) : t("battery {percent}%", { percent: battery.percent });
+    put(element, "textContent", words);
+    element.classList.toggle("low", battery.percent < this.chargeBelow && !battery.charging);
+    element.classList.toggle("charging", Boolean(battery.charging));
   }
 
   /** @param {string | null} thing */
@@ -324,6 +365,7 @@ export class RobotsPanel {
     put(parts.zone, "textContent", reported.zone ? zoneText(reported.zone) : "—");
     put(parts.cargo, "textContent", reported.cargo ? t("package") : t("no package"));
     put(parts.cargo, "className", reported.cargo ? "cargo-tag" : "");
+    this.showBattery(parts.battery, reported.battery);
 
     const last = reported.last_command;
     const working = Boolean(reported.task);

@@ -235,6 +235,7 @@ function reset(snapshot) {
   onExperiment(snapshot.experiment);
   tasks.update(snapshot.tasks);
   map.setClosed(snapshot.tasks?.closed || []);
+  robots.setOutOfService(snapshot.tasks?.out_of_service || []);
   zones.update(snapshot.tasks);
   trail.update(snapshot.trail);
   alerts.reset(snapshot.alerts, first);
@@ -328,6 +329,7 @@ const handlers = {
   tasks(message) {
     tasks.update(message);
     map.setClosed(message.closed || []);
+    robots.setOutOfService(message.out_of_service || []);
     zones.update(message);
   },
   trail(message) {
