@@ -33,6 +33,9 @@ ROS2_TESTS := tests/integration/agent
 # than pip.
 UV_VERSION := 0.13.9
 UV := $(BIN)/uv pip install -q
+# Byte code is written and reused: the suite starts hundreds of Python processes (robots,
+# stacks, browsers' servers), and each would compile the sources again without it.
+unexport PYTHONDONTWRITEBYTECODE
 export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
 export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 
@@ -41,10 +44,16 @@ export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 demo: setup
 	$(BIN)/vahr demo
 
-test: setup lint typecheck jstest pytest pytest-ros2
+# The checks that use a core each run side by side, then the suite, which uses both.
+test: setup
+	$(MAKE) --no-print-directory -j4 --output-sync=target lint typecheck jstest pytest-ros2
+	$(MAKE) --no-print-directory pytest
 
-setup: system-packages $(VENV)/.installed $(ROS_SITE)/.linked $(VENV_ROS2)/.installed \
-	node_modules/.installed
+# The environments are made side by side: npm and uv wait on the network while the ROS 2
+# messages compile.
+setup: system-packages
+	$(MAKE) --no-print-directory -j3 $(VENV)/.installed $(ROS_SITE)/.linked \
+		$(VENV_ROS2)/.installed node_modules/.installed
 
 system-packages:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null \

@@ -272,21 +272,28 @@ class DispatchUsage:
     # task, measured on the handler under moto (tests/support/dispatch_meter.py; checked by
     # tests/unit/dispatcher/test_dispatcher_costs.py). The submit: the task's PutItem (1
     # write), the assignment's transaction of two items (4: transactions bill twice), two
-    # consistent Queries of the open tasks, one of the closed zones and a GetItem (4
-    # reads); the robot-freed event: the closing transaction of three items (6 writes),
-    # three Queries and a GetItem (4).
-    table_reads: float = 8.0
+    # consistent Queries of the open tasks, one of the closed zones, one of the robots'
+    # claims (the fleet search skips robots holding a task) and a GetItem (5 reads); the
+    # robot-freed event: the closing transaction of three items (6 writes), three Queries
+    # and a GetItem (4).
+    table_reads: float = 9.0
     table_writes: float = 11.0
+    # The schedule's look at the task once its robot has it (lambda/dispatcher/reoffer.py):
+    # the acknowledgment marked on the task's item (an UpdateItem, 1 write) and the robot
+    # found in the index (one SearchIndex query, shared by the up to about 40 tasks of one
+    # minute: one per task at most). The tick's own reads are the tick's
+    # (`announcer_ticks_cost`, the same schedule).
+    ack_writes: float = 1.0
+    ack_searches: float = 1.0
     # The robot's shadow updates while it does one task (LabUsage: a delivery sends 9).
     # Each is a rule triggered (the rule's topic filter matches every classic shadow's
     # documents; counted whether or not WHERE selects it) and an index update (a robot's
     # reported state is under 1 KB).
     shadow_updates: int = 9
-    # SearchIndex's page (AWS: maxResults "cannot exceed 100").
-    search_page: int = 100
-    # Share of the fleet that may take a task (idle or busy, connected) when it is
-    # submitted; every one of them is a candidate the index returns.
-    free_share: float = 1.0
+    # SearchIndex calls of a submit: the first page of connected idle robots holds a free
+    # one (lambda/dispatcher/fleet_search.py reads further only when it does not), so one
+    # whatever the fleet's size; reading every free robot would be one per 100 of them.
+    search_pages: int = 1
     # Reading a robot's shadow instead (GetThingShadow): a document with metadata, 1-2 KB.
     shadow_units_per_read: int = 2
     # The command: in once, out to its robot at QoS 1 (the PUBLISH and the PUBACK).
@@ -300,17 +307,18 @@ def dispatch_billable(
     reading every robot's shadow."""
     common = {
         "dynamodb_reads": usage.table_reads,
-        "dynamodb_writes": usage.table_writes,
+        "dynamodb_writes": usage.table_writes + usage.ack_writes,
         "lambda_requests": 2.0,  # the skill's submit, the robot-freed event
         "rules_triggered": float(usage.shadow_updates),
         "rule_actions": 1.0,
         "messages": float(usage.command_messages),
     }
     if not index:
-        return Billable(shadow_operations=robots * usage.shadow_units_per_read, **common)
-    candidates = math.ceil(robots * usage.free_share)
+        # The candidates, and the schedule's look at the task's robot, by shadow reads.
+        reads = (robots + usage.ack_searches) * usage.shadow_units_per_read
+        return Billable(shadow_operations=reads, **common)
     return Billable(
-        index_queries=max(1, math.ceil(candidates / usage.search_page)),
+        index_queries=float(usage.search_pages) + usage.ack_searches,
         index_updates=float(usage.shadow_updates),
         **common,
     )

@@ -13,7 +13,8 @@ Least privilege: the function may read one secret (the skill's Alexa Skill Messa
 client id and secret, created by you, never in the template), read and write its one
 state table, publish on the one announcements topic, write its own logs and send to its
 dead-letter queue. IoT may invoke it only
-from these two rules, EventBridge only from its schedule. A message the rule cannot
+from these two rules, EventBridge only from its schedule; with the dispatcher, the
+dispatcher's role may invoke it too, to tell a task the fleet lost. A message the rule cannot
 deliver (the function throttled or missing) and an event the function failed on after
 Lambda's two retries both land in the same encrypted queue, kept 14 days: nothing is lost
 silently.

@@ -6,12 +6,15 @@ The rule reads every classic shadow's `update/documents` and passes on only the 
 that leave a robot idle or stopped when it was not, or that change whether it is
 connected while it is free (`freed_sql`); driving, progress and pose reports cost a rule
 evaluation and nothing more. The skill invokes the function synchronously to submit,
-list and cancel tasks. An EventBridge schedule wakes it once a minute to give queued tasks
-to robots that are free now, should a rule event have been lost.
+list and cancel tasks. An EventBridge schedule wakes it once a minute to offer again the
+commands robots never acknowledged and to give queued tasks to robots that are free now,
+should a rule event have been lost. With the announcer, it may invoke the announcer
+function (asynchronously) to tell a task it lost.
 
 Least privilege: the function may read and write only its task table, search only the
 `AWS_Things` index, publish only on the fleet's robots' command topics, write its own
-logs and send to its dead-letter queue. IoT may invoke it only from its rule, EventBridge
+logs, send to its dead-letter queue and invoke the announcer function (when there is one).
+IoT may invoke it only from its rule, EventBridge
 only from its schedule. A message
 the rule cannot deliver and an event the function failed on after Lambda's two retries
 land in one encrypted queue, kept 14 days.
@@ -48,8 +51,9 @@ TIMEOUT = cdk.Duration.seconds(30)
 MEMORY_MB = 512
 # The fleet index the skill may ask for counts and searches (issue 35's status summary).
 SKILL_INDEX_ACTIONS = ("iot:SearchIndex", "iot:GetBucketsAggregation", "iot:GetStatistics")
-# How often the schedule has the function give queued tasks to robots free now, in case a
-# robot's rule event was lost. With nothing queued a tick is one read of the queue.
+# How often the schedule has the function offer again the commands robots never acknowledged
+# and give queued tasks to robots free now, in case a robot's rule event was lost. With no
+# open task a tick is one read of the open tasks (and the closed zones told again).
 TICK = cdk.Duration.minutes(1)
 
 
@@ -85,7 +89,9 @@ class Dispatcher(Construct):
         table: dynamodb.ITable,
         index_arn: str,
         data_endpoint: str,
+        announcer: lambda_.IFunction | None = None,
     ) -> None:
+        """`announcer`: the announcer function, told of each task the dispatcher loses."""
         super().__init__(scope, construct_id)
         stack = cdk.Stack.of(self)
         self.index_arn = index_arn
@@ -110,6 +116,7 @@ class Dispatcher(Construct):
                     "dynamodb:GetItem",
                     "dynamodb:PutItem",
                     "dynamodb:DeleteItem",
+                    "dynamodb:UpdateItem",
                     "dynamodb:Query",
                 ],
                 resources=[table.table_arn],
@@ -143,6 +150,22 @@ class Dispatcher(Construct):
                 resources=[closures],
             )
         )
+        environment = {
+            "VAHR_TASK_TABLE": table.table_name,
+            "VAHR_FLEET_INDEX": INDEX_NAME,
+            "VAHR_IOT_DATA_ENDPOINT": f"https://{data_endpoint}",
+            "VAHR_LOG_LEVEL": config.log_level,
+        }
+        if announcer is not None:
+            self.role.add_to_policy(
+                iam.PolicyStatement(
+                    # A lost task told; the function's ARN alone (no versions, no aliases).
+                    sid="TellLostTasks",
+                    actions=["lambda:InvokeFunction"],
+                    resources=[announcer.function_arn],
+                )
+            )
+            environment["VAHR_ANNOUNCER_FUNCTION"] = announcer.function_name
         self.function, self.log_group = python_function(
             self,
             config=config,
@@ -155,12 +178,7 @@ class Dispatcher(Construct):
             dead_letter_queue=self.dead_letters,
             retry_attempts=2,
             max_event_age=cdk.Duration.hours(1),
-            environment={
-                "VAHR_TASK_TABLE": table.table_name,
-                "VAHR_FLEET_INDEX": INDEX_NAME,
-                "VAHR_IOT_DATA_ENDPOINT": f"https://{data_endpoint}",
-                "VAHR_LOG_LEVEL": config.log_level,
-            },
+            environment=environment,
         )
         self.rule_role = rule_role(
             self,
@@ -183,7 +201,7 @@ class Dispatcher(Construct):
         self.schedule = events.Rule(
             self,
             "Tick",
-            description="Wakes the VAHR dispatcher to give queued tasks to free robots",
+            description="Wakes the VAHR dispatcher to offer unacknowledged and queued tasks",
             schedule=events.Schedule.rate(TICK),
             targets=[targets.LambdaFunction(self.function, retry_attempts=0, max_event_age=TICK)],
         )

@@ -2,11 +2,13 @@
 
 There is no CloudFormation resource for it: a custom resource calls
 `iot:UpdateIndexingConfiguration` at deploy time, turning on thing indexing with the
-registry and the classic shadow (REGISTRY_AND_SHADOW) and three custom fields,
-`shadow.reported.status` and `shadow.reported.zone` (String) and `shadow.reported.connected`
-(Boolean), which `SearchIndex` matches exactly and `GetBucketsAggregation` and
-`GetStatistics` can count by (the dispatcher searches by status and zone; the skill's
-status summary counts by status and connection). Connectivity indexing stays off: the
+registry and the classic shadow (REGISTRY_AND_SHADOW) and five custom fields,
+`shadow.reported.status` and `shadow.reported.zone` (String), `shadow.reported.connected`
+(Boolean), and the battery, `shadow.reported.battery.percent` (Number) and
+`shadow.reported.battery.charging` (Boolean), which `SearchIndex` matches exactly (and
+numbers by range, `shadow.reported.battery.percent:[0 TO 20]`) and `GetBucketsAggregation`
+and `GetStatistics` can count by (the dispatcher searches by status, connection and zone;
+the skill's status summary counts by status and connection). Connectivity indexing stays off: the
 robots' shadows report `connected` themselves (the presence rule keeps it true to the MQTT
 session).
 
@@ -32,6 +34,8 @@ CUSTOM_FIELDS = (
     ("shadow.reported.status", "String"),
     ("shadow.reported.zone", "String"),
     ("shadow.reported.connected", "Boolean"),
+    ("shadow.reported.battery.percent", "Number"),
+    ("shadow.reported.battery.charging", "Boolean"),
 )
 
 

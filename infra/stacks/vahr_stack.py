@@ -154,6 +154,7 @@ class VahrStack(cdk.Stack):
                 table=self.task_table.table,
                 index_arn=self.fleet_indexing.index_arn,
                 data_endpoint=self.data_endpoint.address,
+                announcer=self.announcer.function if self.announcer is not None else None,
             )
             self.dispatcher.admit_skill(self.skill_function.function, self.skill_function.role)
             # What the dispatcher does by itself (a queued task given to a freed robot).

@@ -6,7 +6,9 @@ The rule's SQL (infra/constructs/announcer.py) gives each event as the robot sen
 "sender"}`. Each announcement Alexa accepted is published on `vahr/assistant/announcements`
 for the operator station. An EventBridge schedule also invokes it once a minute (`"source":
 "aws.events"`): nothing happened, but time passed, so what the rate limit held back is told
-without waiting for the next robot event. A malformed message is logged and skipped
+without waiting for the next robot event. The dispatcher function invokes it (asynchronously)
+with `{"lost_task": ...}` (`vahr.protocol.lost_tasks.LostTask`) for a fleet task it could
+not see through, told as a `cancelled` announcement. A malformed message is logged and skipped
 (retrying cannot mend it); a failure to deliver raises `AnnouncerError`, so Lambda retries
 the event and then dead-letters it. The state is written only when it changed.
 """
@@ -24,10 +26,16 @@ from announcer.aws import AnnouncementTopic, SkillCredentials, StateStore
 from announcer.config import AnnouncerConfig
 from announcer.errors import AnnouncerError, DeliveryFailed, StateConflict
 from announcer.proactive_events import ProactiveEvents
-from vahr.announce import AnnouncePolicy, signals_from_event, signals_from_presence
+from vahr.announce import (
+    AnnouncePolicy,
+    TaskCancelled,
+    signals_from_event,
+    signals_from_presence,
+)
 from vahr.announce.speech import Names
 from vahr.domain import load_fleet
-from vahr.protocol import Event, Presence
+from vahr.protocol import Event, Presence, ProtocolError
+from vahr.protocol.lost_tasks import LOST_TASK_KEY, lost_task_from
 
 if TYPE_CHECKING:
     from vahr.announce import Signal
@@ -88,6 +96,13 @@ def signals_of(message: dict[str, Any]) -> list[Signal]:
     understood."""
     if is_tick(message):
         return []
+    if LOST_TASK_KEY in message:
+        try:
+            lost = lost_task_from(message[LOST_TASK_KEY])
+        except ProtocolError as err:
+            log.warning("ignoring a malformed lost task: %s", err)
+            return []
+        return [TaskCancelled(lost.task, lost.thing, lost.kind, lost.zone, lost.at, lost.why)]
     sender = message.get("sender")
     try:
         if "online" in message:

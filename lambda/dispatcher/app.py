@@ -1,7 +1,10 @@
 """The dispatcher's Lambda handler. Thin: parse the event, run the core, answer.
 
 Three callers (see `dispatcher.requests`): the skill, synchronously, the topic rule on the
-robots' shadow documents, and an EventBridge schedule once a minute. Errors are mapped
+robots' shadow documents, and an EventBridge schedule once a minute. A task the fleet
+loses (its robot sent elsewhere by name, gone offline, or never acknowledging it) is told
+to the announcer function (`announcer_channel`), never closed without a word. Errors are
+mapped
 here and nowhere else: a request that cannot be carried out (a bad order, an unknown
 task) is answered with its one line, and the skill speaks it; an AWS failure raises, so a
 rule's event is retried by Lambda and then kept in the dead-letter queue, and the skill
@@ -11,16 +14,19 @@ hears that the dispatcher failed.
 from __future__ import annotations
 
 import logging
+from contextlib import AbstractContextManager, nullcontext
 from datetime import UTC, datetime
 from functools import cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import msgspec
 
+from dispatcher.announcer_channel import AnnouncerChannel
 from dispatcher.command_channel import CommandChannel
 from dispatcher.config import DispatcherConfig
 from dispatcher.errors import BadRequest, ConfigError, DispatcherError
 from dispatcher.fleet_search import FleetSearch, robot_state
+from dispatcher.reoffer import watch_assigned
 from dispatcher.requests import (
     OPERATIONS,
     Answer,
@@ -38,11 +44,16 @@ from dispatcher.requests import (
 from dispatcher.robot_updates import robot_freed
 from dispatcher.task_table import TaskTable
 from dispatcher.trail_table import TrailTable
-from vahr.dispatch import Dispatcher, DispatchError
+from vahr.dispatch import Dispatcher, DispatchError, Task
 from vahr.dispatch.grid_routes import DistancesError, floor_routes
 from vahr.dispatch.records import task_given
 from vahr.domain import load_fleet
 from vahr.protocol.errors import ProtocolError, from_validation_error
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from vahr.protocol.lost_tasks import LostTask
 
 log = logging.getLogger("dispatcher")
 
@@ -61,10 +72,11 @@ def runtime() -> Dispatcher:
     except DistancesError as err:
         raise ConfigError(f"the fleet's map: {err}") from err
     channel = CommandChannel(config.iot_data_endpoint)
+    table = TaskTable(config.table, closed_task_days=config.closed_task_days)
     return Dispatcher(
         fleet=fleet,
-        store=TaskTable(config.table, closed_task_days=config.closed_task_days),
-        candidates=FleetSearch(index_name=config.index_name),
+        store=table,
+        candidates=FleetSearch(index_name=config.index_name, holding=table.holders),
         publish=channel,
         routes=lambda closed: routes,
         publish_closures=channel.closures,
@@ -78,9 +90,24 @@ def trail() -> TrailTable | None:
     return TrailTable(table) if table else None
 
 
+@cache
+def announcer() -> Callable[[LostTask], None]:
+    """Where lost tasks are told: the announcer function, or only the log without one."""
+    function = DispatcherConfig.from_env().announcer_function
+    return AnnouncerChannel(function) if function else _logged_only
+
+
+def _logged_only(lost: LostTask) -> None:
+    log.warning(
+        "task %s lost (%s) is not announced: no announcer function (VAHR_ANNOUNCER_FUNCTION)",
+        lost.task,
+        lost.why,
+    )
+
+
 def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
     try:
-        return handle(event, runtime(), trail())
+        return handle(event, runtime(), trail(), announcer())
     except DispatcherError as err:
         log.error("dispatcher failed: %s", err)
         raise
@@ -90,15 +117,19 @@ def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
 
 
 def handle(
-    event: dict[str, Any], dispatcher: Dispatcher, trail: TrailTable | None = None
+    event: dict[str, Any],
+    dispatcher: Dispatcher,
+    trail: TrailTable | None = None,
+    tell: Callable[[LostTask], None] = _logged_only,
 ) -> dict[str, Any]:
     """One invocation: a robot's update (from the rule), the schedule's tick, or a skill's
     request. What the dispatcher does by itself (a queued task given to a robot) goes to
-    `trail`; a skill's request is recorded by the skill, with who asked."""
+    `trail`, and a task it loses to `tell`; a skill's request is recorded by the skill,
+    with who asked."""
     if is_robot_update(event):
-        return on_robot_update(event, dispatcher, trail)
+        return on_robot_update(event, dispatcher, trail, tell)
     if is_tick(event):
-        return on_tick(dispatcher, trail)
+        return on_tick(dispatcher, trail, tell)
     try:
         answer = on_request(_request(event), dispatcher)
     except BadRequest as err:
@@ -110,7 +141,10 @@ def handle(
 
 
 def on_robot_update(
-    event: dict[str, Any], dispatcher: Dispatcher, trail: TrailTable | None = None
+    event: dict[str, Any],
+    dispatcher: Dispatcher,
+    trail: TrailTable | None = None,
+    tell: Callable[[LostTask], None] = _logged_only,
 ) -> dict[str, Any]:
     """A robot's update the rule selected: it may have finished its task and be free."""
     try:
@@ -123,7 +157,7 @@ def on_robot_update(
     if state is None or update.thing not in dispatcher.fleet.robot_things:
         log.warning("ignoring an update of %s, which is not a robot of the fleet", update.thing)
         return {"took": None}
-    taken = robot_freed(dispatcher, state, now=datetime.now(UTC))
+    taken = robot_freed(dispatcher, state, now=datetime.now(UTC), tell=tell)
     if taken is not None:
         log.info("task %s (%s to %s) given to %s", taken.id, taken.kind, taken.zone, taken.thing)
         if trail is not None:
@@ -131,25 +165,48 @@ def on_robot_update(
     return {"took": taken.id if taken is not None else None}
 
 
-def on_tick(dispatcher: Dispatcher, trail: TrailTable | None = None) -> dict[str, Any]:
-    """Once a minute: queued tasks go to robots that are free now. A robot freed while its
-    rule event was lost (dead-lettered, or the function failed) would otherwise wait for its
-    next change; with nothing queued this is one read of the queue and nothing more. The
-    closed zones are told again (retained), so two changes published out of order by two
-    invocations agree with the table within a minute."""
+def on_tick(
+    dispatcher: Dispatcher,
+    trail: TrailTable | None = None,
+    tell: Callable[[LostTask], None] = _logged_only,
+) -> dict[str, Any]:
+    """Once a minute: assigned tasks whose robot never acknowledged them are offered again
+    or, when they cannot be carried out any more, told as lost (`reoffer`); then queued
+    tasks go to robots that are free now. A robot freed while its rule event was lost
+    (dead-lettered, or the function failed) would otherwise wait for its next change; with
+    no open task this is one read of the open tasks and nothing more. The closed zones are
+    told again (retained), so two changes published out of order by two invocations agree
+    with the table within a minute."""
     dispatcher.announce_closures()
-    given = dispatcher.drain()
+    table, search = dispatcher.store, dispatcher.candidates
+    assert isinstance(table, TaskTable) and isinstance(search, FleetSearch)
+    watch = watch_assigned(dispatcher, table, search, now=dispatcher.clock(), tell=tell)
+    given = list(watch.given)
+    if watch.queued:
+        with _searching(dispatcher, every=_restricted(watch.queued)):
+            given += dispatcher.drain()
     for task in given:
         log.info("task %s (%s to %s) given to %s", task.id, task.kind, task.zone, task.thing)
         if trail is not None:
             trail.record(task_given(task))
-    return {"given": [task.id for task in given]}
+    return {
+        "given": [task.id for task in given],
+        "offered_again": watch.offered_again,
+        "acknowledged": watch.acknowledged,
+        "closed": watch.closed,
+        "lost": [lost.task for lost in watch.lost],
+    }
 
 
 def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
     if isinstance(request, Submit):
+        order = request.order
+        # "Every idle robot" needs them all; a group's members and the robots in a zone may
+        # be on any page of idle robots.
+        every = order.idle or order.group is not None or order.origin is not None
         try:
-            return Answer(200, dispatcher.submit(request.order))
+            with _searching(dispatcher, every=every):
+                return Answer(200, dispatcher.submit(order))
         except DispatchError as err:
             raise BadRequest(str(err), error=err.code) from err
     if isinstance(request, ListTasks):
@@ -160,7 +217,11 @@ def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
         return Answer(200, {"closed": dispatcher.closed_zones()})
     if isinstance(request, SetZone):
         try:
-            return Answer(200, dispatcher.set_zone(request.zone, closed=request.closed))
+            # Opened, the queued tasks that waited for it go: read every page if one of them
+            # is only some robots' to take.
+            every = not request.closed and _restricted(dispatcher.pending())
+            with _searching(dispatcher, every=every):
+                return Answer(200, dispatcher.set_zone(request.zone, closed=request.closed))
         except DispatchError as err:
             raise BadRequest(str(err), error=err.code) from err
     assert isinstance(request, Cancel)
@@ -168,6 +229,20 @@ def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
     if cancelled is None:
         raise BadRequest(f"no open task {request.task_id!r}", status=404)
     return Answer(200, {"task": cancelled})
+
+
+def _restricted(tasks: list[Task]) -> bool:
+    """Whether a task among these is only some robots' (a group's member, a robot in a
+    zone): such a robot may be on any page of idle robots."""
+    return any(task.robots for task in tasks)
+
+
+def _searching(dispatcher: Dispatcher, *, every: bool) -> AbstractContextManager[None]:
+    """Within it, the fleet search reads every page (`every`) or asks for idle robots first."""
+    search = dispatcher.candidates
+    if every and isinstance(search, FleetSearch):
+        return search.every_robot()
+    return nullcontext()
 
 
 def _request(event: dict[str, Any]) -> SkillRequest:

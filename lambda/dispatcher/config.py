@@ -10,6 +10,7 @@
 | `VAHR_CLOSED_TASK_DAYS` | 30 | how long a finished or cancelled task stays readable |
 | `VAHR_LOG_LEVEL` | INFO | DEBUG, INFO, WARNING or ERROR |
 | `VAHR_AUDIT_TABLE` | unset | the audit trail's table: tasks given by the dispatcher itself |
+| `VAHR_ANNOUNCER_FUNCTION` | unset | the announcer function told of lost tasks (unset: logged) |
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ class DispatcherConfig(msgspec.Struct, frozen=True, kw_only=True):
     closed_task_days: int = 30
     log_level: str = "INFO"
     audit_table: str | None = None
+    announcer_function: str | None = None
 
     @classmethod
     def from_env(cls, environ: Mapping[str, str] | None = None) -> DispatcherConfig:
@@ -68,4 +70,5 @@ class DispatcherConfig(msgspec.Struct, frozen=True, kw_only=True):
             closed_task_days=days,
             log_level=level,
             audit_table=env.get("VAHR_AUDIT_TABLE", "").strip() or None,
+            announcer_function=env.get("VAHR_ANNOUNCER_FUNCTION", "").strip() or None,
         )

@@ -37,3 +37,7 @@ class SearchError(DispatcherError):
 
 class PublishError(DispatcherError):
     """A command could not be published to a robot."""
+
+
+class AnnounceError(DispatcherError):
+    """A lost task could not be told to the announcer function."""

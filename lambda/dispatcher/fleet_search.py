@@ -2,10 +2,19 @@
 `SearchIndex`, never reading a shadow.
 
 Thing indexing with the classic shadow (REGISTRY_AND_SHADOW) and the custom fields
-`shadow.reported.status` and `shadow.reported.zone` (infra/constructs/fleet_indexing.py)
-lets one query find the robots that may take a task; each ThingDocument carries the
-indexed shadow as JSON, so a robot's pose, connection and last command come with it. A
-page holds at most 100 things, so 1,000 free robots cost 10 calls.
+`shadow.reported.status`, `shadow.reported.zone`, `shadow.reported.connected` and
+`shadow.reported.battery.*` (infra/constructs/fleet_indexing.py) lets one query find the
+robots that may take a task; each ThingDocument carries the indexed shadow as JSON, so a
+robot's pose, battery, connection and last command come with it.
+
+A page holds at most 100 things, so reading every free robot of 10,000 costs 100 calls, one
+after the other. Idle robots rank before every busy one (`vahr.dispatch.rank`), so a search
+for a task asks for the connected idle robots first and stops after the first page that
+holds one not already holding a task; only when no idle robot is free does it read the
+busy ones. A task is then ranked among the (at least 100) idle robots of that page, not
+among every idle robot of a larger fleet: the index has no order by distance. Orders that
+need every robot of a kind (`every_robot`: "every idle robot", a group's members) and a
+search within one zone read every page.
 
 The index follows the shadows within seconds, not at once: a robot that just left
 `idle` may still be found. That is harmless here, since the task table's conditional
@@ -14,6 +23,7 @@ The index follows the shadows within seconds, not at once: a robot that just lef
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 import boto3
@@ -24,11 +34,13 @@ from botocore.exceptions import BotoCoreError, ClientError
 from dispatcher.errors import SearchError
 from vahr.dispatch import BUSY_STATUSES, IDLE_STATUSES, RobotState
 
-# msgspec reads the annotations at run time: Pose is needed outside TYPE_CHECKING.
+# msgspec reads the annotations at run time: Pose and Battery are needed outside
+# TYPE_CHECKING.
 from vahr.domain.fleet import Pose  # noqa: TC001
+from vahr.protocol.shadow import Battery  # noqa: TC001
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator
+    from collections.abc import Callable, Iterable, Iterator
 
 CLIENT_CONFIG = Config(
     connect_timeout=2.0, read_timeout=5.0, retries={"mode": "standard", "total_max_attempts": 3}
@@ -37,6 +49,9 @@ CLIENT_CONFIG = Config(
 PAGE_SIZE = 100
 STATUS_FIELD = "shadow.reported.status"
 ZONE_FIELD = "shadow.reported.zone"
+CONNECTED_FIELD = "shadow.reported.connected"
+# AWS's limit on a query string's length: a search for many things by name is split.
+MAX_QUERY_CHARS = 1000
 
 
 class _LastCommand(msgspec.Struct):
@@ -52,6 +67,7 @@ class _Reported(msgspec.Struct):
     connected: bool = False
     pose: Pose | None = None
     last_command: _LastCommand | None = None
+    battery: Battery | None = None
 
 
 class _Shadow(msgspec.Struct):
@@ -86,17 +102,39 @@ def robot_state(thing: str, reported: dict[str, Any] | _Reported | None) -> Robo
         pose=reported.pose,
         last_command_id=last.id if last else None,
         last_result=last.result if last else None,
+        battery=reported.battery,
     )
 
 
 def available_query(zone: str | None = None) -> str:
     """The index query for robots that may take a task (idle or busy), in `zone` if given."""
-    free = sorted(IDLE_STATUSES | BUSY_STATUSES)
-    statuses = " OR ".join(f"{STATUS_FIELD}:{status}" for status in free)
-    query = f"({statuses})"
+    return status_query(IDLE_STATUSES | BUSY_STATUSES, zone)
+
+
+def status_query(statuses: Iterable[str], zone: str | None = None) -> str:
+    """The index query for connected robots reporting one of `statuses`, in `zone` if
+    given."""
+    terms = " OR ".join(f"{STATUS_FIELD}:{status}" for status in sorted(statuses))
+    query = f"({terms}) AND {CONNECTED_FIELD}:true"
     if zone is not None:
         query += f" AND {ZONE_FIELD}:{_term(zone)}"
     return query
+
+
+def name_queries(things: Iterable[str]) -> list[str]:
+    """Queries finding these things by name, each within AWS's query length."""
+    queries: list[str] = []
+    current = ""
+    for thing in sorted(set(things)):
+        term = f"thingName:{_term(thing)}"
+        joined = f"{current} OR {term}" if current else term
+        if len(joined) > MAX_QUERY_CHARS:
+            queries.append(current)
+            joined = term
+        current = joined
+    if current:
+        queries.append(current)
+    return queries
 
 
 def _term(value: str) -> str:
@@ -109,23 +147,82 @@ def _term(value: str) -> str:
 class FleetSearch:
     """`Candidates` on IoT fleet indexing (the `AWS_Things` index)."""
 
-    def __init__(self, *, index_name: str = "AWS_Things", client: Any = None) -> None:
+    def __init__(
+        self,
+        *,
+        index_name: str = "AWS_Things",
+        client: Any = None,
+        holding: Callable[[], Iterable[str]] | None = None,
+        usable: Callable[[RobotState], bool] | None = None,
+    ) -> None:
+        """`holding` names the robots holding a task now (the task table's claims) and
+        `usable` says whether the dispatcher would give a robot a task at all (a rule on
+        its battery, say): a page whose idle robots all hold a task or are not usable is
+        read past. Without them, every robot found counts as free."""
         self._index = index_name
         self._client = client or boto3.client("iot", config=CLIENT_CONFIG)
+        self._holding = holding
+        self._usable = usable
+        self._every_robot = False
+
+    @contextmanager
+    def every_robot(self) -> Iterator[None]:
+        """Within it, `available` reads every page: for orders that need every robot of a
+        kind ("every idle robot") or only some robots (a group's members), which the first
+        page of idle robots may not hold."""
+        before, self._every_robot = self._every_robot, True
+        try:
+            yield
+        finally:
+            self._every_robot = before
 
     def available(self, *, zone: str | None = None) -> list[RobotState]:
-        found = (robot_state(*entry) for entry in self._search(available_query(zone)))
+        if zone is not None or self._every_robot:
+            return self._found(self._search(available_query(zone)))
+        holding = set(self._holding()) if self._holding is not None else set()
+        robots: list[RobotState] = []
+        # Idle robots rank before every busy one: the busy are read only when no idle robot
+        # is free, and each search stops after the first page holding a free robot.
+        for statuses in (IDLE_STATUSES, BUSY_STATUSES):
+            for page in self._pages(status_query(statuses)):
+                found = self._found(page)
+                robots.extend(found)
+                usable = self._usable
+                if any(
+                    robot.thing not in holding and (usable is None or usable(robot))
+                    for robot in found
+                ):
+                    return robots
+        return robots
+
+    def state(self, thing: str) -> RobotState | None:
+        return self.states([thing]).get(thing)
+
+    def states(self, things: Iterable[str]) -> dict[str, RobotState]:
+        """The state of each of `things` the index knows (and that reports a status), with
+        one search per 40 or so names."""
+        wanted = set(things)
+        states: dict[str, RobotState] = {}
+        for query in name_queries(wanted):
+            for name, reported in self._search(query):
+                state = robot_state(name, reported) if name in wanted else None
+                if state is not None:
+                    states[name] = state
+        return states
+
+    @staticmethod
+    def _found(entries: Iterable[tuple[str, _Reported | None]]) -> list[RobotState]:
+        found = (robot_state(*entry) for entry in entries)
         # The index may lag a shadow by seconds; the state it holds is checked again here.
         return [robot for robot in found if robot is not None and robot.available]
 
-    def state(self, thing: str) -> RobotState | None:
-        for name, reported in self._search(f"thingName:{_term(thing)}"):
-            if name == thing:
-                return robot_state(name, reported)
-        return None
-
     def _search(self, query: str) -> Iterator[tuple[str, _Reported | None]]:
         """(thing, reported state) of every thing the query finds, page after page."""
+        for page in self._pages(query):
+            yield from page
+
+    def _pages(self, query: str) -> Iterator[list[tuple[str, _Reported | None]]]:
+        """The things the query finds, one page (one SearchIndex call) at a time."""
         request: dict[str, Any] = {
             "indexName": self._index,
             "queryString": query,
@@ -142,8 +239,10 @@ class FleetSearch:
                 ) from err
             except BotoCoreError as err:
                 raise SearchError(f"the fleet index did not answer {query!r}: {err}") from err
-            for document in page.get("things", []):
-                yield document.get("thingName", ""), _reported(document.get("shadow"))
+            yield [
+                (document.get("thingName", ""), _reported(document.get("shadow")))
+                for document in page.get("things", [])
+            ]
             token = page.get("nextToken")
             if not token:
                 return

@@ -9,6 +9,10 @@ One table, keyed by `section` (partition) and `id` (sort):
 | `robot` | thing | the robot's claim on its one assigned task: `task_id` |
 | `zone` | zone id | a zone closed at run time, since `closed_at` |
 
+An assigned task's item also keeps how its command fared, beside the task: `offers` (how
+often the schedule sent it again), `offered_at` (when last) and `acknowledged` (its robot
+was seen to have it). Rewriting the task (released, assigned anew) starts them afresh.
+
 Every open task lives in one partition, so the queue is one strongly consistent Query
 (a fleet's queue is tens of tasks, far below a partition's 3,000 reads a second), and a
 finished task leaves that partition, so the Query never reads the history.
@@ -48,6 +52,16 @@ _LOST_RACE = ("ConditionalCheckFailed", "TransactionConflict")
 
 class _Conflict(Exception):
     """A conditional write found the item changed since it was read."""
+
+
+class Offer(msgspec.Struct, frozen=True, kw_only=True):
+    """An assigned task and how its command fared: sent again `offers` times (the last at
+    `offered_at`), and whether its robot was seen to have it (`acknowledged`)."""
+
+    task: Task
+    offers: int = 0
+    offered_at: str | None = None
+    acknowledged: bool = False
 
 
 class TaskTable:
@@ -153,6 +167,62 @@ class TaskTable:
     def active(self) -> list[Task]:
         assigned = [task for task in self._all_open() if task.status == "assigned"]
         return sorted(assigned, key=lambda task: (task.assigned_at or "", task.id))
+
+    # --- beyond the TaskStore: what the schedule needs to offer a task again ---------------
+
+    def offers(self) -> tuple[list[Offer], list[Task]]:
+        """Every assigned task with how its command fared (oldest first), and the queue:
+        one read of the open tasks."""
+        assigned: list[Offer] = []
+        queued: list[Task] = []
+        for item in self._open_items():
+            task = self._decode(item)
+            if task.status == "queued":
+                queued.append(task)
+                continue
+            assigned.append(
+                Offer(
+                    task=task,
+                    offers=int(item.get("offers", {}).get("N", "0")),
+                    offered_at=item.get("offered_at", {}).get("S"),
+                    acknowledged=item.get("acknowledged", {}).get("BOOL", False),
+                )
+            )
+        assigned.sort(key=lambda offer: (offer.task.assigned_at or "", offer.task.id))
+        return assigned, sorted(queued, key=lambda task: task.order_key)
+
+    def offered(self, task: Task, *, at: str) -> bool:
+        """Count one more sending of `task`'s command, at `at`; False when the task changed
+        meanwhile (it ended, or went back to the queue)."""
+        return self._mark(
+            task,
+            "SET offers = if_not_exists(offers, :zero) + :one, offered_at = :at",
+            {":zero": {"N": "0"}, ":one": {"N": "1"}, ":at": {"S": at}},
+        )
+
+    def acknowledged(self, task: Task) -> bool:
+        """Record that `task`'s robot has its command: it is never sent again."""
+        return self._mark(task, "SET acknowledged = :yes", {":yes": {"BOOL": True}})
+
+    def holders(self) -> set[str]:
+        """The robots holding a task now (their claims)."""
+        query: dict[str, Any] = {
+            "TableName": self._table,
+            "KeyConditionExpression": "#section = :robot",
+            "ExpressionAttributeNames": {"#section": "section"},
+            "ExpressionAttributeValues": {":robot": {"S": ROBOT}},
+            "ConsistentRead": True,
+        }
+        things: set[str] = set()
+        while True:
+            try:
+                page = self._client.query(**query)
+            except (ClientError, BotoCoreError) as err:
+                raise StoreError(f"cannot read the robots' claims: {_message(err)}") from err
+            things.update(item["id"]["S"] for item in page.get("Items", []))
+            if "LastEvaluatedKey" not in page:
+                return things
+            query["ExclusiveStartKey"] = page["LastEvaluatedKey"]
 
     def close_zone(self, zone: str, *, at: str) -> bool:
         try:
@@ -272,6 +342,29 @@ class TaskTable:
         except BotoCoreError as err:
             raise StoreError(f"cannot write the task table: {err}") from err
 
+    def _mark(self, task: Task, update: str, values: dict[str, Any]) -> bool:
+        """Update an assigned task's open item beside its JSON, over the version read."""
+        try:
+            self._client.update_item(
+                TableName=self._table,
+                Key={"section": {"S": OPEN}, "id": {"S": task.id}},
+                UpdateExpression=update,
+                ConditionExpression="version = :seen AND #status = :assigned",
+                ExpressionAttributeNames={"#status": "status"},
+                ExpressionAttributeValues={
+                    **values,
+                    ":seen": {"N": str(task.version)},
+                    ":assigned": {"S": "assigned"},
+                },
+            )
+        except ClientError as err:
+            if _code(err) == "ConditionalCheckFailedException":
+                return False
+            raise StoreError(f"cannot update task {task.id}: {_message(err)}") from err
+        except BotoCoreError as err:
+            raise StoreError(f"cannot update task {task.id}: {err}") from err
+        return True
+
     def _open(self, task_id: str) -> Task | None:
         return self._read(OPEN, task_id)
 
@@ -287,7 +380,10 @@ class TaskTable:
         return None if item is None else self._decode(item)
 
     def _all_open(self) -> list[Task]:
-        tasks: list[Task] = []
+        return [self._decode(item) for item in self._open_items()]
+
+    def _open_items(self) -> list[dict[str, Any]]:
+        items: list[dict[str, Any]] = []
         query: dict[str, Any] = {
             "TableName": self._table,
             "KeyConditionExpression": "#section = :open",
@@ -302,9 +398,9 @@ class TaskTable:
                 page = self._client.query(**query)
             except (ClientError, BotoCoreError) as err:
                 raise StoreError(f"cannot read the task queue: {_message(err)}") from err
-            tasks.extend(self._decode(item) for item in page.get("Items", []))
+            items.extend(page.get("Items", []))
             if "LastEvaluatedKey" not in page:
-                return tasks
+                return items
             query["ExclusiveStartKey"] = page["LastEvaluatedKey"]
 
     def _decode(self, item: dict[str, Any]) -> Task:

@@ -21,6 +21,7 @@ from botocore.exceptions import BotoCoreError, ClientError, NoRegionError
 from skill.errors import GatewayError
 from skill.iot_data import CLIENT_CONFIG
 from vahr.protocol import Reported
+from vahr.protocol.decoding import LazyDecoder
 
 if TYPE_CHECKING:
     from skill.config import SkillConfig
@@ -57,7 +58,7 @@ class _Shadow(msgspec.Struct):
     reported: dict[str, Any] = {}
 
 
-_shadow_decoder = msgspec.json.Decoder(_Shadow)
+_shadow_decoder: LazyDecoder[_Shadow] = LazyDecoder(_Shadow)
 
 
 def _robot(document: dict[str, Any]) -> IndexedRobot:

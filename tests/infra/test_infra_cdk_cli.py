@@ -38,7 +38,10 @@ def cdk_synth(outdir: Path, *context: str) -> subprocess.CompletedProcess[str]:
     )  # fmt: skip
 
 
+# Three synths through the CLI (node and the Python app each time): about 100 s beside the
+# rest of the suite on two cores, more than the suite's default bound.
 @pytest.mark.slow
+@pytest.mark.timeout(300)
 def test_cdk_synth_works_offline_without_credentials_with_and_without_options(
     tmp_path: Path,
 ) -> None:

@@ -86,6 +86,8 @@ def test_fleet_indexing_indexes_shadows_with_status_and_zone_and_is_off_after_de
                 {"name": "shadow.reported.status", "type": "String"},
                 {"name": "shadow.reported.zone", "type": "String"},
                 {"name": "shadow.reported.connected", "type": "Boolean"},
+                {"name": "shadow.reported.battery.percent", "type": "Number"},
+                {"name": "shadow.reported.battery.charging", "type": "Boolean"},
             ],
         }
     }
@@ -214,6 +216,7 @@ def test_the_function_may_keep_tasks_search_the_index_and_command_the_fleet_only
         ("Allow", "dynamodb:GetItem", table),
         ("Allow", "dynamodb:PutItem", table),
         ("Allow", "dynamodb:DeleteItem", table),
+        ("Allow", "dynamodb:UpdateItem", table),
         ("Allow", "dynamodb:Query", table),
         ("Allow", "iot:SearchIndex", INDEX),
         ("Allow", "iot:Publish", f"{IOT}:topic/vahr/robots/placebot1/cmd"),

@@ -15,13 +15,19 @@ from template_tools import bare_stack, resources, role_grants
 from infra.config import InfraConfig
 from infra.constructs.dispatcher import Dispatcher
 from infra.constructs.task_table import TaskTable
-from tests.support.dispatch_meter import measure_dispatch, measure_zone_change
+from tests.support.dispatch_meter import (
+    ANNOUNCER,
+    measure_dispatch,
+    measure_lost_task,
+    measure_zone_change,
+)
 from vahr.domain import load_fleet
 
 if TYPE_CHECKING:
     from pathlib import Path
 
 IOT = "arn:aws:iot:us-east-1:123456789012"
+ANNOUNCER_ARN = f"arn:aws:lambda:us-east-1:123456789012:function:{ANNOUNCER}"
 INDEX = f"{IOT}:index/AWS_Things"
 # A transaction is authorized as the writes in it.
 TRANSACTION_PARTS = {"Put": "PutItem", "Delete": "DeleteItem", "Update": "UpdateItem",
@@ -42,6 +48,8 @@ def needed(
         return {(f"dynamodb:{operation}", table)}
     if operation == "SearchIndex":
         return {("iot:SearchIndex", f"{IOT}:index/{params.get('indexName', 'AWS_Things')}")}
+    if operation == "Invoke":
+        return {("lambda:InvokeFunction", ANNOUNCER_ARN)}
     if operation == "Publish":
         topic = f"{IOT}:topic/{params['topic']}"
         if params.get("retain"):
@@ -62,13 +70,14 @@ def credentials(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_every_call_of_a_task_is_allowed_and_every_right_is_used(
     tmp_path: Path, credentials: None
 ) -> None:
-    # Given the dispatcher's role as the stack synthesizes it
+    # Given the dispatcher's role as the stack synthesizes it, beside the announcer
     stack = bare_stack(tmp_path)
     tasks = TaskTable(stack, "Tasks", deletion_protection=False)
     Dispatcher(
         stack, "Dispatcher", config=InfraConfig(), fleet=load_fleet(),
         code=lambda_.Code.from_inline("def lambda_handler(e, c): pass"),
         table=tasks.table, index_arn=INDEX, data_endpoint="x-ats.iot.us-east-1.amazonaws.com",
+        announcer=lambda_.Function.from_function_arn(stack, "Announcer", ANNOUNCER_ARN),
     )  # fmt: skip
     template = Template.from_stack(stack).to_json()
     [table_id] = resources(template, "AWS::DynamoDB::Table")
@@ -82,14 +91,16 @@ def test_every_call_of_a_task_is_allowed_and_every_right_is_used(
         for effect, action, resource in role_grants(template, role_id)
         if effect == "Allow" and not action.startswith(("logs:", "sqs:"))
     }
-    # When the real handler dispatches a task to placebot1 or placebot2 and closes it, and
-    # (on another table) closes a zone
+    # When the real handler dispatches a task to placebot1 or placebot2 and closes it,
+    # (on another table) closes a zone, and (on a third) offers a task again and loses it
     with mock_aws():
         measured = measure_dispatch(2)
     with mock_aws():
         zone_change = measure_zone_change()
+    with mock_aws(config={"lambda": {"use_docker": False}}):
+        lost = measure_lost_task()
     used: set[tuple[str, str]] = set()
-    for meter in (measured.submit, measured.freed, zone_change):
+    for meter in (measured.submit, measured.freed, zone_change, lost):
         for service, operation, params in meter.requests:
             used |= needed(service, operation, params, table)
     # Then each call is allowed
@@ -98,6 +109,7 @@ def test_every_call_of_a_task_is_allowed_and_every_right_is_used(
     publish_rights = {(a, r) for a, r in granted if a == "iot:Publish"}
     assert granted - publish_rights <= used, sorted(granted - publish_rights - used)
     assert ("iot:Publish", f"{IOT}:topic/vahr/robots/{measured.assigned_to}/cmd") in used
+    assert ("lambda:InvokeFunction", ANNOUNCER_ARN) in granted
     assert publish_rights == {
         ("iot:Publish", f"{IOT}:topic/vahr/robots/{thing}/cmd")
         for thing in load_fleet().robot_things

@@ -159,7 +159,7 @@ def test_the_dispatcher_loads_from_the_same_bundle_and_answers_in_one_line(
         "status": 400,
         "body": {
             "code": 400,
-            "message": "operation: 'launch' is not one of submit, tasks, pending, cancel",
+            "message": "operation: 'launch' is not one of submit, tasks, pending, cancel, zones, zone",
         },
     }
     assert seen["loaded"] == ["vahr.dispatch"]
@@ -228,11 +228,9 @@ def test_the_bundled_handler_publishes_a_spoken_command_through_iot_data(
         "print(json.dumps(skill.app.lambda_handler(event, None)))"
     )
     # When Alexa sends "send placebot one to zone a"
-    started = time.monotonic()
     result = run_in_lambda_python(
         bundle.out_dir, script, VAHR_IOT_DATA_ENDPOINT=endpoint, VAHR_ACK_TIMEOUT_S="0.3"
     )
-    elapsed = time.monotonic() - started
     assert result.returncode == 0, result.stderr
     # Then a navigate command went out on placebot1's command topic, signed by boto3
     commands = [
@@ -241,10 +239,10 @@ def test_the_bundled_handler_publishes_a_spoken_command_through_iot_data(
     assert [c["action"] for c in commands] == ["navigate"]
     assert commands[0]["params"] == {"zone": "A"}
     assert commands[0]["source"] == "alexa"
-    # And the skill answered in words within Alexa's limit
+    # And the skill answered in words (how long a cold start takes is measured, not
+    # asserted: bench/lambda_bundle.py and bench/skill_cold_start.py)
     speech = json.loads(result.stdout)["response"]["outputSpeech"]["ssml"]
     assert speech.startswith("<speak>") and len(speech) > len("<speak></speak>")
-    assert elapsed < 8
 
 
 def test_a_rebuild_reuses_the_installed_dependencies(tmp_path: Path) -> None:

@@ -19,11 +19,12 @@ def bundle(tmp_path_factory: pytest.TempPathFactory) -> lambda_asset.BuildResult
     return lambda_asset.build(tmp_path_factory.mktemp("asset") / "bundle")
 
 
-def test_the_bundle_carries_each_locales_words_and_replies(
+def test_the_bundle_carries_each_locales_words_replies_and_announcements(
     bundle: lambda_asset.BuildResult,
 ) -> None:
     locales = bundle.out_dir / "vahr" / "domain" / "locales"
     assert sorted(p.relative_to(locales).as_posix() for p in locales.rglob("*.yaml")) == [
+        "de-DE/announcements.yaml",
         "de-DE/language.yaml",
         "de-DE/replies.yaml",
         "en-US/language.yaml",

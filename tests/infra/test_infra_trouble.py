@@ -303,3 +303,23 @@ def test_logging_and_the_audit_can_be_left_to_another_stack(tmp_path: Path) -> N
     }  # fmt: skip
     # The alarms stay: they belong to this stack alone
     assert "AWS::CloudWatch::Alarm" in found
+
+
+def test_the_dispatcher_may_invoke_the_announcer_alone_to_tell_a_lost_task(
+    template: dict[str, Any],
+) -> None:
+    """A task the dispatcher loses is told through the announcer function: its role may
+    invoke that one function (no version, no alias), whose name it is given."""
+    by_handler = {
+        function["Handler"]: (logical_id, function)
+        for logical_id, function in resources(template, "AWS::Lambda::Function").items()
+    }
+    announcer_id, _ = by_handler["announcer.app.lambda_handler"]
+    _, dispatcher = by_handler["dispatcher.app.lambda_handler"]
+    assert dispatcher["Environment"]["Variables"]["VAHR_ANNOUNCER_FUNCTION"] == f"<{announcer_id}>"
+    invokes = {
+        (effect, resource)
+        for effect, action, resource in role_grants(template, logical_id_of(dispatcher["Role"]))
+        if action == "lambda:InvokeFunction"
+    }
+    assert invokes == {("Allow", f"<{announcer_id}.Arn>")}

@@ -16,17 +16,19 @@ import json
 import threading
 from collections import Counter
 from dataclasses import dataclass, field
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from typing import Any
 
 import boto3
 
 from dispatcher import app
+from dispatcher.announcer_channel import AnnouncerChannel
 from dispatcher.command_channel import CommandChannel
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
 from infra.cost_estimate import dynamodb_units
+from tests.support.dynamodb_tables import create_task_table
 from vahr.dispatch import Dispatcher
 from vahr.domain import load_fleet
 from vahr.twin.dataplane import DataPlane, DataPlaneServer
@@ -106,10 +108,13 @@ class CallMeter:
 
 @dataclass(frozen=True)
 class DispatchMeasure:
-    """The calls and units of one task: its submit and the event that closed it."""
+    """The calls and units of one task: its submit, the schedule's look at it once its
+    robot had it (the tick's own reads of the open tasks and the closed zones, and the
+    closures told, are the tick's whatever the tasks), and the event that closed it."""
 
     robots: int
     submit: CallMeter
+    tick: CallMeter
     freed: CallMeter
     assigned_to: str
 
@@ -149,22 +154,26 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
         store.update(thing, None, json.dumps({"state": {"reported": reported}}).encode())
     dynamodb = boto3.client("dynamodb", region_name=REGION)
     _create_table(dynamodb)
+    now = [datetime.now(UTC)]
     with server:
-        submit_meter, freed_meter = CallMeter(), CallMeter()
+        submit_meter, tick_meter, freed_meter = CallMeter(), CallMeter(), CallMeter()
 
         def dispatcher(meter: CallMeter) -> Dispatcher:
+            # Built as the function's runtime builds it (dispatcher.app.runtime).
+            table = TaskTable(
+                TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION))
+            )
             return Dispatcher(
                 fleet=fleet,
-                store=TaskTable(
-                    TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION))
-                ),
+                store=table,
                 candidates=FleetSearch(
-                    client=meter.watch(boto3.client("iot", endpoint_url=server.url))
+                    client=meter.watch(boto3.client("iot", endpoint_url=server.url)),
+                    holding=table.holders,
                 ),
                 publish=CommandChannel(
                     client=meter.watch(boto3.client("iot-data", region_name=REGION))
                 ),
-                clock=lambda: datetime.now(UTC),
+                clock=lambda: now[0],
             )
 
         answer = app.handle(
@@ -172,6 +181,16 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
             dispatcher(submit_meter),
         )
         [task] = answer["body"]["assigned"]
+        # The robot took it; a minute later the schedule sees that, once.
+        accepted = {
+            "status": "navigating",
+            "connected": True,
+            "last_command": {"id": task["id"], "action": "deliver", "result": "accepted"},
+        }
+        store.update(task["thing"], None, json.dumps({"state": {"reported": accepted}}).encode())
+        now[0] += timedelta(minutes=1)
+        tick = app.handle(load_event("eventbridge_schedule"), dispatcher(tick_meter))
+        assert tick["acknowledged"] == [task["id"]], tick
         done = {
             "status": "idle",
             "zone": "C",
@@ -179,7 +198,7 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
             "last_command": {"id": task["id"], "action": "deliver", "result": "done"},
         }
         app.handle({"thing": task["thing"], "reported": done}, dispatcher(freed_meter))
-    return DispatchMeasure(robots, submit_meter, freed_meter, task["thing"])
+    return DispatchMeasure(robots, submit_meter, tick_meter, freed_meter, task["thing"])
 
 
 def measure_zone_change() -> CallMeter:
@@ -199,4 +218,52 @@ def measure_zone_change() -> CallMeter:
     )
     answer = app.handle({"operation": "zone", "zone": "B", "closed": True}, core)
     assert answer["body"]["changed"] is True, answer
+    return meter
+
+
+# The announcer function the dispatcher tells of lost tasks (infra: its `function_name`).
+ANNOUNCER = "vahr-announcer"
+
+
+def measure_lost_task() -> CallMeter:
+    """A trip to zone A given to placebot2, whose command never reaches it: the schedule
+    sends it again, then placebot2 goes offline and the next tick tells the announcer the
+    task is lost. Call it inside `mock_aws(config={"lambda": {"use_docker": False}})`."""
+    store = ShadowStore(None)
+    shadows = ShadowService(store, publish=lambda _topic, _payload: None)
+    server = DataPlaneServer(DataPlane(shadows, publish=lambda *_: None, meter=Meter()), 0)
+
+    def report(**reported: object) -> None:
+        body = {"state": {"reported": {"status": "idle", "zone": "A", **reported}}}
+        store.update("placebot2", None, json.dumps(body).encode())
+
+    report(connected=True)
+    create_task_table(boto3.client("dynamodb", region_name=REGION), TABLE)
+    meter = CallMeter()
+    now = [datetime.now(UTC)]
+    tick = load_event("eventbridge_schedule")
+    with server:
+        table = TaskTable(TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION)))
+        core = Dispatcher(
+            fleet=load_fleet(),
+            store=table,
+            candidates=FleetSearch(
+                client=meter.watch(boto3.client("iot", endpoint_url=server.url)),
+                holding=table.holders,
+            ),
+            publish=CommandChannel(
+                client=meter.watch(boto3.client("iot-data", region_name=REGION))
+            ),
+            clock=lambda: now[0],
+        )
+        tell = AnnouncerChannel(
+            ANNOUNCER, client=meter.watch(boto3.client("lambda", region_name=REGION))
+        )
+        answer = app.handle({"operation": "submit", "order": {"zone": "A"}}, core, None, tell)
+        [task] = answer["body"]["assigned"]
+        now[0] += timedelta(minutes=1)
+        assert app.handle(tick, core, None, tell)["offered_again"] == [task["id"]]
+        report(connected=False)
+        now[0] += timedelta(minutes=1)
+        assert app.handle(tick, core, None, tell)["lost"] == [task["id"]]
     return meter

@@ -26,7 +26,7 @@ class RecordingAssistant:
         self,
         utterance: str,
         *,
-        origin: str,
+        origin: str = "say",
         heard: dict[str, Any] | None = None,
         user: str | None = None,
     ) -> dict[str, Any]:

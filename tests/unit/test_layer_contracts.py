@@ -74,7 +74,7 @@ def test_the_packages_keep_every_contract(tree: Path) -> None:
         ("announcer/app.py", "import skill.iot_data", "The announcer imports only"),
         ("announcer/app.py", "import boto3", "Only the announcer's data-access module"),
         ("dispatcher/app.py", "import vahr.twin.fleet_index", "The dispatcher imports only"),
-        ("dispatcher/app.py", "import boto3", "Only the dispatcher's four adapters"),
+        ("dispatcher/app.py", "import boto3", "Only the dispatcher's five adapters"),
         ("vahr/announce/policy.py", "import vahr.errors", "The announcement policy imports"),
         ("vahr/announce/speech.py", "import vahr.skill_model", "The announcement policy"),
         # The local stack starting the station itself: the station is handed to it from above.

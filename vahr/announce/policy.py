@@ -110,13 +110,16 @@ class Dispatched:
 @dataclass(frozen=True)
 class TaskCancelled:
     """The fleet gave up task `task` that `thing` held: someone sent `thing` elsewhere by
-    name. `kind` is the task's (`deliver`, `navigate`), `zone` where it was going."""
+    name (`why` "preempted"), or `thing` went offline or never acknowledged it (`why`
+    "offline", "unacknowledged"). `kind` is the task's (`deliver`, `navigate`), `zone`
+    where it was going."""
 
     task: str
     thing: str
     kind: str
     zone: str
     at: datetime
+    why: str = "preempted"
 
 
 @dataclass(frozen=True)
@@ -172,6 +175,8 @@ class Fault(msgspec.Struct, kw_only=True):
     seen_at: float
     reason: str | None = None
     zone: str | None = None
+    # How a `cancelled` task was lost, when not because its robot was sent elsewhere.
+    why: str | None = None
     told: bool = False
     # The rate limit held it back at least once (counted once in `PolicyState.held`).
     held: bool = False
@@ -271,6 +276,7 @@ class AnnouncePolicy:
                         seen_at=self._clock().timestamp(),
                         reason=signal.kind,
                         zone=signal.zone,
+                        why=None if signal.why == "preempted" else signal.why,
                     )
                 )
             self.state.queued = [t for t in self.state.queued if t.task != signal.task]
@@ -411,6 +417,7 @@ class AnnouncePolicy:
                 reason=fault.reason,
                 zone=fault.zone,
                 waited_s=now.timestamp() - fault.opened_at,
+                why=fault.why,
             ),
             reason=fault.reason,
             person=person,

@@ -22,6 +22,9 @@ WORDS: dict[str, str] = {
     "offline": "{robot} has gone offline.",
     "waiting": "A task{for_robot} has waited {waited} in the queue.",
     "cancelled": "{robot} was given another command, so {task}{to_zone} is cancelled.",
+    # A task lost for another reason (`vahr.protocol.lost_tasks.LostWhy`): `cancelled_<why>`.
+    "cancelled_offline": "{robot} went offline before it started {task}{to_zone}; it is cancelled.",
+    "cancelled_unacknowledged": "{robot} is not doing {task}{to_zone}, so it is cancelled.",
     "done": "{robot} has finished its task{where}.",
     "battery_low": "{robot} is low on battery and is going to charge.",
     "on_its_way": " on its way to {zone}",
@@ -80,16 +83,19 @@ def sentence(
     reason: str | None = None,
     zone: str | None = None,
     waited_s: float = 0.0,
+    why: str | None = None,
 ) -> str:
     """The announcement's words, first letter capitalised. For `cancelled`, `reason` is
-    the task's kind (`deliver`, `navigate`)."""
+    the task's kind (`deliver`, `navigate`) and `why` how it was lost, when not because its
+    robot was sent elsewhere (`offline`, `unacknowledged`)."""
     words = names.words
     where = ""
     if zone:
         where = words["on_its_way" if kind == "stuck" else "at"].format(zone=names.zone(zone))
     # The zone a reason names by id is said by its name.
     said = reason_said(reason, zone, names.zone(zone)) if reason and zone else reason
-    text = words[kind].format(
+    template = words.get(f"{kind}_{why}", words[kind]) if why else words[kind]
+    text = template.format(
         robot=names.robot(thing),
         where=where,
         reason=(said or words["no_reason"]).rstrip("."),

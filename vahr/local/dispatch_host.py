@@ -175,7 +175,7 @@ class TasksApi:
         self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
     ) -> Answer:
         answer = self._respond(method, path, body)
-        recorded = any(name.lower() == RECORDED_BY_HEADER.lower() for name in headers or {})
+        recorded = _recorded_by_sender(headers)
         if self._record is not None and method in ("POST", "DELETE") and not recorded:
             self._record(_api_entry(method, path, body, answer))
         return answer
@@ -231,7 +231,7 @@ class ZonesApi:
         self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
     ) -> Answer:
         answer = self._respond(method, path, body)
-        recorded = any(name.lower() == RECORDED_BY_HEADER.lower() for name in headers or {})
+        recorded = _recorded_by_sender(headers)
         if self._record is not None and method == "POST" and not recorded:
             self._record(_zone_entry(path, body, answer))
         return answer
@@ -254,6 +254,11 @@ class ZonesApi:
             return _ok(self.dispatcher.set_zone(zone, closed=request.closed))
         except DispatchError as err:
             return _error(400, str(err), error=err.code)
+
+
+def _recorded_by_sender(headers: Mapping[str, str] | None) -> bool:
+    """Whether the request's sender recorded it in the trail itself (with its person)."""
+    return any(name.lower() == RECORDED_BY_HEADER.lower() for name in headers or {})
 
 
 class ServiceRequest(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
@@ -279,7 +284,7 @@ class RobotsApi:
         self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
     ) -> Answer:
         answer = self._respond(method, path, body)
-        recorded = any(name.lower() == RECORDED_BY_HEADER.lower() for name in headers or {})
+        recorded = _recorded_by_sender(headers)
         if self._record is not None and method == "POST" and not recorded:
             self._record(_robot_entry(path, body, answer))
         return answer

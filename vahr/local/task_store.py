@@ -11,7 +11,6 @@ changes no row and it gets None.
 
 from __future__ import annotations
 
-import sqlite3
 import threading
 from contextlib import contextmanager
 from pathlib import Path
@@ -20,8 +19,10 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from vahr.dispatch import Outcome, Task
+from vahr.plumbing.sqlite_file import open_shared
 
 if TYPE_CHECKING:
+    import sqlite3
     from collections.abc import Iterator
 
 FILE_NAME = "tasks.sqlite3"
@@ -57,14 +58,7 @@ class SqliteTaskStore:
 
     def __init__(self, path: Path | str) -> None:
         self.path = Path(path)
-        # Autocommit mode: each transaction is opened explicitly with BEGIN IMMEDIATE, which
-        # takes the write lock at once, so a check and its update cannot interleave.
-        self._db = sqlite3.connect(
-            self.path, check_same_thread=False, isolation_level=None, timeout=10.0
-        )
-        self._db.execute("PRAGMA journal_mode=WAL")
-        self._db.execute("PRAGMA synchronous=NORMAL")
-        self._db.executescript(_SCHEMA)
+        self._db = open_shared(self.path, _SCHEMA)
         self._lock = threading.Lock()
 
     @classmethod

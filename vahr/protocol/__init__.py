@@ -5,8 +5,9 @@ Import from here: topic builders (`topics`), messages (`Command`, `Event`, `Pres
 `ReportedPose`), the reported shadow state (`Reported`), and the one error type decoding
 raises (`ProtocolError`). `link` is the port MQTT adapters implement, `broker` how they reach
 the broker, `announcements`, `fault_request` and `station_topics` the messages of the
-assistant's, the fault injector's and the station's topics, and `conversation` what the
-skill and the assistant keep of a conversation. Every Lambda and robot imports it, so it
+assistant's, the fault injector's and the station's topics, `lost_tasks` what the
+dispatcher function tells the announcer function of a task it lost, and `conversation` what
+the skill and the assistant keep of a conversation. Every Lambda and robot imports it, so it
 imports only msgspec; the domain (the fleet, its words) is `vahr.domain`.
 """
 

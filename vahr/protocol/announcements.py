@@ -12,6 +12,7 @@ from typing import Annotated, Literal
 
 import msgspec
 
+from vahr.protocol.decoding import LazyDecoder
 from vahr.protocol.errors import from_validation_error
 from vahr.protocol.messages import Timestamp, check_payload
 
@@ -52,7 +53,7 @@ class Announcement(msgspec.Struct, frozen=True, kw_only=True):
     opened_at: Timestamp
 
 
-_decoder = msgspec.json.Decoder(Announcement)
+_decoder: LazyDecoder[Announcement] = LazyDecoder(Announcement)
 
 
 def decode_announcement(payload: bytes | bytearray | memoryview) -> Announcement:

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import msgspec
 
+from vahr.protocol.decoding import LazyDecoder
 from vahr.protocol.errors import from_validation_error
 
 if TYPE_CHECKING:
@@ -126,7 +127,7 @@ CSV_COLUMNS = (
 )
 
 _encoder = msgspec.json.Encoder(order="sorted")
-_record_decoder = msgspec.json.Decoder(AuditRecord)
+_record_decoder: LazyDecoder[AuditRecord] = LazyDecoder(AuditRecord)
 
 
 def now() -> str:

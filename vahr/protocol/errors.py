@@ -7,11 +7,12 @@ import re
 import msgspec
 
 # msgspec reports the failing location as a JSON path such as `$.params.zone` or `$[0]`.
-_AT_PATH = re.compile(r"^(?P<reason>.*?)(?: - at `\$(?P<path>[^`]*)`)?$", re.DOTALL)
-_MISSING = re.compile(r"^Object missing required field `(?P<field>[^`]+)`$")
-_UNKNOWN = re.compile(r"^Object contains unknown field `(?P<field>[^`]+)`$")
-_EXPECTED = re.compile(r"^Expected `(?P<want>[^`]+)`, got `(?P<got>[^`]+)`$")
-_TAG = re.compile(r"^Invalid value '?(?P<value>[^']*)'?$")
+# Compiled on first use (re's cache): most importers never see a validation error.
+_AT_PATH = r"(?s)^(?P<reason>.*?)(?: - at `\$(?P<path>[^`]*)`)?$"
+_MISSING = r"^Object missing required field `(?P<field>[^`]+)`$"
+_UNKNOWN = r"^Object contains unknown field `(?P<field>[^`]+)`$"
+_EXPECTED = r"^Expected `(?P<want>[^`]+)`, got `(?P<got>[^`]+)`$"
+_TAG = r"^Invalid value '?(?P<value>[^']*)'?$"
 
 
 MAX_SHOWN = 40
@@ -51,19 +52,19 @@ def _join(path: str, field: str) -> str:
 
 def from_validation_error(err: msgspec.ValidationError | msgspec.DecodeError) -> ProtocolError:
     """Translate a msgspec error into a ProtocolError naming the field in dotted form."""
-    match = _AT_PATH.match(str(err))
+    match = re.match(_AT_PATH, str(err))
     reason = match["reason"] if match else str(err)
     path = (match["path"] or "") if match else ""
     path = re.sub(r"\[(\d+)\]", r".\1", path).lstrip(".")
-    if found := _MISSING.match(reason):
+    if found := re.match(_MISSING, reason):
         return ProtocolError(_join(path, found["field"]), "is required but missing")
-    if found := _UNKNOWN.match(reason):
+    if found := re.match(_UNKNOWN, reason):
         # The name is the sender's own: shown cut short, like any value a payload carries.
         return ProtocolError(_join(path, shown(found["field"])), "is not a known field")
-    if found := _EXPECTED.match(reason):
+    if found := re.match(_EXPECTED, reason):
         return ProtocolError(path or "payload", f"expected {found['want']}, got {found['got']}")
     if isinstance(err, msgspec.DecodeError) and not path:
         return ProtocolError("payload", f"is not valid JSON ({reason.lower()})")
-    if path == "action" and (found := _TAG.match(reason)):
+    if path == "action" and (found := re.match(_TAG, reason)):
         return ProtocolError("action", f"'{shown(found['value'])}' is not a known action")
     return ProtocolError(path or "payload", reason[:1].lower() + reason[1:])

@@ -8,10 +8,11 @@ false` with the reason. Topics in `topics.py`; the contract in docs/protocol.md.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import msgspec
 
+from vahr.protocol.decoding import LazyDecoder
 from vahr.protocol.errors import from_validation_error
 from vahr.protocol.messages import CommandId, Timestamp, check_payload
 
@@ -43,15 +44,15 @@ class FaultAnswer(msgspec.Struct, frozen=True, kw_only=True):
     reason: str | None = None
 
 
-def _decode(decoder: msgspec.json.Decoder, payload: bytes):  # type: ignore[no-untyped-def]
+def _decode(decoder: LazyDecoder[Any], payload: bytes) -> Any:
     try:
         return decoder.decode(check_payload(payload))
     except (msgspec.ValidationError, msgspec.DecodeError) as err:
         raise from_validation_error(err) from err
 
 
-_request = msgspec.json.Decoder(FaultRequest)
-_answer = msgspec.json.Decoder(FaultAnswer)
+_request: LazyDecoder[FaultRequest] = LazyDecoder(FaultRequest)
+_answer: LazyDecoder[FaultAnswer] = LazyDecoder(FaultAnswer)
 
 
 def decode_fault_request(payload: bytes) -> FaultRequest:

@@ -10,10 +10,11 @@ from __future__ import annotations
 import math
 import uuid
 from datetime import UTC, datetime
-from typing import TYPE_CHECKING, Annotated, Literal, Protocol
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Protocol
 
 import msgspec
 
+from vahr.protocol.decoding import LazyDecoder
 from vahr.protocol.errors import ProtocolError, from_validation_error, shown
 
 if TYPE_CHECKING:
@@ -122,7 +123,7 @@ _COMMAND_TYPES: dict[str, type[_Command]] = {
     "stop": Stop,
     "ping": Ping,
 }
-_command_decoder = msgspec.json.Decoder(Command)
+_command_decoder: LazyDecoder[Command] = LazyDecoder(Command)
 
 
 def new_command(
@@ -271,12 +272,12 @@ class ZoneClosures(msgspec.Struct, frozen=True):
     at: Timestamp
 
 
-_event_decoder = msgspec.json.Decoder(Event)
-_closures_decoder = msgspec.json.Decoder(ZoneClosures)
-_presence_decoder = msgspec.json.Decoder(Presence)
+_event_decoder: LazyDecoder[Event] = LazyDecoder(Event)
+_closures_decoder: LazyDecoder[ZoneClosures] = LazyDecoder(ZoneClosures)
+_presence_decoder: LazyDecoder[Presence] = LazyDecoder(Presence)
 
 
-def _decode(decoder: msgspec.json.Decoder, payload: bytes | bytearray | memoryview):  # type: ignore[no-untyped-def]
+def _decode(decoder: LazyDecoder[Any], payload: bytes | bytearray | memoryview) -> Any:
     data = check_payload(payload)
     try:
         return decoder.decode(data)

@@ -11,6 +11,7 @@ from typing import Annotated, Any, Literal
 
 import msgspec
 
+from vahr.protocol.decoding import LazyDecoder
 from vahr.protocol.errors import ProtocolError, from_validation_error
 from vahr.protocol.messages import ReportedPose
 
@@ -102,8 +103,8 @@ class _AcknowledgingDocument(msgspec.Struct, frozen=True):
     state: _AcknowledgingState = _AcknowledgingState()
 
 
-_document_decoder = msgspec.json.Decoder(_Document)
-_acknowledging_decoder = msgspec.json.Decoder(_AcknowledgingDocument)
+_document_decoder: LazyDecoder[_Document] = LazyDecoder(_Document)
+_acknowledging_decoder: LazyDecoder[_AcknowledgingDocument] = LazyDecoder(_AcknowledgingDocument)
 
 
 def robot_shadow_from_payload(

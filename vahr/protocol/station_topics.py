@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import msgspec
 
+from vahr.protocol.decoding import LazyDecoder
 from vahr.protocol.errors import ProtocolError, from_validation_error
 from vahr.protocol.messages import MAX_PAYLOAD_BYTES, Timestamp, check_payload
 
@@ -141,12 +142,12 @@ class ExperimentStatus(msgspec.Struct, frozen=True, kw_only=True, omit_defaults=
     at: Timestamp | None = None
 
 
-_turn_decoder = msgspec.json.Decoder(AssistantTurn)
-_input_decoder = msgspec.json.Decoder(StationInput)
-_status_decoder = msgspec.json.Decoder(ExperimentStatus)
+_turn_decoder: LazyDecoder[AssistantTurn] = LazyDecoder(AssistantTurn)
+_input_decoder: LazyDecoder[StationInput] = LazyDecoder(StationInput)
+_status_decoder: LazyDecoder[ExperimentStatus] = LazyDecoder(ExperimentStatus)
 
 
-def _decode(decoder: msgspec.json.Decoder[Any], payload: bytes, limit: int) -> Any:
+def _decode(decoder: LazyDecoder[Any], payload: bytes, limit: int) -> Any:
     if len(payload) > limit:
         raise ProtocolError("payload", f"is {len(payload)} bytes; the limit is {limit}")
     try:

@@ -19,14 +19,14 @@ ALL_SHADOW_DOCUMENTS = "$aws/things/+/shadow/update/documents"
 EVERY_TOPIC = "#"
 EVERY_AWS_TOPIC = "$aws/#"
 
+# Patterns, compiled on first use by re's own cache rather than at import: every Lambda
+# and robot imports this module, most never parse a topic.
 # AWS IoT thing names: 1-128 of letters, digits, colon, underscore and hyphen. Anything
 # else (notably `/`, `+` and `#`) would change the meaning of a topic.
-_THING = re.compile(r"^[A-Za-z0-9:_-]{1,128}$")
-_SHADOW_NAME = re.compile(r"^[A-Za-z0-9:_-]{1,64}$")
-_ROBOT_TOPIC = re.compile(r"^vahr/robots/(?P<thing>[^/]+)/(?P<kind>cmd|events|presence)$")
-_SHADOW_TOPIC = re.compile(
-    r"^\$aws/things/(?P<thing>[^/]+)/shadow/(?:name/(?P<name>[^/]+)/)?(?P<op>.+)$"
-)
+_THING = r"^[A-Za-z0-9:_-]{1,128}$"
+_SHADOW_NAME = r"^[A-Za-z0-9:_-]{1,64}$"
+_ROBOT_TOPIC = r"^vahr/robots/(?P<thing>[^/]+)/(?P<kind>cmd|events|presence)$"
+_SHADOW_TOPIC = r"^\$aws/things/(?P<thing>[^/]+)/shadow/(?:name/(?P<name>[^/]+)/)?(?P<op>.+)$"
 
 SHADOW_OPERATIONS = (
     "update",
@@ -48,7 +48,7 @@ SHADOW_RESPONSES = tuple(op for op in SHADOW_OPERATIONS if op not in SHADOW_REQU
 
 def check_thing(thing: str) -> str:
     """Return `thing` if it is a valid thing name, else raise ValueError naming the rule."""
-    if not _THING.match(thing):
+    if not re.match(_THING, thing):
         raise ValueError(
             f"thing: {thing!r} is not a valid thing name (1-128 letters, digits, ':', '_', '-')"
         )
@@ -76,7 +76,7 @@ def shadow(thing: str, operation: str, name: str | None = None) -> str:
         raise ValueError(f"operation: {operation!r} is not a shadow operation")
     base = f"$aws/things/{check_thing(thing)}/shadow"
     if name is not None:
-        if not _SHADOW_NAME.match(name):
+        if not re.match(_SHADOW_NAME, name):
             raise ValueError(f"name: {name!r} is not a valid shadow name")
         base = f"{base}/name/{name}"
     return f"{base}/{operation}"
@@ -101,13 +101,13 @@ def shadow_filter(thing: str = "+") -> str:
 
 def parse_robot_topic(topic: str) -> tuple[str, str] | None:
     """`vahr/robots/{thing}/{kind}` -> (thing, kind), or None for any other topic."""
-    found = _ROBOT_TOPIC.match(topic)
+    found = re.match(_ROBOT_TOPIC, topic)
     return (found["thing"], found["kind"]) if found else None
 
 
 def parse_shadow_topic(topic: str) -> tuple[str, str | None, str] | None:
     """`$aws/things/{thing}/shadow[/name/{name}]/{op}` -> (thing, name, op), else None."""
-    found = _SHADOW_TOPIC.match(topic)
+    found = re.match(_SHADOW_TOPIC, topic)
     if not found or found["op"] not in SHADOW_OPERATIONS:
         return None
     return found["thing"], found["name"], found["op"]
@@ -116,7 +116,7 @@ def parse_shadow_topic(topic: str) -> tuple[str, str | None, str] | None:
 # The local stack's room channel (docs/voice.md): speech as audio between a robot and the
 # local assistant, standing in for the air between a robot's speaker and an Echo.
 ROOM_ROBOT_SPEECH = "vahr/room/+/robot"
-_ROOM_TOPIC = re.compile(r"^vahr/room/(?P<thing>[^/]+)/(?P<speaker>robot|assistant)$")
+_ROOM_TOPIC = r"^vahr/room/(?P<thing>[^/]+)/(?P<speaker>robot|assistant)$"
 
 
 def room_robot_speech(thing: str) -> str:
@@ -131,7 +131,7 @@ def room_assistant_speech(thing: str) -> str:
 
 def parse_room_topic(topic: str) -> tuple[str, str] | None:
     """`vahr/room/{thing}/{robot|assistant}` -> (thing, speaker), else None."""
-    found = _ROOM_TOPIC.match(topic)
+    found = re.match(_ROOM_TOPIC, topic)
     return (found["thing"], found["speaker"]) if found else None
 
 
@@ -140,7 +140,7 @@ def parse_room_topic(topic: str) -> tuple[str, str] | None:
 # fault`), and the robot's answer. The local broker's ACL lets a robot hear only its own;
 # the cloud's robot policy allows neither, so no robot on AWS IoT Core ever gets one.
 ALL_FAULT_ANSWERS = "vahr/dev/robots/+/fault/answer"
-_FAULT_ANSWER_TOPIC = re.compile(r"^vahr/dev/robots/(?P<thing>[^/]+)/fault/answer$")
+_FAULT_ANSWER_TOPIC = r"^vahr/dev/robots/(?P<thing>[^/]+)/fault/answer$"
 
 
 def robot_fault(thing: str) -> str:
@@ -155,7 +155,7 @@ def robot_fault_answer(thing: str) -> str:
 
 def parse_fault_answer_topic(topic: str) -> str | None:
     """The thing that answered on `topic`, or None."""
-    found = _FAULT_ANSWER_TOPIC.match(topic)
+    found = re.match(_FAULT_ANSWER_TOPIC, topic)
     return found["thing"] if found else None
 
 

@@ -69,8 +69,11 @@ class Audio:
                     SAMPLE_RATE,
                 ):
                     return cls(wav.readframes(wav.getnframes()))
-        except (wave.Error, EOFError):
-            pass  # float or extensible WAV, which the wave module cannot read: sox can
+        except (wave.Error, EOFError, RuntimeError):
+            # A float or extensible WAV, which the wave module cannot read: sox can. (It
+            # raises RuntimeError for a chunk that claims more bytes than the file has:
+            # sox then says in one line what is wrong with it.)
+            pass
         return cls(convert_to_pcm16k(data, "wav"))
 
 

@@ -15,7 +15,6 @@ log).
 from __future__ import annotations
 
 import logging
-import threading
 import urllib.error
 import urllib.request
 from typing import TYPE_CHECKING
@@ -27,6 +26,7 @@ from vahr.dispatch import Task  # noqa: TC001 (msgspec reads it at run time)
 from vahr.protocol.audit import RECORDED_BY_HEADER
 from vahr.station.errors import RequestError
 from vahr.station.page_messages import TasksMessage
+from vahr.station.polling import Poller
 
 if TYPE_CHECKING:
     from vahr.station.feed import Feed
@@ -68,7 +68,7 @@ def read_tasks(url: str, timeout_s: float = TIMEOUT_S) -> TasksMessage:
     )
 
 
-class TaskPoller:
+class TaskPoller(Poller):
     """Read `url` every `every_s` into `feed` until `stop()`."""
 
     def __init__(self, url: str, feed: Feed, *, every_s: float = EVERY_S) -> None:
@@ -76,19 +76,8 @@ class TaskPoller:
             raise ValueError(f"tasks URL must be http(s): {url}")
         self.url = url
         self.feed = feed
-        self.every_s = every_s
-        self._stopped = threading.Event()
-        self._thread = threading.Thread(target=self._run, name="vahr-station-tasks", daemon=True)
+        super().__init__("vahr-station-tasks", every_s=every_s, join_s=TIMEOUT_S + 1)
         self._warned = False
-
-    def start(self) -> TaskPoller:
-        self._thread.start()
-        return self
-
-    def stop(self) -> None:
-        self._stopped.set()
-        if self._thread.is_alive():
-            self._thread.join(TIMEOUT_S + 1)
 
     def poll(self) -> None:
         """Read once and hand the queue to the feed."""
@@ -100,11 +89,6 @@ class TaskPoller:
             self._warned = True
             return
         self.feed.set_tasks(tasks)
-
-    def _run(self) -> None:
-        while not self._stopped.is_set():
-            self.poll()
-            self._stopped.wait(self.every_s)
 
 
 class _Refusal(msgspec.Struct):

@@ -16,7 +16,6 @@ read leaves the last records shown, and is logged once.
 from __future__ import annotations
 
 import logging
-import threading
 from typing import TYPE_CHECKING, Protocol
 
 import msgspec
@@ -26,6 +25,7 @@ from vahr.plumbing.client import call
 from vahr.protocol import ProtocolError
 from vahr.protocol.audit import TrailHead, record_from_builtins
 from vahr.station.feed import TRAIL_SHOWN
+from vahr.station.polling import Poller
 
 if TYPE_CHECKING:
     from vahr.protocol.audit import AuditEntry, AuditRecord
@@ -71,26 +71,15 @@ class HttpTrail:
         return records, (TrailHead(int(head["seq"]), str(head["hash"])) if head else None)
 
 
-class TrailPoller:
+class TrailPoller(Poller):
     """Read the trail's newest records into `feed` every `every_s` until `stop()`."""
 
     def __init__(self, trail: StationTrail, feed: Feed, *, every_s: float = EVERY_S) -> None:
         self.trail = trail
         self.feed = feed
-        self.every_s = every_s
         self._after: int | None = None
-        self._stopped = threading.Event()
-        self._thread = threading.Thread(target=self._run, name="vahr-station-trail", daemon=True)
+        super().__init__("vahr-station-trail", every_s=every_s, join_s=TIMEOUT_S + 1)
         self._warned = False
-
-    def start(self) -> TrailPoller:
-        self._thread.start()
-        return self
-
-    def stop(self) -> None:
-        self._stopped.set()
-        if self._thread.is_alive():
-            self._thread.join(TIMEOUT_S + 1)
 
     def poll(self) -> None:
         """Read what is new (at first, the latest `TRAIL_SHOWN`) and hand it to the feed."""
@@ -107,8 +96,3 @@ class TrailPoller:
         if records:
             self._after = records[-1].seq
         self.feed.add_records(records)
-
-    def _run(self) -> None:
-        while not self._stopped.is_set():
-            self.poll()
-            self._stopped.wait(self.every_s)

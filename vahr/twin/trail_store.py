@@ -16,7 +16,6 @@ reads a page of records with the head.
 
 from __future__ import annotations
 
-import sqlite3
 import threading
 from contextlib import contextmanager
 from pathlib import Path
@@ -24,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
+from vahr.plumbing.sqlite_file import open_shared
 from vahr.protocol import ProtocolError
 from vahr.protocol.audit import (
     AuditEntry,
@@ -35,6 +35,7 @@ from vahr.protocol.audit import (
 )
 
 if TYPE_CHECKING:
+    import sqlite3
     from collections.abc import Iterator
 
 FILE_NAME = "audit.sqlite3"
@@ -61,12 +62,7 @@ class SqliteTrail:
 
     def __init__(self, path: Path | str) -> None:
         self.path = Path(path)
-        self._db = sqlite3.connect(
-            self.path, check_same_thread=False, isolation_level=None, timeout=10.0
-        )
-        self._db.execute("PRAGMA journal_mode=WAL")
-        self._db.execute("PRAGMA synchronous=NORMAL")
-        self._db.executescript(_SCHEMA)
+        self._db = open_shared(self.path, _SCHEMA)
         self._lock = threading.Lock()
 
     @classmethod

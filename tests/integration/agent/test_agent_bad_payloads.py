@@ -139,4 +139,5 @@ def test_a_rejected_command_keeps_its_id_in_the_shadow_so_the_skill_can_tell(
         "action": "navigate",
         "result": "rejected",
         "reason": "params.zone: 'Q' is not a zone; zones are LOADING, A, B, C, D",
+        "zone": None,
     }

@@ -340,7 +340,14 @@ def test_robot_agent_run_with_the_nav2_backend_drives_nav2_from_mqtt(
         state = tap.reported(
             "placebot1",
             lambda r: (
-                (r["last_command"] or {}) == {"id": "nav-b", "action": "navigate", "result": "done"}
+                (r["last_command"] or {})
+                == {
+                    "id": "nav-b",
+                    "action": "navigate",
+                    "result": "done",
+                    "reason": None,
+                    "zone": "B",
+                }
             ),
         )
         goal = stand_in.seen("goal")[goals]

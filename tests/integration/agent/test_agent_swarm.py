@@ -52,7 +52,16 @@ def test_one_fleet_command_reaches_every_robot_of_the_swarm(
         tap.publish("vahr/robots/swarm0007/cmd", command("solo", "navigate", {"zone": "C"}))
         done = tap.reported(
             "swarm0007",
-            lambda r: r["last_command"] == {"id": "solo", "action": "navigate", "result": "done"},
+            lambda r: (
+                r["last_command"]
+                == {
+                    "id": "solo",
+                    "action": "navigate",
+                    "result": "done",
+                    "reason": None,
+                    "zone": "C",
+                }
+            ),
             timeout_s=20,
         )
         assert done["zone"] == "C"

@@ -190,6 +190,7 @@ def test_sigint_stops_the_agent_cleanly_too(
         "action": "navigate",
         "result": "cancelled",
         "reason": "the agent is shutting down",
+        "zone": "A",
     }
     assert final["status"] == "stopped" and final["task"] is None
 
@@ -247,4 +248,5 @@ def test_weather_delivery_without_a_voice_fails_with_the_reason(
         "action": "weather_delivery",
         "result": "failed",
         "reason": "voice not configured",
+        "zone": None,
     }

@@ -170,7 +170,8 @@ def test_one_fault_one_announcement_under_a_100_robot_swarm(
     assert stuck.speech == "Swarm 1 is stuck on its way to zone A and needs your help."
     failed = next(a for a in heard.told if a.thing == FAILED[0])
     assert (
-        failed.speech == "Swarm 11 could not finish its task: goal to A aborted: an injected fault."
+        failed.speech
+        == "Swarm 11 could not finish its task: goal to zone A aborted: an injected fault."
     )
     # And each went out once on the announcements topic, as the station hears them
     on_wire = [

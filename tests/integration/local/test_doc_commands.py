@@ -238,7 +238,7 @@ def _check(
         else:
             assert args is not None
     elif program == "vahr":
-        _parse(_vahr(), argv)
+        parsed = _parse(_vahr(), argv)
         if argv[0] == "nlu" and "--eval" not in argv:
             from vahr.cli import main as vahr
 
@@ -248,9 +248,7 @@ def _check(
             out = printed.getvalue()
             assert '"intent"' in out and "AMAZON.FallbackIntent" not in out, str(command)
         elif argv[0] == "say":
-            utterance = next(word for word in argv[1:] if not word.startswith("-") and
-                             word not in ("de-DE", "en-US"))  # fmt: skip
-            _understood(utterance, fleet, locale)
+            _understood(parsed.utterance, fleet, locale)
     else:
         raise AssertionError(f"{command}: no check for {program!r}")
 

@@ -167,7 +167,7 @@ def up_with(fleet: Path, state: Path) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [*VAHR, "up", "--fleet", str(fleet), "--state-dir", str(state), "--no-voice",
          "--api-port", str(free_port()), "--mqtts-port", str(free_port()),
-         "--mqtt-port", str(free_port()), "--station-port", str(free_port())],
+         "--station-port", str(free_port())],
         cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=60,
     )  # fmt: skip
 

@@ -11,6 +11,7 @@ from moto import mock_aws
 
 from dispatcher.task_table import TaskTable
 from tests.support.dispatch_meter import REGION, TABLE
+from tests.support.dynamodb_tables import create_task_table
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -34,19 +35,7 @@ def aws_credentials(monkeypatch: pytest.MonkeyPatch) -> None:
 def dynamodb(aws_credentials: None) -> Iterator[Any]:
     with mock_aws():
         client = boto3.client("dynamodb", region_name=REGION)
-        # The key schema of infra/constructs/task_table.py.
-        client.create_table(
-            TableName=TABLE,
-            KeySchema=[
-                {"AttributeName": "section", "KeyType": "HASH"},
-                {"AttributeName": "id", "KeyType": "RANGE"},
-            ],
-            AttributeDefinitions=[
-                {"AttributeName": "section", "AttributeType": "S"},
-                {"AttributeName": "id", "AttributeType": "S"},
-            ],
-            BillingMode="PAY_PER_REQUEST",
-        )
+        create_task_table(client, TABLE)
         yield client
 
 

@@ -4,8 +4,6 @@ index on boto3's wire."""
 
 from __future__ import annotations
 
-import math
-
 import pytest
 from moto import mock_aws
 
@@ -14,7 +12,7 @@ from tests.support.dispatch_meter import measure_dispatch
 
 
 @pytest.mark.parametrize("robots", [10, 250])
-def test_a_task_costs_the_modelled_table_units_and_one_search_page_per_hundred(
+def test_a_task_costs_the_modelled_table_units_and_one_search_page_whatever_the_fleet(
     aws_credentials: None, robots: int
 ) -> None:
     with mock_aws():
@@ -23,13 +21,16 @@ def test_a_task_costs_the_modelled_table_units_and_one_search_page_per_hundred(
     # The table's units do not depend on the fleet's size
     assert measured.submit.reads + measured.freed.reads == usage.table_reads
     assert measured.submit.writes + measured.freed.writes == usage.table_writes
-    # Candidates: one SearchIndex page per 100 free robots, and no shadow read at all
-    assert measured.submit.calls["SearchIndex"] == math.ceil(robots / 100)
+    # Candidates: one SearchIndex page of idle robots however many, and no shadow read
+    assert measured.submit.calls["SearchIndex"] == 1
     assert measured.freed.calls["SearchIndex"] == 0
     assert "GetThingShadow" not in measured.submit.calls + measured.freed.calls
+    # The schedule saw the robot with it once: one search, the acknowledgment marked
+    assert measured.tick.calls["SearchIndex"] == usage.ack_searches
+    assert measured.tick.calls["UpdateItem"] == 1 and measured.tick.writes == usage.ack_writes
     # One command published, to the robot that took the task
     assert measured.submit.calls["Publish"] == 1 and measured.freed.calls["Publish"] == 0
-    assert dispatch_billable(robots, index=True).index_queries == math.ceil(robots / 100)
+    assert dispatch_billable(robots, index=True).index_queries == 1 + usage.ack_searches
 
 
 def test_the_index_is_cheaper_than_reading_every_shadow_from_a_few_hundred_robots() -> None:

@@ -25,6 +25,7 @@ from dispatcher.task_table import TaskTable
 from dispatcher.trail_table import TrailTable
 from skill.audit_table import AuditTable
 from tests.support.dispatch_meter import REGION, AtomicCalls, load_event
+from tests.support.dynamodb_tables import create_audit_table
 from vahr.dispatch import Dispatcher, Task, timestamp
 from vahr.domain import load_fleet
 from vahr.protocol import topics
@@ -177,18 +178,7 @@ def test_a_robot_that_finishes_its_task_takes_the_next_in_line(
 
 def audit_trail(dynamodb: Any) -> TrailTable:
     """The audit table the stack makes (keys as infra/constructs/people_tables.py), in moto."""
-    dynamodb.create_table(
-        TableName=AUDIT_TABLE,
-        KeySchema=[
-            {"AttributeName": "trail", "KeyType": "HASH"},
-            {"AttributeName": "seq", "KeyType": "RANGE"},
-        ],
-        AttributeDefinitions=[
-            {"AttributeName": "trail", "AttributeType": "S"},
-            {"AttributeName": "seq", "AttributeType": "N"},
-        ],
-        BillingMode="PAY_PER_REQUEST",
-    )
+    create_audit_table(dynamodb, AUDIT_TABLE)
     return TrailTable(AUDIT_TABLE, dynamodb)
 
 
@@ -376,9 +366,9 @@ def test_the_schedule_gives_a_queued_task_to_a_robot_whose_event_was_lost(
     dispatcher = make_dispatcher(table, index)
     queued = submit(dispatcher, zone="D")["body"]["queued"][0]
     tick = load_event("eventbridge_schedule")
-    assert app.handle(tick, dispatcher) == {"given": []}  # still stuck: nothing to give
+    assert app.handle(tick, dispatcher)["given"] == []  # still stuck: nothing to give
     # When the robot is idle again but its rule event never reached the function
     index.report("placebot1", status="idle", zone="B")
     # Then the next tick gives it the task
-    assert app.handle(tick, dispatcher) == {"given": [queued["id"]]}
+    assert app.handle(tick, dispatcher)["given"] == [queued["id"]]
     assert [topic for topic, _ in published] == [topics.robot_cmd("placebot1")]

@@ -175,3 +175,28 @@ def test_a_task_added_twice_is_refused(table: TaskTable) -> None:
 def test_a_missing_table_is_one_line(dynamodb: Any) -> None:
     with pytest.raises(StoreError, match="ResourceNotFoundException"):
         TaskTable("no-such-table", client=dynamodb).pending()
+
+
+def test_offers_are_counted_beside_the_task_and_never_on_a_task_that_changed(
+    table: TaskTable,
+) -> None:
+    # Given t1 assigned to placebot1 and t2 waiting
+    table.add(task("t1"))
+    table.add(task("t2", minute=1))
+    taken = table.assign("t1", "placebot1", at=AT)
+    assert taken is not None
+    # When its command is sent again twice, then its robot is seen with it
+    assert table.offered(taken, at="2026-11-26T22:05:00.000000Z")
+    assert table.offered(taken, at="2026-11-26T22:06:00.000000Z")
+    [offer], queued = table.offers()
+    assert (offer.task, offer.offers, offer.offered_at, offer.acknowledged) == (
+        taken, 2, "2026-11-26T22:06:00.000000Z", False,
+    )  # fmt: skip
+    assert [t.id for t in queued] == ["t2"] and table.holders() == {"placebot1"}
+    assert table.acknowledged(taken)
+    assert table.offers()[0][0].acknowledged
+    # And once the task is cancelled, the version read is stale: nothing is counted
+    table.cancel("t1")
+    assert not table.offered(taken, at="2026-11-26T22:07:00.000000Z")
+    assert not table.acknowledged(taken)
+    assert table.offers() == ([], [table.get("t2")]) and table.holders() == set()

@@ -12,6 +12,7 @@ import pytest
 from skill_testkit import REGION
 
 from skill.audit_table import AuditTable
+from tests.support.dynamodb_tables import create_audit_table
 from vahr.protocol.audit import TRAIL_RECORDS as RECORDS
 from vahr.protocol.audit import AuditEntry, verify
 
@@ -34,18 +35,7 @@ def entry(number: int) -> AuditEntry:
 @pytest.fixture
 def client(aws: None) -> Any:
     dynamodb = boto3.client("dynamodb", region_name=REGION)
-    dynamodb.create_table(
-        TableName=TABLE,
-        KeySchema=[
-            {"AttributeName": "trail", "KeyType": "HASH"},
-            {"AttributeName": "seq", "KeyType": "RANGE"},
-        ],
-        AttributeDefinitions=[
-            {"AttributeName": "trail", "AttributeType": "S"},
-            {"AttributeName": "seq", "AttributeType": "N"},
-        ],
-        BillingMode="PAY_PER_REQUEST",
-    )
+    create_audit_table(dynamodb, TABLE)
     return dynamodb
 
 

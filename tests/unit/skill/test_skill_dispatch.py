@@ -427,3 +427,23 @@ def test_taking_a_group_out_of_service_names_its_members_in_german(
     spoken = said(skill, event)
     assert spoken.endswith("sind jetzt außer Betrieb und bekommen keine Aufträge."), spoken
     assert desk.out_of_service() == ["curlew", "dunlin", "plover"]
+def test_with_confirmation_on_a_zone_is_closed_only_after_its_askers_yes(
+    aws: None, desk: CoreDesk, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Given a skill that confirms fleet-wide commands first
+    monkeypatch.setattr(skill_app, "task_desk", lambda config: desk)
+    handler = skill_app.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS), confirm=True))
+    close = intent("CloseZoneIntent", zone=("the oven", "OVEN"))
+    # When someone asks to close the oven, it is said back and nothing is closed yet
+    asked = handler(close, None)
+    assert speech(asked) == "Close the oven, so that no robot goes there, is that right?"
+    assert asked["response"]["directives"][0]["type"] == "Dialog.ConfirmIntent"
+    assert desk.closed_zones() == []
+    # Then their yes closes it
+    yes = copy.deepcopy(close)
+    yes["session"]["new"] = False
+    yes["session"]["attributes"] = asked.get("sessionAttributes") or {}
+    yes["request"]["dialogState"] = "IN_PROGRESS"
+    yes["request"]["intent"]["confirmationStatus"] = "CONFIRMED"
+    assert speech(handler(yes, None)).startswith("The oven is closed.")
+    assert desk.closed_zones() == ["OVEN"]

@@ -19,6 +19,7 @@ from skill_testkit import REGION, published, speech
 from skill.audit_table import AuditTable
 from skill.users_table import write_people
 from tests.conftest import load_event
+from tests.support.dynamodb_tables import create_audit_table
 from vahr.domain.people import People, Person
 from vahr.protocol.audit import verify
 
@@ -75,18 +76,7 @@ def directive(response: dict[str, Any]) -> str | None:
 def tables(aws: None) -> tuple[AuditTable, Any]:
     """The audit and users tables the stack makes (keys as infra/constructs/people_tables.py)."""
     client = boto3.client("dynamodb", region_name=REGION)
-    client.create_table(
-        TableName=AUDIT_TABLE,
-        KeySchema=[
-            {"AttributeName": "trail", "KeyType": "HASH"},
-            {"AttributeName": "seq", "KeyType": "RANGE"},
-        ],
-        AttributeDefinitions=[
-            {"AttributeName": "trail", "AttributeType": "S"},
-            {"AttributeName": "seq", "AttributeType": "N"},
-        ],
-        BillingMode="PAY_PER_REQUEST",
-    )
+    create_audit_table(client, AUDIT_TABLE)
     client.create_table(
         TableName=USERS_TABLE,
         KeySchema=[{"AttributeName": "id", "KeyType": "HASH"}],
