@@ -427,6 +427,8 @@ def test_taking_a_group_out_of_service_names_its_members_in_german(
     spoken = said(skill, event)
     assert spoken.endswith("sind jetzt außer Betrieb und bekommen keine Aufträge."), spoken
     assert desk.out_of_service() == ["curlew", "dunlin", "plover"]
+
+
 def test_with_confirmation_on_a_zone_is_closed_only_after_its_askers_yes(
     aws: None, desk: CoreDesk, monkeypatch: pytest.MonkeyPatch
 ) -> None:
