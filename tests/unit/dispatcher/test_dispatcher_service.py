@@ -21,8 +21,11 @@ from dispatcher import app, fleet_search
 from dispatcher.command_channel import CommandChannel
 from dispatcher.fleet_search import FleetSearch
 from dispatcher.task_table import TaskTable
+from dispatcher.trail_table import TrailTable
+from skill.audit_table import AuditTable
 from skill.task_desk import LambdaTaskDesk, TaskRefused
 from tests.support.dispatch_meter import REGION, AtomicCalls, load_event
+from tests.support.dynamodb_tables import create_audit_table
 from tests.support.fleets import THREE_ROVERS
 from tests.unit.dispatcher.test_dispatcher_handler import Index
 from tests.unit.skill.test_skill_task_desk import InProcessLambda
@@ -38,6 +41,7 @@ Published = list[tuple[str, bytes]]
 FULL = {"percent": 100, "charging": False}
 LOW = {"percent": 10, "charging": False}
 DOCK = "DOCK"
+AUDIT_TABLE = "vahr-audit"
 
 
 @pytest.fixture
@@ -208,18 +212,22 @@ def test_a_first_page_of_low_robots_is_read_past(
 
 
 def test_the_schedule_sends_an_idle_low_robot_to_charge(
-    function: Dispatcher, index: Index, table: TaskTable, published: Published
+    function: Dispatcher, index: Index, table: TaskTable, published: Published, dynamodb: Any
 ) -> None:
     # Given rover1 ran low standing idle (no rule event: its status never changed)
     index.report("rover1", battery=LOW)
     tick = load_event("eventbridge_schedule")
+    create_audit_table(dynamodb, AUDIT_TABLE)
     # When the schedule ticks
-    answer = app.handle(tick, function)
+    answer = app.handle(tick, function, TrailTable(AUDIT_TABLE, dynamodb))
     # Then rover1 holds the charger and is on its way
     [task] = table.active()
     assert (task.kind, task.zone, task.thing) == ("charge", DOCK, "rover1")
     assert answer["charging"] == [task.id]
     assert commands(published) == [(topics.robot_cmd("rover1"), "navigate", {"zone": DOCK})]
+    # And the trail records that the dispatcher sent it
+    [record] = AuditTable(AUDIT_TABLE, dynamodb).records()
+    assert (record.who, record.robots, record.commands) == ("dispatcher", ["rover1"], [task.id])
     # And the next tick sends nothing more (rover2 low too: the one charger is taken)
     index.report("rover2", battery=LOW)
     assert app.handle(tick, function)["charging"] == []
