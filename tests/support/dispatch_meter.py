@@ -163,18 +163,21 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
             table = TaskTable(
                 TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION))
             )
-            return Dispatcher(
+            core = Dispatcher(
                 fleet=fleet,
                 store=table,
                 candidates=FleetSearch(
                     client=meter.watch(boto3.client("iot", endpoint_url=server.url)),
                     holding=table.holders,
+                    usable=lambda robot: core.usable(robot),
+                    out_of_service=table.out_of_service,
                 ),
                 publish=CommandChannel(
                     client=meter.watch(boto3.client("iot-data", region_name=REGION))
                 ),
                 clock=lambda: now[0],
             )
+            return core
 
         answer = app.handle(
             {"operation": "submit", "order": {"kind": "deliver", "zone": "C"}},
