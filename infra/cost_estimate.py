@@ -273,10 +273,11 @@ class DispatchUsage:
     # tests/unit/dispatcher/test_dispatcher_costs.py). The submit: the task's PutItem (1
     # write), the assignment's transaction of two items (4: transactions bill twice), two
     # consistent Queries of the open tasks, one of the closed zones, one of the robots'
-    # claims (the fleet search skips robots holding a task) and a GetItem (5 reads); the
-    # robot-freed event: the closing transaction of three items (6 writes), three Queries
-    # and a GetItem (4).
-    table_reads: float = 9.0
+    # claims (the fleet search skips robots holding a task), one of the robots out of
+    # service and a GetItem (6 reads); the robot-freed event: the closing transaction of
+    # three items (6 writes), four Queries (one of them the robots out of service) and a
+    # GetItem (5).
+    table_reads: float = 11.0
     table_writes: float = 11.0
     # The schedule's look at the task once its robot has it (lambda/dispatcher/reoffer.py):
     # the acknowledgment marked on the task's item (an UpdateItem, 1 write) and the robot

@@ -31,10 +31,13 @@ from dispatcher.requests import (
     OPERATIONS,
     Answer,
     Cancel,
+    Charge,
     ListClosed,
+    ListOutOfService,
     ListPending,
     ListTasks,
     RobotUpdate,
+    SetService,
     SetZone,
     SkillRequest,
     Submit,
@@ -42,6 +45,7 @@ from dispatcher.requests import (
     is_tick,
 )
 from dispatcher.robot_updates import robot_freed
+from dispatcher.service import out_of_service, set_in_service
 from dispatcher.task_table import TaskTable
 from dispatcher.trail_table import TrailTable
 from vahr.dispatch import Dispatcher, DispatchError, Task
@@ -73,14 +77,23 @@ def runtime() -> Dispatcher:
         raise ConfigError(f"the fleet's map: {err}") from err
     channel = CommandChannel(config.iot_data_endpoint)
     table = TaskTable(config.table, closed_task_days=config.closed_task_days)
-    return Dispatcher(
+    # The search reads past a page of robots the dispatcher would not give a task (low,
+    # out of service): the dispatcher's own test, bound once it exists.
+    search = FleetSearch(
+        index_name=config.index_name,
+        holding=table.holders,
+        usable=lambda robot: dispatcher.usable(robot),
+        out_of_service=table.out_of_service,
+    )
+    dispatcher = Dispatcher(
         fleet=fleet,
         store=table,
-        candidates=FleetSearch(index_name=config.index_name, holding=table.holders),
+        candidates=search,
         publish=channel,
         routes=lambda closed: routes,
         publish_closures=channel.closures,
     )
+    return dispatcher
 
 
 @cache
@@ -131,7 +144,7 @@ def handle(
     if is_tick(event):
         return on_tick(dispatcher, trail, tell)
     try:
-        answer = on_request(_request(event), dispatcher)
+        answer = on_request(_request(event), dispatcher, trail)
     except BadRequest as err:
         refusal: dict[str, Any] = {"code": err.status, "message": str(err)}
         if err.error is not None:
@@ -157,6 +170,8 @@ def on_robot_update(
     if state is None or update.thing not in dispatcher.fleet.robot_things:
         log.warning("ignoring an update of %s, which is not a robot of the fleet", update.thing)
         return {"took": None}
+    if isinstance(dispatcher.candidates, FleetSearch):
+        state = dispatcher.candidates.in_service(state)
     taken = robot_freed(dispatcher, state, now=datetime.now(UTC), tell=tell)
     if taken is not None:
         log.info("task %s (%s to %s) given to %s", taken.id, taken.kind, taken.zone, taken.thing)
@@ -176,7 +191,10 @@ def on_tick(
     (dead-lettered, or the function failed) would otherwise wait for its next change; with
     no open task this is one read of the open tasks and nothing more. The closed zones are
     told again (retained), so two changes published out of order by two invocations agree
-    with the table within a minute."""
+    with the table within a minute. Last, when the fleet's batteries drain, the idle robots
+    that are low go to charge (`Dispatcher.charge_low`, the rule `observe` applies to each
+    report): the rule selects a robot's update only when it becomes idle or stops, so a
+    robot that runs low standing idle, or found every charger taken, is sent from here."""
     dispatcher.announce_closures()
     table, search = dispatcher.store, dispatcher.candidates
     assert isinstance(table, TaskTable) and isinstance(search, FleetSearch)
@@ -185,20 +203,31 @@ def on_tick(
     if watch.queued:
         with _searching(dispatcher, every=_restricted(watch.queued)):
             given += dispatcher.drain()
-    for task in given:
-        log.info("task %s (%s to %s) given to %s", task.id, task.kind, task.zone, task.thing)
-        if trail is not None:
-            trail.record(task_given(task))
+    charging: list[Task] = []
+    if dispatcher.respect_battery and dispatcher.fleet.batteries_drain:
+        charging = dispatcher.charge_low(search.idle())
+    _given(given + charging, trail)
     return {
         "given": [task.id for task in given],
         "offered_again": watch.offered_again,
         "acknowledged": watch.acknowledged,
         "closed": watch.closed,
         "lost": [lost.task for lost in watch.lost],
+        "charging": [task.id for task in charging],
     }
 
 
-def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
+def _given(tasks: list[Task], trail: TrailTable | None) -> None:
+    """Log and record the tasks the dispatcher gave robots by itself."""
+    for task in tasks:
+        log.info("task %s (%s to %s) given to %s", task.id, task.kind, task.zone, task.thing)
+        if trail is not None:
+            trail.record(task_given(task))
+
+
+def on_request(
+    request: SkillRequest, dispatcher: Dispatcher, trail: TrailTable | None = None
+) -> Answer:
     if isinstance(request, Submit):
         order = request.order
         # "Every idle robot" needs them all; a group's members and the robots in a zone may
@@ -210,7 +239,18 @@ def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
         except DispatchError as err:
             raise BadRequest(str(err), error=err.code) from err
     if isinstance(request, ListTasks):
-        return Answer(200, {"tasks": dispatcher.tasks(), "closed": dispatcher.closed_zones()})
+        return Answer(
+            200,
+            {
+                "tasks": dispatcher.tasks(),
+                "closed": dispatcher.closed_zones(),
+                "out_of_service": out_of_service(dispatcher),
+            },
+        )
+    if isinstance(request, ListOutOfService):
+        return Answer(200, {"out_of_service": out_of_service(dispatcher)})
+    if isinstance(request, SetService | Charge):
+        return _on_robot(request, dispatcher, trail)
     if isinstance(request, ListPending):
         return Answer(200, {"tasks": dispatcher.pending()})
     if isinstance(request, ListClosed):
@@ -229,6 +269,31 @@ def on_request(request: SkillRequest, dispatcher: Dispatcher) -> Answer:
     if cancelled is None:
         raise BadRequest(f"no open task {request.task_id!r}", status=404)
     return Answer(200, {"task": cancelled})
+
+
+def _on_robot(
+    request: SetService | Charge, dispatcher: Dispatcher, trail: TrailTable | None
+) -> Answer:
+    """A robot out of service or back, or sent to charge now: the local host's
+    `/vahr/service/{thing}` and `/vahr/charge/{thing}`, with their answers and refusals."""
+    thing = request.thing
+    if thing not in dispatcher.fleet.robot_things:
+        raise BadRequest(
+            f"{thing[:40]} is not a robot of the fleet", status=404, error="unknown_robot"
+        )
+    # A task given back to the queue (or waiting for a robot back) may be only some
+    # robots' to take: read every page then.
+    with _searching(dispatcher, every=_restricted(dispatcher.pending())):
+        if isinstance(request, Charge):
+            try:
+                task = dispatcher.charge(thing, asked=True)
+            except DispatchError as err:
+                raise BadRequest(str(err), error=err.code) from err
+            return Answer(200, {"task": task})
+        change = set_in_service(dispatcher, thing, request.in_service)
+    given = change.given + [task for task in change.reassigned if task.thing is not None]
+    _given(given, trail)
+    return Answer(200, change)
 
 
 def _restricted(tasks: list[Task]) -> bool:

@@ -16,6 +16,11 @@ among every idle robot of a larger fleet: the index has no order by distance. Or
 need every robot of a kind (`every_robot`: "every idle robot", a group's members) and a
 search within one zone read every page.
 
+A robot out of service is the task table's, not the index's: `out_of_service` names them,
+and they are left out of `available` and read as such (`RobotState.in_service` False) by
+`state`. The schedule's `idle` reads every page of idle robots, so the dispatcher can send
+the low ones among them to charge.
+
 The index follows the shadows within seconds, not at once: a robot that just left
 `idle` may still be found. That is harmless here, since the task table's conditional
 `assign`, not the index, decides who takes a task; the index only proposes.
@@ -82,7 +87,9 @@ class _Document(msgspec.Struct):
 _SHADOW = msgspec.json.Decoder(_Document)
 
 
-def robot_state(thing: str, reported: dict[str, Any] | _Reported | None) -> RobotState | None:
+def robot_state(
+    thing: str, reported: dict[str, Any] | _Reported | None, *, in_service: bool = True
+) -> RobotState | None:
     """A robot's reported state as the dispatcher's `RobotState`; None without a status."""
     if reported is None:
         return None
@@ -103,6 +110,7 @@ def robot_state(thing: str, reported: dict[str, Any] | _Reported | None) -> Robo
         last_command_id=last.id if last else None,
         last_result=last.result if last else None,
         battery=reported.battery,
+        in_service=in_service,
     )
 
 
@@ -154,15 +162,18 @@ class FleetSearch:
         client: Any = None,
         holding: Callable[[], Iterable[str]] | None = None,
         usable: Callable[[RobotState], bool] | None = None,
+        out_of_service: Callable[[], Iterable[str]] | None = None,
     ) -> None:
         """`holding` names the robots holding a task now (the task table's claims) and
         `usable` says whether the dispatcher would give a robot a task at all (a rule on
         its battery, say): a page whose idle robots all hold a task or are not usable is
-        read past. Without them, every robot found counts as free."""
+        read past. Without them, every robot found counts as free. `out_of_service` names
+        the robots out of service (the task table's), read once per search."""
         self._index = index_name
         self._client = client or boto3.client("iot", config=CLIENT_CONFIG)
         self._holding = holding
         self._usable = usable
+        self._out_of_service = out_of_service
         self._every_robot = False
 
     @contextmanager
@@ -177,15 +188,16 @@ class FleetSearch:
             self._every_robot = before
 
     def available(self, *, zone: str | None = None) -> list[RobotState]:
+        out = self._out()
         if zone is not None or self._every_robot:
-            return self._found(self._search(available_query(zone)))
+            return self._found(self._search(available_query(zone)), out)
         holding = set(self._holding()) if self._holding is not None else set()
         robots: list[RobotState] = []
         # Idle robots rank before every busy one: the busy are read only when no idle robot
         # is free, and each search stops after the first page holding a free robot.
         for statuses in (IDLE_STATUSES, BUSY_STATUSES):
             for page in self._pages(status_query(statuses)):
-                found = self._found(page)
+                found = self._found(page, out)
                 robots.extend(found)
                 usable = self._usable
                 if any(
@@ -195,6 +207,13 @@ class FleetSearch:
                     return robots
         return robots
 
+    def idle(self) -> list[RobotState]:
+        """Every connected idle robot in service, every page: what the schedule reads to
+        send the low ones to charge."""
+        out = self._out()
+        found = self._found(self._search(status_query(IDLE_STATUSES)), out)
+        return [robot for robot in found if robot.idle]
+
     def state(self, thing: str) -> RobotState | None:
         return self.states([thing]).get(thing)
 
@@ -202,17 +221,30 @@ class FleetSearch:
         """The state of each of `things` the index knows (and that reports a status), with
         one search per 40 or so names."""
         wanted = set(things)
+        out = self._out() if wanted else frozenset()
         states: dict[str, RobotState] = {}
         for query in name_queries(wanted):
             for name, reported in self._search(query):
-                state = robot_state(name, reported) if name in wanted else None
+                found = name in wanted
+                state = robot_state(name, reported, in_service=name not in out) if found else None
                 if state is not None:
                     states[name] = state
         return states
 
+    def in_service(self, state: RobotState) -> RobotState:
+        """`state` (read elsewhere: the rule's event) with the table's word on its service."""
+        if state.thing in self._out():
+            return msgspec.structs.replace(state, in_service=False)
+        return state
+
+    def _out(self) -> frozenset[str]:
+        return frozenset(self._out_of_service()) if self._out_of_service else frozenset()
+
     @staticmethod
-    def _found(entries: Iterable[tuple[str, _Reported | None]]) -> list[RobotState]:
-        found = (robot_state(*entry) for entry in entries)
+    def _found(
+        entries: Iterable[tuple[str, _Reported | None]], out: frozenset[str] = frozenset()
+    ) -> list[RobotState]:
+        found = (robot_state(*entry) for entry in entries if entry[0] not in out)
         # The index may lag a shadow by seconds; the state it holds is checked again here.
         return [robot for robot in found if robot is not None and robot.available]
 

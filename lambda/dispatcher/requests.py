@@ -9,11 +9,17 @@ The skill invokes it synchronously (`lambda:InvokeFunction`, RequestResponse) wi
 | `{"operation": "tasks"}` | `{"tasks": [...]}`: the tasks robots hold, then the queue |
 | `{"operation": "pending"}` | `{"tasks": [...]}`: the queue, next first |
 | `{"operation": "cancel", "task_id": "..."}` | `{"task": Task}` as it was before it was cancelled |
+| `{"operation": "zones"}` | `{"closed": [zone ids]}` |
+| `{"operation": "zone", "zone": "...", "closed": bool}` | the `ZoneChange` |
+| `{"operation": "service"}` | `{"out_of_service": [things]}` |
+| `{"operation": "set_service", "thing": "...", "in_service": bool}` | the `ServiceChange` |
+| `{"operation": "charge", "thing": "..."}` | `{"task": Task}`: the robot's charge task |
 
 and gets `{"status": N, "body": ...}` back: the status and body the local data plane
-answers `POST`, `GET` and `DELETE {api}/vahr/tasks` with, so the skill's two `TaskDesk`
-adapters read one shape. A request that cannot be carried out is `{"status": 400 or 404,
-"body": {"code": N, "message": "one line"}}` and changes nothing.
+answers on `{api}/vahr/tasks`, `/vahr/zones`, `/vahr/service` and `/vahr/charge`, so the
+skill's two `TaskDesk` adapters read one shape. A request that cannot be carried out is
+`{"status": 400 or 404, "body": {"code": N, "message": "one line"}}` (with `error`, the
+`DispatchError.code`, when the dispatcher refused it) and changes nothing.
 
 The topic rule (infra/constructs/dispatcher.py) sends `{"thing", "reported"}`:
 the robot's whole reported state after an update that left it idle or stopped. An
@@ -57,8 +63,45 @@ class SetZone(msgspec.Struct, frozen=True, tag_field="operation", tag="zone"):
     closed: bool
 
 
-SkillRequest = Submit | ListTasks | ListPending | Cancel | ListClosed | SetZone
-OPERATIONS = ("submit", "tasks", "pending", "cancel", "zones", "zone")
+class ListOutOfService(msgspec.Struct, frozen=True, tag_field="operation", tag="service"):
+    pass
+
+
+class SetService(msgspec.Struct, frozen=True, tag_field="operation", tag="set_service"):
+    """Take a robot out of service (`in_service: false`) or put it back."""
+
+    thing: str
+    in_service: bool
+
+
+class Charge(msgspec.Struct, frozen=True, tag_field="operation", tag="charge"):
+    """Send a robot to the nearest free charger now."""
+
+    thing: str
+
+
+SkillRequest = (
+    Submit
+    | ListTasks
+    | ListPending
+    | Cancel
+    | ListClosed
+    | SetZone
+    | ListOutOfService
+    | SetService
+    | Charge
+)
+OPERATIONS = (
+    "submit",
+    "tasks",
+    "pending",
+    "cancel",
+    "zones",
+    "zone",
+    "service",
+    "set_service",
+    "charge",
+)
 
 
 class RobotUpdate(msgspec.Struct, frozen=True, kw_only=True):

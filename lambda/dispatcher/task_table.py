@@ -8,6 +8,8 @@ One table, keyed by `section` (partition) and `id` (sort):
 | `closed` | task id | a done or cancelled task, kept until `expires_at` (the table's TTL) |
 | `robot` | thing | the robot's claim on its one assigned task: `task_id` |
 | `zone` | zone id | a zone closed at run time, since `closed_at` |
+| `charger` | zone id | the charger's hold by its one assigned `charge` task: `task_id` |
+| `service` | thing | a robot out of service, since `since` |
 
 An assigned task's item also keeps how its command fared, beside the task: `offers` (how
 often the schedule sent it again), `offered_at` (when last) and `acknowledged` (its robot
@@ -20,7 +22,10 @@ finished task leaves that partition, so the Query never reads the history.
 `assign` is one transaction of two conditional writes: the task's item is rewritten only
 if its `version` is the one read and it is still `queued`, and the robot's claim is
 created only if the robot has none. Either condition failing cancels both: two robots
-never take one task, one robot never takes two. Every other change is conditional on the
+never take one task, one robot never takes two. A `charge` task's `assign` adds a third:
+the charger's hold, created only if the charger has none, so two robots never take one
+charger, whichever invocations race for it; releasing or closing the task drops the hold
+in the same transaction. Every other change is conditional on the
 version read too, and is retried on a lost race a bounded number of times.
 """
 
@@ -44,6 +49,7 @@ CLIENT_CONFIG = Config(
     connect_timeout=2.0, read_timeout=3.0, retries={"mode": "standard", "total_max_attempts": 3}
 )
 OPEN, CLOSED, ROBOT, ZONE = "open", "closed", "robot", "zone"
+CHARGER, SERVICE = "charger", "service"
 # A change that lost a race to another writer reads the task again and decides anew; a
 # task is written by a handful of invocations at most, so a few rounds settle it.
 ATTEMPTS = 4
@@ -97,21 +103,14 @@ class TaskTable:
         if task is None or task.status != "queued":
             return None
         taken = task.assigned(thing, at=at)
+        writes = [
+            self._rewrite(taken, seen=task, status="queued"),
+            self._claim(ROBOT, thing, task_id),
+        ]
+        if task.kind == "charge":
+            writes.append(self._claim(CHARGER, task.zone, task_id))
         try:
-            self._transact(
-                self._rewrite(taken, seen=task, status="queued"),
-                {
-                    "Put": {
-                        "TableName": self._table,
-                        "Item": {
-                            "section": {"S": ROBOT},
-                            "id": {"S": thing},
-                            "task_id": {"S": task_id},
-                        },
-                        "ConditionExpression": "attribute_not_exists(id)",
-                    }
-                },
-            )
+            self._transact(*writes)
         except _Conflict:
             return None
         return taken
@@ -123,9 +122,7 @@ class TaskTable:
                 return None
             back = task.released()
             try:
-                self._transact(
-                    self._rewrite(back, seen=task), self._drop_claim(task.thing, task_id)
-                )
+                self._transact(self._rewrite(back, seen=task), *self._drop_claims(task))
             except _Conflict:
                 continue
             return back
@@ -206,23 +203,43 @@ class TaskTable:
 
     def holders(self) -> set[str]:
         """The robots holding a task now (their claims)."""
-        query: dict[str, Any] = {
-            "TableName": self._table,
-            "KeyConditionExpression": "#section = :robot",
-            "ExpressionAttributeNames": {"#section": "section"},
-            "ExpressionAttributeValues": {":robot": {"S": ROBOT}},
-            "ConsistentRead": True,
+        return set(self._keys(ROBOT, "the robots' claims"))
+
+    def chargers_held(self) -> dict[str, str]:
+        """Each charger held now, with the id of the charge task holding it."""
+        return {
+            item["id"]["S"]: item.get("task_id", {}).get("S", "")
+            for item in self._section(CHARGER, "the chargers' holds")
         }
-        things: set[str] = set()
-        while True:
-            try:
-                page = self._client.query(**query)
-            except (ClientError, BotoCoreError) as err:
-                raise StoreError(f"cannot read the robots' claims: {_message(err)}") from err
-            things.update(item["id"]["S"] for item in page.get("Items", []))
-            if "LastEvaluatedKey" not in page:
-                return things
-            query["ExclusiveStartKey"] = page["LastEvaluatedKey"]
+
+    # --- robots out of service ------------------------------------------------------------
+
+    def set_in_service(self, thing: str, in_service: bool, *, at: str) -> bool:
+        """Record `thing` in service or out of it (since `at`); False when it already was.
+        One conditional write: two invocations changing it at once change it once."""
+        key = {"section": {"S": SERVICE}, "id": {"S": thing}}
+        try:
+            if in_service:
+                answer = self._client.delete_item(
+                    TableName=self._table, Key=key, ReturnValues="ALL_OLD"
+                )
+                return "Attributes" in answer
+            self._client.put_item(
+                TableName=self._table,
+                Item={**key, "since": {"S": at}},
+                ConditionExpression="attribute_not_exists(id)",
+            )
+        except ClientError as err:
+            if _code(err) == "ConditionalCheckFailedException":
+                return False
+            raise StoreError(f"cannot record {thing}'s service: {_message(err)}") from err
+        except BotoCoreError as err:
+            raise StoreError(f"cannot record {thing}'s service: {err}") from err
+        return True
+
+    def out_of_service(self) -> list[str]:
+        """The robots out of service now, sorted."""
+        return sorted(self._keys(SERVICE, "the robots out of service"))
 
     def close_zone(self, zone: str, *, at: str) -> bool:
         try:
@@ -251,22 +268,30 @@ class TaskTable:
         return "Attributes" in answer
 
     def closed_zones(self) -> list[str]:
+        return sorted(self._keys(ZONE, "the closed zones"))
+
+    def _keys(self, section: str, what: str) -> list[str]:
+        return [item["id"]["S"] for item in self._section(section, what)]
+
+    def _section(self, section: str, what: str) -> list[dict[str, Any]]:
+        """Every item of one small section (claims, holds, zones, robots out of service),
+        strongly consistent, page after page."""
         query: dict[str, Any] = {
             "TableName": self._table,
-            "KeyConditionExpression": "#section = :zone",
+            "KeyConditionExpression": "#section = :section",
             "ExpressionAttributeNames": {"#section": "section"},
-            "ExpressionAttributeValues": {":zone": {"S": ZONE}},
+            "ExpressionAttributeValues": {":section": {"S": section}},
             "ConsistentRead": True,
         }
-        zones: list[str] = []
+        items: list[dict[str, Any]] = []
         while True:
             try:
                 page = self._client.query(**query)
             except (ClientError, BotoCoreError) as err:
-                raise StoreError(f"cannot read the closed zones: {_message(err)}") from err
-            zones.extend(item["id"]["S"] for item in page.get("Items", []))
+                raise StoreError(f"cannot read {what}: {_message(err)}") from err
+            items.extend(page.get("Items", []))
             if "LastEvaluatedKey" not in page:
-                return sorted(zones)
+                return items
             query["ExclusiveStartKey"] = page["LastEvaluatedKey"]
 
     # --- inside ---------------------------------------------------------------------------
@@ -300,12 +325,38 @@ class TaskTable:
             put["ExpressionAttributeNames"] = {"#status": "status"}
         return {"Put": put}
 
-    def _drop_claim(self, thing: str, task_id: str) -> dict[str, Any]:
+    def _claim(self, section: str, key: str, task_id: str) -> dict[str, Any]:
+        """Create a robot's or a charger's hold by `task_id`, only if it has none."""
+        return {
+            "Put": {
+                "TableName": self._table,
+                "Item": {"section": {"S": section}, "id": {"S": key}, "task_id": {"S": task_id}},
+                "ConditionExpression": "attribute_not_exists(id)",
+            }
+        }
+
+    def _drop_claims(self, task: Task) -> list[dict[str, Any]]:
+        """Drop the holds an assigned task has: its robot's and, a charge task, its
+        charger's."""
+        drops = []
+        if task.thing is not None:
+            drops.append(self._drop_claim(ROBOT, task.thing, task.id))
+        if task.kind == "charge":
+            # A charge task assigned before chargers were held has no hold to drop.
+            drops.append(self._drop_claim(CHARGER, task.zone, task.id, missing_ok=True))
+        return drops
+
+    def _drop_claim(
+        self, section: str, key: str, task_id: str, *, missing_ok: bool = False
+    ) -> dict[str, Any]:
+        condition = "task_id = :task"
+        if missing_ok:
+            condition = f"attribute_not_exists(id) OR {condition}"
         return {
             "Delete": {
                 "TableName": self._table,
-                "Key": {"section": {"S": ROBOT}, "id": {"S": thing}},
-                "ConditionExpression": "task_id = :task",
+                "Key": {"section": {"S": section}, "id": {"S": key}},
+                "ConditionExpression": condition,
                 "ExpressionAttributeValues": {":task": {"S": task_id}},
             }
         }
@@ -323,8 +374,8 @@ class TaskTable:
             },
             {"Put": {"TableName": self._table, "Item": self._task_item(CLOSED, ended)}},
         ]
-        if before.status == "assigned" and before.thing is not None:
-            writes.append(self._drop_claim(before.thing, before.id))
+        if before.status == "assigned":
+            writes.extend(self._drop_claims(before))
         self._transact(*writes)
 
     def _transact(self, *writes: dict[str, Any]) -> None:

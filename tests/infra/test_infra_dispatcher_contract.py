@@ -19,8 +19,10 @@ from tests.support.dispatch_meter import (
     ANNOUNCER,
     measure_dispatch,
     measure_lost_task,
+    measure_service_and_charge,
     measure_zone_change,
 )
+from tests.support.fleets import THREE_ROVERS
 from vahr.domain import load_fleet
 
 if TYPE_CHECKING:
@@ -114,3 +116,38 @@ def test_every_call_of_a_task_is_allowed_and_every_right_is_used(
         ("iot:Publish", f"{IOT}:topic/vahr/robots/{thing}/cmd")
         for thing in load_fleet().robot_things
     } | {("iot:Publish", f"{IOT}:topic/vahr/fleet/zones")}
+
+
+@pytest.mark.parametrize("fleet_file", [None, str(THREE_ROVERS)], ids=["bundled", "charger"])
+def test_robots_out_of_service_and_charging_need_no_new_right(
+    tmp_path: Path, credentials: None, fleet_file: str | None
+) -> None:
+    # Given the dispatcher's role as the stack synthesizes it for a fleet (one with a
+    # charger and batteries: its chargers are held in the task table)
+    stack = bare_stack(tmp_path)
+    tasks = TaskTable(stack, "Tasks", deletion_protection=False)
+    Dispatcher(
+        stack, "Dispatcher", config=InfraConfig(), fleet=load_fleet(fleet_file),
+        code=lambda_.Code.from_inline("def lambda_handler(e, c): pass"),
+        table=tasks.table, index_arn=INDEX, data_endpoint="x-ats.iot.us-east-1.amazonaws.com",
+    )  # fmt: skip
+    template = Template.from_stack(stack).to_json()
+    [table_id] = resources(template, "AWS::DynamoDB::Table")
+    [role_id] = [
+        f["Role"].strip("<>").split(".")[0]
+        for f in resources(template, "AWS::Lambda::Function").values()
+    ]
+    granted = {
+        (action, resource)
+        for effect, action, resource in role_grants(template, role_id)
+        if effect == "Allow"
+    }
+    # When the real handler takes a robot out of service and back, sends one to charge
+    # and ticks with a low robot idle
+    with mock_aws():
+        meter = measure_service_and_charge(fleet_file)
+    used: set[tuple[str, str]] = set()
+    for service, operation, params in meter.requests:
+        used |= needed(service, operation, params, f"<{table_id}.Arn>")
+    # Then each call is allowed by the rights it already had
+    assert used <= granted, sorted(used - granted)

@@ -159,7 +159,8 @@ def test_the_dispatcher_loads_from_the_same_bundle_and_answers_in_one_line(
         "status": 400,
         "body": {
             "code": 400,
-            "message": "operation: 'launch' is not one of submit, tasks, pending, cancel, zones, zone",
+            "message": "operation: 'launch' is not one of submit, tasks, pending, cancel, "
+            "zones, zone, service, set_service, charge",
         },
     }
     assert seen["loaded"] == ["vahr.dispatch"]

@@ -163,18 +163,21 @@ def measure_dispatch(robots: int) -> DispatchMeasure:
             table = TaskTable(
                 TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION))
             )
-            return Dispatcher(
+            core = Dispatcher(
                 fleet=fleet,
                 store=table,
                 candidates=FleetSearch(
                     client=meter.watch(boto3.client("iot", endpoint_url=server.url)),
                     holding=table.holders,
+                    usable=lambda robot: core.usable(robot),
+                    out_of_service=table.out_of_service,
                 ),
                 publish=CommandChannel(
                     client=meter.watch(boto3.client("iot-data", region_name=REGION))
                 ),
                 clock=lambda: now[0],
             )
+            return core
 
         answer = app.handle(
             {"operation": "submit", "order": {"kind": "deliver", "zone": "C"}},
@@ -266,4 +269,53 @@ def measure_lost_task() -> CallMeter:
         report(connected=False)
         now[0] += timedelta(minutes=1)
         assert app.handle(tick, core, None, tell)["lost"] == [task["id"]]
+    return meter
+
+
+def measure_service_and_charge(fleet_file: str | None = None) -> CallMeter:
+    """Through the function's runtime on `fleet_file` (default: the bundled fleet), with
+    every robot idle, full and connected: a task given, its robot taken out of service (the
+    task goes to another), listed, put back, sent to charge (refused without a charger
+    free), and a tick with a low robot idle. Call it inside `mock_aws()`."""
+    fleet = load_fleet(fleet_file)
+    store = ShadowStore(None)
+    shadows = ShadowService(store, publish=lambda _topic, _payload: None)
+    server = DataPlaneServer(DataPlane(shadows, publish=lambda *_: None, meter=Meter()), 0)
+
+    def report(thing: str, percent: int) -> None:
+        battery = {"percent": percent, "charging": False}
+        body = {"state": {"reported": {"status": "idle", "zone": fleet.zones[0].id,
+                                       "connected": True, "battery": battery}}}  # fmt: skip
+        store.update(thing, None, json.dumps(body).encode())
+
+    for thing in fleet.robot_things:
+        report(thing, 100)
+    create_task_table(boto3.client("dynamodb", region_name=REGION), TABLE)
+    meter = CallMeter()
+    with server:
+        table = TaskTable(TABLE, client=meter.watch(boto3.client("dynamodb", region_name=REGION)))
+        core = Dispatcher(
+            fleet=fleet,
+            store=table,
+            candidates=FleetSearch(
+                client=meter.watch(boto3.client("iot", endpoint_url=server.url)),
+                holding=table.holders,
+                out_of_service=table.out_of_service,
+            ),
+            publish=CommandChannel(
+                client=meter.watch(boto3.client("iot-data", region_name=REGION))
+            ),
+        )
+        first, second = fleet.robot_things[:2]
+        answer = app.handle({"operation": "submit", "order": {"zone": fleet.zones[0].id}}, core)
+        [task] = answer["body"]["assigned"]
+        out = app.handle({"operation": "set_service", "thing": task["thing"], "in_service": False}, core)  # fmt: skip
+        assert out["body"]["changed"] is True, out
+        assert app.handle({"operation": "service"}, core)["body"]["out_of_service"]
+        back = app.handle({"operation": "set_service", "thing": task["thing"], "in_service": True}, core)  # fmt: skip
+        assert back["body"]["changed"] is True, back
+        charged = app.handle({"operation": "charge", "thing": first}, core)
+        assert charged["status"] == (200 if fleet.chargers else 400), charged
+        report(second, 5)
+        app.handle(load_event("eventbridge_schedule"), core)
     return meter

@@ -451,6 +451,37 @@ class Dispatcher:
             raise DispatchError("no_charger", "every charger is taken or closed now")
         return None
 
+    def usable(self, robot: RobotState) -> bool:
+        """Whether the dispatcher would give `robot` a task at all now: in service and, when
+        batteries count, not so low that it must charge first (`EnergyRule.takes_tasks`).
+        A fleet search that stops at its first page holding a free robot reads past the
+        robots that are not (the dispatcher Lambda's)."""
+        if not robot.in_service:
+            return False
+        if not self.respect_battery or not self.fleet.batteries_drain:
+            return True
+        return EnergyRule(self.fleet, STRAIGHT).takes_tasks(robot)
+
+    def charge_low(self, robots: list[RobotState]) -> list[Task]:
+        """Send each of `robots` that is idle, in service, holds no task and is low
+        (`EnergyRule.wants_charge`) to charge, as `observe` does with a robot's report:
+        for a host that does not see every report (the dispatcher Lambda's schedule).
+        Returns the charge tasks given; a robot with no charger free now is left alone."""
+        energy = self._energy()
+        if energy is None:
+            return []
+        holding = {task.thing for task in self.store.active()}
+        given = []
+        for robot in robots:
+            if not (robot.idle and robot.in_service and energy.wants_charge(robot)):
+                continue
+            if robot.thing in holding:
+                continue
+            task = self.charge(robot.thing, state=robot)
+            if task is not None:
+                given.append(task)
+        return given
+
     def _free_chargers(self, thing: str, closed: frozenset[str]) -> list[Zone]:
         """The chargers no other robot holds (a `charge` task) or stands at, not closed."""
         held = {task.zone for task in self.store.active() if task.kind == "charge"}

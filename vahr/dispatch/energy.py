@@ -70,12 +70,21 @@ class EnergyRule:
 
     def can_do(self, robot: RobotState, metres: float, after: After) -> bool:
         """Whether `robot`, `metres` from the task's end by its way there, may take it."""
+        if not self.takes_tasks(robot):
+            return False
         battery = robot.battery
         if battery is None or not self.fleet.battery_rates(robot.thing).drains:
             return True
-        if battery.percent < self.plan.charge_below:
-            return False
         return battery.percent - self.needed(robot.thing, metres, after) >= self.plan.reserve
+
+    def takes_tasks(self, robot: RobotState) -> bool:
+        """Whether `robot` may take any task at all: not under the fleet's `charge_below`
+        (charging or not), or not planned by the rule. What a search for free robots reads
+        past (the dispatcher Lambda's fleet search)."""
+        battery = robot.battery
+        if battery is None or not self.fleet.battery_rates(robot.thing).drains:
+            return True
+        return battery.percent >= self.plan.charge_below
 
     def wants_charge(self, robot: RobotState) -> bool:
         """Under the fleet's threshold and not charging: it should go to a charger."""
