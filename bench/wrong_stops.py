@@ -13,6 +13,7 @@ action. Run: `.venv/bin/python bench/wrong_stops.py`.
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -79,6 +80,15 @@ def count(
 
 
 def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--voices",
+        nargs="+",
+        default=list(DEVELOPMENT_VOICES),
+        choices=DEVELOPMENT_VOICES,
+        help="the development voices to hear (default: all)",
+    )
+    voices = parser.parse_args().voices
     model = InteractionModel.load()
     read = Reader(model)
     recognizer = command_recognizer()
@@ -90,7 +100,7 @@ def main() -> int:
         for rule in (False, True)
     }
     clips_heard = 0
-    for voice in DEVELOPMENT_VOICES:
+    for voice in voices:
         clips = hear(recognizer, [(item, voice) for item in development_set.items()])
         seconds = {n: text for n, (text, _) in hear_again(whisper, clips).items()}
         clips_heard += len(clips)
@@ -107,7 +117,8 @@ def main() -> int:
     body = f"""
 {clips_heard} clips: {DEVELOPMENT_SET.name} ({len(development_set.items())} sentences, of
 which {sum(i.intent == STOP_INTENT for i in development_set.items())} stops, and its
-out-of-domain sentences) spoken by each development voice, decided with the station's
+out-of-domain sentences) spoken by {len(voices)} of the {len(DEVELOPMENT_VOICES)} development
+voices ({", ".join(voices)}), decided with the station's
 constants as it decides now (a stop either ear hears clearly is acted on; Whisper hears
 every clip pocketsphinx took for speech) and as it decided before, in the same run.
 
