@@ -110,25 +110,27 @@ def main() -> int:
                 totals[rule][key] += value
             rows.append(_row(f"{voice}, {'with' if rule else 'without'} the rule", counts))
     rows += [
-        _row(f"all voices, {'with' if rule else 'without'} the rule", totals[rule])
+        _row(f"together, {'with' if rule else 'without'} the rule", totals[rule])
         for rule in (False, True)
     ]
     table = "\n".join(rows)
+    requests = [i for i in development_set.items() if i.intent != FALLBACK_INTENT]
+    stops = sum(i.intent == STOP_INTENT for i in requests)
     body = f"""
-{clips_heard} clips: {DEVELOPMENT_SET.name} ({len(development_set.items())} sentences, of
-which {sum(i.intent == STOP_INTENT for i in development_set.items())} stops, and its
-out-of-domain sentences) spoken by {len(voices)} of the {len(DEVELOPMENT_VOICES)} development
-voices ({", ".join(voices)}), decided with the station's
-constants as it decides now (a stop either ear hears clearly is acted on; Whisper hears
-every clip pocketsphinx took for speech) and as it decided before, in the same run.
+{clips_heard} clips: the {len(requests)} requests ({stops} of them stops) and
+{len(development_set.items()) - len(requests)} out-of-domain sentences of
+{DEVELOPMENT_SET.name}, spoken by {len(voices)} of the {len(DEVELOPMENT_VOICES)} development
+voices ({", ".join(voices)}), decided with the station's constants as it decides now (a
+stop either ear hears clearly is acted on; Whisper hears every clip pocketsphinx took for
+speech) and as it decided before the rule, in the same run.
 
-| voice | stops said | acted on as a stop | stops acted on that nobody said | wrong actions |
+| voices | stops said | acted on as a stop | stops acted on that nobody said | wrong actions |
 | --- | ---: | ---: | ---: | ---: |
 {table}
 
-A wrong stop halts a robot nobody asked to halt (safe, but a task is interrupted); the
-rows without the rule are the decisions of "Push-to-talk: spoken requests understood",
-whose second-ear rows were measured before the rule.
+A wrong stop halts a robot nobody asked to halt (safe, but a task is interrupted). The
+second-ear rows of "Push-to-talk: spoken requests understood" were measured before the
+rule.
 """
     write_section("wrong_stops", "Push-to-talk: stops either ear hears", body)
     return 0
