@@ -208,7 +208,7 @@ def stop_heard(
     intent at the NLU's own confidence threshold, its robot (if named) heard as one value.
     A stop is the one request where acting is always safe, so a stop either ear hears
     clearly is acted on even when the other ear heard something else or nothing it
-    understood (docs/voice.md measures the wrong stops this costs). None otherwise."""
+    understood (`bench/wrong_stops.py` measures what it costs and gains). None otherwise."""
     read = reading or request_reader(model)
     understood = read(heard)
     if understood.intent != STOP_INTENT or understood.confidence < CONFIDENCE_THRESHOLD:
