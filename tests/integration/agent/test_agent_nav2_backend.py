@@ -192,7 +192,9 @@ async def test_a_goal_that_never_answers_fails_after_the_feedback_timeout(
         await executor.close()
     reason = "Nav2's 'navigate_to_pose' server said nothing about the goal to A for 1 s"
     assert rec.first("failed", "t1").reason == reason
-    assert 1 <= took < 4, (took, nav2_stand_in.log()[-6:], time.monotonic())
+    # Not before the timeout; the upper bound only says it did not hang (a loaded machine
+    # adds the cancel's round trip and the spin period to the timeout).
+    assert 1 <= took < 10, (took, nav2_stand_in.log()[-6:], time.monotonic())
     # and the mute goal was cancelled on the server, which still listens, before it failed
     nav2_stand_in.wait_for("cancel_requested", seen + 1, timeout_s=0)
 
