@@ -446,8 +446,9 @@ class Executor:
             # slack so that float steps of exactly a quarter still count as a quarter. The
             # start and the end of the way are never reported: nothing is done yet, or
             # `arrived`, with the pose, follows at once.
+            # Compared as reported (three decimals): 0.9996 would be reported as 1.0.
             if (
-                0 < fraction < 1
+                0 < round(fraction, 3) < 1
                 and now - last_report >= interval
                 and fraction - last_fraction >= step - 1e-9
             ):
