@@ -156,7 +156,34 @@ class IndexCandidates:
         return self._state(entry) if entry is not None and thing in self.robots else None
 
 
-class TasksApi:
+class _RecordedApi:
+    """A data-plane route whose changes a program asks for are recorded in the audit trail
+    (`record`), unless their sender recorded them itself (`_recorded_by_sender`).
+    Subclasses answer in `_respond` and make the record in `_entry`."""
+
+    # The methods that change something, and so are recorded.
+    RECORDED_METHODS: tuple[str, ...] = ("POST",)
+
+    def __init__(self, record: Callable[[AuditEntry], object] | None) -> None:
+        self._record = record
+
+    def respond(
+        self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
+    ) -> Answer:
+        answer = self._respond(method, path, body)
+        recorded = _recorded_by_sender(headers)
+        if self._record is not None and method in self.RECORDED_METHODS and not recorded:
+            self._record(self._entry(method, path, body, answer))
+        return answer
+
+    def _respond(self, method: str, path: str, body: bytes) -> Answer:
+        raise NotImplementedError
+
+    def _entry(self, method: str, path: str, body: bytes, answer: Answer) -> AuditEntry:
+        raise NotImplementedError
+
+
+class TasksApi(_RecordedApi):
     """`/vahr/tasks` on the data plane, in its typed-route form: (status, body, error type).
     `record`, when given, takes the trail's entry for each order and cancel;
     `out_of_service` says which robots are out of service, for the list."""
@@ -167,18 +194,14 @@ class TasksApi:
         record: Callable[[AuditEntry], object] | None = None,
         out_of_service: Callable[[], list[str]] | None = None,
     ) -> None:
+        super().__init__(record)
         self.dispatcher = dispatcher
-        self._record = record
         self._out_of_service = out_of_service
 
-    def respond(
-        self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
-    ) -> Answer:
-        answer = self._respond(method, path, body)
-        recorded = _recorded_by_sender(headers)
-        if self._record is not None and method in ("POST", "DELETE") and not recorded:
-            self._record(_api_entry(method, path, body, answer))
-        return answer
+    RECORDED_METHODS = ("POST", "DELETE")
+
+    def _entry(self, method: str, path: str, body: bytes, answer: Answer) -> AuditEntry:
+        return _api_entry(method, path, body, answer)
 
     def _respond(self, method: str, path: str, body: bytes) -> Answer:
         if path == TASKS_PATH:
@@ -217,24 +240,18 @@ class ZoneRequest(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     closed: bool
 
 
-class ZonesApi:
+class ZonesApi(_RecordedApi):
     """`/vahr/zones` on the data plane: the zones closed at run time. `record`, when given,
     takes the trail's entry for each change asked for."""
 
     def __init__(
         self, dispatcher: Dispatcher, record: Callable[[AuditEntry], object] | None = None
     ) -> None:
+        super().__init__(record)
         self.dispatcher = dispatcher
-        self._record = record
 
-    def respond(
-        self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
-    ) -> Answer:
-        answer = self._respond(method, path, body)
-        recorded = _recorded_by_sender(headers)
-        if self._record is not None and method == "POST" and not recorded:
-            self._record(_zone_entry(path, body, answer))
-        return answer
+    def _entry(self, method: str, path: str, body: bytes, answer: Answer) -> AuditEntry:
+        return _zone_entry(path, body, answer)
 
     def _respond(self, method: str, path: str, body: bytes) -> Answer:
         if path == ZONES_PATH:
@@ -267,7 +284,7 @@ class ServiceRequest(msgspec.Struct, frozen=True, forbid_unknown_fields=True):
     in_service: bool
 
 
-class RobotsApi:
+class RobotsApi(_RecordedApi):
     """`/vahr/service` and `/vahr/charge` on the data plane: robots out of service and back
     (`GET /vahr/service` answers `{"out_of_service": [things]}`, `POST /vahr/service/{thing}`
     with `{"in_service": true|false}` answers the `ServiceChange`) and a robot sent to charge
@@ -277,17 +294,11 @@ class RobotsApi:
     def __init__(
         self, host: LocalDispatcher, record: Callable[[AuditEntry], object] | None = None
     ) -> None:
+        super().__init__(record)
         self.host = host
-        self._record = record
 
-    def respond(
-        self, method: str, path: str, body: bytes, headers: Mapping[str, str] | None = None
-    ) -> Answer:
-        answer = self._respond(method, path, body)
-        recorded = _recorded_by_sender(headers)
-        if self._record is not None and method == "POST" and not recorded:
-            self._record(_robot_entry(path, body, answer))
-        return answer
+    def _entry(self, method: str, path: str, body: bytes, answer: Answer) -> AuditEntry:
+        return _robot_entry(path, body, answer)
 
     def _respond(self, method: str, path: str, body: bytes) -> Answer:
         if path == SERVICE_PATH:
