@@ -37,7 +37,7 @@ import json
 import threading
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rapidfuzz import fuzz, process
 
@@ -52,7 +52,10 @@ from vahr.domain import FLEET_GROUP
 from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.errors import VahrError
 from vahr.skill_model.intents import GROUP_TYPE, ROBOT_TYPE, ZONE_TYPE
-from vahr.speech.text_classifier import TextClassifier, default_cache_dir
+from vahr.speech.model_cache import default_cache_dir
+
+if TYPE_CHECKING:
+    from vahr.speech.text_classifier import TextClassifier
 
 __all__ = [
     "CONFIDENCE_THRESHOLD",

@@ -38,7 +38,6 @@ import hashlib
 import itertools
 import json
 import math
-import os
 import re
 from dataclasses import dataclass, replace
 from importlib.metadata import version
@@ -52,6 +51,7 @@ from vahr.domain.weather import plain_negations, weather_words
 from vahr.errors import VahrError
 from vahr.skill_model.intents import ROBOT_TYPE
 from vahr.skill_model.templates import expand
+from vahr.speech.model_cache import write_atomically
 
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
@@ -349,13 +349,7 @@ def load_or_train(
             pass
     model = _train(sequences)
     if file is not None:
-        try:
-            file.parent.mkdir(parents=True, exist_ok=True)
-            partial = file.with_suffix(f".{os.getpid()}.tmp")
-            partial.write_bytes(model)
-            partial.replace(file)
-        except OSError:
-            pass
+        write_atomically(file, model)
     return RolesTagger(intent, slot_types, model, lexicon), False
 
 

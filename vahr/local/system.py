@@ -142,6 +142,7 @@ class StartStation(Protocol):
         locale: str = "en-US",
         people: People | None = None,
         trail: SqliteTrail | None = None,
+        model_file: Path | None = None,
     ) -> ServedStation: ...
 
 
@@ -190,6 +191,7 @@ class LocalSystem:
         self._room_client: MqttClient | None = None
         self._station_client: MqttClient | None = None
         self.station: ServedStation | None = None
+        self._spoken_model: Path | None = None
         self._online: dict[str, bool] = {}
         self._changed = threading.Condition()
         self._restarts: dict[str, deque[float]] = {}
@@ -239,6 +241,8 @@ class LocalSystem:
             fleet_file = write_fleet(self.fleet, cfg.state_dir / "fleet.yaml")
             model_file = cfg.state_dir / "interaction-model.json"
             model_file.write_text(render(model), encoding="utf-8")
+            # Push-to-talk listens in English: the model just written when it is English's.
+            self._spoken_model = model_file if cfg.locale == SPOKEN_LOCALE else None
             self.stack.start()
             self.alexa = serve_alexa(
                 self.stack,
@@ -390,6 +394,7 @@ class LocalSystem:
             locale=self.config.locale,
             people=self.config.people,
             trail=self.stack.trail,
+            model_file=self._spoken_model,
         )
         self.stack.dataplane.redirects["/vahr/dashboard"] = self.station.url
 

@@ -45,7 +45,6 @@ import hashlib
 import io
 import itertools
 import json
-import os
 import pickle
 import shutil
 import signal
@@ -61,6 +60,7 @@ import msgspec
 
 from vahr.speech.audio import SAMPLE_RATE, SpeechDetector
 from vahr.speech.errors import SpeechError
+from vahr.speech.model_cache import write_atomically
 from vahr.speech.pronounce import guesses
 from vahr.speech.stt import (
     NOTHING_HEARD,
@@ -201,14 +201,8 @@ def _read_cached(file: Path, key: str) -> LanguageModel | None:
 
 
 def _write_cached(file: Path, key: str, model: LanguageModel) -> None:
-    try:
-        file.parent.mkdir(parents=True, exist_ok=True)
-        partial = file.with_suffix(f".{os.getpid()}.tmp")
-        partial.write_bytes(msgspec.json.encode(_CachedModel(key, _digest(model), model)))
-        partial.replace(file)
-    except OSError:
-        return
-    _forget_oldest(file.parent)
+    if write_atomically(file, msgspec.json.encode(_CachedModel(key, _digest(model), model))):
+        _forget_oldest(file.parent)
 
 
 def _forget_oldest(folder: Path) -> None:

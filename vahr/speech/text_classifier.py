@@ -25,14 +25,15 @@ import fcntl
 import hashlib
 import json
 import math
-import os
 from collections import Counter
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from vahr.speech.model_cache import write_atomically
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
+    from pathlib import Path
 
     Analyzer = Callable[[str], list[str]]
 
@@ -130,12 +131,6 @@ def training_key(recipe: str, texts: list[str], labels: list[str]) -> str:
     return digest.hexdigest()
 
 
-def default_cache_dir() -> Path:
-    """$XDG_CACHE_HOME/vahr (or ~/.cache/vahr): trained models, keyed by their data."""
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "vahr"
-
-
 def load_or_train(
     texts: list[str],
     labels: list[str],
@@ -163,13 +158,7 @@ def load_or_train(
         if cached is not None:
             return TextClassifier(cached, analyzer), True
         exported = _trained(texts, labels, analyzer, key)
-        try:
-            file.parent.mkdir(parents=True, exist_ok=True)
-            partial = file.with_suffix(f".{os.getpid()}.tmp")
-            partial.write_text(json.dumps(exported), encoding="utf-8")
-            partial.replace(file)
-        except OSError:
-            pass
+        write_atomically(file, json.dumps(exported).encode())
     return TextClassifier(exported, analyzer), False
 
 

@@ -140,13 +140,15 @@ def on_local_system(
     locale: str = "en-US",
     people: People | None = None,
     trail: StationTrail | None = None,
+    model_file: Path | None = None,
 ) -> Station:
     """`vahr up`'s station, started: on the stack's broker, the simulator in-process, shadows
     read from the store, every turn seen on the broker, the task queue from `tasks_url`, its
-    words and names in the stack's `locale`, `people` signing in, and the stack's audit
-    trail."""
+    words and names in the stack's `locale`, `people` signing in, the stack's audit trail,
+    and push-to-talk listening for the English interaction model in `model_file` (None:
+    generated from the fleet)."""
     return Station(
-        StationConfig(port=port, tasks_url=tasks_url, locale=locale),
+        StationConfig(port=port, tasks_url=tasks_url, locale=locale, model_file=model_file),
         fleet,
         link=link,
         assistant=assistant,

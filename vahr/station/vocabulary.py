@@ -20,6 +20,7 @@ only loads it.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import logging
 import re
@@ -27,10 +28,13 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
+import msgspec
+
 from vahr.assistant import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases, confirmation_phrases
 from vahr.domain.fleet import zone_phrase
 from vahr.domain.text import normalize, spell_numbers
 from vahr.errors import VahrError
+from vahr.speech.model_cache import write_atomically
 
 if TYPE_CHECKING:
     from vahr.domain import Fleet
@@ -51,6 +55,9 @@ _RULE_SLOTS = frozenset(RULE_SLOTS.values())
 MAX_COPIES = 100
 # Ways of leaving a session, which the simulator answers like Alexa does.
 EXITS = ("exit", "goodbye", "stop", "cancel")
+# How `sentences` writes a model out, beside the data in the cache key (the document, the
+# built-in and confirmation phrases, the exits, MAX_COPIES): change the code, change this.
+SENTENCES_RECIPE = "every value once per sample, shared past MAX_COPIES; numbers spelled"
 
 
 def _phrase(text: str) -> str:
@@ -143,11 +150,42 @@ def command_model(
     if model_file is None and fleet is not None:
         from vahr.skill_model.generator import build_interaction_model
 
-        found = sentences(build_interaction_model(fleet))
+        document = build_interaction_model(fleet)
     else:
-        found = sentences(load_model(model_file))
+        document = load_model(model_file)
+    found, listed = cached_sentences(document, cache_dir)
     model, cached = cached_language_model(found, cache_dir=cache_dir)
-    return CommandModel(found, model, cached, time.perf_counter() - started)
+    return CommandModel(found, model, listed and cached, time.perf_counter() - started)
+
+
+class _CachedSentences(msgspec.Struct, frozen=True):
+    """An interaction model's sentences as the cache keeps them, with their key."""
+
+    key: str
+    sentences: list[str]
+
+
+def cached_sentences(document: dict[str, Any], cache_dir: Path | None) -> tuple[list[str], bool]:
+    """`sentences(document)`, from the cache in `cache_dir` when it holds them (True) or
+    written out now and kept (False). Writing out a fleet's 185,000 sentences took most of
+    the station's start (3 s of CPU); the language model is then read from its own cache by
+    their hash. The key is everything they are made from."""
+    made_from = [
+        SENTENCES_RECIPE, MAX_COPIES, EXITS, built_in_phrases(), confirmation_phrases(), document
+    ]  # fmt: skip
+    digest = hashlib.sha256(json.dumps(made_from, sort_keys=True).encode()).hexdigest()
+    file = cache_dir / f"sentences-{digest[:24]}.json" if cache_dir else None
+    if file is not None:
+        try:
+            kept = msgspec.json.decode(file.read_bytes(), type=_CachedSentences)
+            if kept.key == digest:
+                return kept.sentences, True
+        except (OSError, msgspec.DecodeError):
+            pass  # not there yet, or damaged: written out again below
+    found = sentences(document)
+    if file is not None:
+        write_atomically(file, msgspec.json.encode(_CachedSentences(digest, found)))
+    return found, False
 
 
 def command_recognizer(
@@ -163,7 +201,7 @@ def command_recognizer(
     loaded here. The model is cached in `cache_dir` (default: the trained models' cache,
     `$XDG_CACHE_HOME/vahr`) unless `use_cache` is False."""
     from vahr.speech.lm_stt import LanguageModelRecognizer, in_child_process
-    from vahr.speech.text_classifier import default_cache_dir
+    from vahr.speech.model_cache import default_cache_dir
 
     cache = (cache_dir or default_cache_dir()) if use_cache else None
     started = time.perf_counter()

@@ -77,15 +77,26 @@ def test_a_second_start_reads_the_model_from_the_cache(model_file: Path, tmp_pat
     cache = tmp_path / "cache"
     first = command_model(model_file, None, cache)
     assert not first.cached
-    [file] = cache.iterdir()
-    written = file.stat().st_mtime_ns
+    # The sentences written out and their language model, each kept
+    written = {file.name: file.stat().st_mtime_ns for file in cache.iterdir()}
+    assert sorted(name.split("-")[0] for name in written) == ["language", "sentences"]
     second = command_model(model_file, None, cache)
     assert second.cached
-    assert second.model == first.model
-    assert file.stat().st_mtime_ns == written
-    # The station's own start, through the child process, finds it too.
+    assert (second.sentences, second.model) == (first.sentences, first.model)
+    # The station's own start, through the child process, finds them too, and nothing is
+    # written again
     assert command_recognizer(model_file, cache_dir=cache).model == first.model
-    assert list(cache.iterdir()) == [file]
+    assert {file.name: file.stat().st_mtime_ns for file in cache.iterdir()} == written
+
+
+def test_a_damaged_list_of_sentences_is_written_out_again(model_file: Path, tmp_path: Path) -> None:
+    cache = tmp_path / "cache"
+    first = command_model(model_file, None, cache)
+    [kept] = cache.glob("sentences-*.json")
+    kept.write_text("{not json")
+    again = command_model(model_file, None, cache)
+    assert again.sentences == first.sentences and not again.cached
+    assert command_model(model_file, None, cache).cached
 
 
 def test_without_the_cache_nothing_is_kept(model_file: Path, tmp_path: Path) -> None:
@@ -110,3 +121,17 @@ def test_a_warm_up_that_fails_says_why_and_the_first_press_tries_again(
     assert "the recognizer could not be built: cannot read the interaction model" in caplog.text
     with pytest.raises(VahrError, match="cannot read the interaction model"):
         talk.recognizer()
+
+
+def test_another_interaction_model_is_written_out_anew(model_file: Path, tmp_path: Path) -> None:
+    cache = tmp_path / "cache"
+    command_model(model_file, None, cache)
+    # Given the same model with a zone e, When it is loaded with the same cache
+    grown = json.loads(model_file.read_text())
+    zones = grown["interactionModel"]["languageModel"]["types"][1]["values"]
+    zones.append({"name": {"value": "zone e"}})
+    other = tmp_path / "grown.json"
+    other.write_text(json.dumps(grown), encoding="utf-8")
+    made = command_model(other, None, cache)
+    # Then its sentences are its own, not the cached ones
+    assert not made.cached and "send placebot two to zone e" in made.sentences

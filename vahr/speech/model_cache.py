@@ -1,0 +1,32 @@
+"""Where trained and built models are kept between runs, and how a file is put there.
+
+Every model (the intent classifier, the role taggers, the language models, the station's
+sentences) is kept under a hash of what it is made from, so a file is either the right one
+or not read at all. A file appears whole or not at all: several processes (the robots of
+`vahr up` on a first start) may write the same one at once.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+
+def default_cache_dir() -> Path:
+    """$XDG_CACHE_HOME/vahr (or ~/.cache/vahr): trained models, keyed by their data."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "vahr"
+
+
+def write_atomically(file: Path, data: bytes) -> bool:
+    """Write `data` to `file` through a file of this process's own, renamed into place;
+    False (and nothing left behind) when the cache cannot be written: it is skipped."""
+    partial = file.with_suffix(f".{os.getpid()}.tmp")
+    try:
+        file.parent.mkdir(parents=True, exist_ok=True)
+        partial.write_bytes(data)
+        partial.replace(file)
+    except OSError:
+        partial.unlink(missing_ok=True)
+        return False
+    return True
