@@ -15,11 +15,8 @@ GERMAN_MODEL = Path(DEFAULT_MODEL).with_name("de-DE.json")
 
 
 @pytest.fixture(scope="module")
-def german(tmp_path_factory: pytest.TempPathFactory) -> InteractionModel:
-    cache = tmp_path_factory.mktemp("cache")
-    return InteractionModel.load(
-        GERMAN_MODEL, cache_dir=cache, understanding=load_understanding("de-DE")
-    )
+def german() -> InteractionModel:
+    return InteractionModel.load(GERMAN_MODEL, understanding=load_understanding("de-DE"))
 
 
 def test_digits_are_read_in_the_locales_words() -> None:

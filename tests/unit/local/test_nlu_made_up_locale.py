@@ -12,41 +12,37 @@ samples (the test holds it).
 from __future__ import annotations
 
 import json
-from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import msgspec
 import pytest
 
+from tests.support.made_up_locale import (
+    LOCALE,
+    LOCALES,
+    made_up_document,
+    made_up_understanding,
+)
 from vahr.assistant.nlu import InteractionModel
 from vahr.assistant.understanding import load_understanding
-from vahr.domain.fleet import load_fleet
 from vahr.domain.invocation import FALLBACK_INTENT
-from vahr.domain.locale import Language, read_yaml
 from vahr.errors import VahrError
-from vahr.skill_model.generator import build_interaction_model
-from vahr.skill_model.locale_templates import locale_intents
 
-LOCALES = Path(__file__).resolve().parents[2] / "data" / "locales"
-LOCALE = "xx-XX"
+if TYPE_CHECKING:
+    from pathlib import Path
 
 
 @pytest.fixture(scope="module")
 def document() -> dict[str, Any]:
     """The locale's interaction model, generated as a shipped locale's is."""
-    language: Language = read_yaml(str(LOCALES / LOCALE / "language.yaml"), Language)
-    fleet = load_fleet(LOCALES / LOCALE / "fleet.yaml")
-    model = build_interaction_model(fleet, locale_intents(LOCALE, directory=LOCALES))
-    model["interactionModel"]["languageModel"]["invocationName"] = language.invocation_name
-    return model
+    return made_up_document()
 
 
 @pytest.fixture(scope="module")
 def model(document: dict[str, Any], tmp_path_factory: pytest.TempPathFactory) -> InteractionModel:
     file: Path = tmp_path_factory.mktemp("models") / f"{LOCALE}.json"
     file.write_text(json.dumps(document))
-    understanding = load_understanding(LOCALE, directory=LOCALES)
-    return InteractionModel.load(file, use_cache=False, understanding=understanding)
+    return InteractionModel.load(file, use_cache=False, understanding=made_up_understanding())
 
 
 def samples_of(document: dict[str, Any]) -> set[str]:
@@ -106,7 +102,7 @@ def test_a_locale_without_understanding_data_is_one_line() -> None:
 
 def test_a_role_example_naming_no_slot_is_one_line(document: dict[str, Any]) -> None:
     # Given the locale's data with a misspelt slot in a role example
-    understanding = load_understanding(LOCALE, directory=LOCALES)
+    understanding = made_up_understanding()
     typo = msgspec.structs.replace(understanding.roles[0], examples=["zub {robot} ka {zon}"])
     broken = msgspec.structs.replace(understanding, roles=[typo])
     # When the NLU is built from it, Then one line names the intent and the reference

@@ -25,9 +25,8 @@ if TYPE_CHECKING:
 
 
 @pytest.fixture(scope="module")
-def model(tmp_path_factory: pytest.TempPathFactory) -> InteractionModel:
-    cache = tmp_path_factory.mktemp("cache")
-    return InteractionModel.load(cache_dir=cache)
+def model() -> InteractionModel:
+    return InteractionModel.load()
 
 
 def ids(understood: Understanding) -> dict[str, str | None]:
@@ -89,17 +88,30 @@ def test_a_value_never_takes_another_types_slot(model: InteractionModel) -> None
         assert label.lstrip("+?").split("&")[0] in kinds[match.type] | {roles.NO_SLOT}
 
 
-def test_the_tagger_is_cached_by_its_data(tmp_path: Path) -> None:
-    understanding = load_understanding()
-    first = InteractionModel.load(cache_dir=tmp_path, understanding=understanding)
-    written = {path.name: path.stat().st_mtime_ns for path in tmp_path.glob("roles-*.crfsuite")}
-    # One model per intent with slots
-    assert len(written) == len([i for i, slots in first.intent_slots.items() if slots])
-    again = InteractionModel.load(cache_dir=tmp_path, understanding=understanding)
-    said = "have robot two deliver to zone d after robot one delivers to zone a"
-    assert ids(again.understand(said)) == ids(first.understand(said))
-    # Read from the cache, not trained and written again
-    assert {p.name: p.stat().st_mtime_ns for p in tmp_path.glob("roles-*.crfsuite")} == written
+def test_each_intent_with_slots_has_a_tagger(model: InteractionModel) -> None:
+    assert set(model._taggers) == {name for name, slots in model.intent_slots.items() if slots}
+
+
+def test_the_tagger_is_cached_by_its_data(model: InteractionModel, tmp_path: Path) -> None:
+    intent = "SequentialDeliveryIntent"
+    slots, sequences = model.intent_slots[intent], model.role_training[intent]
+
+    def load(data: list[roles.Sequence_]) -> tuple[roles.RolesTagger, bool]:
+        return roles.load_or_train(intent, slots, data, tmp_path, model.role_lexicon)
+
+    # Given an empty cache, the intent's tagger is trained and written
+    first, cached = load(sequences)
+    [file] = tmp_path.glob("roles-*.crfsuite")
+    written = file.stat().st_mtime_ns
+    assert not cached
+    # Then loaded again it is read from the cache, not trained and written again
+    again, cached = load(sequences)
+    assert cached and file.stat().st_mtime_ns == written
+    words, matches = model.find_slots("robot two to zone d after robot one to zone a")
+    assert again.labels(words, matches) == first.labels(words, matches)
+    # And other data is another tagger, in a file of its own
+    _, cached = load(sequences[1:])
+    assert not cached and len(list(tmp_path.glob("roles-*.crfsuite"))) == 2
 
 
 def test_nothing_understood_is_nothing_assigned(model: InteractionModel) -> None:

@@ -11,8 +11,8 @@ from vahr.assistant.nlu import ROLES_CONFIDENCE_THRESHOLD, InteractionModel
 
 
 @pytest.fixture(scope="module")
-def model(tmp_path_factory: pytest.TempPathFactory) -> InteractionModel:
-    return InteractionModel.load(cache_dir=tmp_path_factory.mktemp("cache"))
+def model() -> InteractionModel:
+    return InteractionModel.load()
 
 
 @pytest.mark.parametrize(

@@ -23,9 +23,8 @@ def roles_set() -> LabelledSet:
 
 
 @pytest.fixture(scope="module")
-def report(roles_set: LabelledSet, tmp_path_factory: pytest.TempPathFactory) -> Report:
-    cache = tmp_path_factory.mktemp("cache")
-    return evaluate(InteractionModel.load(cache_dir=cache), roles_set)
+def report(roles_set: LabelledSet) -> Report:
+    return evaluate(InteractionModel.load(), roles_set)
 
 
 def test_the_set_is_about_roles(roles_set: LabelledSet) -> None:
