@@ -109,13 +109,18 @@ def render(
     synthesizer_for: Callable[[str], Any],
     *,
     source: str = "",
+    voices_in_turn: bool = False,
 ) -> Manifest:
-    """Speak every sentence in every voice, clean and at each SNR, into `directory`."""
+    """Speak every sentence in every voice, clean and at each SNR, into `directory`; with
+    `voices_in_turn`, each sentence in one voice only, the voices taken in turn (a third of
+    the clips for three voices, every sentence, voice and condition among them)."""
     clips: list[Clip] = []
     conditions: list[float | None] = [None, *phrasings.snr_db]
-    for voice in phrasings.voices:
+    every = phrasings.sentences()
+    for turn, voice in enumerate(phrasings.voices):
         tts = synthesizer_for(voice)
-        for name, expected, text in phrasings.sentences():
+        sentences = every[turn :: len(phrasings.voices)] if voices_in_turn else every
+        for name, expected, text in sentences:
             clean: Audio = tts.synthesize(text)
             for snr in conditions:
                 condition = condition_name(snr)

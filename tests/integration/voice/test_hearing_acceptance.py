@@ -1,12 +1,14 @@
-"""Acceptance of the robot's hearing (issue 13) on the whole spoken evaluation set,
-`robot_agent/voice/data/hearing-eval.yaml`: 67 answers and 70 unrelated sentences in three
-espeak-ng voices, clean, at 20 dB and at 10 dB SNR (1,233 clips, rendered with the set's
-seed, so the same on every run; about two minutes here). `bench/hearing.py` scores the same set
-and times it.
+"""Acceptance of the robot's hearing (issue 13) on the spoken evaluation set,
+`robot_agent/voice/data/hearing-eval.yaml`: its 67 answers and 70 unrelated sentences, each in
+one of the set's three espeak-ng voices in turn, clean, at 20 dB and at 10 dB SNR (411 clips,
+rendered with the set's seed, so the same on every run). Hearing a clip takes about 0.4 s of
+CPU here, so the whole set (all three voices: 1,233 clips, eight minutes of CPU) is scored by
+`bench/hearing.py`, whose figures are in docs/benchmarks.md; this third keeps the suite
+within its time.
 
-The set was written blind and scored once (docs/voice.md, "How well it hears"). What it
-measured is kept as floors, so that nothing gets worse, beside the targets, which it meets
-(a target a set does not meet is held as a strict expected failure)."""
+The set was written blind and scored once (docs/voice.md, "How well it hears"). What this
+third measured is kept as floors, so that nothing gets worse, beside the targets, which it
+meets (a target a set does not meet is held as a strict expected failure)."""
 
 from __future__ import annotations
 
@@ -21,17 +23,16 @@ from vahr.speech.tts import EspeakSynthesizer
 if TYPE_CHECKING:
     from robot_agent.voice.hearing import Hearing
 
-# Rendering and hearing 1,233 clips takes three to four minutes on two cores (241 s alone,
-# with a benchmark beside it); beside the rest of the suite, three workers on two cores, it
-# took more than 600 s: the bound only guards against a hang.
-pytestmark = [pytest.mark.slow, pytest.mark.timeout(1500)]
+# Rendering and hearing 411 clips takes about three minutes of CPU (172 s); beside the rest
+# of the suite, three workers on two cores, it takes longer: the bound guards against a hang.
+pytestmark = [pytest.mark.slow, pytest.mark.timeout(900)]
 
 
 @pytest.fixture(scope="module")
 def report(hearing: Hearing, tmp_path_factory: pytest.TempPathFactory) -> Report:
-    # Given the evaluation set, rendered as `--make-eval-set` does
+    # Given the evaluation set, rendered as `--make-eval-set` does, each sentence in one voice
     directory = tmp_path_factory.mktemp("evaluation")
-    render(Phrasings.load(EVALUATION_SET), directory, EspeakSynthesizer)
+    render(Phrasings.load(EVALUATION_SET), directory, EspeakSynthesizer, voices_in_turn=True)
     # When the robot hears every clip
     return score(directory, hearing.hear, time.perf_counter)
 
@@ -44,10 +45,10 @@ def _answers_right(report: Report) -> dict[str, float]:
 
 
 def test_heard_answers_stay_at_the_measured_figures(report: Report) -> None:
-    # Then answers are right as measured (197, 194 and 185 of 201: 98.0% clean, 96.5% at
-    # 20 dB, 92.0% at 10 dB), and never taken for the other weather
+    # Then answers are right as measured (66, 64 and 62 of 67: 98.5% clean, 95.5% at 20 dB,
+    # 92.5% at 10 dB), and never taken for the other weather
     right = {c: report.answers(c).counts["right"] for c in CONDITIONS}
-    assert right["clean"] >= 197 and right["snr20"] >= 194 and right["snr10"] >= 185, right
+    assert right["clean"] >= 66 and right["snr20"] >= 64 and right["snr10"] >= 62, right
     assert all(report.answers(c).counts["wrong"] == 0 for c in CONDITIONS)
 
 
@@ -58,8 +59,8 @@ def test_heard_answers_meet_the_targets(report: Report) -> None:
 
 
 def test_unrelated_speech_stays_at_the_measured_figure(report: Report) -> None:
-    # Then unrelated speech is taken for an answer no more often than measured (11 of 630)
-    assert report.unrelated().counts["wrong"] <= 11, report.unrelated().to_json()
+    # Then unrelated speech is taken for an answer no more often than measured (2 of 210)
+    assert report.unrelated().counts["wrong"] <= 2, report.unrelated().to_json()
 
 
 def test_unrelated_speech_is_rarely_taken_for_an_answer(report: Report) -> None:

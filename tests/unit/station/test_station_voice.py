@@ -4,9 +4,11 @@ words are pronounced, and what the page is answered for speech, silence and nons
 from __future__ import annotations
 
 import io
+import itertools
 import subprocess
 import threading
 import wave
+from collections import Counter
 from typing import TYPE_CHECKING, Any
 
 import pytest
@@ -216,12 +218,18 @@ def test_a_thousand_robots_share_out_their_names_and_each_is_heard() -> None:
     # Not every sample written with each of the ~1,000 names (1.2 million sentences)...
     assert len(found) < 250_000
     # ...yet every robot's name is among them, in more than one context
-    heard = "\n".join(f" {sentence} " for sentence in found)
     language = document["interactionModel"]["languageModel"]
     [robots] = [t for t in language["types"] if t["name"] == "ROBOT"]
-    for value in robots["values"]:
-        name = spell_numbers(value["name"]["value"].lower())
-        assert heard.count(f" {name} ") >= 2, name
+    names = {spell_numbers(value["name"]["value"].lower()) for value in robots["values"]}
+    longest = max(len(name.split()) for name in names)
+    said: Counter[str] = Counter()
+    for sentence in found:
+        words = sentence.split()
+        for start, size in itertools.product(range(len(words)), range(1, longest + 1)):
+            phrase = " ".join(words[start : start + size])
+            if phrase in names:
+                said[phrase] += 1
+    assert all(said[name] >= 2 for name in names), sorted(n for n in names if said[n] < 2)
 
 
 class SecondEar:
