@@ -1,5 +1,5 @@
 """`cdk synth` as a user runs it: the pinned CLI, no AWS credentials, no network needed,
-the Lambda bundle built locally (no Docker), with and without the optional parts."""
+the Lambda bundle built locally (no Docker); a missing skill id and a bad flag refused in one line."""
 
 from __future__ import annotations
 
@@ -38,8 +38,10 @@ def cdk_synth(outdir: Path, *context: str) -> subprocess.CompletedProcess[str]:
     )  # fmt: skip
 
 
-# Three synths through the CLI (node and the Python app each time): about 100 s beside the
-# rest of the suite on two cores, more than the suite's default bound.
+# Three runs of the CLI (node and the Python app each time), one of them a whole synth: more
+# than the suite's default bound beside the rest of the suite on two cores. The optional
+# parts are synthesized in-process (test_infra_app.py); here a `-c` flag reaching the app is
+# shown by allowAnySkill.
 @pytest.mark.slow
 @pytest.mark.timeout(300)
 def test_cdk_synth_works_offline_without_credentials_with_and_without_options(
@@ -60,7 +62,6 @@ def test_cdk_synth_works_offline_without_credentials_with_and_without_options(
     # When the user accepts it by name
     lean = cdk_synth(outdir, "allowAnySkill=true")
     assert lean.returncode == 0, lean.stderr[-3000:]
-    lean_template = json.loads((outdir / "Vahr.template.json").read_text())
     # Then the skill's code was bundled locally from the one build script
     assets = json.loads((outdir / "Vahr.assets.json").read_text())["files"]
     bundles = [
@@ -77,19 +78,6 @@ def test_cdk_synth_works_offline_without_credentials_with_and_without_options(
     assert (nag["conclusion"], nag["violations"]) == ("success", [])
     # And the user is told, as a warning, that any skill may call the function for now
     assert "allowAnySkill=true: any Alexa skill may invoke this function" in lean.stderr
-
-    # When the optional parts are switched on from the command line
-    full = cdk_synth(outdir, "skill=true", "lex=true")
-    assert full.returncode == 0, full.stderr[-3000:]
-    full_template = json.loads((outdir / "Vahr.template.json").read_text())
-
-    # Then the skill, the bot and the role alias appear, and only then
-    def types(template: dict[str, object]) -> set[str]:
-        return {r["Type"] for r in template["Resources"].values()}  # type: ignore[attr-defined]
-
-    optional = {"Alexa::ASK::Skill", "AWS::Lex::Bot", "AWS::Lex::BotAlias", "AWS::IoT::RoleAlias"}
-    assert optional <= types(full_template)
-    assert not optional & types(lean_template)
 
     # And a bad flag is refused in one line, before anything is synthesized
     bad = cdk_synth(tmp_path / "bad", "architecture=mips")

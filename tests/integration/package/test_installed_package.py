@@ -3,7 +3,7 @@ an empty directory with no checkout in sight.
 
 `robot-agent run` must find its bundled fleet, and `vahr up` / `vahr say` the bundled
 interaction model and the skill, all from inside the installed package. Dependencies are
-installed at the pinned versions, so pip takes them from its cache after the first run.
+installed at the pinned versions by uv, which takes them from the cache `make setup` filled.
 """
 
 from __future__ import annotations
@@ -69,12 +69,14 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> Path:
     )  # fmt: skip
     [wheel] = wheels.glob("vahr-*.whl")
     venv = work / "venv"
-    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, timeout=120)
-    # Without byte-compiling every dependency at install (botocore's thousands of modules
-    # among them): a module is compiled when it is first imported, as pip would have done.
+    # With uv, as `make setup` installs (its cache already holds every pinned dependency), and
+    # without byte-compiling them (botocore's thousands of modules among them): a module is
+    # compiled when it is first imported, as it would be after pip's install.
+    uv = str(Path(sys.executable).with_name("uv"))
+    subprocess.run([uv, "venv", "-q", str(venv)], check=True, timeout=120)
     subprocess.run(
-        [str(venv / "bin" / "pip"), "install", "-q", "--disable-pip-version-check",
-         "--no-compile", "-c", str(ROOT / "requirements.txt"), str(wheel)],
+        [uv, "pip", "install", "-q", "--python", str(venv / "bin" / "python"),
+         "-c", str(ROOT / "requirements.txt"), str(wheel)],
         check=True, capture_output=True, timeout=INSTALL_TIMEOUT_S,
     )  # fmt: skip
     return venv / "bin"
