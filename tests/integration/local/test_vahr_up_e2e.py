@@ -3,14 +3,17 @@ simulator, and replies that reflect their acknowledgments."""
 
 from __future__ import annotations
 
+import http.client
 import json
 import signal
 import socket
 import subprocess
 import sys
+import time
 import urllib.request
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+from urllib.parse import urlsplit
 
 import pytest
 
@@ -91,6 +94,63 @@ def test_boto3_with_dummy_credentials_commands_a_robot(up: Up) -> None:
     # Then the robot drives there
     arrived = up.wait_event("boto3-1", "arrived")
     assert (arrived["event"], arrived["zone"]) == ("arrived", "C")
+
+
+def forge(api: str, path: str, body: dict[str, Any], headers: dict[str, str]) -> int:
+    """POST `body` to the data plane with `headers` as a web page's browser could send them
+    (Host included); the HTTP status it answers with."""
+    address = urlsplit(api)
+    connection = http.client.HTTPConnection(address.hostname, address.port, timeout=10)
+    try:
+        connection.putrequest("POST", path, skip_host="Host" in headers)
+        for name, value in headers.items():
+            connection.putheader(name, value)
+        payload = json.dumps(body).encode()
+        connection.putheader("Content-Length", str(len(payload)))
+        connection.endheaders(payload)
+        return connection.getresponse().status
+    finally:
+        connection.close()
+
+
+def test_what_a_web_page_can_send_moves_no_robot(up: Up) -> None:
+    api = up.endpoints["api"]
+    command = {"action": "navigate", "params": {"zone": "D"}, "source": "console",
+               "issued_at": "2026-01-01T00:00:00Z"}  # fmt: skip
+    topic = "/topics/vahr/robots/placebot1/cmd?qos=1"
+    # When a page sends commands as a browser can without asking first: a text/plain POST
+    # from a foreign origin, a POST marked cross-site, a name rebound to 127.0.0.1, and a
+    # desired command in the shadow
+    forged = {
+        "forged-origin": (topic, {"Content-Type": "text/plain", "Origin": "https://evil.example"}),
+        "forged-site": (topic, {"Content-Type": "application/json", "Sec-Fetch-Site": "cross-site"}),
+        "forged-host": (topic, {"Content-Type": "application/json", "Host": "evil.example"}),
+        "forged-plain": (topic, {"Content-Type": "text/plain"}),
+    }  # fmt: skip
+    statuses = {
+        name: forge(api, path, {**command, "id": name}, headers)
+        for name, (path, headers) in forged.items()
+    }
+    desired = {"state": {"desired": {"command": {**command, "id": "forged-shadow"}}}}
+    statuses["forged-shadow"] = forge(
+        api, "/things/placebot1/shadow", desired, {"Content-Type": "text/plain"}
+    )
+    # Then each is refused
+    assert statuses == {
+        "forged-origin": 403, "forged-site": 403, "forged-host": 421, "forged-plain": 415,
+        "forged-shadow": 415,
+    }  # fmt: skip
+    # And nothing reached the robot: a command sent as the repository's clients send it
+    # (JSON, no page's headers) is the first it acknowledges
+    marker = {**command, "id": "after-the-forgeries", "params": {"zone": "A"}}
+    assert forge(api, topic, marker, {"Content-Type": "application/json"}) == 200
+    seen: list[dict[str, Any]] = []
+    deadline = time.monotonic() + 20
+    while not any(line.get("command_id") == marker["id"] for line in seen):
+        seen.append(up.lines.get(timeout=max(0.01, deadline - time.monotonic())))
+    assert not [line for line in seen if str(line.get("command_id", "")).startswith("forged")]
+    shadow = json.loads(urllib.request.urlopen(f"{api}/things/placebot1/shadow", timeout=10).read())
+    assert "forged" not in json.dumps(shadow)
 
 
 def test_the_old_dashboard_leads_to_the_station_and_status_shows_the_robots(up: Up) -> None:
