@@ -30,8 +30,8 @@ from typing import TYPE_CHECKING
 
 from robot_agent.voice.answers import read_yaml
 from vahr.domain.text import normalize
+from vahr.model_cache import default_cache_dir
 from vahr.speech.errors import SpeechError
-from vahr.speech.model_cache import default_cache_dir
 from vahr.speech.text_classifier import load_or_train, ngram_features
 
 if TYPE_CHECKING:

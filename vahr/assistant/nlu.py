@@ -51,8 +51,8 @@ from vahr.assistant.understanding import LanguageUnderstanding, load_understandi
 from vahr.domain import FLEET_GROUP
 from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.errors import VahrError
+from vahr.model_cache import default_cache_dir
 from vahr.skill_model.intents import GROUP_TYPE, ROBOT_TYPE, ZONE_TYPE
-from vahr.speech.model_cache import default_cache_dir
 
 if TYPE_CHECKING:
     from vahr.speech.text_classifier import TextClassifier

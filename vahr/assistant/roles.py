@@ -49,9 +49,9 @@ from vahr.domain import FLEET_GROUP
 from vahr.domain.locale import LocaleError
 from vahr.domain.weather import plain_negations, weather_words
 from vahr.errors import VahrError
+from vahr.model_cache import write_atomically
 from vahr.skill_model.intents import ROBOT_TYPE
 from vahr.skill_model.templates import expand
-from vahr.speech.model_cache import write_atomically
 
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence

@@ -11,11 +11,16 @@ that breaks this.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import random
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cache, cached_property
+from pathlib import Path
 
 from vahr.domain.invocation import FALLBACK_INTENT
+from vahr.model_cache import default_cache_dir, write_atomically
+from vahr.skill_model import templates
 from vahr.skill_model.phrases import RULES
 from vahr.skill_model.templates import draw
 
@@ -79,8 +84,25 @@ class IntentSpec:
 
         Each template's sentences are drawn and shuffled with a seed made of the intent's
         name, so the choice is varied (not the first words of every alternative) and the
-        same on every run.
+        same on every run. Drawing every intent's takes a second of CPU at each start of
+        `vahr up`; they depend on nothing but this spec, the shared phrases and the code
+        that draws them, so they are kept in the model cache under a hash of those.
         """
+        made_from = [_drawing_code(), self.name, self.templates, self.essentials,
+                     self.max_samples, MAX_SAMPLES_PER_INTENT, RULES]  # fmt: skip
+        key = hashlib.sha256(json.dumps(made_from).encode()).hexdigest()
+        file = default_cache_dir() / f"samples-{self.name}-{key[:24]}.json"
+        try:
+            kept = json.loads(file.read_bytes())
+            if kept["key"] == key:
+                return list(kept["samples"])
+        except (OSError, ValueError, KeyError, TypeError):
+            pass  # not drawn yet here, or damaged: drawn again
+        drawn = self._drawn()
+        write_atomically(file, json.dumps({"key": key, "samples": drawn}).encode())
+        return drawn
+
+    def _drawn(self) -> list[str]:
         rng = random.Random(f"{self.name}:samples")
         pools: list[list[str]] = []
         for template in self.templates:
@@ -93,6 +115,16 @@ class IntentSpec:
                 if pool and len(chosen) < self.max_samples:
                     chosen.setdefault(pool.pop(), None)
         return list(chosen)
+
+
+@cache
+def _drawing_code() -> str:
+    """A hash of the modules that draw samples (this one and the templates'), so that a
+    change to how they are drawn draws them anew."""
+    code = hashlib.sha256()
+    for module in (__file__, templates.__file__):
+        code.update(Path(module).read_bytes())
+    return code.hexdigest()
 
 
 ROBOT = SlotSpec("robot", ROBOT_TYPE)

@@ -58,9 +58,9 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import msgspec
 
+from vahr.model_cache import write_atomically
 from vahr.speech.audio import SAMPLE_RATE, SpeechDetector
 from vahr.speech.errors import SpeechError
-from vahr.speech.model_cache import write_atomically
 from vahr.speech.pronounce import guesses
 from vahr.speech.stt import (
     NOTHING_HEARD,

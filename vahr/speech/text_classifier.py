@@ -29,7 +29,7 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from vahr.speech.model_cache import write_atomically
+from vahr.model_cache import write_atomically
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator

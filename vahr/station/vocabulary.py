@@ -34,7 +34,7 @@ from vahr.assistant import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases, confirma
 from vahr.domain.fleet import zone_phrase
 from vahr.domain.text import normalize, spell_numbers
 from vahr.errors import VahrError
-from vahr.speech.model_cache import write_atomically
+from vahr.model_cache import write_atomically
 
 if TYPE_CHECKING:
     from vahr.domain import Fleet
@@ -200,8 +200,8 @@ def command_recognizer(
     Its sentences and language model are made in a child process, only the decoder is
     loaded here. The model is cached in `cache_dir` (default: the trained models' cache,
     `$XDG_CACHE_HOME/vahr`) unless `use_cache` is False."""
+    from vahr.model_cache import default_cache_dir
     from vahr.speech.lm_stt import LanguageModelRecognizer, in_child_process
-    from vahr.speech.model_cache import default_cache_dir
 
     cache = (cache_dir or default_cache_dir()) if use_cache else None
     started = time.perf_counter()

@@ -119,3 +119,25 @@ def test_the_generator_refuses_too_many_sample_characters(fleet: Fleet) -> None:
     )
     with pytest.raises(ModelError, match="sample utterances exceed"):
         build_interaction_model(fleet, wordy)
+
+
+def test_drawn_samples_are_kept_and_read_back_by_their_spec(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+
+    def spec(*templates: str) -> IntentSpec:
+        return IntentSpec("KeptIntent", (SlotSpec("zone", "ZONE"),), templates)
+
+    # Given a spec's samples drawn once
+    drawn = spec("(go|drive|head) [now] to {zone}").samples
+    [kept] = (tmp_path / "vahr").glob("samples-KeptIntent-*.json")
+    # Then another spec the same reads them from the cache, not drawing them again
+    document = json.loads(kept.read_text())
+    kept.write_text(json.dumps({**document, "samples": ["read from the cache {zone}"]}))
+    assert spec("(go|drive|head) [now] to {zone}").samples == ["read from the cache {zone}"]
+    # And a spec with another template draws its own
+    assert "go to {zone}" not in spec("(walk|run) to {zone}").samples
+    # And a damaged file is drawn again, as at first
+    kept.write_text("{not json")
+    assert spec("(go|drive|head) [now] to {zone}").samples == drawn
