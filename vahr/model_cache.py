@@ -8,6 +8,7 @@ or not read at all. A file appears whole or not at all: several processes (the r
 
 from __future__ import annotations
 
+import contextlib
 import os
 from pathlib import Path
 
@@ -27,6 +28,7 @@ def write_atomically(file: Path, data: bytes) -> bool:
         partial.write_bytes(data)
         partial.replace(file)
     except OSError:
-        partial.unlink(missing_ok=True)
+        with contextlib.suppress(OSError):  # the folder itself may be what failed
+            partial.unlink(missing_ok=True)
         return False
     return True
