@@ -9,7 +9,10 @@ or not read at all. A file appears whole or not at all: several processes (the r
 from __future__ import annotations
 
 import contextlib
+import hashlib
+import importlib
 import os
+from functools import cache
 from pathlib import Path
 
 
@@ -17,6 +20,16 @@ def default_cache_dir() -> Path:
     """$XDG_CACHE_HOME/vahr (or ~/.cache/vahr): trained models, keyed by their data."""
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "vahr"
+
+
+@cache
+def code_digest(*modules: str) -> str:
+    """A hash of the source of the modules named: what the code that makes a model adds to
+    its key, so that a change to how it is made makes it anew."""
+    code = hashlib.sha256()
+    for name in modules:
+        code.update(Path(str(importlib.import_module(name).__file__)).read_bytes())
+    return code.hexdigest()
 
 
 def write_atomically(file: Path, data: bytes) -> bool:

@@ -15,11 +15,10 @@ import hashlib
 import json
 import random
 from dataclasses import dataclass
-from functools import cache, cached_property
-from pathlib import Path
+from functools import cached_property
 
 from vahr.domain.invocation import FALLBACK_INTENT
-from vahr.model_cache import default_cache_dir, write_atomically
+from vahr.model_cache import code_digest, default_cache_dir, write_atomically
 from vahr.skill_model import templates
 from vahr.skill_model.phrases import RULES
 from vahr.skill_model.templates import draw
@@ -88,8 +87,9 @@ class IntentSpec:
         `vahr up`; they depend on nothing but this spec, the shared phrases and the code
         that draws them, so they are kept in the model cache under a hash of those.
         """
-        made_from = [_drawing_code(), self.name, self.templates, self.essentials,
-                     self.max_samples, MAX_SAMPLES_PER_INTENT, RULES]  # fmt: skip
+        drawing = code_digest(__name__, templates.__name__)
+        made_from = [drawing, self.name, self.templates, self.essentials, self.max_samples,
+                     MAX_SAMPLES_PER_INTENT, RULES]  # fmt: skip
         key = hashlib.sha256(json.dumps(made_from).encode()).hexdigest()
         file = default_cache_dir() / f"samples-{self.name}-{key[:24]}.json"
         try:
@@ -115,16 +115,6 @@ class IntentSpec:
                 if pool and len(chosen) < self.max_samples:
                     chosen.setdefault(pool.pop(), None)
         return list(chosen)
-
-
-@cache
-def _drawing_code() -> str:
-    """A hash of the modules that draw samples (this one and the templates'), so that a
-    change to how they are drawn draws them anew."""
-    code = hashlib.sha256()
-    for module in (__file__, templates.__file__):
-        code.update(Path(module).read_bytes())
-    return code.hexdigest()
 
 
 ROBOT = SlotSpec("robot", ROBOT_TYPE)

@@ -34,7 +34,7 @@ from vahr.assistant import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases, confirma
 from vahr.domain.fleet import zone_phrase
 from vahr.domain.text import normalize, spell_numbers
 from vahr.errors import VahrError
-from vahr.model_cache import write_atomically
+from vahr.model_cache import code_digest, write_atomically
 
 if TYPE_CHECKING:
     from vahr.domain import Fleet
@@ -55,9 +55,6 @@ _RULE_SLOTS = frozenset(RULE_SLOTS.values())
 MAX_COPIES = 100
 # Ways of leaving a session, which the simulator answers like Alexa does.
 EXITS = ("exit", "goodbye", "stop", "cancel")
-# How `sentences` writes a model out, beside the data in the cache key (the document, the
-# built-in and confirmation phrases, the exits, MAX_COPIES): change the code, change this.
-SENTENCES_RECIPE = "every value once per sample, shared past MAX_COPIES; numbers spelled"
 
 
 def _phrase(text: str) -> str:
@@ -169,9 +166,11 @@ def cached_sentences(document: dict[str, Any], cache_dir: Path | None) -> tuple[
     """`sentences(document)`, from the cache in `cache_dir` when it holds them (True) or
     written out now and kept (False). Writing out a fleet's 185,000 sentences took most of
     the station's start (3 s of CPU); the language model is then read from its own cache by
-    their hash. The key is everything they are made from."""
+    their hash. The key is everything they are made from: the document, the phrases added
+    to it, and the code that writes them out (this module's and the text's)."""
     made_from = [
-        SENTENCES_RECIPE, MAX_COPIES, EXITS, built_in_phrases(), confirmation_phrases(), document
+        code_digest(__name__, "vahr.domain.text"), built_in_phrases(), confirmation_phrases(),
+        document,
     ]  # fmt: skip
     digest = hashlib.sha256(json.dumps(made_from, sort_keys=True).encode()).hexdigest()
     file = cache_dir / f"sentences-{digest[:24]}.json" if cache_dir else None

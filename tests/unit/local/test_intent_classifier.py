@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections import Counter
+
 import pytest
 
 from vahr.assistant.intent_classifier import features, fit
@@ -18,8 +20,16 @@ def training() -> tuple[list[str], list[str]]:
 
 
 def test_the_export_gives_sklearns_probabilities(training: tuple[list[str], list[str]]) -> None:
-    # Given the pipeline fitted on the generated samples and its plain-number export
-    texts, labels = training
+    # Given the pipeline fitted on every third generated sample of the larger intents (the
+    # export does not depend on how much it learnt from, and the whole fit takes ten
+    # seconds), and its plain-number export
+    counts = Counter(training[1])
+    kept = [
+        (text, label)
+        for n, (text, label) in enumerate(zip(*training, strict=True))
+        if counts[label] <= 30 or n % 3 == 0
+    ]
+    texts, labels = [text for text, _ in kept], [label for _, label in kept]
     pipeline = fit(texts, labels)
     exported = TextClassifier(export(pipeline), features)
     # When both score utterances seen and unseen in training
