@@ -44,7 +44,7 @@ def cdk_synth(outdir: Path, *context: str) -> subprocess.CompletedProcess[str]:
 # shown by allowAnySkill.
 @pytest.mark.slow
 @pytest.mark.timeout(300)
-def test_cdk_synth_works_offline_without_credentials_with_and_without_options(
+def test_cdk_synth_works_offline_without_credentials_and_refuses_in_one_line(
     tmp_path: Path,
 ) -> None:
     assert CDK_CLI.is_file(), "run `make setup` (npm ci) to install the pinned CDK CLI"
