@@ -6,7 +6,8 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 # pytest's workers. Three on two cores: much of the suite waits on brokers, stacks and
-# browsers, and a third worker fills that time (8.5 minutes against 10).
+# browsers, and a third worker fills that time (with three, 1.7 of the 2 cores are busy on
+# average over the suite).
 WORKERS ?= 3
 # Debian packages the project runs: the MQTT broker, speech (sphinxtrain's tools remake the
 # hearing's acoustic adaptation), ROS 1 for the ros1 backend, chromium for the operator
