@@ -8,7 +8,8 @@ for the operator station. An EventBridge schedule also invokes it once a minute 
 "aws.events"`): nothing happened, but time passed, so what the rate limit held back is told
 without waiting for the next robot event. The dispatcher function invokes it (asynchronously)
 with `{"lost_task": ...}` (`vahr.protocol.lost_tasks.LostTask`) for a fleet task it could
-not see through, told as a `cancelled` announcement. A malformed message is logged and skipped
+not see through, told as a `cancelled` announcement, and with `{"gone_to_charge": ...}` for a
+robot it sent to charge by itself, told as `battery_low`. A malformed message is logged and skipped
 (retrying cannot mend it); a failure to deliver raises `AnnouncerError`, so Lambda retries
 the event and then dead-letters it. The state is written only when it changed.
 """
@@ -28,6 +29,7 @@ from announcer.errors import AnnouncerError, DeliveryFailed, StateConflict
 from announcer.proactive_events import ProactiveEvents
 from vahr.announce import (
     AnnouncePolicy,
+    LowBattery,
     TaskCancelled,
     signals_from_event,
     signals_from_presence,
@@ -35,7 +37,12 @@ from vahr.announce import (
 from vahr.announce.speech import Names
 from vahr.domain import load_fleet
 from vahr.protocol import Event, Presence, ProtocolError
-from vahr.protocol.lost_tasks import LOST_TASK_KEY, lost_task_from
+from vahr.protocol.lost_tasks import (
+    GONE_TO_CHARGE_KEY,
+    LOST_TASK_KEY,
+    gone_to_charge_from,
+    lost_task_from,
+)
 
 if TYPE_CHECKING:
     from vahr.announce import Signal
@@ -103,6 +110,13 @@ def signals_of(message: dict[str, Any]) -> list[Signal]:
             log.warning("ignoring a malformed lost task: %s", err)
             return []
         return [TaskCancelled(lost.task, lost.thing, lost.kind, lost.zone, lost.at, lost.why)]
+    if GONE_TO_CHARGE_KEY in message:
+        try:
+            gone = gone_to_charge_from(message[GONE_TO_CHARGE_KEY])
+        except ProtocolError as err:
+            log.warning("ignoring a malformed robot gone to charge: %s", err)
+            return []
+        return [LowBattery(gone.thing, gone.at, zone=gone.zone)]
     sender = message.get("sender")
     try:
         if "online" in message:

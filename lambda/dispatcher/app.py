@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
-from dispatcher.announcer_channel import AnnouncerChannel
+from dispatcher.announcer_channel import AnnouncerChannel, gone_to_charge
 from dispatcher.command_channel import CommandChannel
 from dispatcher.config import DispatcherConfig
 from dispatcher.errors import BadRequest, ConfigError, DispatcherError
@@ -53,11 +53,12 @@ from vahr.dispatch.grid_routes import DistancesError, floor_routes
 from vahr.dispatch.records import task_given
 from vahr.domain import load_fleet
 from vahr.protocol.errors import ProtocolError, from_validation_error
+from vahr.protocol.lost_tasks import LostTask
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from vahr.protocol.lost_tasks import LostTask
+    from vahr.protocol.lost_tasks import Tidings
 
 log = logging.getLogger("dispatcher")
 
@@ -104,18 +105,20 @@ def trail() -> TrailTable | None:
 
 
 @cache
-def announcer() -> Callable[[LostTask], None]:
-    """Where lost tasks are told: the announcer function, or only the log without one."""
+def announcer() -> Callable[[Tidings], None]:
+    """Where lost tasks and robots gone to charge are told: the announcer function, or
+    only the log without one."""
     function = DispatcherConfig.from_env().announcer_function
     return AnnouncerChannel(function) if function else _logged_only
 
 
-def _logged_only(lost: LostTask) -> None:
-    log.warning(
-        "task %s lost (%s) is not announced: no announcer function (VAHR_ANNOUNCER_FUNCTION)",
-        lost.task,
-        lost.why,
+def _logged_only(tidings: Tidings) -> None:
+    what = (
+        f"task {tidings.task} lost ({tidings.why})"
+        if isinstance(tidings, LostTask)
+        else f"{tidings.thing} gone to charge"
     )
+    log.warning("%s is not announced: no announcer function (VAHR_ANNOUNCER_FUNCTION)", what)
 
 
 def lambda_handler(event: dict[str, Any], context: object) -> dict[str, Any]:
@@ -133,7 +136,7 @@ def handle(
     event: dict[str, Any],
     dispatcher: Dispatcher,
     trail: TrailTable | None = None,
-    tell: Callable[[LostTask], None] = _logged_only,
+    tell: Callable[[Tidings], None] = _logged_only,
 ) -> dict[str, Any]:
     """One invocation: a robot's update (from the rule), the schedule's tick, or a skill's
     request. What the dispatcher does by itself (a queued task given to a robot) goes to
@@ -157,7 +160,7 @@ def on_robot_update(
     event: dict[str, Any],
     dispatcher: Dispatcher,
     trail: TrailTable | None = None,
-    tell: Callable[[LostTask], None] = _logged_only,
+    tell: Callable[[Tidings], None] = _logged_only,
 ) -> dict[str, Any]:
     """A robot's update the rule selected: it may have finished its task and be free."""
     try:
@@ -172,18 +175,19 @@ def on_robot_update(
         return {"took": None}
     if isinstance(dispatcher.candidates, FleetSearch):
         state = dispatcher.candidates.in_service(state)
-    taken = robot_freed(dispatcher, state, now=datetime.now(UTC), tell=tell)
+    now = datetime.now(UTC)
+    taken = robot_freed(dispatcher, state, now=now, tell=tell)
     if taken is not None:
-        log.info("task %s (%s to %s) given to %s", taken.id, taken.kind, taken.zone, taken.thing)
-        if trail is not None:
-            trail.record(task_given(taken))
+        _given([taken], trail)
+        if taken.kind == "charge":  # low, it left its work: told, as the local stack tells it
+            tell(gone_to_charge(taken, now))
     return {"took": taken.id if taken is not None else None}
 
 
 def on_tick(
     dispatcher: Dispatcher,
     trail: TrailTable | None = None,
-    tell: Callable[[LostTask], None] = _logged_only,
+    tell: Callable[[Tidings], None] = _logged_only,
 ) -> dict[str, Any]:
     """Once a minute: assigned tasks whose robot never acknowledged them are offered again
     or, when they cannot be carried out any more, told as lost (`reoffer`); then queued
@@ -207,6 +211,8 @@ def on_tick(
     if dispatcher.respect_battery and dispatcher.fleet.batteries_drain:
         charging = dispatcher.charge_low(search.idle())
     _given(given + charging, trail)
+    for task in charging:
+        tell(gone_to_charge(task, dispatcher.clock()))
     return {
         "given": [task.id for task in given],
         "offered_again": watch.offered_again,

@@ -1,7 +1,9 @@
-"""A fleet task the dispatcher could not see through, as it tells the announcer.
+"""What the dispatcher tells the announcer: a fleet task it could not see through, and a
+robot it sent to charge by itself.
 
-The dispatcher function invokes the announcer function with `{"lost_task": LostTask}`; the
-local stack calls its announcer in-process with the same facts. `why` says what happened:
+The dispatcher function invokes the announcer function with `{"lost_task": LostTask}` or
+`{"gone_to_charge": GoneToCharge}`; the local stack calls its announcer in-process with the
+same facts. A lost task's `why` says what happened:
 
 | why | what happened |
 | --- | --- |
@@ -12,12 +14,14 @@ local stack calls its announcer in-process with the same facts. `why` says what 
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Literal, TypeVar
 
 import msgspec
 
 from vahr.protocol.errors import from_validation_error
 from vahr.protocol.messages import Timestamp  # noqa: TC001 - msgspec reads it at run time
+
+_T = TypeVar("_T")
 
 LostWhy = Literal["preempted", "offline", "unacknowledged"]
 LOST_WHYS: tuple[LostWhy, ...] = ("preempted", "offline", "unacknowledged")
@@ -37,9 +41,36 @@ class LostTask(msgspec.Struct, frozen=True, kw_only=True):
     why: LostWhy
 
 
+# The key of the announcer's invocation payload that holds a `GoneToCharge`.
+GONE_TO_CHARGE_KEY = "gone_to_charge"
+
+
+class GoneToCharge(msgspec.Struct, frozen=True, kw_only=True):
+    """Robot `thing`, low on charge, was sent by the dispatcher to the charger `zone` at
+    `at`: it leaves the pool until it is charged."""
+
+    thing: str
+    zone: str
+    at: Timestamp
+
+
+# What the dispatcher tells the announcer.
+Tidings = LostTask | GoneToCharge
+
+
 def lost_task_from(value: object) -> LostTask:
     """Validate a lost task from JSON-like data; raises ProtocolError naming the field."""
+    return _converted(value, LostTask)
+
+
+def gone_to_charge_from(value: object) -> GoneToCharge:
+    """Validate a robot gone to charge from JSON-like data; raises ProtocolError naming
+    the field."""
+    return _converted(value, GoneToCharge)
+
+
+def _converted(value: object, kind: type[_T]) -> _T:
     try:
-        return msgspec.convert(value, LostTask, strict=False)
+        return msgspec.convert(value, kind, strict=False)
     except msgspec.ValidationError as err:
         raise from_validation_error(err) from err

@@ -323,6 +323,17 @@ def test_the_announcer_says_a_lost_task_from_its_real_shaped_invocation(
     assert announcer_app.announce(bad, announcer.runtime)["told"] == []
 
 
+def test_the_announcer_says_a_robot_gone_to_charge_from_its_real_shaped_invocation(
+    announcer: InProcessAnnouncer, wire: list[tuple[str, bytes]]
+) -> None:
+    told = announcer_app.announce(load_event("lambda_gone_to_charge"), announcer.runtime)
+    assert len(told["told"]) == 1
+    assert spoken(wire) == ["Placebot two is low on battery and is going to charge."]
+    # And a malformed one is skipped with a warning, telling nothing
+    bad = {"gone_to_charge": {"thing": "placebot2"}}
+    assert announcer_app.announce(bad, announcer.runtime)["told"] == []
+
+
 def test_the_announcer_is_invoked_asynchronously_and_a_refusal_is_one_line(
     aws_credentials: None,
 ) -> None:

@@ -31,6 +31,7 @@ from tests.unit.dispatcher.test_dispatcher_handler import Index
 from tests.unit.skill.test_skill_task_desk import InProcessLambda
 from vahr.dispatch import Dispatcher, Task
 from vahr.protocol import topics
+from vahr.protocol.lost_tasks import GoneToCharge, Tidings
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -219,12 +220,15 @@ def test_the_schedule_sends_an_idle_low_robot_to_charge(
     tick = load_event("eventbridge_schedule")
     create_audit_table(dynamodb, AUDIT_TABLE)
     # When the schedule ticks
-    answer = app.handle(tick, function, TrailTable(AUDIT_TABLE, dynamodb))
+    told: list[Tidings] = []
+    answer = app.handle(tick, function, TrailTable(AUDIT_TABLE, dynamodb), told.append)
     # Then rover1 holds the charger and is on its way
     [task] = table.active()
     assert (task.kind, task.zone, task.thing) == ("charge", DOCK, "rover1")
     assert answer["charging"] == [task.id]
     assert commands(published) == [(topics.robot_cmd("rover1"), "navigate", {"zone": DOCK})]
+    # And the announcer is told, as the local stack tells its announcer
+    assert [(t.thing, t.zone) for t in told if isinstance(t, GoneToCharge)] == [("rover1", DOCK)]
     # And the trail records that the dispatcher sent it
     [record] = AuditTable(AUDIT_TABLE, dynamodb).records()
     assert (record.who, record.robots, record.commands) == ("dispatcher", ["rover1"], [task.id])
@@ -232,6 +236,21 @@ def test_the_schedule_sends_an_idle_low_robot_to_charge(
     index.report("rover2", battery=LOW)
     assert app.handle(tick, function)["charging"] == []
     assert len(commands(published)) == 1
+
+
+def test_a_robot_freed_low_goes_to_charge_and_the_announcer_is_told(
+    function: Dispatcher, index: Index, table: TaskTable, published: Published
+) -> None:
+    # Given rover2 low, when its update says it is idle (the rule selects it)
+    index.report("rover2", battery=LOW)
+    reported = {"status": "idle", "zone": "A", "pose": {"x": 5.0, "y": 1.0}, "battery": LOW,
+                "connected": True}  # fmt: skip
+    told: list[Tidings] = []
+    answer = app.handle({"thing": "rover2", "reported": reported}, function, None, told.append)
+    # Then it takes the charger, and the announcer is told it went to charge
+    [task] = table.active()
+    assert (answer["took"], task.kind, task.thing) == (task.id, "charge", "rover2")
+    assert [(t.thing, t.zone) for t in told if isinstance(t, GoneToCharge)] == [("rover2", DOCK)]
 
 
 def test_two_invocations_racing_for_one_charger_give_it_to_one_robot(
