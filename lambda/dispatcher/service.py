@@ -42,13 +42,7 @@ def set_in_service(dispatcher: Dispatcher, thing: str, in_service: bool) -> Serv
     assert isinstance(table, ServiceRecord), "the task store records no service"
     changed = table.set_in_service(thing, in_service, at=timestamp(dispatcher.clock()))
     if not changed:
-        waiting = [task for task in dispatcher.pending() if task.robots == [thing]]
-        return ServiceChange(
-            thing=thing,
-            in_service=in_service,
-            changed=False,
-            waiting=[] if in_service else waiting,
-        )
+        return dispatcher.service_kept(thing, in_service)
     if in_service:
         return dispatcher.reinstated(thing)
     return dispatcher.withdrawn(thing)

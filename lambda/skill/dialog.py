@@ -1,4 +1,5 @@
-"""Reading ROBOT and ZONE slots against the fleet, and asking again when they fall short.
+"""Reading ROBOT, ZONE and GROUP slots against the fleet, and asking again when they fall
+short.
 
 A value the words fit several ways ("zone b" heard as B or D) is asked about by name
 ("Zone B or zone D?") rather than acted on; the answer fills the slot afresh. Zones named by
@@ -12,9 +13,13 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from skill import prompts
+from skill.catalog import current_locale
 from skill.responses import answer, elicit, may_ask_again, questions_asked
 from skill.slots import read_slot
 from skill.vocabulary import LOADING, capitalise, join_choices
+from vahr.domain import FLEET_GROUP
+from vahr.domain.fleet import spoken_in
+from vahr.domain.text import normalize
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
@@ -40,6 +45,34 @@ def robot(handler_input: HandlerInput, runtime: SkillRuntime, name: str) -> Slot
 def zone(handler_input: HandlerInput, runtime: SkillRuntime, name: str) -> SlotReading:
     vocabulary = runtime.vocabulary
     return read_slot(_intent(handler_input), name, runtime.fleet.zone_ids, vocabulary.zone_id)
+
+
+def group(handler_input: HandlerInput, runtime: SkillRuntime) -> tuple[str | None, str]:
+    """The group the `group` slot names (None when none was said), or what to say when the
+    fleet has no group of that name."""
+    groups = {g.id: g for g in runtime.fleet.groups if g.id != FLEET_GROUP}
+    names = {
+        normalize(name): g.id
+        for g in groups.values()
+        for name in [*g.spoken, *spoken_in(g, current_locale())]
+    }
+    reading = read_slot(
+        _intent(handler_input), "group", groups, lambda heard: names.get(normalize(heard))
+    )
+    if reading.missing:
+        return None, ""
+    if reading.id is not None:
+        return reading.id, ""
+    if not groups:
+        return None, prompts.NO_GROUPS.format(heard=reading.heard)
+    choices = join_choices([group_name(runtime, group_id) for group_id in groups])
+    return None, prompts.UNKNOWN_GROUP.format(heard=reading.heard, choices=choices)
+
+
+def group_name(runtime: SkillRuntime, group_id: str) -> str:
+    """A group's first name in the request's language."""
+    found = next(g for g in runtime.fleet.groups if g.id == group_id)
+    return spoken_in(found, current_locale())[0]
 
 
 def ask_robot(

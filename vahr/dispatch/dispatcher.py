@@ -547,6 +547,14 @@ class Dispatcher:
 
     # --- service ------------------------------------------------------------------------
 
+    def service_kept(self, thing: str, in_service: bool) -> ServiceChange:
+        """`thing` was already in (or out of) service: nothing changed; out of service, the
+        queued tasks that wait for it alone."""
+        waiting = [task for task in self.pending() if task.robots == [thing]]
+        return ServiceChange(
+            thing=thing, in_service=in_service, changed=False, waiting=[] if in_service else waiting
+        )
+
     def withdrawn(self, thing: str) -> ServiceChange:
         """`thing` was just taken out of service (the host records it, and its candidates
         say so from now on): the task it holds goes back to the queue, in its place, and to

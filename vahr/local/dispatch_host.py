@@ -44,7 +44,6 @@ from vahr.dispatch import (
     Order,
     RobotState,
 )
-from vahr.dispatch.dispatcher import ServiceChange
 from vahr.dispatch.records import task_given
 from vahr.dispatch.tasks import timestamp
 from vahr.domain import Pose
@@ -61,6 +60,7 @@ if TYPE_CHECKING:
     from pathlib import Path
 
     from vahr.dispatch import Task
+    from vahr.dispatch.dispatcher import ServiceChange
     from vahr.domain import Fleet
     from vahr.plumbing.mqtt import MqttEndpoint
     from vahr.protocol import Command, ZoneClosures
@@ -477,13 +477,7 @@ class LocalDispatcher:
             changed = self.tasks.set_in_service(thing, in_service, at=timestamp(utc_now()))
             self.candidates.set_out_of_service(self.tasks.out_of_service())
         if not changed:
-            waiting = [t for t in self.dispatcher.pending() if t.robots == [thing]]
-            return ServiceChange(
-                thing=thing,
-                in_service=in_service,
-                changed=False,
-                waiting=[] if in_service else waiting,
-            )
+            return self.dispatcher.service_kept(thing, in_service)
         if in_service:
             change = self.dispatcher.reinstated(thing)
             self._recorded(change.given)

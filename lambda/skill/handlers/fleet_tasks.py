@@ -16,16 +16,12 @@ from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_intent_name
 
 from skill import deeds, dialog, prompts, task_speech
-from skill.catalog import current_locale
 from skill.guard import confirm_first
 from skill.responses import answer
 from skill.slots import read_slot, spoken_number
 from skill.task_desk import TaskRefused
-from skill.vocabulary import capitalise, join_choices
+from skill.vocabulary import capitalise
 from vahr.dispatch import Order
-from vahr.domain import FLEET_GROUP
-from vahr.domain.fleet import spoken_in
-from vahr.domain.text import normalize
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
@@ -119,7 +115,7 @@ class FleetNavigateIntentHandler(_FleetHandler):
         zone = self.zone(handler_input)
         if zone.id is None:
             return dialog.ask_zone(handler_input, self.runtime, zone)
-        group, refusal = self._group(handler_input)
+        group, refusal = dialog.group(handler_input, self.runtime)
         if refusal:
             return answer(handler_input, refusal)
         count, refusal = self._count(handler_input, group)
@@ -128,33 +124,12 @@ class FleetNavigateIntentHandler(_FleetHandler):
         order = Order(kind="navigate", zone=zone.id, count=count, group=group)
         return self.submit(handler_input, order, when_none=prompts.NO_FREE_ROBOT)
 
-    def _group(self, handler_input: HandlerInput) -> tuple[str | None, str]:
-        """The group named (None for none), or what to say when it is unknown."""
-        fleet = self.runtime.fleet
-        groups = {group.id: group for group in fleet.groups if group.id != FLEET_GROUP}
-        names = {
-            normalize(name): group.id
-            for group in groups.values()
-            for name in [*group.spoken, *spoken_in(group, current_locale())]
-        }
-        reading = read_slot(
-            _intent(handler_input), "group", groups, lambda heard: names.get(normalize(heard))
-        )
-        if reading.missing:
-            return None, ""
-        if reading.id is not None:
-            return reading.id, ""
-        if not groups:
-            return None, prompts.NO_GROUPS.format(heard=reading.heard)
-        choices = join_choices([self._group_name(group_id) for group_id in groups])
-        return None, prompts.UNKNOWN_GROUP.format(heard=reading.heard, choices=choices)
-
     def _count(self, handler_input: HandlerInput, group: str | None) -> tuple[int | None, str]:
         """How many robots: 1 when no count was said ("a robot"), except for a group (every
         member); or what to say when more were asked for than there are."""
         fleet = self.runtime.fleet
         members = next((len(g.robots) for g in fleet.groups if g.id == group), len(fleet.robots))
-        owner = "The fleet" if group is None else capitalise(self._group_name(group))
+        owner = "The fleet" if group is None else capitalise(dialog.group_name(self.runtime, group))
         reading = read_slot(
             _intent(handler_input),
             "count",
@@ -169,11 +144,6 @@ class FleetNavigateIntentHandler(_FleetHandler):
         if count > members:
             return None, prompts.TOO_MANY.format(owner=owner, most=members, count=count)
         return count, ""
-
-    def _group_name(self, group_id: str) -> str:
-        """A group's first name in the request's language."""
-        group = next(g for g in self.runtime.fleet.groups if g.id == group_id)
-        return spoken_in(group, current_locale())[0]
 
 
 class ZoneRobotsIntentHandler(_FleetHandler):

@@ -16,15 +16,10 @@ from ask_sdk_core.dispatch_components import AbstractRequestHandler
 from ask_sdk_core.utils import is_intent_name
 
 from skill import battery_speech, deeds, dialog, prompts
-from skill.catalog import current_locale
-from skill.dialog import _intent
 from skill.guard import confirm_first
 from skill.responses import answer
-from skill.slots import read_slot
 from skill.task_desk import TaskRefused
-from skill.vocabulary import FLEET, join_choices
-from vahr.domain.fleet import FLEET_GROUP, spoken_in
-from vahr.domain.text import normalize
+from skill.vocabulary import FLEET
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
@@ -49,9 +44,10 @@ class _ServiceHandler(AbstractRequestHandler):
         return bool(is_intent_name(self.intent_name)(handler_input))
 
     def handle(self, handler_input: HandlerInput) -> Response:
-        things, refusal = self._group(handler_input)
+        group, refusal = dialog.group(handler_input, self.runtime)
         if refusal:
             return answer(handler_input, refusal)
+        things = next((list(g.robots) for g in self.runtime.fleet.groups if g.id == group), [])
         if not things:
             robot = dialog.robot(handler_input, self.runtime, "robot")
             if robot.id is None:
@@ -83,30 +79,6 @@ class _ServiceHandler(AbstractRequestHandler):
         return answer(
             handler_input, battery_speech.service_report(self.runtime.vocabulary, changes)
         )
-
-    def _group(self, handler_input: HandlerInput) -> tuple[list[str], str]:
-        """The members of the group named (none when no group was said), or what to say
-        when it is unknown."""
-        fleet = self.runtime.fleet
-        groups = {group.id: group for group in fleet.groups if group.id != FLEET_GROUP}
-        names = {
-            normalize(name): group.id
-            for group in groups.values()
-            for name in [*group.spoken, *spoken_in(group, current_locale())]
-        }
-        reading = read_slot(
-            _intent(handler_input), "group", groups, lambda heard: names.get(normalize(heard))
-        )
-        if reading.missing:
-            return [], ""
-        if reading.id is not None:
-            return list(groups[reading.id].robots), ""
-        if not groups:
-            return [], prompts.NO_GROUPS.format(heard=reading.heard)
-        choices = join_choices(
-            [normalize(spoken_in(group, current_locale())[0]) for group in groups.values()]
-        )
-        return [], prompts.UNKNOWN_GROUP.format(heard=reading.heard, choices=choices)
 
 
 class OutOfServiceIntentHandler(_ServiceHandler):
