@@ -4,10 +4,12 @@ others, a package and its own modules included."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import grimp
 import pytest
@@ -25,10 +27,9 @@ def lint_imports(tree: Path) -> subprocess.CompletedProcess[str]:
     )  # fmt: skip
 
 
-@pytest.fixture
-def tree(tmp_path: Path) -> Path:
-    """A copy of the five packages the contracts speak of (their Python files, which is
-    all the check reads), importable from `tmp_path`."""
+def copy_packages(into: Path) -> Path:
+    """A copy of the five packages the contracts speak of (their Python files, which is all
+    the check reads), importable from `into`."""
 
     def ignore(directory: str, names: list[str]) -> set[str]:
         return {
@@ -44,8 +45,13 @@ def tree(tmp_path: Path) -> Path:
         ("announcer", "lambda/announcer"),
         ("dispatcher", "lambda/dispatcher"),
     ):
-        shutil.copytree(ROOT / source, tmp_path / package, ignore=ignore, symlinks=True)
-    return tmp_path
+        shutil.copytree(ROOT / source, into / package, ignore=ignore, symlinks=True)
+    return into
+
+
+@pytest.fixture
+def tree(tmp_path: Path) -> Path:
+    return copy_packages(tmp_path)
 
 
 def test_the_packages_keep_every_contract(tree: Path) -> None:
@@ -54,69 +60,88 @@ def test_the_packages_keep_every_contract(tree: Path) -> None:
     assert "0 broken" in result.stdout
 
 
+# (module, the import added to it, the start of the name of the contract it breaks)
+WRONG_IMPORTS = [
+    ("vahr/protocol/topics.py", "import vahr.plumbing.mqtt", "The wire contract"),
+    ("vahr/protocol/topics.py", "import vahr.domain.fleet", "The wire contract"),
+    ("vahr/protocol/topics.py", "import yaml", "The wire contract"),
+    ("vahr/domain/fleet.py", "import vahr.assistant.nlu", "The domain and the dispatch"),
+    ("vahr/dispatch/tasks.py", "import boto3", "The domain and the dispatch"),
+    ("vahr/speech/audio.py", "import vahr.plumbing.mqtt", "Speech imports nothing"),
+    ("robot_agent/agent.py", "import vahr.local.room_assistant", "robot_agent never imports"),
+    ("robot_agent/agent.py", "import vahr.assistant.nlu", "robot_agent never imports"),
+    ("vahr/local/system.py", "import robot_agent.assembly", "vahr never imports robot_agent"),
+    ("skill/app.py", "import vahr.speech.tts", "The skill imports only"),
+    ("skill/app.py", "import vahr.announce", "The skill imports only"),
+    ("skill/app.py", "import vahr.assistant", "The skill imports only"),
+    ("skill/app.py", "import announcer.app", "The skill imports only"),
+    ("announcer/app.py", "import vahr.plumbing.mqtt", "The announcer imports only"),
+    ("announcer/app.py", "import skill.iot_data", "The announcer imports only"),
+    ("announcer/app.py", "import boto3", "Only the announcer's data-access module"),
+    ("dispatcher/app.py", "import vahr.twin.fleet_index", "The dispatcher imports only"),
+    ("dispatcher/app.py", "import boto3", "Only the dispatcher's five adapters"),
+    ("vahr/announce/policy.py", "import vahr.errors", "The announcement policy imports"),
+    ("vahr/announce/speech.py", "import vahr.skill_model", "The announcement policy"),
+    # The local stack starting the station itself: the station is handed to it from above.
+    ("vahr/local/system.py", "import vahr.station.deployment", "The top layer is one-way"),
+    ("vahr/plumbing/mqtt.py", "import vahr.twin.broker", "No import cycle"),
+    ("vahr/experiment/bus.py", "import vahr.station.desk", "The top layer is one-way"),
+    ("vahr/twin/stack.py", "import vahr.local.system", "The top layer is one-way"),
+    # The plumbing and the assistant are siblings: neither knows the other.
+    ("vahr/plumbing/client.py", "import vahr.assistant.nlu", "The top layer is one-way"),
+    # The station serves any deployment: nothing of the twin or the local hosts.
+    (
+        "vahr/station/voice.py",
+        "import vahr.twin.dataplane",
+        "The station and the experiment know",
+    ),
+    ("vahr/station/app.py", "import vahr.local.system", "The station and the experiment know"),
+    (
+        "vahr/experiment/bus.py",
+        "import vahr.twin.broker",
+        "The station and the experiment know",
+    ),
+    ("vahr/station/vocabulary.py", "import vahr.assistant.nlu", "The station and the"),
+    ("robot_agent/link/shadow.py", "import robot_agent.voice.port", "robot_agent's adapters"),
+    # Cycles no layer names: two modules of one package, two packages of robot_agent.
+    ("vahr/experiment/tlx.py", "import vahr.experiment.results", "No import cycle"),
+    ("vahr/station/errors.py", "import vahr.station.app", "No import cycle"),
+    ("robot_agent/backends/sim.py", "import robot_agent.core.executor", "No import cycle"),
+]
+
+
+@pytest.fixture(scope="module")
+def checked_with_each_wrong_import(tmp_path_factory: pytest.TempPathFactory) -> list[Any]:
+    """The check's exit code and report with each of `WRONG_IMPORTS` added alone to the
+    packages (the module put back after each), all in one interpreter
+    (tests/support/lint_imports_each.py): a `lint-imports` process for each took 26 s."""
+    tree = copy_packages(tmp_path_factory.mktemp("packages"))
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "tests" / "support" / "lint_imports_each.py"),
+         str(ROOT / "pyproject.toml")],
+        input=json.dumps([[module, line] for module, line, _ in WRONG_IMPORTS]),
+        cwd=tree, env={"PATH": "/usr/bin:/bin", "PYTHONPATH": str(tree)},
+        capture_output=True, text=True, timeout=300, check=True,
+    )  # fmt: skip
+    outcomes: list[Any] = json.loads(result.stdout)
+    return outcomes
+
+
 @pytest.mark.parametrize(
-    ("module", "line", "contract"),
-    [
-        ("vahr/protocol/topics.py", "import vahr.plumbing.mqtt", "The wire contract"),
-        ("vahr/protocol/topics.py", "import vahr.domain.fleet", "The wire contract"),
-        ("vahr/protocol/topics.py", "import yaml", "The wire contract"),
-        ("vahr/domain/fleet.py", "import vahr.assistant.nlu", "The domain and the dispatch"),
-        ("vahr/dispatch/tasks.py", "import boto3", "The domain and the dispatch"),
-        ("vahr/speech/audio.py", "import vahr.plumbing.mqtt", "Speech imports nothing"),
-        ("robot_agent/agent.py", "import vahr.local.room_assistant", "robot_agent never imports"),
-        ("robot_agent/agent.py", "import vahr.assistant.nlu", "robot_agent never imports"),
-        ("vahr/local/system.py", "import robot_agent.assembly", "vahr never imports robot_agent"),
-        ("skill/app.py", "import vahr.speech.tts", "The skill imports only"),
-        ("skill/app.py", "import vahr.announce", "The skill imports only"),
-        ("skill/app.py", "import vahr.assistant", "The skill imports only"),
-        ("skill/app.py", "import announcer.app", "The skill imports only"),
-        ("announcer/app.py", "import vahr.plumbing.mqtt", "The announcer imports only"),
-        ("announcer/app.py", "import skill.iot_data", "The announcer imports only"),
-        ("announcer/app.py", "import boto3", "Only the announcer's data-access module"),
-        ("dispatcher/app.py", "import vahr.twin.fleet_index", "The dispatcher imports only"),
-        ("dispatcher/app.py", "import boto3", "Only the dispatcher's five adapters"),
-        ("vahr/announce/policy.py", "import vahr.errors", "The announcement policy imports"),
-        ("vahr/announce/speech.py", "import vahr.skill_model", "The announcement policy"),
-        # The local stack starting the station itself: the station is handed to it from above.
-        ("vahr/local/system.py", "import vahr.station.deployment", "The top layer is one-way"),
-        ("vahr/plumbing/mqtt.py", "import vahr.twin.broker", "No import cycle"),
-        ("vahr/experiment/bus.py", "import vahr.station.desk", "The top layer is one-way"),
-        ("vahr/twin/stack.py", "import vahr.local.system", "The top layer is one-way"),
-        # The plumbing and the assistant are siblings: neither knows the other.
-        ("vahr/plumbing/client.py", "import vahr.assistant.nlu", "The top layer is one-way"),
-        # The station serves any deployment: nothing of the twin or the local hosts.
-        (
-            "vahr/station/voice.py",
-            "import vahr.twin.dataplane",
-            "The station and the experiment know",
-        ),
-        ("vahr/station/app.py", "import vahr.local.system", "The station and the experiment know"),
-        (
-            "vahr/experiment/bus.py",
-            "import vahr.twin.broker",
-            "The station and the experiment know",
-        ),
-        ("vahr/station/vocabulary.py", "import vahr.assistant.nlu", "The station and the"),
-        ("robot_agent/link/shadow.py", "import robot_agent.voice.port", "robot_agent's adapters"),
-        # Cycles no layer names: two modules of one package, two packages of robot_agent.
-        ("vahr/experiment/tlx.py", "import vahr.experiment.results", "No import cycle"),
-        ("vahr/station/errors.py", "import vahr.station.app", "No import cycle"),
-        ("robot_agent/backends/sim.py", "import robot_agent.core.executor", "No import cycle"),
-    ],
+    "case", range(len(WRONG_IMPORTS)), ids=lambda n: " ".join(WRONG_IMPORTS[n][:2])
 )
 def test_an_import_against_a_layer_fails_the_check_naming_the_contract(
-    tree: Path, module: str, line: str, contract: str
+    checked_with_each_wrong_import: list[Any], case: int
 ) -> None:
     # Given one module with one more import: across a layer boundary, or round a loop
-    path = tree / module
-    path.write_text(path.read_text() + f"\n{line}  # noqa\n")
+    _, _, contract = WRONG_IMPORTS[case]
     # When the contracts are checked
-    result = lint_imports(tree)
+    outcome = checked_with_each_wrong_import[case]
     # Then the check fails and names the broken contract
-    assert result.returncode != 0
+    assert outcome["exit"] != 0
     # A contract with ignored imports ends its line with "BROKEN (N ignored imports)".
-    broken = [line for line in result.stdout.splitlines() if " BROKEN" in line]
-    assert any(name.startswith(contract) for name in broken), result.stdout
+    broken = [line for line in outcome["report"].splitlines() if " BROKEN" in line]
+    assert any(name.startswith(contract) for name in broken), outcome["report"]
 
 
 def import_cycles(graph: grimp.ImportGraph) -> list[list[str]]:
