@@ -33,12 +33,17 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from vahr.assistant.localized import supported
+    from vahr.domain.locale import LocaleError, check_locale
     from vahr.domain.people import MAX_ID_CHARS, valid_person_id
     from vahr.errors import VahrError
     from vahr.plumbing.client import default_api, say
 
-    supported(args.locale)
+    # Checked here rather than by `vahr.assistant.localized.supported`: importing the
+    # assistant loads its NLU's libraries, half of this command's start.
+    try:
+        check_locale(args.locale)
+    except LocaleError as err:
+        raise VahrError(str(err)) from err
     if not args.utterance.strip():
         raise VahrError("the utterance is empty")
     for flag in ("user", "person"):
