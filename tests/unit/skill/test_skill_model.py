@@ -361,20 +361,29 @@ def test_example_phrases_are_sample_utterances(model: dict[str, Any]) -> None:
         )
         for slot_type in lm["types"]
     }
-    patterns = []
-    for intent in lm["intents"]:
-        types = {slot["name"]: slot["type"] for slot in intent.get("slots", [])}
-        for sample in intent["samples"]:
-            regex = re.escape(sample)
-            for slot, slot_type in types.items():
-                regex = regex.replace(re.escape("{" + slot + "}"), f"(?:{names[slot_type]})")
-            patterns.append(re.compile(f"^{regex}$"))
+
+    def is_sample(spoken: str, sample: str, types: dict[str, str]) -> bool:
+        # Only a sample whose own words are all in the phrase is made a pattern: the model
+        # has thousands, and compiling each took seconds.
+        if not all(words.strip() in spoken for words in re.split(r"\{\w+\}", sample)):
+            return False
+        regex = re.escape(sample)
+        for slot, slot_type in types.items():
+            regex = regex.replace(re.escape("{" + slot + "}"), f"(?:{names[slot_type]})")
+        return re.match(f"^{regex}$", spoken) is not None
+
+    samples = [
+        (sample, {slot["name"]: slot["type"] for slot in intent.get("slots", [])})
+        for intent in lm["intents"]
+        for sample in intent["samples"]
+    ]
     manifest = json.loads((ROOT / MANIFEST_PATH).read_text())
     phrases = manifest["manifest"]["publishingInformation"]["locales"]["en-US"]["examplePhrases"]
     assert phrases[0] == f"Alexa, open {lm['invocationName']}"
     for phrase in phrases[1:]:
         spoken = re.sub(rf"^Alexa, ask {lm['invocationName']} (to )?", "", phrase)
-        assert spoken != phrase and any(p.match(spoken) for p in patterns), phrase
+        assert spoken != phrase
+        assert any(is_sample(spoken, sample, types) for sample, types in samples), phrase
 
 
 def test_the_robots_weather_question_is_a_weather_intent_sample(model: dict[str, Any]) -> None:
