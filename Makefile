@@ -130,10 +130,9 @@ pytest: setup
 # The tests marked ros2 (the nav2 backend against real rclpy and Fast DDS) in .venv-ros2, in a
 # private network namespace where one can be made (root, as CI is): no DDS packet leaves it
 # and no other process's DDS meets these. Inside, each test's ROS graph has a domain of its
-# own and discovery stays on localhost (tests/support/nav2.py). Their two files run side by
-# side (a worker each, each worker's domains its own): the tests mostly wait on DDS, and
-# together take 34 s instead of 52.
-ROS2_PYTEST := $(BIN_ROS2)/pytest -q -n 2 --dist loadgroup -m ros2 $(ROS2_TESTS)
+# own and discovery stays on localhost (tests/support/nav2.py). One file at a time: with
+# the two side by side, a server's discovery took more than the 3 s a test allows.
+ROS2_PYTEST := $(BIN_ROS2)/pytest -q -m ros2 $(ROS2_TESTS)
 pytest-ros2: setup
 	if [ "$$(id -u)" = 0 ] && unshare -n true 2>/dev/null; then \
 		unshare -n sh -c 'ip link set lo up && exec $(ROS2_PYTEST)'; \
