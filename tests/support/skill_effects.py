@@ -62,6 +62,7 @@ class SkillEffects:
 
         from skill.app import make_lambda_handler
         from skill.config import SkillConfig
+        from tests.support.shared_models import default_session
 
         # moto's credentials and region, no endpoint or fleet file of a real run; the
         # environment is given back as it was on exit.
@@ -75,6 +76,7 @@ class SkillEffects:
         self._environment.start()
         self._moto = mock_aws()
         self._moto.start()
+        default_session()
         iot, self._data = boto3.client("iot"), boto3.client("iot-data")
         for thing in (*self.fleet.robot_things, self.fleet.experiment_thing):
             iot.create_thing(thingName=thing)

@@ -15,6 +15,7 @@ from cryptography.x509.oid import NameOID
 from moto import mock_aws
 
 from robot_agent.cli import main
+from tests.support.shared_models import default_session
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -38,6 +39,7 @@ def aws_credentials(monkeypatch: pytest.MonkeyPatch) -> None:
 @pytest.fixture
 def iot(aws_credentials: None) -> Iterator[object]:
     with mock_aws():
+        default_session()
         client = boto3.client("iot", region_name=REGION)
         client.create_policy(
             policyName="vahr-robot-policy",

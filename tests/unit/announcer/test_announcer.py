@@ -29,6 +29,7 @@ from announcer.aws import AnnouncementTopic, SkillCredentials, StateStore
 from announcer.config import AnnouncerConfig, events_url
 from announcer.errors import AnnouncerError, ConfigError, DeliveryFailed
 from announcer.proactive_events import ProactiveEvents
+from tests.support.shared_models import default_session
 from vahr.announce import settings_from
 from vahr.announce.speech import Names
 from vahr.protocol import topics
@@ -180,6 +181,7 @@ def runtime(
     for name in ("AWS_PROFILE", "AWS_ENDPOINT_URL"):
         monkeypatch.delenv(name, raising=False)
     with mock_aws():
+        default_session()
         secrets = boto3.client("secretsmanager", region_name=REGION)
         secrets.create_secret(Name="vahr/skill-messaging", SecretString=json.dumps(
             {"clientId": CLIENT_ID, "clientSecret": CLIENT_SECRET}))  # fmt: skip

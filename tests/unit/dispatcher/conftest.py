@@ -12,6 +12,7 @@ from moto import mock_aws
 from dispatcher.task_table import TaskTable
 from tests.support.dispatch_meter import REGION, TABLE
 from tests.support.dynamodb_tables import create_task_table
+from tests.support.shared_models import default_session
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -34,6 +35,7 @@ def aws_credentials(monkeypatch: pytest.MonkeyPatch) -> None:
 @pytest.fixture
 def dynamodb(aws_credentials: None) -> Iterator[Any]:
     with mock_aws():
+        default_session()
         client = boto3.client("dynamodb", region_name=REGION)
         create_task_table(client, TABLE)
         yield client

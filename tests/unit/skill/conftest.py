@@ -9,6 +9,7 @@ import pytest
 from moto import mock_aws
 from skill_testkit import REGION, RobotDoubles
 
+from tests.support.shared_models import default_session
 from vahr.protocol import Reported
 
 if TYPE_CHECKING:
@@ -35,6 +36,7 @@ def aws(monkeypatch: pytest.MonkeyPatch, fleet: Fleet) -> Iterator[None]:
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setenv("AWS_DEFAULT_REGION", REGION)
     with mock_aws():
+        default_session()
         iot = boto3.client("iot", region_name=REGION)
         for thing in (*fleet.robot_things, fleet.experiment_thing):
             iot.create_thing(thingName=thing)
