@@ -21,6 +21,7 @@ from vahr.station.vocabulary import load_model, sentences
 from vahr.station.voice import SORRY, PushToTalk, read_clip
 
 if TYPE_CHECKING:
+    from collections.abc import Iterator
     from pathlib import Path
 
     from vahr.domain import Fleet
@@ -35,6 +36,23 @@ def wav(channels: int = 1, width: int = 2, rate: int = 16_000, seconds: float = 
         out.setframerate(rate)
         out.writeframes(bytes(int(seconds * rate) * channels * width))
     return buffer.getvalue()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def shipped_model_built_once() -> Iterator[None]:
+    """The push-to-talks made here each build the NLU that ships (0.9 s of CPU) on first
+    use; they share one, as the push-to-talk of one station does."""
+    from vahr.assistant import InteractionModel
+
+    shipped = InteractionModel.load()
+    load = InteractionModel.load
+
+    def shipped_or_loaded(path: Path | None = None, **options: Any) -> InteractionModel:
+        return shipped if path is None and not options else load(path, **options)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(InteractionModel, "load", shipped_or_loaded)
+        yield
 
 
 class Heard:
