@@ -90,9 +90,9 @@ $(ROS_SITE)/.linked: $(VENV)/.installed
 
 # ROS 2 Jazzy's wheels (pinned) and nav2_msgs built into the venv; then the project itself at
 # the main venv's versions of its dependencies (a change there does not rebuild nav2_msgs).
+# uv makes the venv in a second (venv's own module took 13 s installing a pip nothing uses).
 $(VENV_ROS2)/.ros2: $(VENV)/.installed requirements-ros2.txt ros2/build-nav2-msgs.sh ros2/nav2_msgs/package.xml \
 		ros2/nav2_msgs/CMakeLists.txt ros2/nav2_msgs/action/NavigateToPose.action
-	# uv makes the venv in a second; venv's own module took 13 s installing a pip nobody uses.
 	test -x $(BIN_ROS2)/python || $(BIN)/uv venv -q --python-preference only-system --python $(PYTHON) $(VENV_ROS2)
 	$(UV) --python $(BIN_ROS2)/python -r requirements-ros2.txt
 	ros2/build-nav2-msgs.sh $(VENV_ROS2) .build/ros2-nav2-msgs
