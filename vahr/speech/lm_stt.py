@@ -36,7 +36,8 @@ robots. A caller that must not hold its interpreter lock that long (the station,
 intake needs it) builds the model with `cached_language_model` in a child process
 (`in_child_process`) and hands the finished `LanguageModel` to the recognizer, which then
 only loads it into the decoder. The cache keeps a built model on disk, keyed by a hash of
-everything it is built from.
+everything it is built from; reading it back (`read_cached_language_model`) is quick enough
+for any caller's own process.
 """
 
 from __future__ import annotations
@@ -171,8 +172,7 @@ def cached_language_model(
     not match its digest is built again and overwritten; one that cannot be written is
     skipped. `cache_dir=None` keeps nothing on disk."""
     examples = tuple(dict.fromkeys(sentences))
-    key = model_key(examples, background_words)
-    file = cache_dir / f"language-model-{key[:24]}.json" if cache_dir else None
+    file, key = _model_file(examples, background_words, cache_dir)
     if file is not None:
         cached = _read_cached(file, key)
         if cached is not None:
@@ -181,6 +181,22 @@ def cached_language_model(
     if file is not None:
         _write_cached(file, key, model)
     return model, False
+
+
+def read_cached_language_model(
+    sentences: Iterable[str], background_words: int = 0, *, cache_dir: Path
+) -> LanguageModel | None:
+    """The model of `sentences` if the cache in `cache_dir` holds it, else None (nothing
+    is built)."""
+    file, key = _model_file(tuple(dict.fromkeys(sentences)), background_words, cache_dir)
+    return _read_cached(file, key) if file is not None else None
+
+
+def _model_file(
+    examples: tuple[str, ...], background_words: int, cache_dir: Path | None
+) -> tuple[Path | None, str]:
+    key = model_key(examples, background_words)
+    return (cache_dir / f"language-model-{key[:24]}.json" if cache_dir else None), key
 
 
 def _digest(model: LanguageModel) -> str:

@@ -15,7 +15,8 @@ The station's recognizer is built from them in a child process (`command_recogni
 with a fleet of 1,000 robots the sentences and their language model take about a minute of
 pure Python, which inside the station would hold the interpreter lock its MQTT intake
 needs. The model is cached on disk by a hash of what it is built from, so the next start
-only loads it.
+only loads it, in the station itself (a tenth of a second even for 1,000 robots; a child's
+interpreter and imports took most of a second of CPU).
 """
 
 from __future__ import annotations
@@ -144,15 +145,35 @@ def command_model(
     from vahr.speech.lm_stt import cached_language_model
 
     started = time.perf_counter()
-    if model_file is None and fleet is not None:
-        from vahr.skill_model.generator import build_interaction_model
-
-        document = build_interaction_model(fleet)
-    else:
-        document = load_model(model_file)
+    document = _document(model_file, fleet)
     found, listed = cached_sentences(document, cache_dir)
     model, cached = cached_language_model(found, cache_dir=cache_dir)
     return CommandModel(found, model, listed and cached, time.perf_counter() - started)
+
+
+def cached_command_model(
+    model_file: Path | None, fleet: Fleet | None, cache_dir: Path
+) -> CommandModel | None:
+    """`command_model` when the cache in `cache_dir` holds both the sentences and their
+    language model; None, building nothing, when it lacks either."""
+    from vahr.speech.lm_stt import read_cached_language_model
+
+    started = time.perf_counter()
+    file, key = _sentences_file(_document(model_file, fleet), cache_dir)
+    found = _read_sentences(file, key)
+    model = read_cached_language_model(found, cache_dir=cache_dir) if found else None
+    if found is None or model is None:
+        return None
+    return CommandModel(found, model, True, time.perf_counter() - started)
+
+
+def _document(model_file: Path | None, fleet: Fleet | None) -> dict[str, Any]:
+    """The interaction model `command_recognizer` listens for (see there)."""
+    if model_file is None and fleet is not None:
+        from vahr.skill_model.generator import build_interaction_model
+
+        return build_interaction_model(fleet)
+    return load_model(model_file)
 
 
 class _CachedSentences(msgspec.Struct, frozen=True):
@@ -168,23 +189,34 @@ def cached_sentences(document: dict[str, Any], cache_dir: Path | None) -> tuple[
     the station's start (3 s of CPU); the language model is then read from its own cache by
     their hash. The key is everything they are made from: the document, the phrases added
     to it, and the code that writes them out (this module's and the text's)."""
+    file, digest = _sentences_file(document, cache_dir)
+    kept = _read_sentences(file, digest)
+    if kept is not None:
+        return kept, True
+    found = sentences(document)
+    if file is not None:
+        write_atomically(file, msgspec.json.encode(_CachedSentences(digest, found)))
+    return found, False
+
+
+def _sentences_file(document: dict[str, Any], cache_dir: Path | None) -> tuple[Path | None, str]:
+    """Where the cache keeps `document`'s sentences, and their key (`cached_sentences`)."""
     made_from = [
         code_digest(__name__, "vahr.domain.text"), built_in_phrases(), confirmation_phrases(),
         document,
     ]  # fmt: skip
     digest = hashlib.sha256(json.dumps(made_from, sort_keys=True).encode()).hexdigest()
-    file = cache_dir / f"sentences-{digest[:24]}.json" if cache_dir else None
-    if file is not None:
-        try:
-            kept = msgspec.json.decode(file.read_bytes(), type=_CachedSentences)
-            if kept.key == digest:
-                return kept.sentences, True
-        except (OSError, msgspec.DecodeError):
-            pass  # not there yet, or damaged: written out again below
-    found = sentences(document)
-    if file is not None:
-        write_atomically(file, msgspec.json.encode(_CachedSentences(digest, found)))
-    return found, False
+    return (cache_dir / f"sentences-{digest[:24]}.json" if cache_dir else None), digest
+
+
+def _read_sentences(file: Path | None, digest: str) -> list[str] | None:
+    if file is None:
+        return None
+    try:
+        kept = msgspec.json.decode(file.read_bytes(), type=_CachedSentences)
+    except (OSError, msgspec.DecodeError):
+        return None  # not there yet, or damaged: written out again
+    return kept.sentences if kept.key == digest else None
 
 
 def command_recognizer(
@@ -196,22 +228,26 @@ def command_recognizer(
 ) -> LanguageModelRecognizer:
     """The push-to-talk recognizer for the interaction model at `model_file`; without one,
     the model generated from `fleet` (in memory), else the one that ships with the package.
-    Its sentences and language model are made in a child process, only the decoder is
-    loaded here. The model is cached in `cache_dir` (default: the trained models' cache,
-    `$XDG_CACHE_HOME/vahr`) unless `use_cache` is False."""
+    Its sentences and language model are read from the cache here, or made in a child
+    process when the cache lacks them; the decoder is loaded here. The model is cached in
+    `cache_dir` (default: the trained models' cache, `$XDG_CACHE_HOME/vahr`) unless
+    `use_cache` is False."""
     from vahr.model_cache import default_cache_dir
     from vahr.speech.lm_stt import LanguageModelRecognizer, in_child_process
 
     cache = (cache_dir or default_cache_dir()) if use_cache else None
     started = time.perf_counter()
-    made = in_child_process(command_model, model_file, fleet, cache)
+    made = cached_command_model(model_file, fleet, cache) if cache else None
+    where = "read from the cache"
+    if made is None:
+        made = in_child_process(command_model, model_file, fleet, cache)
+        where = ("read from the cache" if made.cached else "built") + " in a child process"
     received = time.perf_counter()
     recognizer = LanguageModelRecognizer(made.sentences, nbest=True, model=made.model)
     log.info(
-        "push-to-talk: %d sentences, language model %s in %.1f s in a child process "
-        "(%.1f s with its start), loaded in %.2f s",
+        "push-to-talk: %d sentences, language model %s in %.1f s (%.1f s in all), loaded in %.2f s",
         len(made.sentences),
-        "read from the cache" if made.cached else "built",
+        where,
         made.seconds,
         received - started,
         time.perf_counter() - received,

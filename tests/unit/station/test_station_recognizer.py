@@ -1,10 +1,12 @@
 """The station's push-to-talk recognizer (`vahr.station.vocabulary.command_recognizer`):
 its language model is made in a child process from the interaction model, kept in the
-cache, and the recognizer hears real speech with it; a second start builds nothing."""
+cache and read from it by the station itself at the next start, and the recognizer hears
+real speech with it; a second start builds nothing."""
 
 from __future__ import annotations
 
 import json
+import logging
 from typing import TYPE_CHECKING
 
 import pytest
@@ -83,10 +85,30 @@ def test_a_second_start_reads_the_model_from_the_cache(model_file: Path, tmp_pat
     second = command_model(model_file, None, cache)
     assert second.cached
     assert (second.sentences, second.model) == (first.sentences, first.model)
-    # The station's own start, through the child process, finds them too, and nothing is
-    # written again
+    # The station's own start finds them too, and nothing is written again
     assert command_recognizer(model_file, cache_dir=cache).model == first.model
     assert {file.name: file.stat().st_mtime_ns for file in cache.iterdir()} == written
+
+
+def test_the_station_reads_a_cached_model_itself_and_builds_a_missing_one_in_a_child(
+    model_file: Path, tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    cache = tmp_path / "cache"
+    caplog.set_level(logging.INFO, logger="vahr.station.vocabulary")
+    # A first start builds the model in a child process
+    built = command_recognizer(model_file, cache_dir=cache)
+    assert "language model built in a child process" in caplog.text
+    # A second reads it from the cache in the station itself
+    caplog.clear()
+    assert command_recognizer(model_file, cache_dir=cache).model == built.model
+    assert "language model read from the cache in" in caplog.text
+    assert "child process" not in caplog.text
+    # A damaged model is made again in a child process, the same model
+    caplog.clear()
+    [kept] = cache.glob("language-model-*.json")
+    kept.write_text("{not json")
+    assert command_recognizer(model_file, cache_dir=cache).model == built.model
+    assert "language model built in a child process" in caplog.text
 
 
 def test_a_damaged_list_of_sentences_is_written_out_again(model_file: Path, tmp_path: Path) -> None:
