@@ -79,6 +79,8 @@ class Nav2Backend:
             raise VahrError(f"--backend nav2: cannot start a ROS 2 node ({err})") from err
         self._client = ActionClient(self._node, NavigateToPose, settings.action)
         self._active: Any = None  # the goal handle of the goal being driven, if any
+        # The sends of a goal a stop overtook before the server's answer came: halt()'s.
+        self._overtaken: list[Any] = []
         self._on_battery: Callable[[Battery], None] | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
         if settings.battery_topic:
@@ -180,7 +182,8 @@ class Nav2Backend:
         A request is sent again after `RESEND_S` without an answer: DDS drops a request
         sent to a server that the graph already lists but whose endpoints are not matched
         yet (a bt_navigator just restarted while its dead predecessor's are still listed).
-        Every request left unanswered is cancelled should the server accept it later.
+        Every request left unanswered is cancelled should the server accept it later; those
+        of a goal that a stop or a preemption overtakes are halt()'s to wait for and cancel.
         """
         loop = asyncio.get_running_loop()
         deadline = time.monotonic() + self.settings.answer_timeout_s
@@ -202,6 +205,9 @@ class Nav2Backend:
                         f"Nav2's {self.settings.action!r} server did not accept or reject the "
                         f"goal to {zone.id} within {self.settings.answer_timeout_s:g} s"
                     )
+        except asyncio.CancelledError:
+            self._overtaken, unanswered = unanswered, []
+            raise
         finally:
             for pending in unanswered:
                 pending.add_done_callback(_cancel_if_accepted)
@@ -223,9 +229,13 @@ class Nav2Backend:
         self._pose = progress.pose
         on_progress(progress)
 
+    async def server_ready(self) -> bool:
+        """Whether the action server is found now (DDS discovery has matched it)."""
+        return bool(await self._answer(self._call(self._client.server_is_ready), "answer"))
+
     async def _wait_for_server(self) -> None:
         deadline = time.monotonic() + self.settings.server_timeout_s
-        while not await self._answer(self._call(self._client.server_is_ready), "answer"):
+        while not await self.server_ready():
             if time.monotonic() >= deadline:
                 raise NavigationFailed(
                     f"no Nav2 action server {self.settings.action!r} answered within "
@@ -261,8 +271,11 @@ class Nav2Backend:
         await asyncio.sleep(delay)
 
     async def halt(self) -> None:
-        """Cancel the goal being driven and wait (bounded) for Nav2 to confirm it."""
+        """Cancel the goal being driven, or the one a stop overtook on its way to being
+        accepted, and wait (bounded) for Nav2 to confirm it."""
         handle, self._active = self._active, None
+        if handle is None:
+            handle = await self._accepted_overtaken()
         if handle is None:
             return
         loop = asyncio.get_running_loop()
@@ -281,6 +294,25 @@ class Nav2Backend:
                 "Nav2's %r server refused to cancel the goal; the robot may still be driving",
                 self.settings.action,
             )
+
+    async def _accepted_overtaken(self) -> Any:
+        """The handle of the goal a stop overtook, once Nav2 has accepted it (within
+        `answer_timeout_s`); None if there is none or Nav2 rejected it. Its earlier sends
+        are cancelled should the server accept them."""
+        unanswered, self._overtaken = self._overtaken, []
+        if not unanswered:
+            return None
+        *earlier, last = unanswered
+        for pending in earlier:
+            pending.add_done_callback(_cancel_if_accepted)
+        answer = _awaitable(asyncio.get_running_loop(), last)
+        try:
+            handle = await self._answer(answer, "accept or reject the goal")
+        except NavigationFailed as err:
+            last.add_done_callback(_cancel_if_accepted)
+            log.warning("%s; the robot may still be driving", err)
+            return None
+        return handle if handle.accepted else None
 
     def close_zones(self, closed: frozenset[str]) -> None:
         # Nav2 plans on the robot's own costmaps: a closed area is kept out there, by a

@@ -100,6 +100,8 @@ class StandIn:
             self.log("rejected")
             return GoalResponse.REJECT
         self._pending = mode
+        # A slow answer: a stop can overtake it on the robot.
+        time.sleep(mode.get("accept_delay_s", 0))
         self.log("accepted")
         return GoalResponse.ACCEPT
 
