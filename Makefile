@@ -40,28 +40,37 @@ unexport PYTHONDONTWRITEBYTECODE
 export JSII_SILENCE_WARNING_END_OF_LIFE_NODE_VERSION := 20
 export JSII_RUNTIME_PACKAGE_CACHE_ROOT := $(CURDIR)/.cache/jsii
 
-.PHONY: hearing-adaptation sense-heard demo test test-repeat soak-test lint typecheck jstest pytest pytest-ros2 setup system-packages bench synth deploy skill-model clean
+.PHONY: hearing-adaptation sense-heard demo test test-repeat soak-test lint typecheck jstest pytest pytest-now pytest-ros2 setup system-packages bench synth deploy skill-model clean
 
 demo: setup
 	$(BIN)/vahr demo
 
-# Three parts side by side: the suite, the checks, and the ROS 2 tests. The ROS 2 tests
-# mostly wait (on DDS discovery, on a robot's goal: some 12 s of CPU in 50), and DDS
-# discovery is slow on a busy machine, so the suite and the checks run at a lower priority
-# (nice 10): the ROS 2 tests get a core when they ask for one, and the rest of the time
-# goes to the suite. Each part runs whole; make fails if any part failed.
-test: setup
+# The suite needs only the main venv: it starts as soon as that is made, while npm's packages
+# and the ROS 2 venv are made beside it (npm spends most of a minute on the network; the two
+# test files that use npm's tools wait for it: tests/support/node_tools.py). Then the ROS 2
+# tests run beside the checks. The ROS 2 tests mostly wait (on DDS discovery, on a robot's
+# goal: some 12 s of CPU in 50), and DDS discovery is slow on a busy machine, so the suite
+# and the checks run at a lower priority (nice 10): the ROS 2 tests get a core when they ask
+# for one, and the rest of the time goes to the suite. The last line says which parts passed.
+test: system-packages
+	$(MAKE) --no-print-directory -j2 $(SUITE_ENV)
 	status() { if [ "$$1" = 0 ]; then echo passed; else echo "FAILED (exit $$1)"; fi; }; \
-	nice -n 10 $(MAKE) --no-print-directory pytest & suite=$$!; \
-	nice -n 10 $(MAKE) --no-print-directory -j3 --output-sync=target lint typecheck jstest & checks=$$!; \
-	$(MAKE) --no-print-directory pytest-ros2; ros2=$$?; \
-	wait $$checks; checks=$$?; wait $$suite; suite=$$?; \
-	echo "make test: suite $$(status $$suite), checks $$(status $$checks), ROS 2 tests $$(status $$ros2)"; \
-	[ $$suite = 0 ] && [ $$checks = 0 ] && [ $$ros2 = 0 ]
+	VAHR_AWAIT_NODE_MODULES=1 nice -n 10 $(MAKE) --no-print-directory pytest-now & suite=$$!; \
+	$(MAKE) --no-print-directory -j2 node_modules/.installed $(VENV_ROS2)/.installed; setup=$$?; \
+	checks=1; ros2=1; \
+	if [ $$setup = 0 ]; then \
+		nice -n 10 $(MAKE) --no-print-directory -j3 --output-sync=target lint typecheck jstest & checks=$$!; \
+		$(MAKE) --no-print-directory pytest-ros2; ros2=$$?; \
+		wait $$checks; checks=$$?; \
+	fi; \
+	wait $$suite; suite=$$?; \
+	echo "make test: set-up $$(status $$setup), suite $$(status $$suite), checks $$(status $$checks), ROS 2 tests $$(status $$ros2)"; \
+	[ $$setup = 0 ] && [ $$suite = 0 ] && [ $$checks = 0 ] && [ $$ros2 = 0 ]
 
-# What the checks (lint, types, the page's JS) need: the main venv and npm's packages, not
-# the ROS 2 venv.
-CHECK_ENV := $(VENV)/.installed $(ROS_SITE)/.linked node_modules/.installed
+# What the suite needs: the main venv and ROS 1's Python packages in it. The checks (lint,
+# types, the page's JS) need npm's packages too, not the ROS 2 venv.
+SUITE_ENV := $(VENV)/.installed $(ROS_SITE)/.linked
+CHECK_ENV := $(SUITE_ENV) node_modules/.installed
 
 # The environments are made side by side: npm and uv wait on the network while the ROS 2
 # messages compile.
@@ -130,8 +139,13 @@ typecheck: system-packages $(CHECK_ENV)
 
 # Each test file runs whole on one of $(WORKERS) workers, the longest files first
 # (tests/support/scheduling.py). The 90 s soak is not among them: `make soak-test`.
+SUITE = $(BIN)/pytest -q -n $(WORKERS) --dist loadgroup -m "not soak and not ros2"
 pytest: setup
-	$(BIN)/pytest -q -n $(WORKERS) --dist loadgroup -m "not soak and not ros2"
+	$(SUITE)
+
+# The suite without making anything first: `make test` has made what it needs.
+pytest-now:
+	$(SUITE)
 
 # The tests marked ros2 (the nav2 backend against real rclpy and Fast DDS) in .venv-ros2, in a
 # private network namespace where one can be made (root, as CI is): no DDS packet leaves it

@@ -6,15 +6,14 @@ from __future__ import annotations
 import json
 import os
 import subprocess
-from typing import TYPE_CHECKING
+from pathlib import Path
 
 import pytest
 from template_tools import REPO_ROOT
 
-if TYPE_CHECKING:
-    from pathlib import Path
+from tests.support.node_tools import node_modules
 
-CDK_CLI = REPO_ROOT / "node_modules" / "aws-cdk" / "bin" / "cdk"
+CDK_CLI = Path("aws-cdk") / "bin" / "cdk"  # in node_modules
 
 
 def cdk_synth(outdir: Path, *context: str) -> subprocess.CompletedProcess[str]:
@@ -32,8 +31,9 @@ def cdk_synth(outdir: Path, *context: str) -> subprocess.CompletedProcess[str]:
     # A developer's own `ask deploy` state must not change what is synthesized here.
     flags = ["-c", f"askStatesFile={outdir.parent / 'no-ask-states.json'}"]
     flags += [arg for pair in context for arg in ("-c", pair)]
+    cli = node_modules() / CDK_CLI
     return subprocess.run(
-        ["node", str(CDK_CLI), "synth", "--quiet", "--no-notices", "-o", str(outdir), *flags],
+        ["node", str(cli), "synth", "--quiet", "--no-notices", "-o", str(outdir), *flags],
         capture_output=True, text=True, timeout=300, cwd=REPO_ROOT, env=environment,
     )  # fmt: skip
 
@@ -47,7 +47,7 @@ def cdk_synth(outdir: Path, *context: str) -> subprocess.CompletedProcess[str]:
 def test_cdk_synth_works_offline_without_credentials_and_refuses_in_one_line(
     tmp_path: Path,
 ) -> None:
-    assert CDK_CLI.is_file(), "run `make setup` (npm ci) to install the pinned CDK CLI"
+    assert (node_modules() / CDK_CLI).is_file(), "run `make setup` (npm ci) to install the CDK CLI"
     outdir = tmp_path / "cdk.out"
     # Given no credentials and no skill id yet, When the default app is synthesized
     refused = cdk_synth(outdir)

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
+from tests.support.node_tools import node_modules
 from tests.support.vahr_up import clean_env
 from vahr.assistant.nlu import InteractionModel
 from vahr.assistant.understanding import load_understanding
@@ -212,7 +213,7 @@ def _check(
         assert subprocess.run(["make", "-n", *argv], cwd=ROOT, capture_output=True,
                               check=False).returncode == 0, str(command)  # fmt: skip
     elif program == "npx":
-        assert (ROOT / "node_modules" / ".bin" / argv[0]).exists(), str(command)
+        assert (node_modules() / ".bin" / argv[0]).exists(), str(command)
     elif program == "pip":
         assert argv[0] in ("install", "wheel"), str(command)
     elif program == "pytest":
