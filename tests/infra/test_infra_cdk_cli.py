@@ -1,5 +1,5 @@
 """`cdk synth` as a user runs it: the pinned CLI, no AWS credentials, no network needed,
-the Lambda bundle built locally (no Docker); a missing skill id and a bad flag refused in one line."""
+the Lambda bundle built locally (no Docker); a missing skill id refused in one line."""
 
 from __future__ import annotations
 
@@ -38,10 +38,11 @@ def cdk_synth(outdir: Path, *context: str) -> subprocess.CompletedProcess[str]:
     )  # fmt: skip
 
 
-# Three runs of the CLI (node and the Python app each time), one of them a whole synth: more
+# Two runs of the CLI (node and the Python app each time), one of them a whole synth: more
 # than the suite's default bound beside the rest of the suite on two cores. The optional
 # parts are synthesized in-process (test_infra_app.py); here a `-c` flag reaching the app is
-# shown by allowAnySkill.
+# shown by allowAnySkill. A bad flag takes the refusal's path to the same one line
+# (`infra.app.main`); each flag's message is checked in-process (test_infra_config.py).
 @pytest.mark.slow
 @pytest.mark.timeout(300)
 def test_cdk_synth_works_offline_without_credentials_and_refuses_in_one_line(
@@ -78,8 +79,3 @@ def test_cdk_synth_works_offline_without_credentials_and_refuses_in_one_line(
     assert (nag["conclusion"], nag["violations"]) == ("success", [])
     # And the user is told, as a warning, that any skill may call the function for now
     assert "allowAnySkill=true: any Alexa skill may invoke this function" in lean.stderr
-
-    # And a bad flag is refused in one line, before anything is synthesized
-    bad = cdk_synth(tmp_path / "bad", "architecture=mips")
-    assert bad.returncode != 0
-    assert "error: architecture: 'mips' must be x86_64 or arm64" in bad.stderr
