@@ -1,10 +1,11 @@
 """The dialog through push-to-talk (`POST /api/voice` on a running `vahr up`), spoken by flite
 voices built from recordings of people: a whole command answering "which robot?" is acted
-on with its own zone, never the old one; "no, zone a" turns
-the robot the last command sent and "cancel that" stops only it; an answer to "Zone B or
-zone D?" is weighed as an answer, and asked again it offers "bravo or delta", which the
-hearing tells apart; an answer not caught gets the question again; a correction with nothing to correct, and a chord of music, move nothing and
-say so. The same cases typed are in tests/integration/local/test_dialog_corrections.py."""
+on with its own zone, never the old one; "no, zone a" turns the robot the last command sent
+and "cancel that" stops only it; an answer to "Zone B or zone D?" is weighed as an answer,
+and asked again it offers "bravo or delta", which the hearing tells apart; an answer not
+caught gets the question again; a chord of music, and then a correction with nothing to
+correct, move nothing and say so. Each test has a stack of its own. The same cases typed
+are in tests/integration/local/test_dialog_corrections.py."""
 
 from __future__ import annotations
 
@@ -148,16 +149,16 @@ def test_an_answer_not_caught_gets_the_question_again(up: Up) -> None:
     answer_turns_placebot_one(up, "flite:rms", "delta", "D")
 
 
-def test_a_correction_with_nothing_to_correct_says_so(up: Up) -> None:
-    answer = talk(up, "flite:awb", "i meant placebot two")
-    assert answer["speech"] == "There is no command of mine to correct, so I changed nothing."
-    assert answer["turn"]["commands"] == []
-
-
-def test_music_moves_nothing_and_says_so(up: Up) -> None:
+def test_music_moves_nothing_and_a_correction_with_nothing_to_correct_says_so(up: Up) -> None:
+    # Music is not taken for a command
     answer = talk_to(up.endpoints["station"], music())
     assert answer["understood"] is False
     assert "sent nothing to the robots" in answer["speech"]
+    assert all(state.get("last_command") is None for state in robots(up).values())
+    # so a correction after it has nothing to correct
+    answer = talk(up, "flite:awb", "i meant placebot two")
+    assert answer["speech"] == "There is no command of mine to correct, so I changed nothing."
+    assert answer["turn"]["commands"] == []
     assert all(state.get("last_command") is None for state in robots(up).values())
 
 
