@@ -210,11 +210,23 @@ async def test_a_goal_that_never_answers_fails_after_the_feedback_timeout(
     nav2_stand_in.wait_for("cancel_requested", seen + 1, timeout_s=0)
 
 
+# A stop while the robot drives the goal, and one that overtakes the goal's acceptance on its
+# way to the robot (the server takes a second to accept): either way the robot asks Nav2 to
+# cancel the goal and waits for the answer.
+@pytest.mark.parametrize(
+    ("accept_delay_s", "stop_after"), [(0.0, "accepted"), (1.0, "goal")],
+    ids=["driving", "before-the-acceptance"],
+)  # fmt: skip
 async def test_a_cancel_nav2_refuses_is_logged_as_such(
-    fleet: Fleet, own_stand_in: Nav2StandIn, caplog: pytest.LogCaptureFixture
+    fleet: Fleet,
+    own_stand_in: Nav2StandIn,
+    caplog: pytest.LogCaptureFixture,
+    accept_delay_s: float,
+    stop_after: str,
 ) -> None:
     await asyncio.to_thread(own_stand_in.start)
-    own_stand_in.plan({"mode": "stall", "refuse_cancel": True})
+    plan = {"mode": "stall", "refuse_cancel": True, "accept_delay_s": accept_delay_s}
+    own_stand_in.plan(plan)
     # The refusal's answer may take seconds on a loaded machine (discovery of the cancel
     # service): the robot waits for it here rather than log that none came.
     executor, rec = nav2_robot(
@@ -222,7 +234,7 @@ async def test_a_cancel_nav2_refuses_is_logged_as_such(
     )
     try:
         executor.execute(cmd("navigate", {"zone": "A"}, "z1"))
-        await asyncio.to_thread(own_stand_in.wait_for, "accepted")
+        await asyncio.to_thread(own_stand_in.wait_for, stop_after)
         # When a stop comes and Nav2 refuses to cancel the goal
         executor.execute(cmd("stop", None, "z2"))
         await executor.wait_idle()
@@ -231,32 +243,6 @@ async def test_a_cancel_nav2_refuses_is_logged_as_such(
     own_stand_in.wait_for("cancel_refused", timeout_s=0)
     # Then the stop ends as a stop does, and the log says the robot may still be driving
     assert rec.kinds("z2") == ["accepted", "stopped", "done"]
-    assert (
-        "Nav2's 'navigate_to_pose' server refused to cancel the goal; the robot may still be "
-        "driving"
-    ) in caplog.messages
-
-
-async def test_a_stop_that_overtakes_the_goal_s_acceptance_still_cancels_it(
-    fleet: Fleet, own_stand_in: Nav2StandIn, caplog: pytest.LogCaptureFixture
-) -> None:
-    await asyncio.to_thread(own_stand_in.start)
-    # Given a server that takes a second to accept a goal, and refuses to cancel it
-    own_stand_in.plan({"mode": "stall", "refuse_cancel": True, "accept_delay_s": 1.0})
-    executor, rec = nav2_robot(fleet, own_stand_in.domain_id, answer_timeout_s=20)
-    try:
-        executor.execute(cmd("navigate", {"zone": "A"}, "y1"))
-        await asyncio.to_thread(own_stand_in.wait_for, "goal")
-        # When a stop comes before the acceptance reaches the robot
-        executor.execute(cmd("stop", None, "y2"))
-        await executor.wait_idle()
-    finally:
-        await executor.close()
-    # Then the robot waited for the acceptance and asked Nav2 to cancel the goal, and says
-    # that Nav2 refused
-    own_stand_in.wait_for("accepted", timeout_s=0)
-    own_stand_in.wait_for("cancel_refused", timeout_s=0)
-    assert rec.kinds("y2") == ["accepted", "stopped", "done"]
     assert (
         "Nav2's 'navigate_to_pose' server refused to cancel the goal; the robot may still be "
         "driving"
