@@ -1,11 +1,13 @@
 """The dialog through push-to-talk (`POST /api/voice` on a running `vahr up`), spoken by flite
 voices built from recordings of people: a whole command answering "which robot?" is acted
-on with its own zone, never the old one; "no, zone a" turns the robot the last command sent
-and "cancel that" stops only it; an answer to "Zone B or zone D?" is weighed as an answer,
-and asked again it offers "bravo or delta", which the hearing tells apart; an answer not
-caught gets the question again; a chord of music, and then a correction with nothing to
-correct, move nothing and say so. Each test has a stack of its own. The same cases typed
-are in tests/integration/local/test_dialog_corrections.py."""
+on with its own zone, never the old one; "no, zone a" turns the robot the last command sent,
+"cancel that" stops only it, and "not that robot" offers the other, which a spoken yes
+sends; an answer to "Zone B or zone D?" is weighed as an answer, and asked again it offers
+"bravo or delta", which the hearing tells apart, and an answer not caught gets the question
+again; a chord of music, and then a correction with nothing to correct, move nothing and say
+so. Each test has a stack of its own (a correction reaches back to the speaker's last
+command); within one, each case begins with a command of its own. The same cases typed are
+in tests/integration/local/test_dialog_corrections.py."""
 
 from __future__ import annotations
 
@@ -32,7 +34,7 @@ WAIT_S = 30.0
 @pytest.fixture
 def up(tmp_path: Any) -> Iterator[Up]:
     # A stack of its own for each test: a correction reaches back to the last command of
-    # the same speaker, which must be this test's.
+    # the same speaker, which must be this test's (within a test, each case sends its own).
     running = start_up(tmp_path, "--station-port", str(free_port()), "--sim-speed-factor", "4")
     try:
         yield running
@@ -102,7 +104,9 @@ def test_a_whole_command_answering_which_robot_is_acted_on_with_its_own_zone(up:
     assert robots(up)["placebot1"].get("last_command") is None
 
 
-def test_no_zone_a_turns_the_robot_and_cancel_that_stops_only_it(up: Up) -> None:
+def test_no_zone_a_turns_the_robot_cancel_that_stops_only_it_and_not_that_robot_asks(
+    up: Up,
+) -> None:
     send_placebot_one_to_c(up, "flite:rms")
     corrected = talk(up, "flite:rms", "no, zone a")
     assert corrected["speech"].startswith(
@@ -115,8 +119,20 @@ def test_no_zone_a_turns_the_robot_and_cancel_that_stops_only_it(up: Up) -> None
     # Placebot two, never named, was never sent anywhere
     assert robots(up)["placebot2"].get("last_command") is None
 
+    # A new command, then "not that robot": the other robot is offered, and a spoken yes to
+    # the skill's yes-or-no question is weighed as the answer (alone it is no request at all)
+    send_placebot_one_to_c(up, "flite:rms")
+    asked = talk(up, "flite:rms", "not that robot")
+    assert asked["speech"] == "Placebot two instead?", asked
+    confirmed = talk(up, "flite:rms", "yes")
+    assert "Placebot two is on its way to zone C" in confirmed["speech"], confirmed
+    eventually(up, "placebot1", status="stopped")
+    eventually(up, "placebot2", destination="C")
 
-def test_an_answer_to_zone_b_or_zone_d_is_weighed_as_an_answer(up: Up) -> None:
+
+def test_an_answer_to_zone_b_or_zone_d_is_weighed_and_one_not_caught_is_asked_again(
+    up: Up,
+) -> None:
     send_placebot_one_to_c(up, "flite:awb")
     # "no, zone b": B and D are the letters the hearing confuses, so it asks
     asked = talk(up, "flite:awb", "no, zone b")
@@ -131,9 +147,7 @@ def test_an_answer_to_zone_b_or_zone_d_is_weighed_as_an_answer(up: Up) -> None:
     # which the hearing tells apart
     answer_turns_placebot_one(up, "flite:awb", "bravo", "B")
 
-
-def test_an_answer_not_caught_gets_the_question_again(up: Up) -> None:
-    # Given the question typed into being (the station's typing and its voice share the
+    # The question again, typed into being (the station's typing and its voice share the
     # conversation)
     assert type_in(up.endpoints["station"], "send placebot one to zone c")["commands"]
     asked = type_in(up.endpoints["station"], "no, zone b or zone d")
@@ -160,15 +174,3 @@ def test_music_moves_nothing_and_a_correction_with_nothing_to_correct_says_so(up
     assert answer["speech"] == "There is no command of mine to correct, so I changed nothing."
     assert answer["turn"]["commands"] == []
     assert all(state.get("last_command") is None for state in robots(up).values())
-
-
-def test_not_that_robot_is_confirmed_with_a_spoken_yes(up: Up) -> None:
-    send_placebot_one_to_c(up, "flite:rms")
-    asked = talk(up, "flite:rms", "not that robot")
-    assert asked["speech"] == "Placebot two instead?", asked
-    # A yes to the skill's yes-or-no question is weighed as the answer (alone it is no
-    # request at all)
-    confirmed = talk(up, "flite:rms", "yes")
-    assert "Placebot two is on its way to zone C" in confirmed["speech"], confirmed
-    eventually(up, "placebot1", status="stopped")
-    eventually(up, "placebot2", destination="C")
