@@ -312,6 +312,8 @@ class Nav2Backend:
             last.add_done_callback(_cancel_if_accepted)
             log.warning("%s; the robot may still be driving", err)
             return None
+        except Exception:  # noqa: BLE001 - a send rclpy failed put no goal on the server
+            return None
         return handle if handle.accepted else None
 
     def close_zones(self, closed: frozenset[str]) -> None:
