@@ -15,8 +15,8 @@ The station's recognizer is built from them in a child process (`command_recogni
 with a fleet of 1,000 robots the sentences and their language model take about a minute of
 pure Python, which inside the station would hold the interpreter lock its MQTT intake
 needs. The model is cached on disk by a hash of what it is built from, so the next start
-only loads it, in the station itself (a tenth of a second even for 1,000 robots; a child's
-interpreter and imports took most of a second of CPU).
+only loads it, in the station itself (0.4 s of CPU for 1,000 robots; a child's interpreter
+and imports alone took most of a second).
 """
 
 from __future__ import annotations
