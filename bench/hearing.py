@@ -57,10 +57,12 @@ def main() -> None:
     if args.voices:
         many_voices(phrasings, args.voices.split(","), args.phrasings.name)
         return
-    started = time.perf_counter()
-    answers = WeatherAnswers.load()
-    recognizer = weather_recognizer(answers)
-    build_s = time.perf_counter() - started
+    with tempfile.TemporaryDirectory() as cache:
+        # Built as on a robot's first start: its model cache empty.
+        started = time.perf_counter()
+        answers = WeatherAnswers.load()
+        recognizer = weather_recognizer(answers, cache_dir=Path(cache))
+        build_s = time.perf_counter() - started
     with tempfile.TemporaryDirectory() as cache:
         begun = time.perf_counter()
         SenseCheck.train(answers, cache_dir=Path(cache))

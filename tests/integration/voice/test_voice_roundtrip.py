@@ -13,6 +13,8 @@ from vahr.speech.audio import SAMPLE_RATE, Audio, add_white_noise, concatenate
 from vahr.speech.tts import EspeakSynthesizer
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from robot_agent.voice.hearing import Hearing
 
 VOICES = ("en-us+f2", "en-us+m3")
@@ -121,3 +123,23 @@ def test_a_decode_that_fails_does_not_deafen_the_recognizer() -> None:
     # Then the next clip is still heard
     heard = recognizer.recognize(EspeakSynthesizer("en-us+f2").synthesize("It is sunny."))
     assert (heard.accepted, heard.text) == (True, "it is sunny")
+
+
+def test_a_robot_reads_its_hearing_from_the_model_cache_and_hears_the_same(
+    tmp_path: Path,
+) -> None:
+    from robot_agent.voice.answers import WeatherAnswers
+    from robot_agent.voice.hearing import weather_recognizer
+
+    # Given a robot's first start, with an empty model cache
+    answers = WeatherAnswers.load()
+    built = weather_recognizer(answers, cache_dir=tmp_path)
+    assert len(list(tmp_path.glob("language-model-*.json"))) == 1
+    # When it starts again
+    again = weather_recognizer(answers, cache_dir=tmp_path)
+    # Then it hears with the model it built (nothing new in the cache), as it did
+    assert len(list(tmp_path.glob("language-model-*.json"))) == 1
+    assert again.model == built.model  # type: ignore[attr-defined]
+    audio = EspeakSynthesizer("en-us+m3").synthesize("It will rain today.")
+    assert again.recognize(audio) == built.recognize(audio)
+    assert again.recognize(audio).text == "it will rain today"
