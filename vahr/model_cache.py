@@ -15,6 +15,8 @@ import os
 from functools import cache
 from pathlib import Path
 
+import msgspec
+
 
 def default_cache_dir() -> Path:
     """$XDG_CACHE_HOME/vahr (or ~/.cache/vahr): trained models, keyed by their data."""
@@ -30,6 +32,13 @@ def code_digest(*modules: str) -> str:
     for name in modules:
         code.update(Path(str(importlib.import_module(name).__file__)).read_bytes())
     return code.hexdigest()
+
+
+def content_key(made_from: object) -> str:
+    """The cache key of what a model is made from: a sha256 (hex) of it written as JSON,
+    mappings' keys sorted. msgspec writes it: the standard library's json took a third of a
+    second for a fleet's sentences, at every start."""
+    return hashlib.sha256(msgspec.json.encode(made_from, order="sorted")).hexdigest()
 
 
 def write_atomically(file: Path, data: bytes) -> bool:

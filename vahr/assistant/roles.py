@@ -34,9 +34,7 @@ classifier is (`vahr.speech.text_classifier`).
 
 from __future__ import annotations
 
-import hashlib
 import itertools
-import json
 import math
 import re
 from dataclasses import dataclass, replace
@@ -49,7 +47,7 @@ from vahr.domain import FLEET_GROUP
 from vahr.domain.locale import LocaleError
 from vahr.domain.weather import plain_negations, weather_words
 from vahr.errors import VahrError
-from vahr.model_cache import write_atomically
+from vahr.model_cache import content_key, write_atomically
 from vahr.skill_model.intents import ROBOT_TYPE
 from vahr.skill_model.templates import expand
 
@@ -340,7 +338,7 @@ def load_or_train(
 ) -> tuple[RolesTagger, bool]:
     """The intent's tagger, from the cache (True) or trained now and cached (False)."""
     learnt_from = [RECIPE, TRAINING_PARAMETERS, version("python-crfsuite"), intent, sequences]
-    key = hashlib.sha256(json.dumps(learnt_from).encode()).hexdigest()
+    key = content_key(learnt_from)
     file = cache_dir / f"roles-{intent}-{key[:24]}.crfsuite" if cache_dir else None
     if file is not None:
         try:

@@ -11,14 +11,13 @@ that breaks this.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import random
 from dataclasses import dataclass
 from functools import cached_property
 
 from vahr.domain.invocation import FALLBACK_INTENT
-from vahr.model_cache import code_digest, default_cache_dir, write_atomically
+from vahr.model_cache import code_digest, content_key, default_cache_dir, write_atomically
 from vahr.skill_model import templates
 from vahr.skill_model.phrases import RULES
 from vahr.skill_model.templates import draw
@@ -90,7 +89,7 @@ class IntentSpec:
         drawing = code_digest(__name__, templates.__name__)
         made_from = [drawing, self.name, self.templates, self.essentials, self.max_samples,
                      MAX_SAMPLES_PER_INTENT, RULES]  # fmt: skip
-        key = hashlib.sha256(json.dumps(made_from).encode()).hexdigest()
+        key = content_key(made_from)
         file = default_cache_dir() / f"samples-{self.name}-{key[:24]}.json"
         try:
             kept = json.loads(file.read_bytes())

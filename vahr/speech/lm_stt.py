@@ -45,7 +45,6 @@ from __future__ import annotations
 import hashlib
 import io
 import itertools
-import json
 import pickle
 import shutil
 import signal
@@ -59,7 +58,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import msgspec
 
-from vahr.model_cache import write_atomically
+from vahr.model_cache import content_key, write_atomically
 from vahr.speech.audio import SAMPLE_RATE, SpeechDetector
 from vahr.speech.errors import SpeechError
 from vahr.speech.pronounce import guesses
@@ -161,7 +160,7 @@ def model_key(sentences: Sequence[str], background_words: int = 0) -> str:
     except PackageNotFoundError:
         library = "absent"
     built_from = [MODEL_RECIPE, library, _espeak_version(), background_words, list(sentences)]
-    return hashlib.sha256(json.dumps(built_from).encode()).hexdigest()
+    return content_key(built_from)
 
 
 def cached_language_model(

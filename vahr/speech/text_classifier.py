@@ -22,14 +22,14 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
-import hashlib
-import json
 import math
 from collections import Counter
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from vahr.model_cache import write_atomically
+import msgspec
+
+from vahr.model_cache import content_key, write_atomically
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
@@ -127,8 +127,7 @@ def training_key(recipe: str, texts: list[str], labels: list[str]) -> str:
         learner = version("scikit-learn")
     except PackageNotFoundError:
         learner = "absent"
-    digest = hashlib.sha256(json.dumps([LEARNER, recipe, learner, texts, labels]).encode())
-    return digest.hexdigest()
+    return content_key([LEARNER, recipe, learner, texts, labels])
 
 
 def load_or_train(
@@ -158,16 +157,16 @@ def load_or_train(
         if cached is not None:
             return TextClassifier(cached, analyzer), True
         exported = _trained(texts, labels, analyzer, key)
-        write_atomically(file, json.dumps(exported).encode())
+        write_atomically(file, msgspec.json.encode(exported))
     return TextClassifier(exported, analyzer), False
 
 
 def _cached(file: Path, key: str) -> dict[str, Any] | None:
     try:
-        exported: dict[str, Any] = json.loads(file.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        exported = msgspec.json.decode(file.read_bytes())
+    except (OSError, msgspec.DecodeError):
         return None
-    return exported if exported.get("key") == key else None
+    return exported if isinstance(exported, dict) and exported.get("key") == key else None
 
 
 def _trained(texts: list[str], labels: list[str], analyzer: Analyzer, key: str) -> dict[str, Any]:

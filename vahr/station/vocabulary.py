@@ -21,7 +21,6 @@ and imports alone took most of a second).
 
 from __future__ import annotations
 
-import hashlib
 import json
 import logging
 import re
@@ -35,7 +34,7 @@ from vahr.assistant import DEFAULT_MODEL, RULE_SLOTS, built_in_phrases, confirma
 from vahr.domain.fleet import zone_phrase
 from vahr.domain.text import normalize, spell_numbers
 from vahr.errors import VahrError
-from vahr.model_cache import code_digest, write_atomically
+from vahr.model_cache import code_digest, content_key, write_atomically
 
 if TYPE_CHECKING:
     from vahr.domain import Fleet
@@ -205,7 +204,7 @@ def _sentences_file(document: dict[str, Any], cache_dir: Path | None) -> tuple[P
         code_digest(__name__, "vahr.domain.text"), built_in_phrases(), confirmation_phrases(),
         document,
     ]  # fmt: skip
-    digest = hashlib.sha256(json.dumps(made_from, sort_keys=True).encode()).hexdigest()
+    digest = content_key(made_from)
     return (cache_dir / f"sentences-{digest[:24]}.json" if cache_dir else None), digest
 
 
