@@ -139,12 +139,19 @@ typecheck: system-packages $(CHECK_ENV)
 
 # Each test file runs whole on one of $(WORKERS) workers, the longest files first
 # (tests/support/scheduling.py). The 90 s soak is not among them: `make soak-test`.
-SUITE = $(BIN)/pytest -q -n $(WORKERS) --dist loadgroup -m "not soak and not ros2"
+SUITE_TESTS := -m "not soak and not ros2"
+SUITE = $(BIN)/pytest -q -n $(WORKERS) --dist loadgroup $(SUITE_TESTS)
 pytest: setup
 	$(SUITE)
 
-# The suite without making anything first: `make test` has made what it needs.
+# The suite without making anything first: `make test` has made what it needs. One process
+# collects it first: in a fresh clone no byte code is written yet, and each of the workers
+# would compile the suite's modules and their libraries at the same time (three cold
+# collections took 103 s of CPU here; one, then three warm ones, 90 s, and the machine's
+# other core was making the ROS 2 venv meanwhile). A collection error is the suite's to
+# report, at once after.
 pytest-now:
+	$(BIN)/pytest -q --collect-only -p no:xdist $(SUITE_TESTS) >/dev/null 2>&1 || true
 	$(SUITE)
 
 # The tests marked ros2 (the nav2 backend against real rclpy and Fast DDS) in .venv-ros2, in a
@@ -168,7 +175,7 @@ soak-test: setup
 # passes only most of the time fails here (see docs/reliability.md).
 test-repeat: setup
 	for run in 1 2 3 4 5; do echo "integration run $$run of 5"; \
-		$(BIN)/pytest -q -n $(WORKERS) --dist loadgroup -m "not soak and not ros2" tests/integration || exit 1; done
+		$(SUITE) tests/integration || exit 1; done
 
 bench: setup
 	for script in bench/*.py; do case $$script in */_*) continue;; esac; $(BIN)/python $$script || exit 1; done

@@ -24,7 +24,7 @@ EVENTS_DIR = Path(__file__).parent / "events"
 
 
 def pytest_configure() -> None:
-    """One BLAS and OpenMP thread per process, set before numpy loads: the suite's two
+    """One BLAS and OpenMP thread per process, set before numpy loads: the suite's
     workers already keep both cores busy, and the threads numpy, scipy and scikit-learn
     would add per core only contend (a model fit in each worker at once took 14 s instead
     of 4). The robots and stacks the tests start inherit it."""
