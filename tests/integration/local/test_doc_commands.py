@@ -9,6 +9,8 @@ parsed by the command's own argument parser instead (a flag or subcommand the co
 does not have fails); a `make` target must exist (`make -n`); a sentence given to
 `vahr say` must be understood, robot and zone, by the stack the same block starts (its
 `--fleet` and `--locale`). Lines in a block that are output, not commands, are left out.
+Every page's `curl` lines against the local data plane run against a `vahr up`, and what
+a line's comment says it answers is what it answers.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import argparse
 import contextlib
 import importlib
 import io
+import json
 import re
 import shlex
 import shutil
@@ -29,7 +32,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from tests.support.node_tools import node_modules
-from tests.support.vahr_up import clean_env
+from tests.support.vahr_up import clean_env, start_up, stop_up
 from vahr.assistant.nlu import InteractionModel
 from vahr.assistant.understanding import load_understanding
 from vahr.domain import load_fleet
@@ -41,6 +44,8 @@ if TYPE_CHECKING:
 ROOT = Path(__file__).resolve().parents[3]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs" / "guides").glob("*.md"))]
 BOTO3_PAGE = ROOT / "docs" / "local.md"
+# Where the docs' `curl` examples reach the local data plane (`vahr up`'s default port).
+DATA_PLANE = "localhost:8180"
 SHELL_LANGUAGES = ("", "sh", "bash", "console", "shell")
 # The programs a command line may start with; any other line of a block is output.
 PROGRAMS = ("make", "npx", "pip", "robot-agent", "vahr", "export", ".venv/bin/")
@@ -273,6 +278,38 @@ def test_the_boto3_example_reads_a_shadow_as_written(local_stack: LocalStack) ->
     # Then boto3 reads the shadow
     assert done.returncode == 0, done.stderr[-800:]
     assert '"status": "idle"' in done.stdout or '"status":"idle"' in done.stdout
+
+
+def data_plane_calls() -> list[tuple[str, str, str | None]]:
+    """Each `curl` line of the docs against the local data plane, in page order: (the page,
+    the command, the answer its comment shows, if any)."""
+    found = []
+    for page in sorted((ROOT / "docs").glob("*.md")):
+        for block in shell_blocks(page):
+            for line in block.splitlines():
+                if line.startswith("curl ") and DATA_PLANE in line:
+                    command, _, shown = line.partition("#")
+                    found.append((page.name, command.strip(), shown.strip() or None))
+    return found
+
+
+def test_every_data_plane_curl_in_the_docs_is_answered(tmp_path: Path) -> None:
+    # Given the docs' curl lines (the tasks of docs/dispatch.md, the zones of docs/floors.md)
+    calls = data_plane_calls()
+    assert {page for page, _, _ in calls} >= {"dispatch.md", "floors.md"}
+    up = start_up(tmp_path)
+    try:
+        api = up.endpoints["api"].removeprefix("http://")
+        for page, line, shown in calls:
+            # When each runs as written against the stack (its port aside)
+            words = [word.replace(DATA_PLANE, api) for word in shlex.split(line)]
+            body, _, status = _run([*words, "-w", "\n%{http_code}"], tmp_path).rpartition("\n")
+            # Then it is answered, and with what its comment shows
+            assert status == "200", f"{page}: {line}: {status} {body}"
+            if shown is not None:
+                assert json.loads(body) == json.loads(shown), f"{page}: {line}"
+    finally:
+        stop_up(up.process)
 
 
 def test_a_command_the_product_lacks_fails_here() -> None:
