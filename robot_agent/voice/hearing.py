@@ -129,12 +129,7 @@ def weather_recognizer(answers: WeatherAnswers, *, cache_dir: Path | None = None
         corpus, BACKGROUND_WORDS, cache_dir=cache_dir or default_cache_dir()
     )
     log.debug("the hearing's language model was %s", "read from the cache" if cached else "built")
-    return LanguageModelRecognizer(
-        corpus,
-        adaptation=hearing_adaptation(),
-        background_words=BACKGROUND_WORDS,
-        model=model,
-    )
+    return LanguageModelRecognizer(corpus, adaptation=hearing_adaptation(), model=model)
 
 
 def hearing_adaptation(setting: str | None = None) -> Path | None:

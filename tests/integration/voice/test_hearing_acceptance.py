@@ -3,7 +3,7 @@
 one of the set's three espeak-ng voices in turn, clean and at 10 dB SNR, the set's two ends
 (274 clips, rendered with the set's seed, so the same on every run: each clip's noise is
 seeded by the clip, so these are the very clips the whole set holds). Hearing a clip takes
-about a quarter of a second of CPU here, so the whole set (all three voices and 20 dB as
+a quarter to a third of a second of CPU here, so the whole set (all three voices and 20 dB as
 well: 1,233 clips, eight minutes of CPU) is scored by `bench/hearing.py`, whose figures are
 in docs/benchmarks.md; this part keeps the suite within its time.
 

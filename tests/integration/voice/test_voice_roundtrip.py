@@ -1,6 +1,7 @@
 """Acceptance: espeak-ng speaks the assistant's answers, pocketsphinx and the local
 interpreter understand every one, clean and with white noise at 20 dB SNR, in two voices;
-silence and unrelated sentences come back unknown, with the reason."""
+silence and unrelated sentences come back unknown, with the reason; a robot's second start
+hears with the language model its first one cached."""
 
 from __future__ import annotations
 
