@@ -68,8 +68,11 @@ const LABELS_UP_TO = 12; // more robots than this: numbers only, no names under 
 // A zone's letter and name are this many screen pixels high, and its box at least this many
 // across, whatever the floor's size: a thousand robots' floor is as readable as four's.
 const ZONE_LETTER_PX = 18, ZONE_NAME_PX = 12, ZONE_BOX_PX = 34;
-// Frames a second the map moves robots at: smooth for a few, calmer (and cheaper) for many.
-const FRAME_MS_FEW = 0, FRAME_MS_MANY = 50, MANY = 20;
+// How often the map moves robots: 30 frames a second for a few (a robot at 0.5 m/s moves
+// under a pixel a frame at 30 on the default floor in a laptop's window, so the screen's 60
+// add nothing one can see, and cost an open page half as much CPU again while two robots
+// drove), 20 for many.
+const FRAME_MS_FEW = 33, FRAME_MS_MANY = 50, MANY = 20;
 // More robots than this are drawn on a canvas: SVG's per-element styling and layout cost
 // grows with every robot drawn each frame.
 export const SVG_ROBOTS_UP_TO = 24;
