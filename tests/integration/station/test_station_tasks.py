@@ -29,7 +29,7 @@ from vahr.station.assembly import Station, StationConfig
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
-    from playwright.sync_api import Page, ViewportSize
+    from playwright.sync_api import Browser, Page, ViewportSize
 
     from vahr.domain import Fleet
     from vahr.twin.broker import Mosquitto
@@ -105,19 +105,30 @@ def station(
         link.stop()
 
 
-@pytest.fixture
-def page(station: tuple[Station, RecordingAssistant]) -> Iterator[Page]:
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Browser]:
+    # One browser for the file (starting one costs some 2 s of CPU); a page of its own,
+    # in a context of its own, for each test.
     with sync_playwright() as playwright:
-        browser = launch(playwright)
+        launched = launch(playwright)
         try:
-            opened = browser.new_page(viewport=VIEWPORT)
-            watch = Watch(opened)
-            opened.goto(station[0].url)
-            opened.locator('#link-state[data-state="live"]').wait_for(timeout=WAIT_MS)
-            yield opened
-            assert watch.problems == [], "the page logged errors or had failed requests"
+            yield launched
         finally:
-            browser.close()
+            launched.close()
+
+
+@pytest.fixture
+def page(browser: Browser, station: tuple[Station, RecordingAssistant]) -> Iterator[Page]:
+    context = browser.new_context(viewport=VIEWPORT)
+    try:
+        opened = context.new_page()
+        watch = Watch(opened)
+        opened.goto(station[0].url)
+        opened.locator('#link-state[data-state="live"]').wait_for(timeout=WAIT_MS)
+        yield opened
+        assert watch.problems == [], "the page logged errors or had failed requests"
+    finally:
+        context.close()
 
 
 def eventually(check: Callable[[], Any], what: str, timeout_s: float = 15.0) -> Any:
