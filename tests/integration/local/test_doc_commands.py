@@ -9,8 +9,10 @@ parsed by the command's own argument parser instead (a flag or subcommand the co
 does not have fails); a `make` target must exist (`make -n`); a sentence given to
 `vahr say` must be understood, robot and zone, by the stack the same block starts (its
 `--fleet` and `--locale`). Lines in a block that are output, not commands, are left out.
-Every page's `curl` lines against the local data plane run against a `vahr up`, and what
-a line's comment says it answers is what it answers.
+Every docs page's block that calls a running `vahr up` with `curl` (its data plane, its
+station's push-to-talk) runs against one, each line as written; what a line's comment says
+it answers is what it answers, and a clip posted to the station is answered with the fields
+docs/push-to-talk.md lists.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ import shlex
 import shutil
 import subprocess
 import sys
+import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -44,8 +47,11 @@ if TYPE_CHECKING:
 ROOT = Path(__file__).resolve().parents[3]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs" / "guides").glob("*.md"))]
 BOTO3_PAGE = ROOT / "docs" / "local.md"
-# Where the docs' `curl` examples reach the local data plane (`vahr up`'s default port).
-DATA_PLANE = "localhost:8180"
+# Where the docs' `curl` examples reach a running `vahr up` (its default ports), and which
+# of its endpoints each is: the data plane and the station.
+LOCAL_ADDRESSES = {"localhost:8180": "api", "127.0.0.1:8181": "station"}
+# What the station answers a clip with (docs/push-to-talk.md, `POST /api/voice`).
+VOICE_ANSWER = {"heard", "recognizer_ms", "understood", "speech", "turn"}
 SHELL_LANGUAGES = ("", "sh", "bash", "console", "shell")
 # The programs a command line may start with; any other line of a block is output.
 PROGRAMS = ("make", "npx", "pip", "robot-agent", "vahr", "export", ".venv/bin/")
@@ -280,34 +286,57 @@ def test_the_boto3_example_reads_a_shadow_as_written(local_stack: LocalStack) ->
     assert '"status": "idle"' in done.stdout or '"status":"idle"' in done.stdout
 
 
-def data_plane_calls() -> list[tuple[str, str, str | None]]:
-    """Each `curl` line of the docs against the local data plane, in page order: (the page,
-    the command, the answer its comment shows, if any)."""
+def local_blocks() -> list[tuple[str, list[str]]]:
+    """Each docs page's shell block with a `curl` line to a running `vahr up`, in page
+    order: (the page, the block's lines)."""
     found = []
     for page in sorted((ROOT / "docs").glob("*.md")):
         for block in shell_blocks(page):
-            for line in block.splitlines():
-                if line.startswith("curl ") and DATA_PLANE in line:
-                    command, _, shown = line.partition("#")
-                    found.append((page.name, command.strip(), shown.strip() or None))
+            lines = [line.strip() for line in block.splitlines() if line.strip()]
+            if any(line.startswith("curl ") and _local_address(line) for line in lines):
+                found.append((page.name, lines))
     return found
 
 
-def test_every_data_plane_curl_in_the_docs_is_answered(tmp_path: Path) -> None:
-    # Given the docs' curl lines (the tasks of docs/dispatch.md, the zones of docs/floors.md)
-    calls = data_plane_calls()
-    assert {page for page, _, _ in calls} >= {"dispatch.md", "floors.md"}
-    up = start_up(tmp_path)
+def _local_address(line: str) -> str | None:
+    return next((address for address in LOCAL_ADDRESSES if address in line), None)
+
+
+def test_every_local_curl_in_the_docs_is_answered(tmp_path: Path) -> None:
+    # Given the docs' blocks that call a running stack (the tasks of docs/dispatch.md, the
+    # zones of docs/floors.md, the clips of docs/push-to-talk.md)
+    blocks = local_blocks()
+    assert {page for page, _ in blocks} >= {"dispatch.md", "floors.md", "push-to-talk.md"}
+    # (Whisper aside: a clip is answered with the same fields without its second hearing.)
+    up = start_up(tmp_path, env={"VAHR_WHISPER": "off"})
     try:
-        api = up.endpoints["api"].removeprefix("http://")
-        for page, line, shown in calls:
-            # When each runs as written against the stack (its port aside)
-            words = [word.replace(DATA_PLANE, api) for word in shlex.split(line)]
-            body, _, status = _run([*words, "-w", "\n%{http_code}"], tmp_path).rpartition("\n")
-            # Then it is answered, and with what its comment shows
-            assert status == "200", f"{page}: {line}: {status} {body}"
-            if shown is not None:
-                assert json.loads(body) == json.loads(shown), f"{page}: {line}"
+        for page, lines in blocks:
+            spoken = None
+            for line in lines:
+                command, _, shown = line.partition(" #")
+                words = shlex.split(command)
+                if words[0].startswith(".venv/bin/"):
+                    words[0] = str(ROOT / words[0])
+                address = _local_address(command)
+                if not (words[0] == "curl" and address):
+                    _run(words, tmp_path)  # the clip the next line posts
+                    spoken = words[words.index("speak") + 1] if "speak" in words else None
+                    continue
+                # When each call runs as written against the stack (its port aside)
+                running = urllib.parse.urlsplit(up.endpoints[LOCAL_ADDRESSES[address]]).netloc
+                words = [word.replace(address, running) for word in words]
+                answer = _run([*words, "-w", "\n%{http_code}"], tmp_path)
+                body, _, status = answer.rpartition("\n")
+                # Then it is answered, with what its comment shows, or a clip with its fields
+                assert status == "200", f"{page}: {line}: {status} {body}"
+                if shown.strip():
+                    assert json.loads(body) == json.loads(shown), f"{page}: {line}"
+                if "/api/voice" in command:
+                    # heard as it was spoken, and acted on
+                    voiced = json.loads(body)
+                    assert set(voiced) >= VOICE_ANSWER, f"{page}: {line}: {body}"
+                    assert voiced["heard"]["transcript"] == spoken, f"{page}: {body}"
+                    assert voiced["turn"] is not None, f"{page}: {body}"
     finally:
         stop_up(up.process)
 
