@@ -46,8 +46,8 @@ demo: setup
 	$(BIN)/vahr demo
 
 # The suite needs only the main venv: it starts as soon as that is made, while npm's packages
-# and the ROS 2 venv are made beside it (npm spends most of a minute on the network; the two
-# test files that use npm's tools wait for it: tests/support/node_tools.py). Then the ROS 2
+# and the ROS 2 venv are made beside it (npm waits on the network; the two test files that
+# use npm's tools wait for it: tests/support/node_tools.py). Then the ROS 2
 # tests run beside the checks. The ROS 2 tests mostly wait (on DDS discovery, on a robot's
 # goal: some 12 s of CPU in 50), and DDS discovery is slow on a busy machine, so the suite
 # and the checks run at a lower priority (nice 10): the ROS 2 tests get a core when they ask
@@ -73,9 +73,10 @@ SUITE_ENV := $(VENV)/.installed $(ROS_SITE)/.linked
 CHECK_ENV := $(SUITE_ENV) node_modules/.installed
 
 # The environments are made side by side: npm and uv wait on the network while the ROS 2
-# messages compile.
+# messages compile. The ASK CLI is for deploying only (docs/deploy.md): set-up installs it,
+# the tests do not need it.
 setup: system-packages
-	$(MAKE) --no-print-directory -j3 $(CHECK_ENV) $(VENV_ROS2)/.installed
+	$(MAKE) --no-print-directory -j3 $(CHECK_ENV) $(VENV_ROS2)/.installed $(ASK_CLI)
 
 system-packages:
 	@missing=$$(for p in $(DEB_PACKAGES); do dpkg-query -W -f='$${Status}' $$p 2>/dev/null \
@@ -117,8 +118,17 @@ $(VENV_ROS2)/.installed: $(VENV_ROS2)/.ros2 requirements.txt pyproject.toml
 	$(UV) --python $(BIN_ROS2)/python -c requirements.txt --no-build-isolation -e .
 	touch $@
 
-node_modules/.installed: package.json package-lock.json
-	npm ci --no-audit --no-fund --loglevel=error
+# npm's packages for the checks and the tests: the CDK CLI and TypeScript, not the
+# workspaces (the ASK CLI's 500 packages took 40 s of CPU to install and are used only to
+# deploy).
+node_modules/.installed: package.json package-lock.json tools/ask-cli/package.json
+	npm ci --workspaces=false --no-audit --no-fund --loglevel=error
+	touch $@
+
+# The pinned ASK CLI (the workspace tools/ask-cli), added at the lock's versions: `npx ask`.
+ASK_CLI := node_modules/.ask-cli
+$(ASK_CLI): node_modules/.installed
+	npm install --workspace=tools/ask-cli --no-save --no-audit --no-fund --loglevel=error
 	touch $@
 
 lint: system-packages $(CHECK_ENV)

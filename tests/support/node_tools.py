@@ -1,7 +1,7 @@
 """npm's packages, for the tests that use npm's tools (the CDK CLI, the docs' `npx` commands).
 
 `make test` starts the suite as soon as the Python venv is made, while `npm ci` is still at
-work beside it (it spends most of a minute on the network, and nothing else in the suite
+work beside it (it waits on the network on a fresh machine, and nothing else in the suite
 needs it). It says so with VAHR_AWAIT_NODE_MODULES, and these tests then wait for the marker
 make writes when `npm ci` is done; anywhere else a missing install fails at once.
 """
