@@ -52,6 +52,7 @@ import subprocess
 import sys
 import tempfile
 import threading
+from collections import Counter
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -120,10 +121,34 @@ def arpa_model(sentences: Iterable[str]) -> str:
     """A trigram language model (ARPA text) of `sentences` (already normalized)."""
     from pocketsphinx.lm import ArpaBoLM
 
+    class CountedArpaBoLM(ArpaBoLM):
+        """`ArpaBoLM` reading a corpus of normalized sentences with `Counter`s: the same
+        counts in the same order, so the same model to the byte, in a third of the time
+        (its own `read_corpus` first strips a transcript's trailing "(file id)" from each
+        line with a backtracking regular expression, half its time on the station's 185,000
+        sentences; normalized sentences have no parentheses)."""
+
+        def read_corpus(self, infile: Iterable[str]) -> None:
+            unigrams: Counter[str] = Counter()
+            bigrams: Counter[tuple[str, str]] = Counter()
+            trigrams: Counter[tuple[str, str, str]] = Counter()
+            for line in infile:
+                words = ["<s>", *line.split(), "</s>"]
+                unigrams.update(words)
+                bigrams.update(itertools.pairwise(words))
+                trigrams.update(zip(words, words[1:], words[2:], strict=False))
+            for word, count in unigrams.items():
+                self.grams_1[word] += count
+            for (first, second), count in bigrams.items():
+                self.grams_2[first][second] += count
+            for (first, second, third), count in trigrams.items():
+                self.grams_3[first][second][third] += count
+
     corpus = "\n".join(dict.fromkeys(s for s in sentences if s.strip()))
     if not corpus:
         raise SpeechError("the language model needs at least one sentence")
-    model = ArpaBoLM(text=corpus, add_start=True, discount_mass=DISCOUNT_MASS)
+    reader = ArpaBoLM if "(" in corpus else CountedArpaBoLM
+    model = reader(text=corpus, add_start=True, discount_mass=DISCOUNT_MASS)
     model.compute()
     out = io.StringIO()
     model.write(out)

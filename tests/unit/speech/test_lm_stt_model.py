@@ -4,6 +4,7 @@ builds nothing, and a damaged or unreadable cache file is built again, never an 
 
 from __future__ import annotations
 
+import io
 from typing import TYPE_CHECKING
 
 import pytest
@@ -11,6 +12,7 @@ import pytest
 from vahr.speech import lm_stt
 from vahr.speech.errors import SpeechError
 from vahr.speech.lm_stt import (
+    DISCOUNT_MASS,
     LanguageModel,
     build_language_model,
     cached_language_model,
@@ -42,6 +44,24 @@ def test_the_model_built_in_a_child_process_is_the_one_built_here() -> None:
     assert there.dictionary == here.dictionary
     assert "\\3-grams:" in here.arpa
     assert here.words == {word for sentence in SENTENCES for word in sentence.split()}
+
+
+def test_the_model_is_pocketsphinxs_own_arpabolm_to_the_byte() -> None:
+    # Given the station's sentences of the default interaction model (every fifth: the
+    # whole set takes seconds), and one with parentheses, which ArpaBoLM reads itself
+    from pocketsphinx.lm import ArpaBoLM
+
+    from vahr.station.vocabulary import load_model, sentences
+
+    corpus = sentences(load_model())[::5]
+    for examples in (corpus, [*SENTENCES, "stop placebot one (utterance 7)"]):
+        # When the model is built, and ArpaBoLM reads the same text as it reads a file
+        library = ArpaBoLM(text="\n".join(examples), add_start=True, discount_mass=DISCOUNT_MASS)
+        library.compute()
+        written = io.StringIO()
+        library.write(written)
+        # Then both are the same text
+        assert lm_stt.arpa_model(examples) == written.getvalue()
 
 
 def test_an_error_in_the_child_process_is_raised_here() -> None:
