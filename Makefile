@@ -51,14 +51,12 @@ demo: setup
 # tests run beside the checks. The ROS 2 tests mostly wait (on DDS discovery, on a robot's
 # goal: some 12 s of CPU in 50), and DDS discovery is slow on a busy machine, so the suite
 # and the checks run at a lower priority (nice 10): the ROS 2 tests get a core when they ask
-# for one, and the rest of the time goes to the suite. The suite's first collection, which
-# every worker waits for, is not lowered, and the ROS 2 venv's build (whose compiler runs
-# four jobs) yields to it. The last line says which parts passed.
+# for one, and the rest of the time goes to the suite. The last line says which parts passed.
 test: system-packages
 	$(MAKE) --no-print-directory -j2 $(SUITE_ENV)
 	status() { case "$$1" in 0) echo passed;; -) echo "not run";; *) echo "FAILED (exit $$1)";; esac; }; \
-	VAHR_AWAIT_NODE_MODULES=1 $(MAKE) --no-print-directory pytest-now SUITE_PRIORITY="nice -n 10" & suite=$$!; \
-	nice -n 5 $(MAKE) --no-print-directory -j2 node_modules/.installed $(VENV_ROS2)/.installed; setup=$$?; \
+	VAHR_AWAIT_NODE_MODULES=1 nice -n 10 $(MAKE) --no-print-directory pytest-now & suite=$$!; \
+	$(MAKE) --no-print-directory -j2 node_modules/.installed $(VENV_ROS2)/.installed; setup=$$?; \
 	checks=-; ros2=-; \
 	if [ $$setup = 0 ]; then \
 		nice -n 10 $(MAKE) --no-print-directory -j3 --output-sync=target lint typecheck jstest & checks=$$!; \
@@ -153,8 +151,6 @@ typecheck: system-packages $(CHECK_ENV)
 # (tests/support/scheduling.py). The 90 s soak is not among them: `make soak-test`.
 SUITE_TESTS := -m "not soak and not ros2"
 SUITE = $(BIN)/pytest -q -n $(WORKERS) --dist loadgroup $(SUITE_TESTS)
-# A command the suite runs under (`make test` gives "nice -n 10").
-SUITE_PRIORITY ?=
 pytest: setup
 	$(SUITE)
 
@@ -166,7 +162,7 @@ pytest: setup
 # report, at once after.
 pytest-now:
 	$(BIN)/pytest -q --collect-only -p no:xdist $(SUITE_TESTS) >/dev/null 2>&1 || true
-	$(SUITE_PRIORITY) $(SUITE)
+	$(SUITE)
 
 # The tests marked ros2 (the nav2 backend against real rclpy and Fast DDS) in .venv-ros2, in a
 # private network namespace where one can be made (root, as CI is): no DDS packet leaves it
