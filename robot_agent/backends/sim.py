@@ -101,7 +101,8 @@ class SimBackend:
     def watch_battery(self, on_battery: Callable[[Battery], None]) -> None:
         """Report the battery now and whenever its whole percent or charging changes."""
         self.battery.watch(on_battery)
-        self._battery_ticker.add(self.battery)
+        if self.battery.changes_unwatched:
+            self._battery_ticker.add(self.battery)
 
     def set_battery(self, percent: float) -> None:
         """Set the charge (a fault injected for tests and demos)."""

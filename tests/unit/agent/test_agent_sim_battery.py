@@ -11,11 +11,11 @@ import pytest
 
 from robot_agent.backends.port import NavigationFailed
 from robot_agent.backends.sim import SimBackend
-from robot_agent.backends.sim_battery import SimBattery
+from robot_agent.backends.sim_battery import BatteryTicker, SimBattery
 from robot_agent.clock import ScaledClock
 from robot_agent.config import SimSettings
-from vahr.domain import Pose, load_fleet
-from vahr.domain.battery import BatteryType
+from vahr.domain import Pose, Zone, load_fleet
+from vahr.domain.battery import NO_DRAIN, BatteryType
 from vahr.protocol import Battery
 
 FLEET = load_fleet(Path(__file__).parents[2] / "fleets" / "three_rovers.yaml")
@@ -105,5 +105,45 @@ async def test_a_simulated_robot_drains_as_it_drives_and_stops_when_empty() -> N
     with pytest.raises(NavigationFailed, match="the battery is empty"):
         await robot.go_to(FLEET.zone("A"), lambda progress: None)
     assert robot.pose == stopped
+    await robot.close()
+    await asyncio.sleep(0)
+
+
+class CountingTicker(BatteryTicker):
+    """A battery ticker that remembers what it was given to settle."""
+
+    def __init__(self) -> None:
+        super().__init__(clock=ScaledClock(1.0))
+        self.settled: list[SimBattery] = []
+
+    def add(self, battery: SimBattery) -> None:
+        self.settled.append(battery)
+        super().add(battery)
+
+
+@pytest.mark.parametrize(
+    ("rates", "chargers", "settled"),
+    [
+        (NO_DRAIN, (), False),  # a fleet file without batteries: the charge never changes
+        (NO_DRAIN, FLEET.chargers, True),  # set below full by a fault, it charges at one
+        (BatteryType(drain_per_m=0.0, working_drain_per_h=0.0), (), True),  # idle drain
+        (BatteryType(drain_per_m=0.0, idle_drain_per_h=0.0), (), True),  # working drain
+    ],
+)
+async def test_only_a_battery_whose_charge_can_change_standing_is_settled(
+    rates: BatteryType, chargers: tuple[Zone, ...], settled: bool
+) -> None:
+    ticker = CountingTicker()
+    robot = SimBackend(
+        start=Pose(1.0, 1.0),
+        clock=ScaledClock(1.0),
+        battery=rates,
+        chargers=chargers,
+        battery_ticker=ticker,
+    )
+    seen: list[Battery] = []
+    robot.watch_battery(seen.append)
+    assert seen == [Battery(percent=100, charging=False)]
+    assert bool(ticker.settled) is settled
     await robot.close()
     await asyncio.sleep(0)
