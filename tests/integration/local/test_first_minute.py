@@ -25,7 +25,8 @@ from vahr.plumbing.ports import free_port
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
-# A first start on 2 busy cores learns the fleet's names and four robots' hearing.
+# A first start on 2 busy cores learns the assistant's models for the fleet's names: the
+# intent classifier, the slot-role taggers and the station's sentences and language model.
 FIRST_START_S = 300.0
 
 
