@@ -47,16 +47,20 @@ def test_the_model_built_in_a_child_process_is_the_one_built_here() -> None:
 
 
 def test_the_model_is_pocketsphinxs_own_arpabolm_to_the_byte() -> None:
-    # Given the station's sentences of the default interaction model (every fifth: the
-    # whole set takes seconds), and one with parentheses, which ArpaBoLM reads itself
+    # Given the default interaction model's samples, normalized (thousands of sentences
+    # sharing their words), and sentences with parentheses, which ArpaBoLM reads itself
     from pocketsphinx.lm import ArpaBoLM
 
-    from vahr.station.vocabulary import load_model, sentences
+    from vahr.domain.text import normalize
+    from vahr.station.vocabulary import load_model
 
-    corpus = sentences(load_model())[::5]
+    intents = load_model()["interactionModel"]["languageModel"]["intents"]
+    corpus = [normalize(sample) for intent in intents for sample in intent.get("samples", [])]
+    assert len(corpus) > 1000
     for examples in (corpus, [*SENTENCES, "stop placebot one (utterance 7)"]):
-        # When the model is built, and ArpaBoLM reads the same text as it reads a file
-        library = ArpaBoLM(text="\n".join(examples), add_start=True, discount_mass=DISCOUNT_MASS)
+        # When the model is built, and ArpaBoLM reads the same text (each sentence once)
+        text = "\n".join(dict.fromkeys(examples))
+        library = ArpaBoLM(text=text, add_start=True, discount_mass=DISCOUNT_MASS)
         library.compute()
         written = io.StringIO()
         library.write(written)
