@@ -170,7 +170,7 @@ pytest-now:
 # own and discovery stays on localhost (tests/support/nav2.py). One file at a time: under
 # `make test` they already run beside the suite and the checks.
 ROS2_PYTEST := $(BIN_ROS2)/pytest -q -m ros2 $(ROS2_TESTS)
-pytest-ros2: system-packages $(VENV_ROS2)/.installed
+pytest-ros2: setup
 	if [ "$$(id -u)" = 0 ] && unshare -n true 2>/dev/null; then \
 		unshare -n sh -c 'ip link set lo up && exec $(ROS2_PYTEST)'; \
 	else \
