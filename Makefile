@@ -73,8 +73,9 @@ SUITE_ENV := $(VENV)/.installed $(ROS_SITE)/.linked
 CHECK_ENV := $(SUITE_ENV) node_modules/.installed
 
 # The environments are made side by side: npm and uv wait on the network while the ROS 2
-# messages compile. The ASK CLI is for deploying only (docs/deploy.md): set-up installs it,
-# the tests do not need it.
+# messages compile. The ASK CLI is for deploying only (docs/deploy.md): set-up adds it after
+# the tools the tests use (under `make test` too, through the ROS 2 tests' set-up), and no
+# test waits for it.
 setup: system-packages
 	$(MAKE) --no-print-directory -j3 $(CHECK_ENV) $(VENV_ROS2)/.installed $(ASK_CLI)
 
@@ -119,8 +120,8 @@ $(VENV_ROS2)/.installed: $(VENV_ROS2)/.ros2 requirements.txt pyproject.toml
 	touch $@
 
 # npm's packages for the checks and the tests: the CDK CLI and TypeScript, not the
-# workspaces (the ASK CLI's 500 packages took 40 s of CPU to install and are used only to
-# deploy).
+# workspaces (the ASK CLI's 500 packages, 30-40 s to install, are used only to deploy: the
+# tests that use npm's tools wait for this marker, not for them).
 node_modules/.installed: package.json package-lock.json tools/ask-cli/package.json
 	npm ci --workspaces=false --no-audit --no-fund --loglevel=error
 	touch $@
