@@ -69,7 +69,7 @@ from vahr.domain.invocation import FALLBACK_INTENT
 from vahr.speech.audio import Audio, concatenate  # noqa: E402
 from vahr.speech.stt import Hypothesis, Recognition  # noqa: E402
 from vahr.speech.tts import engine_of, make_synthesizer  # noqa: E402
-from vahr.speech.whisper_stt import WhisperTranscriber  # noqa: E402
+from vahr.speech.whisper_stt import DECODING, WhisperTranscriber  # noqa: E402
 from vahr.station.vocabulary import command_recognizer, whisper_prompt  # noqa: E402
 
 TUNING_SET = DEVELOPMENT_SET.with_name("tuning-en-US.yaml")
@@ -154,8 +154,8 @@ def hear(recognizer: object, items: list[tuple[LabelledUtterance, str]]) -> list
 
 def hear_again(whisper: WhisperTranscriber, clips: list[Clip]) -> dict[int, tuple[str, float]]:
     """Whisper's transcript and seconds for each clip (by its index), kept beside the clip
-    (keyed by the prompt and the weights too), so a second run only re-reads."""
-    heard_by = f"{whisper.weights_sha256}\n{whisper.prompt}"
+    (keyed by the prompt, the weights and how it decodes too), so a second run only re-reads."""
+    heard_by = f"{whisper.weights_sha256}\n{whisper.prompt}\n{DECODING}"
     prompt_key = hashlib.sha256(heard_by.encode()).hexdigest()[:12]
     found = {}
     for n, clip in enumerate(clips):
@@ -418,7 +418,8 @@ were not among the tuning voices):
 {engine_rows}
 {best_only}
 
-**With the second ear** (Whisper tiny.en told "{whisper.prompt}"; a request it and
+**With the second ear** (Whisper tiny.en told "{whisper.prompt}", decoded with {DECODING};
+a request it and
 pocketsphinx's best transcript read alike is acted on, anything else weighed as above with
 a robot or zone the two heard differently asked about; the same development clips, nothing
 tuned):

@@ -39,6 +39,16 @@ MODEL_SHA256 = "1a5afae06a4db91c975c9a9d78be5cc110ee4ea022ad57d55492e4550e936b2a
 THREADS = 2
 # Beam search as Whisper's own decoding does it; greedy decoding misspelled names more.
 BEAM_SIZE = 5
+# Whisper's own mark of a transcript that repeats itself (a decoding loop): zlib compresses
+# it more than this.
+MAX_COMPRESSION_RATIO = 2.4
+# How a clip is decoded, which a measurement of this ear is kept under with the weights.
+# One pass at temperature 0, without timestamps. With timestamps a short clip could loop
+# ("Zone B. Zone D. Zone D. ..." to Whisper's 448 tokens for "zone b"), and faster-whisper
+# then decoded again by sampling at rising temperatures: seconds of CPU, up to six passes,
+# and words that changed from one press to the next. A push-to-talk clip is one segment
+# whose timestamps nothing reads; a transcript that still loops is dropped.
+DECODING = f"beam {BEAM_SIZE}, temperature 0, no timestamps, loops dropped"
 
 
 def model_directory() -> Path:
@@ -103,12 +113,21 @@ class WhisperTranscriber:
         self._lock = threading.Lock()
 
     def transcribe(self, audio: Audio) -> str:
-        """What Whisper heard in `audio`, as written text ("" for nothing)."""
+        """What Whisper heard in `audio`, as written text ("" for nothing, or for a
+        transcript that repeats itself: `DECODING`)."""
         samples = audio.samples().astype("float32") / 32768.0
         with self._lock:
             # `hotwords` puts the prompt before the clip as `initial_prompt` would; it is the
             # form the station's hearing was measured with.
             segments, _ = self._model.transcribe(
-                samples, language="en", beam_size=BEAM_SIZE, hotwords=self.prompt
+                samples,
+                language="en",
+                beam_size=BEAM_SIZE,
+                hotwords=self.prompt,
+                temperature=0.0,
+                without_timestamps=True,
             )
-            return " ".join(segment.text.strip() for segment in segments).strip()
+            heard = [
+                s.text.strip() for s in segments if s.compression_ratio <= MAX_COMPRESSION_RATIO
+            ]
+            return " ".join(heard).strip()

@@ -144,8 +144,6 @@ class Station:
                     document = self._read_shadow(thing)
                     if document is not None:
                         self.feed.load_shadow(thing, document)
-            if self.push_to_talk is not None:
-                self.push_to_talk.warm_up()
             self.server.start()
             if self.tasks is not None:
                 self.tasks.start()

@@ -374,8 +374,8 @@ class _Handler(QuietHandler):
             self.refuse(503, f"at most {MAX_STREAMS} pages at once")
             return
         if station.app.push_to_talk is not None:
-            # Someone is at the page and may talk: Whisper's weights are loaded now.
-            station.app.push_to_talk.warm_second_ear()
+            # Someone is at the page and may talk: both ears are made now.
+            station.app.push_to_talk.warm_up()
         feed = station.app.feed
         subscriber = feed.subscribe()
         self.close_connection = True

@@ -117,12 +117,12 @@ def ask_back(weighed: Weighed, slot_types: Mapping[str, str]) -> str | None:
 class PushToTalk:
     """Recognize a clip, weigh its readings, and pass the understanding to the assistant.
 
-    The recognizer is built on first use, or ahead of it in the background with `warm_up`
-    (building one takes a moment; the first press should not wait for it); the second ear
-    likewise, ahead of it with `warm_second_ear`. The recognizer
-    that `vocabulary.command_recognizer` makes has its language model made in a child
-    process, so the warm-up thread mostly waits, leaving the interpreter lock to the
-    station's MQTT intake. The NLU is the
+    Both ears are made on first use, or ahead of it in the background with `warm_up`,
+    which the station calls when a page opens: someone there may talk, and the first press
+    should not wait for them, while a stack nobody talks to never builds a recognizer nor
+    loads Whisper's weights. The recognizer that `vocabulary.command_recognizer` makes has
+    its language model made in a child process, so the warm-up thread mostly waits, leaving
+    the interpreter lock to the station's MQTT intake. The NLU is the
     simulator's when the assistant is the simulator in this process, else the one that
     ships with the package (built on first use).
     """
@@ -144,21 +144,21 @@ class PushToTalk:
         self._model: InteractionModel | None = None
         self._lock = threading.Lock()
         self._second_lock = threading.Lock()
-        self._warming_second = False
+        # Whether a warm-up was started: a lock of its own, as `_lock` is held while the
+        # recognizer is built (a page opening then must not wait for it).
+        self._warming = False
+        self._warming_lock = threading.Lock()
 
-    def warm_up(self) -> threading.Thread:
-        thread = threading.Thread(target=self._warm, name="station-recognizer", daemon=True)
+    def warm_up(self) -> threading.Thread | None:
+        """Make the recognizer, then the second ear, in the background, once; the thread,
+        or None when they are made or being made already."""
+        with self._warming_lock:
+            if self._warming:
+                return None
+            self._warming = True
+        thread = threading.Thread(target=self._warm, name="station-ears", daemon=True)
         thread.start()
         return thread
-
-    def warm_second_ear(self) -> None:
-        """Make the second ear in the background, once (the station asks when a page
-        opens: a stack nobody talks to never loads Whisper's weights)."""
-        with self._second_lock:
-            if self._make_second is None or self._warming_second:
-                return
-            self._warming_second = True
-        threading.Thread(target=self.second_ear, name="station-second-ear", daemon=True).start()
 
     def _warm(self) -> None:
         try:
@@ -166,6 +166,8 @@ class PushToTalk:
         except (VahrError, SpeechError) as err:
             # Said once here; the first press tries again and answers with the reason.
             log.warning("push-to-talk: the recognizer could not be built: %s", err)
+            return
+        self.second_ear()
 
     def recognizer(self) -> Recognizer:
         with self._lock:

@@ -4,7 +4,7 @@ are loaded, and it writes a spoken command with the fleet's names as the skill s
 from __future__ import annotations
 
 import hashlib
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
@@ -41,6 +41,37 @@ def test_a_command_in_a_voice_built_from_a_person_is_written_with_the_fleets_nam
 ) -> None:
     heard = whisper.transcribe(clip("flite:rms", "send placebot two to the loading zone"))
     assert heard.lower().rstrip(".") == "send placebot two to the loading zone"
+
+
+class CountedPasses:
+    """Whisper's CTranslate2 model, counting the decoding passes it is asked for."""
+
+    def __init__(self, model: Any) -> None:
+        self.model = model
+        self.passes = 0
+
+    def generate(self, *args: Any, **kwargs: Any) -> Any:
+        self.passes += 1
+        return self.model.generate(*args, **kwargs)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.model, name)
+
+
+def test_a_clip_is_decoded_once_and_written_alike_on_every_press(
+    whisper: WhisperTranscriber, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Given "zone b" in a voice on which timestamped decoding loops ("Zone B. Zone D. Zone D.
+    # ..."), after which faster-whisper decoded again by sampling, up to six times
+    counted = CountedPasses(whisper._model.model)
+    monkeypatch.setattr(whisper._model, "model", counted)
+    spoken = clip("flite:awb", "zone b")
+    # When it is pressed three times
+    heard = [whisper.transcribe(spoken) for _ in range(3)]
+    # Then each press is one pass, written the same, and no loop
+    assert counted.passes == 3
+    assert len(set(heard)) == 1, heard
+    assert len(heard[0].split()) <= 3, heard
 
 
 def test_weights_that_are_not_tiny_ens_are_refused(tmp_path: Path) -> None:

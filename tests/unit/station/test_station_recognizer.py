@@ -139,7 +139,9 @@ def test_a_warm_up_that_fails_says_why_and_the_first_press_tries_again(
 ) -> None:
     missing = tmp_path / "nowhere.json"
     talk = PushToTalk(None, lambda: command_recognizer(missing, cache_dir=tmp_path))  # type: ignore[arg-type]
-    talk.warm_up().join(60)
+    warming = talk.warm_up()
+    assert warming is not None
+    warming.join(60)
     assert "the recognizer could not be built: cannot read the interaction model" in caplog.text
     with pytest.raises(VahrError, match="cannot read the interaction model"):
         talk.recognizer()

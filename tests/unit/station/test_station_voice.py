@@ -382,20 +382,25 @@ def test_a_second_ear_that_cannot_be_made_leaves_the_first_alone(
     assert "pocketsphinx alone: Whisper's weights are not installed" in caplog.text
 
 
-def test_the_second_ear_is_made_once_in_the_background_when_asked() -> None:
-    made: list[SecondEar] = []
+def test_both_ears_are_made_once_in_the_background_when_asked() -> None:
+    made: list[Heard | SecondEar] = []
     ready = threading.Event()
+    heard = Recognition("send placebot two to zone c", 0.81, True)
 
-    def make() -> SecondEar:
+    def make_first() -> Heard:
+        made.append(Heard(heard))
+        return Heard(heard)
+
+    def make_second() -> SecondEar:
         made.append(SecondEar("Send placebot two to zone C."))
         ready.set()
-        return made[-1]
+        return SecondEar("Send placebot two to zone C.")
 
-    heard = Recognition("send placebot two to zone c", 0.81, True)
-    ears = PushToTalk(Assistant("NavigateIntent"), lambda: Heard(heard), make)
-    assert made == []  # nothing loaded until someone may talk
-    ears.warm_second_ear()
-    ears.warm_second_ear()
+    ears = PushToTalk(Assistant("NavigateIntent"), make_first, make_second)
+    assert made == []  # nothing built until someone may talk (a page opens)
+    assert ears.warm_up() is not None
+    assert ears.warm_up() is None
     assert ready.wait(5)
     result = ears.handle(wav())
-    assert len(made) == 1 and result["heard"]["second"] == "Send placebot two to zone C."
+    assert [type(ear) for ear in made] == [Heard, SecondEar]
+    assert result["heard"]["second"] == "Send placebot two to zone C."
