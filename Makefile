@@ -74,8 +74,7 @@ CHECK_ENV := $(SUITE_ENV) node_modules/.installed
 
 # The environments are made side by side: npm and uv wait on the network while the ROS 2
 # messages compile. The ASK CLI is for deploying only (docs/deploy.md): set-up adds it after
-# the tools the tests use (under `make test` too, through the ROS 2 tests' set-up), and no
-# test waits for it.
+# the tools the tests use; `make test` leaves it out (no test runs it).
 setup: system-packages
 	$(MAKE) --no-print-directory -j3 $(CHECK_ENV) $(VENV_ROS2)/.installed $(ASK_CLI)
 
@@ -171,7 +170,7 @@ pytest-now:
 # own and discovery stays on localhost (tests/support/nav2.py). One file at a time: under
 # `make test` they already run beside the suite and the checks.
 ROS2_PYTEST := $(BIN_ROS2)/pytest -q -m ros2 $(ROS2_TESTS)
-pytest-ros2: setup
+pytest-ros2: system-packages $(VENV_ROS2)/.installed
 	if [ "$$(id -u)" = 0 ] && unshare -n true 2>/dev/null; then \
 		unshare -n sh -c 'ip link set lo up && exec $(ROS2_PYTEST)'; \
 	else \

@@ -45,6 +45,8 @@ from vahr.protocol.lost_tasks import (
 )
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from vahr.announce import Signal
 
 log = logging.getLogger("announcer")
@@ -54,12 +56,18 @@ SAVE_ATTEMPTS = 3
 SCHEDULE = ("aws.events", "Scheduled Event")
 
 
+def utc_now() -> datetime:
+    return datetime.now(UTC)
+
+
 class Runtime(msgspec.Struct, frozen=True, kw_only=True, dict=True):
     config: AnnouncerConfig
     names: Names
     store: Any
     alexa: Any
     topic: Any
+    # What the policy's rate windows and ages are measured by (a test's own clock).
+    clock: Callable[[], datetime] = utc_now
 
 
 @cache
@@ -143,7 +151,7 @@ def announce(message: dict[str, Any], rt: Runtime) -> dict[str, Any]:
     for attempt in range(1, SAVE_ATTEMPTS + 1):
         state, version = rt.store.load()
         before = msgspec.json.encode(state)
-        policy = AnnouncePolicy(rt.config.settings, rt.names, lambda: datetime.now(UTC), state)
+        policy = AnnouncePolicy(rt.config.settings, rt.names, rt.clock, state)
         told = policy.observe(signals)
         for announcement in told:
             urgent = announcement.priority >= rt.config.settings.urgent_priority

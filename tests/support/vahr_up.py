@@ -107,7 +107,9 @@ def say(api: str, utterance: str, *flags: str) -> dict[str, Any]:
     ID`): the turn it prints."""
     result = subprocess.run(
         [*VAHR, "say", "--json", "--api", api, *flags, utterance],
-        cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=60, check=True,
+        cwd=ROOT, env=clean_env(), capture_output=True, text=True, timeout=60,
     )  # fmt: skip
+    # What `vahr say` said is the failure's message (a stack that went away, a bad flag).
+    assert result.returncode == 0, f"vahr say {utterance!r}: {result.stderr.strip()}"
     turn: dict[str, Any] = json.loads(result.stdout)
     return turn

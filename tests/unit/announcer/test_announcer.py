@@ -9,8 +9,7 @@ from __future__ import annotations
 import json
 import re
 import threading
-import time
-from datetime import datetime, timedelta
+from datetime import UTC, datetime, timedelta
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -352,13 +351,14 @@ def test_a_scheduled_tick_tells_what_the_rate_limit_held_back(
 ) -> None:
     # Given an announcer that may tell one thing in any half second
     settings = settings_from({"max_per_window": 1, "reserve_for_urgent": 0, "window_s": 0.5})
-    rt = replace(runtime, config=replace(runtime.config, settings=settings))
+    now = [datetime.now(UTC)]
+    rt = replace(runtime, config=replace(runtime.config, settings=settings), clock=lambda: now[0])
     # When a robot gets stuck and the other goes offline at once
     first = app.announce(load_event("iot_rule_robot_stuck"), rt)
     held = app.announce(load_event("iot_rule_presence_offline"), rt)
     assert len(first["told"]) == 1 and held["told"] == [] and held["held"] == 1
     # and no robot says anything more until the schedule's tick, after the window
-    time.sleep(0.6)
+    now[0] += timedelta(seconds=0.6)
     ticked = app.announce(load_event("eventbridge_schedule"), rt)
     # Then the tick tells what was held back, and takes the schedule for no robot's message
     assert len(ticked["told"]) == 1 and ticked["dropped"] == 0
