@@ -36,6 +36,7 @@ import copy
 import json
 import threading
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -233,20 +234,20 @@ class InteractionModel:
             next((n for v, n in robot_values if v == FLEET_GROUP), "all robots"),
         )
         lexicon = roles.WeatherLexicon.of_locale(self._understanding.locale)
-        role_sequences = {
-            name: roles.training_sequences(
+        # Labelled here, so that a role example naming what its intent lacks fails the load.
+        role_values = {
+            name: roles.training_values(
                 name,
                 slots,
                 [self._normalized_sample(sample) for sample in samples[name]],
                 self._understanding.roles,
-                lexicon,
             )
             for name, slots in self.intent_slots.items()
             if slots
         }
         self._taggers: dict[str, roles.RolesTagger] = {}
         # What each intent's roles tagger learns from, and the words it reads weather in.
-        self.role_training = role_sequences
+        self._role_values = role_values
         self.role_lexicon = lexicon
         self.training = (texts, labels)
         self.cached: bool | None = None
@@ -257,9 +258,9 @@ class InteractionModel:
 
         def build() -> None:
             try:
-                for name, sequences in role_sequences.items():
-                    self._taggers[name], _ = roles.load_or_train(
-                        name, self.intent_slots[name], sequences, cache, lexicon
+                for name, values in role_values.items():
+                    self._taggers[name], _ = roles.load_or_learn(
+                        name, self.intent_slots[name], values, cache, lexicon
                     )
                 self._classifier, self.cached = load_or_train(texts, labels, cache)
             except BaseException as err:  # reported to whoever waits for the classifier
@@ -310,6 +311,15 @@ class InteractionModel:
         except ValueError as err:
             raise VahrError(f"the interaction model {file} is not valid JSON: {err}") from err
         return cls(document, **options)
+
+    @cached_property
+    def role_training(self) -> dict[str, list[roles.Sequence_]]:
+        """What each intent's roles tagger learns from: its sentences' value features and
+        labels (made when asked: a tagger from the cache needs none)."""
+        return {
+            name: roles.training_sequences(values, self.role_lexicon)
+            for name, values in self._role_values.items()
+        }
 
     @property
     def language(self) -> LanguageUnderstanding:

@@ -29,7 +29,9 @@ stands between the two values of the other type, where it is the first one's. A 
 intent takes, named but given no slot at all, means the words do not fit the intent.
 
 Each intent's model is cached on disk under a hash of its training data, as the intent
-classifier is (`vahr.speech.text_classifier`).
+classifier is (`vahr.speech.text_classifier`): the labelled values of its sentences, the
+lexicon and this module's source, which makes the features from them (`load_or_learn`), so
+that a model read from the cache costs no feature of the thousands of sentences.
 """
 
 from __future__ import annotations
@@ -47,7 +49,7 @@ from vahr.domain import FLEET_GROUP
 from vahr.domain.locale import LocaleError
 from vahr.domain.weather import plain_negations, weather_words
 from vahr.errors import VahrError
-from vahr.model_cache import content_key, write_atomically
+from vahr.model_cache import code_digest, content_key, write_atomically
 from vahr.skill_model.intents import ROBOT_TYPE
 from vahr.skill_model.templates import expand
 
@@ -83,6 +85,8 @@ BOTH = "&"
 # A value in the words: its type, where it starts and ends, and whether it is the fleet.
 Span = tuple[str, int, int, bool]
 Sequence_ = tuple[list[list[str]], list[str]]
+# A sentence's words (each value as `<TYPE>`), its values and their labels.
+Values = tuple[list[str], list[Span], list[str]]
 
 
 @dataclass(frozen=True)
@@ -174,7 +178,17 @@ def value_features(
 def labelled_sequence(
     sentence: str, slot_types: Mapping[str, str], lexicon: WeatherLexicon
 ) -> Sequence_ | None:
-    """A sample or role example as (features, labels); None when it names no value.
+    """A sample or role example as (features, labels); None when it names no value
+    (`labelled_values`)."""
+    values = labelled_values(sentence, slot_types)
+    if values is None:
+        return None
+    words, spans, labels = values
+    return value_features(words, spans, lexicon), labels
+
+
+def labelled_values(sentence: str, slot_types: Mapping[str, str]) -> Values | None:
+    """A sample or role example's words, values and labels; None when it names no value.
 
     `{slot}` is a value for the slot; `{-TYPE}` a value of the type for no slot; `{+slot}`
     and `{?slot}` a value listed with, or offered instead of, the one before it; `{a&b}` a
@@ -201,7 +215,7 @@ def labelled_sequence(
         words.append(f"<{spans[-1][0]}>")
     if not spans:
         return None
-    return value_features(words, spans, lexicon), labels
+    return words, spans, labels
 
 
 class RolesTagger:
@@ -309,13 +323,12 @@ class RolesReading:
     marginals: list[float]
 
 
-def training_sequences(
+def training_values(
     intent: str,
     slot_types: Mapping[str, str],
     samples: Sequence[str],
     examples: Sequence[RoleExamples],
-    lexicon: WeatherLexicon,
-) -> list[Sequence_]:
+) -> list[Values]:
     """The intent's samples and the locale's role examples for it, labelled; a role example
     naming what the intent lacks is a `VahrError` naming the intent."""
     sentences = list(samples)
@@ -323,10 +336,36 @@ def training_sequences(
         if intent in group.intents:
             sentences += [s for template in group.examples for s in expand(template)]
     try:
-        found = [labelled_sequence(sentence, slot_types, lexicon) for sentence in sentences]
+        found = [labelled_values(sentence, slot_types) for sentence in sentences]
     except VahrError as err:
         raise VahrError(f"role examples of {intent}: {err}") from err
-    return [sequence for sequence in found if sequence is not None]
+    return [values for values in found if values is not None]
+
+
+def training_sequences(values: Sequence[Values], lexicon: WeatherLexicon) -> list[Sequence_]:
+    """What the tagger learns from: each sentence's value features and labels."""
+    return [(value_features(words, spans, lexicon), labels) for words, spans, labels in values]
+
+
+def load_or_learn(
+    intent: str,
+    slot_types: Mapping[str, str],
+    values: Sequence[Values],
+    cache_dir: Path | None,
+    lexicon: WeatherLexicon,
+) -> tuple[RolesTagger, bool]:
+    """The intent's tagger learnt from `values` (`training_values`), from the cache (True) or
+    trained now and cached (False). Kept under what the features are made from: reading
+    them from thousands of sentences took half a second at every start."""
+    learnt_from = [
+        RECIPE, TRAINING_PARAMETERS, version("python-crfsuite"), code_digest(__name__),
+        intent, slot_types, values, sorted(lexicon.weathers.items()), sorted(lexicon.negations),
+    ]  # fmt: skip
+    file = _model_file(cache_dir, intent, content_key(learnt_from))
+    tagger = _read(file, intent, slot_types, lexicon)
+    if tagger is not None:
+        return tagger, True
+    return _learn(intent, slot_types, training_sequences(values, lexicon), file, lexicon), False
 
 
 def load_or_train(
@@ -336,19 +375,42 @@ def load_or_train(
     cache_dir: Path | None,
     lexicon: WeatherLexicon,
 ) -> tuple[RolesTagger, bool]:
-    """The intent's tagger, from the cache (True) or trained now and cached (False)."""
+    """The intent's tagger learnt from `sequences`, from the cache (True) or trained now and
+    cached (False)."""
     learnt_from = [RECIPE, TRAINING_PARAMETERS, version("python-crfsuite"), intent, sequences]
-    key = content_key(learnt_from)
-    file = cache_dir / f"roles-{intent}-{key[:24]}.crfsuite" if cache_dir else None
-    if file is not None:
-        try:
-            return RolesTagger(intent, slot_types, file.read_bytes(), lexicon), True
-        except OSError:
-            pass
+    file = _model_file(cache_dir, intent, content_key(learnt_from))
+    tagger = _read(file, intent, slot_types, lexicon)
+    if tagger is not None:
+        return tagger, True
+    return _learn(intent, slot_types, sequences, file, lexicon), False
+
+
+def _model_file(cache_dir: Path | None, intent: str, key: str) -> Path | None:
+    return cache_dir / f"roles-{intent}-{key[:24]}.crfsuite" if cache_dir else None
+
+
+def _read(
+    file: Path | None, intent: str, slot_types: Mapping[str, str], lexicon: WeatherLexicon
+) -> RolesTagger | None:
+    if file is None:
+        return None
+    try:
+        return RolesTagger(intent, slot_types, file.read_bytes(), lexicon)
+    except OSError:
+        return None
+
+
+def _learn(
+    intent: str,
+    slot_types: Mapping[str, str],
+    sequences: list[Sequence_],
+    file: Path | None,
+    lexicon: WeatherLexicon,
+) -> RolesTagger:
     model = _train(sequences)
     if file is not None:
         write_atomically(file, model)
-    return RolesTagger(intent, slot_types, model, lexicon), False
+    return RolesTagger(intent, slot_types, model, lexicon)
 
 
 def _train(sequences: list[Sequence_]) -> bytes:

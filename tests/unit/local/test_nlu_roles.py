@@ -114,6 +114,41 @@ def test_the_tagger_is_cached_by_its_data(model: InteractionModel, tmp_path: Pat
     assert not cached and len(list(tmp_path.glob("roles-*.crfsuite"))) == 2
 
 
+def test_a_model_whose_taggers_are_cached_reads_no_features(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Given a model loaded once, its taggers learnt and cached
+    first = InteractionModel.load(cache_dir=tmp_path)
+    learnt = sorted(tmp_path.glob("roles-*.crfsuite"))
+    assert len(learnt) == len(first._taggers)
+
+    # When it is loaded again with the features out of reach
+    def no_features(*args: object) -> list[list[str]]:
+        raise AssertionError("features read for a cached tagger")
+
+    monkeypatch.setattr(roles, "value_features", no_features)
+    again = InteractionModel.load(cache_dir=tmp_path)
+    monkeypatch.undo()  # (understanding reads the features of what is said)
+    # Then it reads every tagger from the cache, and understands as the first did
+    assert sorted(tmp_path.glob("roles-*.crfsuite")) == learnt
+    said = "robot two to zone d after robot one to zone a"
+    assert again.understand(said) == first.understand(said)
+
+
+def test_a_tagger_is_learnt_again_when_the_weather_words_change(
+    model: InteractionModel, tmp_path: Path
+) -> None:
+    intent = "WeatherDeliveryIntent"
+    slots, values = model.intent_slots[intent], model._role_values[intent]
+    english = model.role_lexicon
+    _, cached = roles.load_or_learn(intent, slots, values, tmp_path, english)
+    assert not cached
+    assert roles.load_or_learn(intent, slots, values, tmp_path, english)[1]
+    # A weather word more is another tagger (its features differ)
+    more = roles.WeatherLexicon({**english.weathers, "drizzly": "rainy"}, english.negations)
+    assert not roles.load_or_learn(intent, slots, values, tmp_path, more)[1]
+
+
 def test_nothing_understood_is_nothing_assigned(model: InteractionModel) -> None:
     assert model.understand("play some jazz").intent == FALLBACK_INTENT
 
