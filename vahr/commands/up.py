@@ -111,15 +111,15 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from vahr.errors import VahrError
-    from vahr.local.robots import SWARM_MAX
-    from vahr.local.system import READY_TIMEOUT_S, LocalSystem, SystemConfig
-    from vahr.station.deployment import on_local_system
 
     setup_logging(args.log_level)
-    from vahr.assistant.localized import supported
-    from vahr.domain.locale import load_language
+    from vahr.domain.locale import LocaleError, check_locale, load_language
 
-    if not load_language(supported(args.locale)).speech.recognised:
+    try:
+        language = load_language(check_locale(args.locale))
+    except LocaleError as err:
+        raise VahrError(str(err)) from err
+    if not language.speech.recognised:
         print(
             f"vahr up: {args.locale} is understood and spoken; speech recognition here is "
             "English only, so push-to-talk and the robots' spoken weather exchange stay English",
@@ -141,6 +141,8 @@ def run(args: argparse.Namespace) -> int:
             f"{len(fleet.robots)}, or add robots to the file (or use --swarm N)"
         )
     if args.swarm is not None:
+        from vahr.local.robots import SWARM_MAX
+
         if args.robots is not None:
             raise VahrError("give either --robots (a process per robot) or --swarm, not both")
         if not 1 <= args.swarm <= SWARM_MAX:
@@ -149,6 +151,10 @@ def run(args: argparse.Namespace) -> int:
                 " fit in one Alexa interaction model; see docs/large-fleets.md)"
             )
     people = _people(args.users)
+    # The system's modules after the flags are checked: a refusal comes without them.
+    from vahr.local.system import READY_TIMEOUT_S, LocalSystem, SystemConfig
+    from vahr.station.deployment import on_local_system
+
     config = SystemConfig(
         state_dir=args.state_dir.resolve(),
         mqtts_port=args.mqtts_port,
