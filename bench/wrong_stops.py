@@ -129,8 +129,8 @@ speech) and as it decided before the rule, in the same run.
 {table}
 
 A wrong stop halts a robot nobody asked to halt (safe, but a task is interrupted). The
-second-ear rows of "Push-to-talk: spoken requests understood" were measured before the
-rule.
+second-ear rows of "Push-to-talk: spoken requests understood" decide as the station did
+before the rule.
 """
     write_section("wrong_stops", "Push-to-talk: stops either ear hears", body)
     return 0
