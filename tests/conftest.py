@@ -32,6 +32,20 @@ def pytest_configure() -> None:
         os.environ.setdefault(name, "1")
 
 
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Any:
+    """A failed test that used a `vahr up` says whether it still ran and what it logged
+    (a stack that went away mid-module shows why, not only that nothing answered)."""
+    from tests.support.vahr_up import Up
+
+    report = yield
+    if report.failed:
+        for name, value in getattr(item, "funcargs", {}).items():
+            if isinstance(value, Up):
+                report.sections.append((f"vahr up ({name})", value.story()))
+    return report
+
+
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """The longest files run first, so that the workers finish close together."""
     longest_files_first(items)

@@ -37,9 +37,13 @@ def clean_env() -> dict[str, str]:
 class Up:
     """A `vahr up --json` process and the JSON lines it prints."""
 
-    def __init__(self, process: subprocess.Popen[str], endpoints: dict[str, Any]) -> None:
+    def __init__(
+        self, process: subprocess.Popen[str], endpoints: dict[str, Any], log: Path | None = None
+    ) -> None:
         self.process = process
         self.endpoints = endpoints
+        # Where its stderr goes (`story`).
+        self.log = log
         self.lines: queue.Queue[dict[str, Any]] = queue.Queue()
         self._reader = threading.Thread(target=self._read, args=(process.stdout,), daemon=True)
         self._reader.start()
@@ -47,6 +51,15 @@ class Up:
     def _read(self, stream: IO[str]) -> None:
         for line in stream:
             self.lines.put(json.loads(line))
+
+    def story(self, lines: int = 40) -> str:
+        """Whether it still runs, and the end of its stderr: what a failed test shows."""
+        code = self.process.poll()
+        state = "running" if code is None else f"exited with code {code}"
+        tail = ""
+        if self.log is not None and self.log.is_file():
+            tail = "\n".join(self.log.read_text(errors="replace").splitlines()[-lines:])
+        return f"vahr up {state}; the end of its stderr:\n{tail or '(nothing)'}"
 
     def wait_event(self, command_id: str, kind: str, timeout_s: float = 20.0) -> dict[str, Any]:
         deadline = time.monotonic() + timeout_s
@@ -82,7 +95,7 @@ def start_up(
     if not first:
         stop_up(process)
         raise AssertionError(f"vahr up did not start: {(state / 'up.err').read_text()}")
-    return Up(process, json.loads(first))
+    return Up(process, json.loads(first), state / "up.err")
 
 
 def stop_up(process: subprocess.Popen[str]) -> None:
