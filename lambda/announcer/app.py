@@ -57,6 +57,7 @@ SCHEDULE = ("aws.events", "Scheduled Event")
 
 
 def utc_now() -> datetime:
+    """The runtime's clock: the time now, in UTC."""
     return datetime.now(UTC)
 
 
