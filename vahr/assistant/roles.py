@@ -54,7 +54,7 @@ from vahr.skill_model.intents import ROBOT_TYPE
 from vahr.skill_model.templates import expand
 
 if TYPE_CHECKING:
-    from collections.abc import Mapping, Sequence
+    from collections.abc import Callable, Mapping, Sequence
     from pathlib import Path
 
     from vahr.assistant.slot_finder import SlotMatch
@@ -361,11 +361,10 @@ def load_or_learn(
         RECIPE, TRAINING_PARAMETERS, version("python-crfsuite"), code_digest(__name__),
         intent, slot_types, values, sorted(lexicon.weathers.items()), sorted(lexicon.negations),
     ]  # fmt: skip
-    file = _model_file(cache_dir, intent, content_key(learnt_from))
-    tagger = _read(file, intent, slot_types, lexicon)
-    if tagger is not None:
-        return tagger, True
-    return _learn(intent, slot_types, training_sequences(values, lexicon), file, lexicon), False
+    return _cached_or_trained(
+        intent, slot_types, learnt_from, lambda: training_sequences(values, lexicon), cache_dir,
+        lexicon,
+    )  # fmt: skip
 
 
 def load_or_train(
@@ -378,39 +377,32 @@ def load_or_train(
     """The intent's tagger learnt from `sequences`, from the cache (True) or trained now and
     cached (False)."""
     learnt_from = [RECIPE, TRAINING_PARAMETERS, version("python-crfsuite"), intent, sequences]
-    file = _model_file(cache_dir, intent, content_key(learnt_from))
-    tagger = _read(file, intent, slot_types, lexicon)
-    if tagger is not None:
-        return tagger, True
-    return _learn(intent, slot_types, sequences, file, lexicon), False
+    return _cached_or_trained(
+        intent, slot_types, learnt_from, lambda: sequences, cache_dir, lexicon
+    )
 
 
-def _model_file(cache_dir: Path | None, intent: str, key: str) -> Path | None:
-    return cache_dir / f"roles-{intent}-{key[:24]}.crfsuite" if cache_dir else None
-
-
-def _read(
-    file: Path | None, intent: str, slot_types: Mapping[str, str], lexicon: WeatherLexicon
-) -> RolesTagger | None:
-    if file is None:
-        return None
-    try:
-        return RolesTagger(intent, slot_types, file.read_bytes(), lexicon)
-    except OSError:
-        return None
-
-
-def _learn(
+def _cached_or_trained(
     intent: str,
     slot_types: Mapping[str, str],
-    sequences: list[Sequence_],
-    file: Path | None,
+    learnt_from: object,
+    sequences: Callable[[], list[Sequence_]],
+    cache_dir: Path | None,
     lexicon: WeatherLexicon,
-) -> RolesTagger:
-    model = _train(sequences)
+) -> tuple[RolesTagger, bool]:
+    """The tagger kept under a hash of `learnt_from`, read (True), or trained on
+    `sequences()` (made only then) and kept (False)."""
+    key = content_key(learnt_from)
+    file = cache_dir / f"roles-{intent}-{key[:24]}.crfsuite" if cache_dir else None
+    if file is not None:
+        try:
+            return RolesTagger(intent, slot_types, file.read_bytes(), lexicon), True
+        except OSError:
+            pass
+    model = _train(sequences())
     if file is not None:
         write_atomically(file, model)
-    return RolesTagger(intent, slot_types, model, lexicon)
+    return RolesTagger(intent, slot_types, model, lexicon), False
 
 
 def _train(sequences: list[Sequence_]) -> bytes:
