@@ -91,9 +91,18 @@ system-packages:
 		fi; \
 	fi
 
+# The venv is made without pip and uv is put into it by the system's pip when there is one:
+# venv's own pip install (ensurepip) took 9 s of a fresh set-up's first 30, with nothing else
+# able to start. The venv's pip (the Lambda bundle is built with it) then comes, pinned, from
+# requirements-dev.txt.
 $(VENV)/.installed: requirements.txt requirements-dev.txt pyproject.toml
-	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install -q uv==$(UV_VERSION)
+	test -x $(BIN)/python || $(PYTHON) -m venv --without-pip $(VENV)
+	$(BIN)/uv --version 2>/dev/null | grep -q "^uv $(UV_VERSION) " || \
+	if $(PYTHON) -m pip --version >/dev/null 2>&1; then \
+		$(PYTHON) -m pip --python $(BIN)/python install -q uv==$(UV_VERSION); \
+	else \
+		$(BIN)/python -m ensurepip >/dev/null && $(BIN)/python -m pip install -q uv==$(UV_VERSION); \
+	fi
 	$(UV) --python $(BIN)/python -r requirements-dev.txt
 	$(UV) --python $(BIN)/python --no-deps --no-build-isolation -e .
 	touch $@
