@@ -27,19 +27,13 @@ FORBIDDEN = (
 )
 
 
-def test_cold_start_loads_nothing_beyond_the_skills_needs() -> None:
-    # Given a fresh interpreter with only a region configured
+def fresh_interpreter(code: str) -> str:
+    """What `code` prints in a fresh interpreter with only a region configured."""
     env = {key: value for key, value in os.environ.items() if not key.startswith(("AWS_", "VAHR_"))}
     env.update(
         AWS_DEFAULT_REGION="us-east-1",
         PYTHONPATH=os.pathsep.join([str(ROOT / "lambda"), str(ROOT)]),
     )
-    code = (
-        "import json, sys\n"
-        "from skill.app import lambda_handler\n"
-        "print(json.dumps(sorted(sys.modules)))\n"
-    )
-    # When Lambda resolves the handler
     done = subprocess.run(
         [sys.executable, "-c", code],
         env=env,
@@ -49,10 +43,25 @@ def test_cold_start_loads_nothing_beyond_the_skills_needs() -> None:
         timeout=60,
         check=True,
     )
-    modules = json.loads(done.stdout)
+    return done.stdout
+
+
+def test_cold_start_loads_nothing_beyond_the_skills_needs() -> None:
+    # When Lambda resolves the handler
+    code = "import json, sys\nfrom skill.app import lambda_handler\nprint(json.dumps(sorted(sys.modules)))"
+    modules = json.loads(fresh_interpreter(code))
     # Then the skill, ask-sdk-core, boto3 and the wire contract are loaded, and nothing else of ours
     assert {"skill.app", "ask_sdk_core.skill_builder", "boto3", "vahr.protocol"} <= set(modules)
     loaded = [
         m for m in modules if any(m == name or m.startswith(name + ".") for name in FORBIDDEN)
     ]
     assert loaded == []
+
+
+def test_the_entry_point_freezes_what_it_made_and_leaves_the_collector_as_it_found_it() -> None:
+    # The skill's modules are imported with the collector paused and then frozen: then it
+    # collects again, and a process that had paused it itself finds it paused still
+    code = "import gc\n{}from skill.app import lambda_handler\nprint(gc.isenabled(), gc.get_freeze_count())"
+    enabled, frozen = fresh_interpreter(code.format("")).split()
+    assert enabled == "True" and int(frozen) > 0
+    assert fresh_interpreter(code.format("gc.disable()\n")).split()[0] == "False"

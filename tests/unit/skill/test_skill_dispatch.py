@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 from skill_testkit import speech
 
-from skill import app as skill_app
+from skill import builder as skill_builder
 from skill.config import SkillConfig
 from skill.task_desk import TaskRefused
 from tests.conftest import load_event
@@ -137,8 +137,8 @@ def desk(tmp_path: Path, robots: Robots, sent: list[tuple[str, Command]]) -> Ite
 def skill(
     aws: None, desk: CoreDesk, monkeypatch: pytest.MonkeyPatch
 ) -> Callable[[dict[str, Any]], dict[str, Any]]:
-    monkeypatch.setattr(skill_app, "task_desk", lambda config: desk)
-    handler = skill_app.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
+    monkeypatch.setattr(skill_builder, "task_desk", lambda config: desk)
+    handler = skill_builder.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
     return lambda event: handler(event, None)
 
 
@@ -342,8 +342,8 @@ def test_every_idle_robot_goes_and_busy_ones_stay(
 
 
 def test_without_a_dispatcher_the_skill_says_so(aws: None, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(skill_app, "task_desk", lambda config: None)
-    handler = skill_app.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
+    monkeypatch.setattr(skill_builder, "task_desk", lambda config: None)
+    handler = skill_builder.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
     response = handler(intent("FleetNavigateIntent", zone=("the shop", "SHOP")), None)
     assert "fleet dispatcher, which is not running here" in speech(response)
 
@@ -433,8 +433,10 @@ def test_with_confirmation_on_a_zone_is_closed_only_after_its_askers_yes(
     aws: None, desk: CoreDesk, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # Given a skill that confirms fleet-wide commands first
-    monkeypatch.setattr(skill_app, "task_desk", lambda config: desk)
-    handler = skill_app.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS), confirm=True))
+    monkeypatch.setattr(skill_builder, "task_desk", lambda config: desk)
+    handler = skill_builder.make_lambda_handler(
+        SkillConfig(fleet_file=str(SIX_ROBOTS), confirm=True)
+    )
     close = intent("CloseZoneIntent", zone=("the oven", "OVEN"))
     # When someone asks to close the oven, it is said back and nothing is closed yet
     asked = handler(close, None)

@@ -139,7 +139,7 @@ def test_a_data_plane_without_the_dispatcher_is_said_as_such(
     plane does for any route it lacks: the skill says there is no dispatcher here."""
     from skill_testkit import speech
 
-    from skill import app as skill_app
+    from skill import builder as skill_builder
     from skill.config import SkillConfig
     from tests.unit.skill.test_skill_dispatch import intent
 
@@ -162,8 +162,8 @@ def test_a_data_plane_without_the_dispatcher_is_said_as_such(
     thread.start()
     try:
         desk = HttpTaskDesk(f"http://127.0.0.1:{server.server_address[1]}")
-        monkeypatch.setattr(skill_app, "task_desk", lambda config: desk)
-        handler = skill_app.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
+        monkeypatch.setattr(skill_builder, "task_desk", lambda config: desk)
+        handler = skill_builder.make_lambda_handler(SkillConfig(fleet_file=str(SIX_ROBOTS)))
         for event in (
             intent("FleetNavigateIntent", zone=("the shop", "SHOP")),
             intent("TaskQueueIntent"),
