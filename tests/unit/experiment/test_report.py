@@ -8,7 +8,6 @@ import random
 from typing import TYPE_CHECKING
 
 import pytest
-from scipy import stats
 
 from vahr.errors import VahrError
 from vahr.experiment.report import build_report, write_report
@@ -54,6 +53,9 @@ def column(path: Path, method: str, name: str) -> list[float]:
 
 
 def test_p_values_match_scipys_one_way_anova(tmp_path: Path) -> None:
+    # scipy is the reference, imported here: every worker collects this module
+    from scipy import stats
+
     # Given a generated data set of 8 participants x 2 methods x 3 trials
     data = generated_csv(tmp_path / "results.csv")
     # When the report is built

@@ -1,14 +1,13 @@
-"""The within-subjects statistics equal statsmodels' and scipy's on a fixed data set."""
+"""The within-subjects statistics equal statsmodels' and scipy's on a fixed data set.
+
+The reference libraries are imported by the tests that use them: every test worker collects
+this module, and importing pandas, scipy.stats and statsmodels costs about 3 s of CPU."""
 
 from __future__ import annotations
 
 import statistics
 
-import pandas as pd
 import pytest
-from scipy import stats
-from statsmodels.stats.anova import AnovaRM
-from statsmodels.stats.weightstats import DescrStatsW
 
 from vahr.experiment.report import build_report
 from vahr.experiment.results import ResultRow
@@ -40,6 +39,11 @@ def participant_means(values: dict[str, dict[str, tuple[float, float]]], m: str)
 
 
 def test_within_subjects_statistics_equal_statsmodels_and_scipy() -> None:
+    import pandas as pd
+    from scipy import stats
+    from statsmodels.stats.anova import AnovaRM
+    from statsmodels.stats.weightstats import DescrStatsW
+
     # When the report is built from the fixed data set
     within = build_report(rows(IE))["objective"]["interaction_time"]["within_subjects"]
     # Then the repeated-measures ANOVA is statsmodels' AnovaRM on the participant means
@@ -72,6 +76,8 @@ def test_within_subjects_statistics_equal_statsmodels_and_scipy() -> None:
 
 
 def test_non_normal_differences_get_the_wilcoxon_signed_rank_test() -> None:
+    from scipy import stats
+
     # Given differences with one far outlier (Shapiro-Wilk rejects normality)
     skewed = {p: {"vahr": v["vahr"], "keyboard": v["keyboard"]} for p, v in IE.items()}
     skewed["P8"] = {"vahr": (900, 910), "keyboard": (163, 166)}
@@ -84,6 +90,8 @@ def test_non_normal_differences_get_the_wilcoxon_signed_rank_test() -> None:
 
 
 def test_the_one_way_anova_stays_scipys_over_every_run() -> None:
+    from scipy import stats
+
     report = build_report(rows(IE))
     voice = [ie for v in IE.values() for ie in v["vahr"]]
     keyboard = [ie for v in IE.values() for ie in v["keyboard"]]
@@ -93,6 +101,8 @@ def test_the_one_way_anova_stays_scipys_over_every_run() -> None:
 
 
 def test_the_change_between_trials_is_paired_per_participant() -> None:
+    from scipy import stats
+
     change = build_report(rows(IE))["trial_change"]["objective"]["interaction_time"]["vahr"]
     first = [v["vahr"][0] for v in IE.values()]
     second = [v["vahr"][1] for v in IE.values()]
