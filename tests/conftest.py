@@ -45,14 +45,23 @@ def pytest_configure() -> None:
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Any:
     """A failed test that used a `vahr up` says whether it still ran and what it logged
-    (a stack that went away mid-module shows why, not only that nothing answered)."""
-    from tests.support.vahr_up import Up
+    (a stack that went away mid-module shows why, not only that nothing answered): each
+    stack of its fixtures, and each it started itself."""
+    from tests.support import vahr_up
 
     report = yield
     if report.failed:
-        for name, value in getattr(item, "funcargs", {}).items():
-            if isinstance(value, Up):
-                report.sections.append((f"vahr up ({name})", value.story()))
+        stacks = {
+            id(value): (name, value)
+            for name, value in getattr(item, "funcargs", {}).items()
+            if isinstance(value, vahr_up.Up)
+        }
+        for number, up in enumerate(vahr_up.started, 1):
+            stacks.setdefault(id(up), (f"started by the test, {number}", up))
+        for name, up in stacks.values():
+            report.sections.append((f"vahr up ({name})", up.story()))
+    if report.when == "teardown":
+        vahr_up.started.clear()
     return report
 
 

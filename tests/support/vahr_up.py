@@ -24,6 +24,9 @@ from vahr.plumbing.ports import free_port
 ROOT = Path(__file__).resolve().parents[2]
 VAHR = [sys.executable, "-m", "vahr.cli"]
 START_TIMEOUT_S = 60.0
+# The stacks the running test started itself: a failed test's report shows each one's story
+# beside the stacks it got from fixtures (tests/conftest.py).
+started: list[Up] = []
 
 
 def clean_env() -> dict[str, str]:
@@ -95,7 +98,9 @@ def start_up(
     if not first:
         stop_up(process)
         raise AssertionError(f"vahr up did not start: {(state / 'up.err').read_text()}")
-    return Up(process, json.loads(first), state / "up.err")
+    up = Up(process, json.loads(first), state / "up.err")
+    started.append(up)
+    return up
 
 
 def stop_up(process: subprocess.Popen[str]) -> None:
