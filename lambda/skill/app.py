@@ -12,7 +12,9 @@ collector paused, and what they made is then frozen (`gc.freeze`): both make man
 long-lived objects and next to no garbage (ask-sdk-model alone defines some 250 modules of
 classes; botocore's client reads its service model's JSON), which collections during the
 cold start, and every full collection after it, would only walk in vain: 697 -> 619 ms of
-CPU measured back to back (docs/benchmarks.md, "Alexa skill: cold start").
+CPU measured back to back (docs/benchmarks.md, "Alexa skill: cold start"). A process that
+imports the skill in-process (the local stack's Alexa host, a test worker) freezes its own
+heap of that moment too: objects that live on anyway, and never walked again.
 """
 
 from __future__ import annotations
