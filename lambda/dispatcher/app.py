@@ -209,7 +209,9 @@ def on_tick(
             given += dispatcher.drain()
     charging: list[Task] = []
     if dispatcher.respect_battery and dispatcher.fleet.batteries_drain:
-        charging = dispatcher.charge_low(search.idle())
+        charging = dispatcher.charge_low(
+            search.low_idle(dispatcher.fleet.battery_plan.charge_below)
+        )
     _given(given + charging, trail)
     for task in charging:
         tell(gone_to_charge(task, dispatcher.clock()))

@@ -18,8 +18,10 @@ search within one zone read every page.
 
 A robot out of service is the task table's, not the index's: `out_of_service` names them,
 and they are left out of `available` and read as such (`RobotState.in_service` False) by
-`state`. The schedule's `idle` reads every page of idle robots, so the dispatcher can send
-the low ones among them to charge.
+`state`. The schedule's `low_idle` asks for the idle robots whose charge is under the
+fleet's threshold, by a range on the indexed charge (`shadow.reported.battery.percent<20`),
+so the dispatcher can send them to charge: a page or two however large the fleet, where
+reading every idle robot of 10,000 took 100 calls a minute.
 
 The index follows the shadows within seconds, not at once: a robot that just left
 `idle` may still be found. That is harmless here, since the task table's conditional
@@ -55,6 +57,7 @@ PAGE_SIZE = 100
 STATUS_FIELD = "shadow.reported.status"
 ZONE_FIELD = "shadow.reported.zone"
 CONNECTED_FIELD = "shadow.reported.connected"
+BATTERY_FIELD = "shadow.reported.battery.percent"
 # AWS's limit on a query string's length: a search for many things by name is split.
 MAX_QUERY_CHARS = 1000
 
@@ -127,6 +130,11 @@ def status_query(statuses: Iterable[str], zone: str | None = None) -> str:
     if zone is not None:
         query += f" AND {ZONE_FIELD}:{_term(zone)}"
     return query
+
+
+def low_query(below: float) -> str:
+    """The index query for connected idle robots whose charge is under `below` percent."""
+    return f"{status_query(IDLE_STATUSES)} AND {BATTERY_FIELD}<{below:g}"
 
 
 def name_queries(things: Iterable[str]) -> list[str]:
@@ -207,11 +215,11 @@ class FleetSearch:
                     return robots
         return robots
 
-    def idle(self) -> list[RobotState]:
-        """Every connected idle robot in service, every page: what the schedule reads to
-        send the low ones to charge."""
+    def low_idle(self, below: float) -> list[RobotState]:
+        """Every connected idle robot in service whose charge is under `below` percent:
+        what the schedule reads to send them to charge."""
         out = self._out()
-        found = self._found(self._search(status_query(IDLE_STATUSES)), out)
+        found = self._found(self._search(low_query(below)), out)
         return [robot for robot in found if robot.idle]
 
     def state(self, thing: str) -> RobotState | None:

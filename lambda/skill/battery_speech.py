@@ -1,7 +1,8 @@
 """What the skill says about batteries and about robots out of service (pure).
 
-Battery answers read the robots' shadows (`reported.battery`); service answers read what
-the dispatcher did (`ServiceChange`). Names are the fleet's, in the request's language.
+Battery answers read the robots' shadows (`reported.battery`), or for a large fleet what
+the fleet index counts and finds; service answers read what the dispatcher did
+(`ServiceChange`). Names are the fleet's, in the request's language.
 """
 
 from __future__ import annotations
@@ -15,9 +16,13 @@ from skill.vocabulary import capitalise
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+    from skill.iot_fleet_index import IndexedRobot
     from skill.robots import ShadowRead
     from skill.vocabulary import Vocabulary
     from vahr.dispatch import ServiceChange
+
+# The robots a large fleet's answer names, the lowest charge first.
+NAMED_MAX = 3
 
 
 def one_battery(vocabulary: Vocabulary, read: ShadowRead) -> str:
@@ -51,6 +56,46 @@ def below(vocabulary: Vocabulary, percent: int, reads: Sequence[ShadowRead]) -> 
     return capitalise(
         wording.format(count=spoken_number(len(low)), percent=percent, robots=and_list(entries))
     )
+
+
+def below_in_index(
+    vocabulary: Vocabulary, percent: int, count: int, found: Sequence[IndexedRobot]
+) -> str:
+    """A large fleet's robots under `percent`: `count` of them by the index, named from
+    `found` (those the index returned: all of them, or a page), lowest first, at most
+    `NAMED_MAX`."""
+    low = sorted(
+        (battery.percent, robot.thing, battery.charging)
+        for robot in found
+        if (battery := robot.reported.battery) is not None and battery.percent < percent
+    )
+    if not count or not low:
+        return prompts.BATTERY_BELOW_NONE.format(percent=percent)
+    entries = [_entry(vocabulary, thing, level, charging) for level, thing, charging in low]
+    if count <= NAMED_MAX and len(low) == count:
+        wording = prompts.BATTERY_BELOW[min(count, 2)]
+    else:
+        wording = prompts.BATTERY_BELOW_LOWEST if len(low) >= count else prompts.BATTERY_BELOW_AMONG
+    return capitalise(
+        wording.format(
+            count=spoken_number(count), percent=percent, robots=and_list(entries[:NAMED_MAX])
+        )
+    )
+
+
+def fleet_counts(total: int, percent: int, low: int, charging: int) -> str:
+    """ "Of 1,000 robots, 12 are below 20 percent and 3 are charging. ...": a large fleet's
+    batteries in two counts."""
+    return prompts.BATTERY_FLEET_COUNTS.format(
+        total=f"{total:,}",
+        low=_counted(prompts.BATTERY_COUNTS["low"], low, percent=percent),
+        charging=_counted(prompts.BATTERY_COUNTS["charging"], charging),
+    )
+
+
+def _counted(forms: tuple[str, ...], n: int, **values: object) -> str:
+    """The form for none, one or many, with the number in it."""
+    return forms[min(n, 2)].format(n=f"{n:,}", **values)
 
 
 def every_battery(vocabulary: Vocabulary, reads: Sequence[ShadowRead]) -> str:

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from skill.iot_fleet_index import FleetIndex
 
 # Above this many recipients of one command, acknowledgments are counted by the index (the
-# same bound as a status question's shadow reads, skill.handlers.status.SHADOW_READ_MAX).
+# same bound as a status question's shadow reads, skill.fleet_question.SHADOW_READ_MAX).
 MANY = 25
 _NOT_DONE = ("rejected", "failed", "cancelled")
 

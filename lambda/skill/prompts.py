@@ -287,10 +287,19 @@ BATTERY_BELOW = {
     2: "{count} robots are below {percent} percent: {robots}.",
 }
 BATTERY_FLEET = "The batteries: {robots}."
-BATTERY_TOO_MANY = (
-    "The fleet has {count} robots, too many to read every battery aloud; the station shows "
-    "each robot's charge."
+# A large fleet's batteries, counted by the fleet index: how many are under a percent and
+# the lowest of them (all of them read: "the lowest"; a page of them: "among them"), and the
+# whole fleet's in two counts (none, one, many).
+BATTERY_BELOW_LOWEST = "{count} robots are below {percent} percent; the lowest: {robots}."
+BATTERY_BELOW_AMONG = "{count} robots are below {percent} percent, among them {robots}."
+BATTERY_FLEET_COUNTS = (
+    "Of {total} robots, {low} and {charging}. The station shows each robot's charge."
 )
+BATTERY_COUNTS = {
+    "low": ("none is below {percent} percent", "{n} is below {percent} percent",
+            "{n} are below {percent} percent"),
+    "charging": ("none is charging", "{n} is charging", "{n} are charging"),
+}  # fmt: skip
 CHARGE_SENT = "{robot} is on its way to {zone} to charge."
 NO_CHARGER = "Every charger is taken or closed now, so {robot} stays where it is."
 # Out of service: "take rover one out of service", "put rover one back in service".

@@ -2,12 +2,14 @@
 
 The shadow store records every change of a classic shadow here (`record`), whichever path
 it came by (MQTT or the HTTP data plane), so the index is never behind the shadows. Each
-thing is one `IndexedThing`: its name, reported status, zone, connectivity, pose and the
-time of its last update. Secondary indexes (things by status, by zone, the connected ones,
-the names in order) make the in-process questions the dispatcher and the skill ask cost
-the size of their answer, not the size of the fleet: at 10,000 robots a count by status is
-a microsecond, the stuck ones three, and the 2,500 idle ones in a zone about a millisecond
-(bench/fleet_index.py).
+thing is one `IndexedThing`: its name, reported status, zone, connectivity, pose, battery
+and the time of its last update. Secondary indexes (things by status, by zone, the
+connected ones, the names in order) make the in-process questions the dispatcher and the
+skill ask cost the size of their answer, not the size of the fleet: at 10,000 robots a
+count by status is a microsecond, the stuck ones three, and the 2,500 idle ones in a zone
+about a millisecond (bench/fleet_index.py). The battery has no secondary index: a range
+over the charge reads every thing once (asked once a minute by the dispatcher and when
+someone asks which robots are low).
 
 `search`, `buckets` and `statistics` answer a query string (`vahr.twin.fleet_query`); the
 data plane serves them as the IoT control plane's `SearchIndex`, `GetBucketsAggregation`
@@ -57,6 +59,9 @@ class IndexedThing(msgspec.Struct, frozen=True):
     # The last command the robot reported seeing, and what became of it.
     command_id: str | None
     command_result: str | None
+    # The battery's charge in percent and whether it charges (None: not reported).
+    battery_percent: float | None
+    battery_charging: bool | None
     # The reported section itself (shared with the store, never changed in place).
     reported: dict[str, Any]
 
@@ -69,6 +74,17 @@ def _last_command(value: object) -> tuple[str | None, str | None]:
     if not isinstance(value, dict):
         return None, None
     return _text(value.get("id")), _text(value.get("result"))
+
+
+def _battery(value: object) -> tuple[float | None, bool | None]:
+    """The charge and whether it charges, each None unless reported as the contract says."""
+    if not isinstance(value, dict):
+        return None, None
+    percent, charging = value.get("percent"), value.get("charging")
+    level = None
+    if isinstance(percent, int | float) and not isinstance(percent, bool):
+        level = float(percent)
+    return level, charging if isinstance(charging, bool) else None
 
 
 def _pose(value: object) -> ReportedPose | None:
@@ -114,6 +130,7 @@ class FleetIndex:
             if before is not None and before.connected == connected:
                 since = before.connected_since
             command_id, command_result = _last_command(reported.get("last_command"))
+            battery_percent, battery_charging = _battery(reported.get("battery"))
             entry = IndexedThing(
                 thing=thing,
                 status=_text(reported.get("status")),
@@ -125,6 +142,8 @@ class FleetIndex:
                 version=version,
                 command_id=command_id,
                 command_result=command_result,
+                battery_percent=battery_percent,
+                battery_charging=battery_charging,
                 reported=reported,
             )
             self._things[thing] = entry
@@ -261,6 +280,12 @@ class FleetIndex:
     def _evaluate(self, query: Query) -> set[str]:
         if isinstance(query, fleet_query.Term):
             return self._match(query)
+        if isinstance(query, fleet_query.Range):  # the one number field: the charge
+            return {
+                name
+                for name, entry in self._things.items()
+                if entry.battery_percent is not None and query.holds(entry.battery_percent)
+            }
         if isinstance(query, fleet_query.Not):
             return set(self._things).difference(self._evaluate(query.operand))
         parts = [self._evaluate(operand) for operand in query.operands]
@@ -274,6 +299,17 @@ class FleetIndex:
             if term.prefix:
                 return set(self._prefixed(term.value))
             return {term.value} if term.value in self._things else set()
+        if term.field == fleet_query.BATTERY_PERCENT:  # `field:*`: a battery is reported
+            return {
+                name for name, entry in self._things.items() if entry.battery_percent is not None
+            }
+        if term.field == fleet_query.BATTERY_CHARGING:
+            return {
+                name
+                for name, entry in self._things.items()
+                if entry.battery_charging is not None
+                and _matches(str(entry.battery_charging).lower(), term)
+            }
         if term.field in (fleet_query.CONNECTED, fleet_query.REPORTED_CONNECTED):
             if term.prefix:
                 return self._connected_matching(term.value)
@@ -297,6 +333,10 @@ class FleetIndex:
 
     def _disconnected(self) -> set[str]:
         return set(self._things).difference(self._connected)
+
+
+def _matches(value: str, term: fleet_query.Term) -> bool:
+    return value.startswith(term.value) if term.prefix else value == term.value
 
 
 def _check_aggregation_field(field: str) -> None:

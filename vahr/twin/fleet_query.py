@@ -3,7 +3,10 @@
 A query is terms `field:value` joined by `AND`, `OR` and `NOT` (and parentheses); terms
 side by side without an operator are joined by `AND`, as AWS does. A value ending in `*`
 matches by prefix, so `field:*` matches every thing that has the field. Values may be
-quoted ("zone C"). The fields are the ones VAHR's robots report and the skill asks about:
+quoted ("zone C"). A number field is also matched by range, in AWS's two forms:
+`field<20` (or `<=`, `>`, `>=`) and `field:[0 TO 19]` (a `{` or `}` leaves its bound out,
+`*` leaves a side open). The fields are the ones VAHR's robots report and the skill and the
+dispatcher ask about:
 
 | field | what it holds |
 | --- | --- |
@@ -13,10 +16,13 @@ quoted ("zone C"). The fields are the ones VAHR's robots report and the skill as
 | `connectivity.connected` / `shadow.reported.connected` | `true` or `false` |
 | `shadow.reported.last_command.id` | the id of the last command the robot saw |
 | `shadow.reported.last_command.result` | what became of it (`accepted`, `done`, `rejected`, ...) |
+| `shadow.reported.battery.percent` | the charge, a number from 0 to 100 |
+| `shadow.reported.battery.charging` | `true` or `false` |
 
 Anything else is a `QueryError` whose message is one line, which the data plane returns
-as AWS's `InvalidQueryException`. Parsing is pure: `parse` gives a tree of `Term`, `Not`,
-`And` and `Or` that the index evaluates.
+as AWS's `InvalidQueryException` (AWS also ranges over text; here only numbers are).
+Parsing is pure: `parse` gives a tree of `Term`, `Range`, `Not`, `And` and `Or` that the
+index evaluates.
 """
 
 from __future__ import annotations
@@ -34,16 +40,33 @@ REPORTED_CONNECTED = "shadow.reported.connected"
 # commands).
 COMMAND_ID = "shadow.reported.last_command.id"
 COMMAND_RESULT = "shadow.reported.last_command.result"
-FIELDS = (THING_NAME, STATUS, ZONE, CONNECTED, REPORTED_CONNECTED, COMMAND_ID, COMMAND_RESULT)
+# The robot's charge (the dispatcher finds the low ones, the skill counts them).
+BATTERY_PERCENT = "shadow.reported.battery.percent"
+BATTERY_CHARGING = "shadow.reported.battery.charging"
+FIELDS = (
+    THING_NAME, STATUS, ZONE, CONNECTED, REPORTED_CONNECTED, COMMAND_ID, COMMAND_RESULT,
+    BATTERY_PERCENT, BATTERY_CHARGING,
+)  # fmt: skip
+# The fields whose values are true or false, and those holding a number.
+BOOLEAN_FIELDS = (CONNECTED, REPORTED_CONNECTED, BATTERY_CHARGING)
+NUMBER_FIELDS = (BATTERY_PERCENT,)
 # AWS's limit on a query string's length.
 MAX_QUERY_CHARS = 1000
 
+_FIELD = r"[A-Za-z][A-Za-z0-9_.]*"
 _TOKEN = re.compile(
-    r"""\s*(?:
+    rf"""\s*(?:
         (?P<open>\()|(?P<close>\))
-      | (?P<term>[A-Za-z][A-Za-z0-9_.]*:(?:"[^"]*"|[^\s()"]*))
+      | (?P<range>{_FIELD}:[\[{{][^\]}}()]*[\]}}])
+      | (?P<term>{_FIELD}:(?:"[^"]*"|[^\s()"]*))
       | (?P<word>[^\s()]+)
     )""",
+    re.VERBOSE,
+)
+_COMPARISON = re.compile(rf"(?P<field>{_FIELD})(?P<operator><=|>=|<|>)(?P<value>.*)")
+_SPAN = re.compile(
+    rf"""(?P<field>{_FIELD}):(?P<open>[\[{{])\s*(?P<low>\S+)
+         \s+TO\s+(?P<high>[^\s\]}}]+)\s*(?P<close>[\]}}])""",
     re.VERBOSE,
 )
 
@@ -57,6 +80,23 @@ class Term:
     field: str
     value: str
     prefix: bool
+
+
+@dataclass(frozen=True)
+class Range:
+    """A number field's values between two bounds (None: open on that side)."""
+
+    field: str
+    low: float | None
+    high: float | None
+    low_inclusive: bool = True
+    high_inclusive: bool = True
+
+    def holds(self, value: float) -> bool:
+        low, high = self.low, self.high
+        if low is not None and (value < low or (value == low and not self.low_inclusive)):
+            return False
+        return high is None or value < high or (value == high and self.high_inclusive)
 
 
 @dataclass(frozen=True)
@@ -74,7 +114,7 @@ class Or:
     operands: tuple[Query, ...]
 
 
-Query = Term | Not | And | Or
+Query = Term | Range | Not | And | Or
 
 
 def _tokens(text: str) -> list[str]:
@@ -90,10 +130,62 @@ def _tokens(text: str) -> list[str]:
     return tokens
 
 
-def _term(token: str) -> Term:
-    field, _, value = token.partition(":")
+def _leaf(token: str) -> Term | Range:
+    """One term: `field:value`, `field<number` (and its kin) or `field:[low TO high]`."""
+    if span := _SPAN.fullmatch(token):
+        field = _known(span["field"])
+        return Range(
+            _number_field(field),
+            _bound(field, span["low"]),
+            _bound(field, span["high"]),
+            low_inclusive=span["open"] == "[",
+            high_inclusive=span["close"] == "]",
+        )
+    if comparison := _COMPARISON.fullmatch(token):
+        field = _number_field(_known(comparison["field"]))
+        operator, value = comparison["operator"], _number(field, comparison["value"])
+        if operator.startswith("<"):
+            return Range(field, None, value, high_inclusive=operator == "<=")
+        return Range(field, value, None, low_inclusive=operator == ">=")
+    if ":" not in token or token in ("AND", "OR", "NOT", ")"):
+        raise QueryError(f"Syntax error in query near '{token}': expected field:value")
+    if token.partition(":")[2].startswith(("[", "{")):
+        raise QueryError(f"Syntax error in range '{token}': expected [low TO high]")
+    return _term(token)
+
+
+def _known(field: str) -> str:
     if field not in FIELDS:
         raise QueryError(f"Unsupported field '{field}' in query; supported: {', '.join(FIELDS)}")
+    return field
+
+
+def _number_field(field: str) -> str:
+    if field not in NUMBER_FIELDS:
+        raise QueryError(
+            f"Field '{field}' is not ranged over here; ranges are answered on "
+            f"{', '.join(NUMBER_FIELDS)}"
+        )
+    return field
+
+
+def _number(field: str, text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise QueryError(f"Field '{field}' takes a number, not '{text}'") from None
+    if value != value or value in (float("inf"), float("-inf")):
+        raise QueryError(f"Field '{field}' takes a number, not '{text}'")
+    return value
+
+
+def _bound(field: str, text: str) -> float | None:
+    return None if text == "*" else _number(field, text)
+
+
+def _term(token: str) -> Term | Range:
+    field, _, value = token.partition(":")
+    _known(field)
     if value.startswith('"'):
         value = value[1:-1]
         prefix = False
@@ -104,8 +196,13 @@ def _term(token: str) -> Term:
             raise QueryError(f"Wildcards are supported only at the end of a value: '{token}'")
     if not value and not prefix:
         raise QueryError(f"Missing value for field '{field}' in query")
-    if field in (CONNECTED, REPORTED_CONNECTED) and not prefix and value not in ("true", "false"):
+    if field in BOOLEAN_FIELDS and not prefix and value not in ("true", "false"):
         raise QueryError(f"Field '{field}' takes true or false, not '{value}'")
+    if field in NUMBER_FIELDS and not (prefix and not value):
+        if prefix:
+            raise QueryError(f"Field '{field}' takes a number, not '{value}*'")
+        exactly = _number(field, value)
+        return Range(field, exactly, exactly)
     return Term(field, value, prefix)
 
 
@@ -154,9 +251,7 @@ class _Parser:
                 raise QueryError("Syntax error in query: a '(' is never closed")
             self.take()
             return inner
-        if ":" not in token or token in ("AND", "OR", "NOT", ")"):
-            raise QueryError(f"Syntax error in query near '{token}': expected field:value")
-        return _term(token)
+        return _leaf(token)
 
 
 def parse(text: str) -> Query:

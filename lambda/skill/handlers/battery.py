@@ -1,9 +1,12 @@
 """BatteryIntent: "how much battery does rover one have", "which robots are below thirty
 percent", "which robots are low on battery"; ChargeIntent: "send rover one to charge".
 
-The charge is each robot's `reported.battery`; sending a robot to charge is the
-dispatcher's (`TaskDesk.charge`): it holds the nearest free charger for the robot, as it
-does when a robot low on charge goes by itself (docs/dispatch.md).
+The charge is each robot's `reported.battery`, read from the shadows of a small fleet and
+asked of the fleet index for a large one (`fleet_question`): how many are under a percent
+(a range on the indexed charge) and a page of them to name the lowest, or for the whole
+fleet how many are low and how many charge. Sending a robot to charge is the dispatcher's
+(`TaskDesk.charge`): it holds the nearest free charger for the robot, as it does when a
+robot low on charge goes by itself (docs/dispatch.md).
 """
 
 from __future__ import annotations
@@ -15,6 +18,8 @@ from ask_sdk_core.utils import is_intent_name
 
 from skill import battery_speech, deeds, dialog, prompts
 from skill.dialog import _intent
+from skill.fleet_question import FleetQuestion
+from skill.iot_fleet_index import SEARCH_MAX
 from skill.responses import answer
 from skill.service_guard import out_of_service
 from skill.slots import read_slot, spoken_number
@@ -28,16 +33,14 @@ if TYPE_CHECKING:
     from skill.runtime import SkillRuntime
     from skill.task_desk import TaskDesk
 
-# The most robots whose batteries are read one shadow at a time (as a status question does).
-SHADOW_READ_MAX = 25
 PERCENTS = frozenset(str(n) for n in range(1, 101))
+# The index's fields for the charge (infra/constructs/fleet_indexing.py).
+PERCENT_FIELD = "shadow.reported.battery.percent"
+CHARGING_FIELD = "shadow.reported.battery.charging"
 
 
-class BatteryIntentHandler(AbstractRequestHandler):
+class BatteryIntentHandler(FleetQuestion, AbstractRequestHandler):
     """The charge of one robot, of every robot, or of those below a percent."""
-
-    def __init__(self, runtime: SkillRuntime) -> None:
-        self.runtime = runtime
 
     def can_handle(self, handler_input: HandlerInput) -> bool:
         return bool(is_intent_name("BatteryIntent")(handler_input))
@@ -51,17 +54,29 @@ class BatteryIntentHandler(AbstractRequestHandler):
         if robot.id is not None and robot.id != FLEET:
             [read] = runtime.robots.shadows([robot.id]).values()
             return answer(handler_input, battery_speech.one_battery(runtime.vocabulary, read))
-        things = runtime.fleet.robot_things
-        if len(things) > SHADOW_READ_MAX:
-            return answer(handler_input, prompts.BATTERY_TOO_MANY.format(count=len(things)))
-        reads = list(runtime.robots.shadows(things).values())
+        threshold = round(runtime.fleet.battery_plan.charge_below)
+        reads = self.read_all()
         if robot.id == FLEET and percent.missing:
+            if reads is None:
+                return answer(handler_input, self._fleet_counts(threshold))
             return answer(handler_input, battery_speech.every_battery(runtime.vocabulary, reads))
-        level = int(percent.id) if percent.id is not None else None
-        if level is None:
-            # "which robots are low on battery": under the fleet's threshold.
-            level = round(runtime.fleet.battery_plan.charge_below)
+        # "which robots are low on battery": under the fleet's threshold.
+        level = int(percent.id) if percent.id is not None else threshold
+        if reads is None:
+            return answer(handler_input, self._below_in_index(level))
         return answer(handler_input, battery_speech.below(runtime.vocabulary, level, reads))
+
+    def _below_in_index(self, level: int) -> str:
+        query = f"{PERCENT_FIELD}<{level}"
+        found = self.index.search(query, SEARCH_MAX)
+        count = len(found) if len(found) < SEARCH_MAX else self.index.count(query)
+        return battery_speech.below_in_index(self.runtime.vocabulary, level, count, found)
+
+    def _fleet_counts(self, threshold: int) -> str:
+        low = self.index.count(f"{PERCENT_FIELD}<{threshold}")
+        charging = self.index.count(f"{CHARGING_FIELD}:true")
+        total = len(self.runtime.fleet.robots)
+        return battery_speech.fleet_counts(total, threshold, low, charging)
 
 
 class ChargeIntentHandler(AbstractRequestHandler):

@@ -4,7 +4,8 @@ boto3's `iot` client with AWS's shapes and pagination (the local data plane's).
 moto's own `search_index` cannot stand in here: it matches only thing names, types, groups
 and attributes (a `shadow.reported.*` term matches nothing), ignores `maxResults` and never
 pages. What neither can show is AWS's indexing delay (seconds) and its exact query parser;
-the adapter sends only field:value terms, OR and AND, which both document.
+the adapter sends only field:value terms, OR and AND, and one range on a number field
+(`field<20`), all of which AWS's query syntax documents.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import boto3
 import pytest
 
 from dispatcher.errors import SearchError
-from dispatcher.fleet_search import FleetSearch, available_query
+from dispatcher.fleet_search import FleetSearch, available_query, low_query
 from vahr.domain.fleet import Pose
 from vahr.protocol.shadow import Battery
 from vahr.twin.dataplane import DataPlane, DataPlaneServer
@@ -185,3 +186,28 @@ def test_a_page_of_robots_the_dispatcher_would_not_use_is_read_past(
     assert {robot.thing for robot in found if charged(robot)} == {
         f"rover{n:03}" for n in range(100, 120)
     }
+
+
+def test_the_idle_robots_low_on_charge_are_one_search_however_many_are_idle(
+    fleet_index: tuple[ShadowStore, Any],
+) -> None:
+    store, iot = fleet_index
+    # Given 300 idle robots (three pages), four of them under 20 percent: one charging, one
+    # offline, one busy beside them, and one at exactly 20
+    for n in range(300):
+        percent = {7: 5, 8: 19, 9: 3, 10: 12, 11: 20}.get(n, 60 + n % 40)
+        report(store, f"rover{n:03}", status="navigating" if n == 10 else "idle",
+               connected=n != 9, battery={"percent": percent, "charging": n == 8})  # fmt: skip
+    queries = searches(iot)
+    low = FleetSearch(client=iot).low_idle(20)
+    # Then one SearchIndex call, a range on the indexed charge, finds the connected idle
+    # ones under 20 percent (the charging one too: whether to send it is the dispatcher's)
+    assert queries == [
+        "(shadow.reported.status:idle OR shadow.reported.status:stopped) "
+        "AND shadow.reported.connected:true AND shadow.reported.battery.percent<20"
+    ]
+    assert {robot.thing: robot.battery for robot in low} == {
+        "rover007": Battery(percent=5, charging=False),
+        "rover008": Battery(percent=19, charging=True),
+    }
+    assert low_query(12.5).endswith("shadow.reported.battery.percent<12.5")

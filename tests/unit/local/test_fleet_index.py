@@ -19,9 +19,12 @@ def _report(store: ShadowStore, thing: str, **reported: object) -> None:
 @pytest.fixture
 def store() -> ShadowStore:
     store = ShadowStore(clock=lambda: 1_800_000_000.0)
-    _report(store, "rover1", status="idle", zone="A", connected=True, pose={"x": 1, "y": 2})
-    _report(store, "rover2", status="navigating", zone="B", connected=True)
-    _report(store, "rover10", status="stuck", zone="C", connected=True)
+    _report(store, "rover1", status="idle", zone="A", connected=True, pose={"x": 1, "y": 2},
+            battery={"percent": 12, "charging": False})  # fmt: skip
+    _report(store, "rover2", status="navigating", zone="B", connected=True,
+            battery={"percent": 20, "charging": True})  # fmt: skip
+    _report(store, "rover10", status="stuck", zone="C", connected=True,
+            battery={"percent": 80})  # fmt: skip
     _report(store, "placebot1", status="idle", zone="A", connected=False)
     return store
 
@@ -79,6 +82,25 @@ def test_the_index_is_rebuilt_from_the_database_after_a_restart(tmp_path) -> Non
         ('shadow.reported.zone:"C"', ["rover10"]),
         ("shadow.reported.status:*", ["placebot1", "rover1", "rover10", "rover2"]),
         ("shadow.reported.status:flying", []),
+        # The charge by range, in both of AWS's forms, and whether it charges
+        ("shadow.reported.battery.percent<20", ["rover1"]),
+        ("shadow.reported.battery.percent<=20", ["rover1", "rover2"]),
+        ("shadow.reported.battery.percent>20", ["rover10"]),
+        ("shadow.reported.battery.percent>=12.5", ["rover10", "rover2"]),
+        ("shadow.reported.battery.percent:[12 TO 20]", ["rover1", "rover2"]),
+        ("shadow.reported.battery.percent:{12 TO 20]", ["rover2"]),
+        ("shadow.reported.battery.percent:[12 TO 20}", ["rover1"]),
+        ("shadow.reported.battery.percent:[50 TO *]", ["rover10"]),
+        ("shadow.reported.battery.percent:20", ["rover2"]),
+        ("shadow.reported.battery.percent:*", ["rover1", "rover10", "rover2"]),
+        ("NOT shadow.reported.battery.percent:*", ["placebot1"]),
+        ("shadow.reported.battery.charging:true", ["rover2"]),
+        ("shadow.reported.battery.charging:false", ["rover1"]),
+        (
+            "(shadow.reported.status:idle OR shadow.reported.status:stuck) "
+            "AND shadow.reported.connected:true AND shadow.reported.battery.percent<90",
+            ["rover1", "rover10"],
+        ),
     ],
 )
 def test_queries_in_aws_syntax(store: ShadowStore, query: str, expected: list[str]) -> None:
@@ -104,6 +126,12 @@ def test_buckets_count_by_status_largest_first(store: ShadowStore) -> None:
         ("connectivity.connected:maybe", "takes true or false"),
         ("idle", "expected field:value"),
         ("shadow.reported.status:idle)", "Syntax error in query near ')'"),
+        ("shadow.reported.battery.percent<low", "takes a number, not 'low'"),
+        ("shadow.reported.battery.percent:2*", "takes a number, not '2*'"),
+        ("shadow.reported.battery.percent:[0 TO]", "expected [low TO high]"),
+        ("shadow.reported.battery.charging:yes", "takes true or false"),
+        ("shadow.reported.zone<5", "ranges are answered on shadow.reported.battery.percent"),
+        ("shadow.reported.zone:[A TO C]", "ranges are answered on shadow.reported.battery.percent"),
     ],
 )
 def test_a_bad_query_is_one_line_naming_the_problem(query: str, message: str) -> None:
