@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 from skill import prompts
 from skill.task_speech import and_list, spoken_number, task_name
-from skill.vocabulary import capitalise
+from skill.vocabulary import capitalise, count_text
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -87,7 +87,7 @@ def fleet_counts(total: int, percent: int, low: int, charging: int) -> str:
     """ "Of 1,000 robots, 12 are below 20 percent and 3 are charging. ...": a large fleet's
     batteries in two counts."""
     return prompts.BATTERY_FLEET_COUNTS.format(
-        total=f"{total:,}",
+        total=count_text(total),
         low=_counted(prompts.BATTERY_COUNTS["low"], low, percent=percent),
         charging=_counted(prompts.BATTERY_COUNTS["charging"], charging),
     )
@@ -95,7 +95,7 @@ def fleet_counts(total: int, percent: int, low: int, charging: int) -> str:
 
 def _counted(forms: tuple[str, ...], n: int, **values: object) -> str:
     """The form for none, one or many, with the number in it."""
-    return forms[min(n, 2)].format(n=f"{n:,}", **values)
+    return forms[min(n, 2)].format(n=count_text(n), **values)
 
 
 def every_battery(vocabulary: Vocabulary, reads: Sequence[ShadowRead]) -> str:

@@ -374,6 +374,8 @@ EVERY_ROBOT = "all robots"
 # robots listed ("heron, plover and curlew").
 OR = "or"
 AND = "and"
+# Between the thousands of a count said in digits ("1,000 robots"; skill.vocabulary.count_text).
+THOUSANDS_SEPARATOR = ","
 
 # Every other locale's sentences are vahr/domain/locales/<locale>/replies.yaml, under these
 # names; the request's locale chooses (skill.catalog).

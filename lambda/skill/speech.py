@@ -8,7 +8,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from skill import prompts
-from skill.vocabulary import capitalise
+from skill.vocabulary import capitalise, count_text
 
 if TYPE_CHECKING:
     from collections.abc import Mapping, Sequence
@@ -60,7 +60,7 @@ def command_report(
         robots = (
             prompts.BOTH_ROBOTS
             if len(mine) == 2
-            else prompts.ALL_ROBOTS.format(count=f"{len(mine):,}")
+            else prompts.ALL_ROBOTS.format(count=count_text(len(mine)))
         )
         return prompts.FLEET_ACKNOWLEDGED[action].format(robots=robots, zone=zone_name)
     unconfirmed = [answer for answer in mine if not answer.confirmed]
@@ -73,7 +73,7 @@ def command_report(
         named.append(prompts.FLEET_PROBLEMS_MORE.format(n=len(unconfirmed) - FLEET_PROBLEMS_NAMED))
     template = prompts.FLEET_PARTIAL if confirmed else prompts.FLEET_NONE
     return template.format(
-        confirmed=f"{len(confirmed):,}", count=f"{len(mine):,}", problems="; ".join(named)
+        confirmed=count_text(len(confirmed)), count=count_text(len(mine)), problems="; ".join(named)
     )
 
 
@@ -234,7 +234,7 @@ def words(text: str) -> int:
 
 
 def _counted(template: tuple[str, str], n: int) -> str:
-    return template[0 if n == 1 else 1].format(n=f"{n:,}")
+    return template[0 if n == 1 else 1].format(n=count_text(n))
 
 
 def _joined(parts: Sequence[str]) -> str:
@@ -265,7 +265,7 @@ def _names(
     places = [_place(vocabulary, robot) for robot in robots]
     for shown in range(len(places), 0, -1):
         rest = count - shown
-        parts = places[:shown] + ([prompts.SUMMARY_MORE.format(n=f"{rest:,}")] if rest else [])
+        parts = places[:shown] + ([prompts.SUMMARY_MORE.format(n=count_text(rest))] if rest else [])
         text = _joined(parts)
         if words(text) <= budget:
             return text
@@ -293,7 +293,7 @@ def fleet_summary(vocabulary: Vocabulary, state: FleetState) -> str:
         clauses.append(_counted(prompts.SUMMARY_COUNTS["unreported"], state.unreported))
     troubles = [status for status in _TROUBLE_CLAUSES if state.counts.get(status)]
     clauses += [_counted(prompts.SUMMARY_COUNTS[s], state.counts[s]) for s in troubles]
-    text = prompts.SUMMARY_OPENING.format(total=f"{state.total:,}", counts=_joined(clauses))
+    text = prompts.SUMMARY_OPENING.format(total=count_text(state.total), counts=_joined(clauses))
     # The trouble named right after the counts (after a colon), and the sentences after it.
     attached = troubles[-1] if troubles else None
     leads: dict[str, str] = {}

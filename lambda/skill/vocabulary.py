@@ -49,6 +49,12 @@ def capitalise(sentence: str) -> str:
     return sentence[:1].upper() + sentence[1:]
 
 
+def count_text(number: int) -> str:
+    """A count in digits as the request's language writes it for the speech engine: "1,000"
+    in English, "1.000" in German (whose comma is the decimal point: "1,000" is one)."""
+    return f"{number:,}".replace(",", prompts.THOUSANDS_SEPARATOR)
+
+
 # A fleet of more robots than this is not listed one by one when the skill asks which robot
 # (each name is a few words, and a question should stay short enough to hear).
 ROBOT_CHOICES_MAX = 6
@@ -148,7 +154,7 @@ class Vocabulary:
         if len(things) > ROBOT_CHOICES_MAX:
             # A thousand names are minutes of speech: a few, then how to name the others.
             names = [self.robot(thing) for thing in things[:ROBOT_CHOICES_SHOWN]]
-            count = f"{len(things):,}"
+            count = count_text(len(things))
             return join_choices([*names, prompts.ANOTHER_ROBOT.format(count=count)])
         names = [self.robot(thing) for thing in things]
         if include_fleet and len(names) > 1:

@@ -107,6 +107,16 @@ def test_status_of_a_thousand_robots_is_a_summary_within_sixty_words(
     assert "http.shadow.get" not in json.dumps(meter.snapshot())
 
 
+def test_in_german_a_thousand_is_written_as_german_reads_it(
+    big_skill: Callable[[dict[str, Any], Any], dict[str, Any]],
+) -> None:
+    # German's comma is its decimal point: "1,000 Robotern" would be read as one robot
+    event = _intent("StatusIntent")
+    event["request"]["locale"] = "de-DE"
+    said = speech(big_skill(event, None))
+    assert said.startswith("Von 1.000 Robotern: 990 warten auf Aufträge, 8 fahren")
+
+
 def test_which_robots_are_stuck_names_them_and_where(
     big_skill: Callable[[dict[str, Any], Any], dict[str, Any]],
 ) -> None:
