@@ -19,6 +19,7 @@ from ask_sdk_core.utils import is_intent_name
 from skill import battery_speech, deeds, dialog, prompts
 from skill.dialog import _intent
 from skill.fleet_question import FleetQuestion
+from skill.handlers.desk_intent import DeskIntentHandler
 from skill.iot_fleet_index import SEARCH_MAX
 from skill.responses import answer
 from skill.service_guard import out_of_service
@@ -30,8 +31,6 @@ if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
     from ask_sdk_model import Response
 
-    from skill.runtime import SkillRuntime
-    from skill.task_desk import TaskDesk
 
 PERCENTS = frozenset(str(n) for n in range(1, 101))
 # The index's fields for the charge (infra/constructs/fleet_indexing.py).
@@ -79,15 +78,10 @@ class BatteryIntentHandler(FleetQuestion, AbstractRequestHandler):
         return battery_speech.fleet_counts(total, threshold, low, charging)
 
 
-class ChargeIntentHandler(AbstractRequestHandler):
+class ChargeIntentHandler(DeskIntentHandler):
     """Send one robot to the nearest free charger now."""
 
-    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None) -> None:
-        self.runtime = runtime
-        self.desk = desk
-
-    def can_handle(self, handler_input: HandlerInput) -> bool:
-        return bool(is_intent_name("ChargeIntent")(handler_input))
+    intent_name = "ChargeIntent"
 
     def handle(self, handler_input: HandlerInput) -> Response:
         runtime = self.runtime

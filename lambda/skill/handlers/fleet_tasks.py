@@ -12,11 +12,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ask_sdk_core.dispatch_components import AbstractRequestHandler
-from ask_sdk_core.utils import is_intent_name
-
 from skill import deeds, dialog, prompts, task_speech
 from skill.guard import confirm_first
+from skill.handlers.desk_intent import DeskIntentHandler
 from skill.responses import answer
 from skill.slots import read_slot, spoken_number
 from skill.task_desk import TaskRefused
@@ -24,6 +22,7 @@ from skill.vocabulary import capitalise
 from vahr.dispatch import Order
 
 if TYPE_CHECKING:
+    from ask_sdk_core.dispatch_components import AbstractRequestHandler
     from ask_sdk_core.handler_input import HandlerInput
     from ask_sdk_model import IntentRequest, Response
 
@@ -32,17 +31,8 @@ if TYPE_CHECKING:
     from skill.task_desk import TaskDesk
 
 
-class _FleetHandler(AbstractRequestHandler):
+class _FleetHandler(DeskIntentHandler):
     """What every dispatch handler shares: the runtime, the desk, submitting an order."""
-
-    intent_name = ""
-
-    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None) -> None:
-        self.runtime = runtime
-        self.desk = desk
-
-    def can_handle(self, handler_input: HandlerInput) -> bool:
-        return bool(is_intent_name(self.intent_name)(handler_input))
 
     def submit(self, handler_input: HandlerInput, order: Order, *, when_none: str) -> Response:
         """Hand `order` to the dispatcher and say what it did; `when_none` is said when no

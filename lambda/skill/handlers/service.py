@@ -12,11 +12,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ask_sdk_core.dispatch_components import AbstractRequestHandler
-from ask_sdk_core.utils import is_intent_name
-
 from skill import battery_speech, deeds, dialog, prompts
 from skill.guard import confirm_first
+from skill.handlers.desk_intent import DeskIntentHandler
 from skill.responses import answer
 from skill.task_desk import TaskRefused
 from skill.vocabulary import FLEET
@@ -25,23 +23,13 @@ if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
     from ask_sdk_model import Response
 
-    from skill.runtime import SkillRuntime
-    from skill.task_desk import TaskDesk
     from vahr.dispatch import ServiceChange
 
 
-class _ServiceHandler(AbstractRequestHandler):
+class _ServiceHandler(DeskIntentHandler):
     """Take the robots named (a robot, a group, or the fleet) out of service or back."""
 
-    intent_name = ""
     in_service = False
-
-    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None) -> None:
-        self.runtime = runtime
-        self.desk = desk
-
-    def can_handle(self, handler_input: HandlerInput) -> bool:
-        return bool(is_intent_name(self.intent_name)(handler_input))
 
     def handle(self, handler_input: HandlerInput) -> Response:
         group, refusal = dialog.group(handler_input, self.runtime)

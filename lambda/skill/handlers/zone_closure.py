@@ -10,11 +10,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ask_sdk_core.dispatch_components import AbstractRequestHandler
-from ask_sdk_core.utils import is_intent_name
-
 from skill import deeds, dialog, prompts, task_speech
 from skill.guard import confirm_first
+from skill.handlers.desk_intent import DeskIntentHandler
 from skill.responses import answer
 from skill.task_desk import TaskRefused
 
@@ -22,22 +20,11 @@ if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
     from ask_sdk_model import Response
 
-    from skill.runtime import SkillRuntime
-    from skill.task_desk import TaskDesk
 
-
-class _ZoneHandler(AbstractRequestHandler):
+class _ZoneHandler(DeskIntentHandler):
     """Close or open the zone named in the request."""
 
-    intent_name = ""
     closes = True
-
-    def __init__(self, runtime: SkillRuntime, desk: TaskDesk | None) -> None:
-        self.runtime = runtime
-        self.desk = desk
-
-    def can_handle(self, handler_input: HandlerInput) -> bool:
-        return bool(is_intent_name(self.intent_name)(handler_input))
 
     def handle(self, handler_input: HandlerInput) -> Response:
         zone = dialog.zone(handler_input, self.runtime, "zone")
