@@ -254,44 +254,13 @@ class AnnouncePolicy:
                 lambda f: f.thing == signal.thing and f.kind in signal.kinds and f.kind != "waiting"
             )
         elif isinstance(signal, Finished):
-            if "done" in self.settings.kinds:
-                self.state.finished.append(
-                    Fault(
-                        subject=signal.thing,
-                        kind="done",
-                        thing=signal.thing,
-                        opened_at=signal.at.timestamp(),
-                        seen_at=self._clock().timestamp(),
-                        zone=signal.zone,
-                    )
-                )
+            self._tell_once("done", signal.thing, signal)
         elif isinstance(signal, TaskCancelled):
-            if "cancelled" in self.settings.kinds:
-                self.state.finished.append(
-                    Fault(
-                        subject=signal.task,
-                        kind="cancelled",
-                        thing=signal.thing,
-                        opened_at=signal.at.timestamp(),
-                        seen_at=self._clock().timestamp(),
-                        reason=signal.kind,
-                        zone=signal.zone,
-                        why=None if signal.why == "preempted" else signal.why,
-                    )
-                )
+            why = None if signal.why == "preempted" else signal.why
+            self._tell_once("cancelled", signal.task, signal, reason=signal.kind, why=why)
             self.state.queued = [t for t in self.state.queued if t.task != signal.task]
         elif isinstance(signal, LowBattery):
-            if "battery_low" in self.settings.kinds:
-                self.state.finished.append(
-                    Fault(
-                        subject=signal.thing,
-                        kind="battery_low",
-                        thing=signal.thing,
-                        opened_at=signal.at.timestamp(),
-                        seen_at=self._clock().timestamp(),
-                        zone=signal.zone,
-                    )
-                )
+            self._tell_once("battery_low", signal.thing, signal)
         elif isinstance(signal, Queued):
             if not any(t.task == signal.task for t in self.state.queued):
                 self.state.queued.append(
@@ -302,6 +271,31 @@ class AnnouncePolicy:
         else:  # Dispatched
             self.state.queued = [t for t in self.state.queued if t.task != signal.task]
             self._clear(lambda f: f.kind == "waiting" and f.subject == signal.task)
+
+    def _tell_once(
+        self,
+        kind: AnnouncementKind,
+        subject: str,
+        signal: Finished | TaskCancelled | LowBattery,
+        *,
+        reason: str | None = None,
+        why: str | None = None,
+    ) -> None:
+        """Keep a one-off announcement (nothing to clear later) for the next turn, if this
+        kind is announced at all."""
+        if kind in self.settings.kinds:
+            self.state.finished.append(
+                Fault(
+                    subject=subject,
+                    kind=kind,
+                    thing=signal.thing,
+                    opened_at=signal.at.timestamp(),
+                    seen_at=self._clock().timestamp(),
+                    reason=reason,
+                    zone=signal.zone,
+                    why=why,
+                )
+            )
 
     def _clear(self, over: Callable[[Fault], bool]) -> None:
         """Forget the faults that are `over`; one not yet told is not news any more."""
