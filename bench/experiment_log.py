@@ -3,7 +3,8 @@
 - append latency: one event committed with WAL and `synchronous=FULL` (what makes the log
   crash-safe), beside `synchronous=NORMAL` for comparison, on this machine's disk;
 - scoring: judging and measuring a long session log (thousands of robot progress events);
-- the report: 100 runs (means, ANOVA) without and with the three figures.
+- the report: 100 runs (means, one-way ANOVAs, the within-subjects analysis) without and
+  with the three figures.
 """
 
 from __future__ import annotations
@@ -118,7 +119,10 @@ def main() -> None:
         assert verdict.task_tally.successes == 3, verdict.to_json()
         data = rows(100)
         start = time.perf_counter()
-        import scipy.stats  # noqa: F401 - the report's first ANOVA pays this once
+        # The report's first analysis pays these imports once.
+        import scipy.stats  # noqa: F401
+        import statsmodels.stats.anova  # noqa: F401
+        import statsmodels.stats.weightstats  # noqa: F401
 
         scipy_ms = (time.perf_counter() - start) * 1000
         start = time.perf_counter()
@@ -140,8 +144,14 @@ def main() -> None:
             f"judge and measure a session log of {len(entries)} events",
             f"{scoring_ms:.0f} ms (IE {times.interaction_s:.0f} s of T {times.time_taken_s:.0f} s)",
         ),
-        ("first `import scipy.stats` (paid once per report)", f"{scipy_ms:.0f} ms"),
-        ("report of 100 runs: means and 15 ANOVAs", f"{report_ms:.0f} ms"),
+        (
+            "first import of scipy.stats and statsmodels (paid once per report)",
+            f"{scipy_ms:.0f} ms",
+        ),
+        (
+            "report of 100 runs: means, 15 one-way ANOVAs and the within-subjects analysis",
+            f"{report_ms:.0f} ms",
+        ),
         ("report of 100 runs with report.md, results.csv and 3 PNG figures", f"{figures_s:.1f} s"),
     ]
     body = "| what | result |\n| --- | --- |\n"
