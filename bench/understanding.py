@@ -183,8 +183,10 @@ NLU build at start-up, a fresh interpreter importing, building and answering onc
 
 `vahr up --no-voice`, spawn to the endpoints line and to the first answered turn ("where
 are the robots"); `before` is the literal-match simulator (`--before`). The
-classifier builds on a thread while the stack starts, so a cold cache delays the first
-turn, not the endpoints (budget: at most 1 s added to the start).
+classifier builds on a thread while the stack starts; `vahr up` prints its endpoints only
+once it can answer, so a cold cache (the classifier trained, a first start only) delays
+the endpoints and the first turn alike. Budget: at most 1 s added to a start with the NLU
+cached.
 
 | checkout | runs | to endpoints (median) | vs before | to first turn (median) |
 | --- | --- | --- | --- | --- |
