@@ -33,7 +33,7 @@ from skill import deeds, prompts
 from skill.access import INTENT_RULES, REQUEST_KINDS, classify
 from skill.errors import PeopleUnavailable
 from skill.responses import answer, confirm_intent
-from skill.slots import MATCH
+from skill.slots import resolved_ids
 from skill.speakers import speaker_id
 from skill.trail import append_or_log
 from skill.vocabulary import capitalise
@@ -44,7 +44,7 @@ from vahr.protocol.audit import AuditEntry, RequestSource, now
 
 if TYPE_CHECKING:
     from ask_sdk_core.handler_input import HandlerInput
-    from ask_sdk_model import Intent, Response
+    from ask_sdk_model import Intent, Response, Slot
 
     from skill.runtime import SkillRuntime
     from vahr.domain.people import ActionKind
@@ -268,13 +268,9 @@ class _Blank(dict[str, str]):
         return ""
 
 
-def _resolved(slot: Any) -> str | None:
-    resolutions = slot.resolutions.resolutions_per_authority if slot.resolutions else None
-    for authority in resolutions or []:
-        code = authority.status.code.value if authority.status and authority.status.code else None
-        if code == MATCH and authority.values and authority.values[0].value:
-            return str(authority.values[0].value.id)
-    return None
+def _resolved(slot: Slot) -> str | None:
+    matched = resolved_ids(slot)
+    return matched[0] if matched else None
 
 
 def slot_values(intent: Intent) -> dict[str, str | None]:

@@ -19,7 +19,7 @@ from vahr.domain.text import normalize, number_in_words
 if TYPE_CHECKING:
     from collections.abc import Callable, Collection
 
-    from ask_sdk_model import Intent
+    from ask_sdk_model import Intent, Slot
 
 MATCH = "ER_SUCCESS_MATCH"
 
@@ -53,26 +53,40 @@ def read_slot(
     heard = (slot.value or "").strip() if slot is not None else ""
     if slot is None or not heard:
         return SlotReading(name, None, None)
+    matched = resolved_ids(slot)
+    if matched is None:
+        return SlotReading(name, heard, lookup(heard))
+    if len(matched) > 1:
+        # The words fit several values ("robot" for either robot): taking the first would
+        # act on a guess, so the slot counts as unresolved.
+        known = tuple(value for value in matched if value in known_ids)
+        return SlotReading(name, heard, None, known if len(known) > 1 else ())
+    if matched and matched[0] in known_ids:
+        return SlotReading(name, heard, matched[0])
+    # Resolutions were present and none matched (ER_SUCCESS_NO_MATCH), or not a known id.
+    return SlotReading(name, heard, None)
+
+
+def resolved_ids(slot: Slot) -> list[str] | None:
+    """The ids the first matching authority (ER_SUCCESS_MATCH) resolved the words to, each
+    once, in Alexa's order; [] when resolutions came and none matched; None when the slot
+    came without resolutions. Empty entries (a value, a wrapper or an authority that is
+    null) are passed over: a request is outside input."""
     resolutions = slot.resolutions.resolutions_per_authority if slot.resolutions else None
-    if resolutions:
-        for authority in resolutions:
-            code = (
-                authority.status.code.value if authority.status and authority.status.code else None
-            )
-            if code == MATCH and authority.values and authority.values[0].value:
-                matched = list(
-                    dict.fromkeys(w.value.id for w in authority.values if w.value and w.value.id)
-                )
-                if len(matched) > 1:
-                    # The words fit several values ("robot" for either robot): taking the
-                    # first would act on a guess, so the slot counts as unresolved.
-                    known = tuple(value for value in matched if value in known_ids)
-                    return SlotReading(name, heard, None, known if len(known) > 1 else ())
-                resolved = authority.values[0].value.id
-                return SlotReading(name, heard, resolved if resolved in known_ids else None)
-        # Resolutions were present and none matched (ER_SUCCESS_NO_MATCH).
-        return SlotReading(name, heard, None)
-    return SlotReading(name, heard, lookup(heard))
+    if not resolutions:
+        return None
+    for authority in resolutions:
+        if authority is None:
+            continue
+        code = authority.status.code.value if authority.status and authority.status.code else None
+        ids = [
+            wrapper.value.id
+            for wrapper in authority.values or []
+            if wrapper is not None and wrapper.value is not None and wrapper.value.id
+        ]
+        if code == MATCH and ids:
+            return list(dict.fromkeys(ids))
+    return []
 
 
 def spoken_number(heard: str | None) -> int | None:

@@ -117,6 +117,29 @@ def test_emergency_stop_without_a_robot_stops_the_whole_fleet(
     assert speech(response) == "Both robots have stopped."
 
 
+@pytest.mark.parametrize("values", [[None, "placebot2"], [None]], ids=["beside", "alone"])
+def test_a_resolution_holding_a_null_value_is_passed_over(
+    skill: Any, robots: RobotDoubles, fleet: Fleet, values: list[str | None]
+) -> None:
+    # Given "stop placebot two" whose resolution came with a null entry (the fuzz test's find)
+    event = load_event("alexa_emergency_stop_robot")
+    resolution = event["request"]["intent"]["slots"]["robot"]["resolutions"]
+    resolution["resolutionsPerAuthority"][0]["values"] = [
+        value and {"value": {"name": "placebot two", "id": value}} for value in values
+    ]
+    response = skill(event, None)
+    # Then the skill answers with valid speech: beside a real value the null one is passed
+    # over and placebot two stops; alone, the name did not resolve and is asked about
+    check_response(response)
+    sent = commands_sent(fleet)
+    if values == [None]:
+        assert sent == [] and "Which robot" in speech(response)
+    else:
+        assert [(topic, command["action"]) for topic, command in sent] == [
+            ("vahr/robots/placebot2/cmd", "stop")
+        ]
+
+
 def test_sequential_delivery_sends_the_second_robot_after_the_first(
     skill: Any, robots: RobotDoubles, fleet: Fleet
 ) -> None:
