@@ -50,7 +50,17 @@ class CatchAllExceptionHandler(AbstractExceptionHandler):
         )
         get_logger().debug("traceback", exc_info=exception)
         if self.runtime is not None:
-            record_failure(handler_input, self.runtime, f"{type(exception).__name__}: {exception}")
+            try:
+                record_failure(
+                    handler_input, self.runtime, f"{type(exception).__name__}: {exception}"
+                )
+            except Exception as failure:  # the answer matters more than its record
+                log_event(
+                    "trail_failed",
+                    logging.ERROR,
+                    error_type=type(failure).__name__,
+                    error=str(failure),
+                )
         speech = speech_for(exception)
         builder = handler_input.response_builder.speak(speech)
         if in_conversation(handler_input):

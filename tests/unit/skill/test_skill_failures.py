@@ -73,6 +73,20 @@ def test_an_intent_without_a_handler_gets_the_safe_sentence(skill: Any, aws: Non
     assert published() == []
 
 
+def test_a_failure_that_cannot_be_recorded_is_still_answered(
+    skill: Any, aws: None, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    # Given a request that fails and a trail whose record of it fails too
+    def unrecordable(*_: object) -> None:
+        raise AttributeError("'NoneType' object has no attribute 'value'")
+
+    monkeypatch.setattr("skill.handlers.catch_all.record_failure", unrecordable)
+    response = skill(load_event("alexa_unknown_intent"), None)
+    # Then Alexa still gets the safe sentence, and the lost record is logged
+    assert speech(response) == "Sorry, something went wrong on my side. Please try again."
+    assert '"event": "trail_failed"' in caplog.text
+
+
 def test_one_unreadable_shadow_does_not_hide_the_others(make_skill: Any, robots: Any) -> None:
     class HalfBroken(IotDataGateway):
         def get_shadow(self, thing: str) -> bytes | None:
