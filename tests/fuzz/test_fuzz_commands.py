@@ -213,10 +213,18 @@ def wire(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[WireTap, Ag
         broker.stop()
 
 
-def _ping(tap: WireTap) -> None:
+def _ping(tap: WireTap, agent: AgentProcess) -> None:
     ping_id = f"ping-{uuid.uuid4().hex[:8]}"
+    mark = tap.mark()
     tap.publish(topics.robot_cmd("placebot1"), command(ping_id, "ping"))
-    tap.event("placebot1", "accepted", ping_id, timeout_s=10)
+    try:
+        tap.event("placebot1", "accepted", ping_id, timeout_s=10, after=mark)
+    except TimeoutError as err:
+        # What the agent did meanwhile says whose side the silence is on.
+        code = agent.process.poll()
+        state = "running" if code is None else f"exited with {code}"
+        log = agent.log()[-1500:]
+        raise AssertionError(f"{err}; the agent is {state}; its log ends:\n{log}") from err
 
 
 # The agent remembers the last 1,000 command ids (RecentIds): the model of what it will
@@ -234,7 +242,7 @@ def test_a_real_agent_survives_any_payload_on_its_command_topic(
     mark = tap.mark()
     # When a payload arrives on its command topic, followed by a ping
     tap.publish(topics.robot_cmd("placebot1"), payload)
-    _ping(tap)
+    _ping(tap, agent)
     # Then it answered exactly as the decoder judged, and is alive and serving
     answers = [
         m.json()
