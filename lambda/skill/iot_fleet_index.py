@@ -28,6 +28,9 @@ if TYPE_CHECKING:
 
 INDEX_NAME = "AWS_Things"
 STATUS_FIELD = "shadow.reported.status"
+# The charge, a Number custom field (searched by range), and whether it charges.
+BATTERY_PERCENT_FIELD = "shadow.reported.battery.percent"
+BATTERY_CHARGING_FIELD = "shadow.reported.battery.charging"
 # AWS's page limit for search_index.
 SEARCH_MAX = 100
 # Every reported status has a bucket (there are eight; room for statuses added later).

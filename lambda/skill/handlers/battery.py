@@ -20,7 +20,7 @@ from skill import battery_speech, deeds, dialog, prompts
 from skill.dialog import _intent
 from skill.fleet_question import FleetQuestion
 from skill.handlers.desk_intent import DeskIntentHandler
-from skill.iot_fleet_index import SEARCH_MAX
+from skill.iot_fleet_index import BATTERY_CHARGING_FIELD, BATTERY_PERCENT_FIELD, SEARCH_MAX
 from skill.responses import answer
 from skill.service_guard import out_of_service
 from skill.slots import read_slot, spoken_number
@@ -33,9 +33,6 @@ if TYPE_CHECKING:
 
 
 PERCENTS = frozenset(str(n) for n in range(1, 101))
-# The index's fields for the charge (infra/constructs/fleet_indexing.py).
-PERCENT_FIELD = "shadow.reported.battery.percent"
-CHARGING_FIELD = "shadow.reported.battery.charging"
 
 
 class BatteryIntentHandler(FleetQuestion, AbstractRequestHandler):
@@ -66,14 +63,14 @@ class BatteryIntentHandler(FleetQuestion, AbstractRequestHandler):
         return answer(handler_input, battery_speech.below(runtime.vocabulary, level, reads))
 
     def _below_in_index(self, level: int) -> str:
-        query = f"{PERCENT_FIELD}<{level}"
+        query = f"{BATTERY_PERCENT_FIELD}<{level}"
         found = self.index.search(query, SEARCH_MAX)
         count = len(found) if len(found) < SEARCH_MAX else self.index.count(query)
         return battery_speech.below_in_index(self.runtime.vocabulary, level, count, found)
 
     def _fleet_counts(self, threshold: int) -> str:
-        low = self.index.count(f"{PERCENT_FIELD}<{threshold}")
-        charging = self.index.count(f"{CHARGING_FIELD}:true")
+        low = self.index.count(f"{BATTERY_PERCENT_FIELD}<{threshold}")
+        charging = self.index.count(f"{BATTERY_CHARGING_FIELD}:true")
         total = len(self.runtime.fleet.robots)
         return battery_speech.fleet_counts(total, threshold, low, charging)
 
